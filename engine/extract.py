@@ -1,0 +1,356 @@
+"""Depsgraph -> a plain scene snapshot (dataclasses and numpy arrays).
+
+Geometry is the expensive part, so it is cached per mesh datablock (or per object when
+modifiers make its mesh unique) and rebuilt only when a depsgraph update says that geometry
+changed. Matrices, materials, lights and the camera are cheap and read every frame.
+"""
+
+import math
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
+
+
+@dataclass
+class Material:
+    base_color: tuple = (0.8, 0.8, 0.8, 1.0)
+    roughness: float = 0.5
+    specular: float = 0.5
+    metallic: float = 0.0
+
+
+@dataclass
+class Geometry:
+    """Triangles of one mesh, de-indexed and sorted by material slot."""
+
+    positions: np.ndarray  # (3 * tris, 3) float32
+    normals: np.ndarray  # (3 * tris, 3) float32
+    ranges: list  # (material index, first vertex, vertex count)
+    bounds: np.ndarray  # (2, 3) local min/max; NaN when empty
+    deps: frozenset = frozenset()
+    gpu: dict = field(default_factory=dict)  # GPU batches, filled by the renderer
+
+    @property
+    def triangle_count(self):
+        return len(self.positions) // 3
+
+
+@dataclass
+class MeshInstance:
+    key: tuple
+    matrix: np.ndarray  # (4, 4) world matrix
+    materials: list  # Material per slot (index = material index)
+
+
+@dataclass
+class Light:
+    type: str
+    color: np.ndarray  # colour * energy * 2^exposure
+    matrix: np.ndarray
+    radius: float
+    spot_size: float = math.pi / 4
+    spot_blend: float = 0.15
+    angle: float = 0.0
+    use_shadow: bool = True
+
+    @property
+    def position(self):
+        return self.matrix[:3, 3].copy()
+
+    @property
+    def direction(self):
+        d = -self.matrix[:3, 2]
+        n = np.linalg.norm(d)
+        return d / n if n > 0 and np.isfinite(n) else np.array([0.0, 0.0, -1.0])
+
+
+@dataclass
+class Camera:
+    view: np.ndarray  # world -> view
+    projection: np.ndarray
+    is_ortho: bool = False
+
+    @property
+    def position(self):
+        try:
+            return np.linalg.inv(self.view)[:3, 3]
+        except np.linalg.LinAlgError:
+            return np.zeros(3)
+
+    @property
+    def forward(self):
+        f = -self.view[2, :3]
+        n = np.linalg.norm(f)
+        return f / n if n > 0 else np.array([0.0, 0.0, -1.0])
+
+
+@dataclass
+class Snapshot:
+    instances: list
+    lights: list
+    world_color: np.ndarray
+    geometry: dict  # key -> Geometry (shared with the cache)
+
+
+def matrix_np(m):
+    return np.array(m, dtype=np.float64).reshape(4, 4)
+
+
+def camera_from_scene(depsgraph, scene, width, height):
+    """The active scene camera's matrices for a final render of ``width`` x ``height``."""
+    cam_ob = scene.camera.evaluated_get(depsgraph)
+    proj = cam_ob.calc_matrix_camera(
+        depsgraph,
+        x=width,
+        y=height,
+        scale_x=scene.render.pixel_aspect_x,
+        scale_y=scene.render.pixel_aspect_y,
+    )
+    view = matrix_np(cam_ob.matrix_world.inverted_safe())
+    return Camera(view=view, projection=matrix_np(proj), is_ortho=cam_ob.data.type == "ORTHO")
+
+
+def camera_from_view(view_matrix, window_matrix):
+    """The viewport's camera from a RegionView3D's ``view_matrix`` and ``window_matrix``."""
+    proj = matrix_np(window_matrix)
+    return Camera(view=matrix_np(view_matrix), projection=proj, is_ortho=abs(proj[3, 3] - 1.0) < 1e-9)
+
+
+# --- materials ---------------------------------------------------------------------------
+
+_SPECULAR_INPUTS = ("Specular IOR Level", "Specular")
+
+
+def _input_value(node, name, default):
+    sock = node.inputs.get(name)
+    if sock is None:
+        return default
+    return sock.default_value
+
+
+def _principled(mat):
+    tree = getattr(mat, "node_tree", None)
+    if tree is None:
+        return None
+    nodes = tree.nodes
+    for out in nodes:
+        if out.bl_idname == "ShaderNodeOutputMaterial" and out.is_active_output:
+            surface = out.inputs.get("Surface")
+            if surface is not None and surface.is_linked:
+                node = surface.links[0].from_node
+                if node.bl_idname == "ShaderNodeBsdfPrincipled":
+                    return node
+    for node in nodes:
+        if node.bl_idname == "ShaderNodeBsdfPrincipled":
+            return node
+    return None
+
+
+def material_from_blender(mat):
+    if mat is None:
+        return Material()
+    node = _principled(mat) if getattr(mat, "use_nodes", True) else None
+    if node is not None:
+        spec = 0.5
+        for name in _SPECULAR_INPUTS:
+            if name in node.inputs:
+                spec = float(_input_value(node, name, 0.5))
+                break
+        return Material(
+            base_color=tuple(_input_value(node, "Base Color", (0.8, 0.8, 0.8, 1.0))),
+            roughness=float(_input_value(node, "Roughness", 0.5)),
+            specular=spec,
+            metallic=float(_input_value(node, "Metallic", 0.0)),
+        )
+    return Material(
+        base_color=tuple(mat.diffuse_color),
+        roughness=float(mat.roughness),
+        specular=float(mat.specular_intensity),
+        metallic=float(mat.metallic),
+    )
+
+
+def world_color(scene):
+    world = scene.world
+    if world is None:
+        return np.zeros(3)
+    tree = getattr(world, "node_tree", None)
+    if tree is not None and getattr(world, "use_nodes", True):
+        for node in tree.nodes:
+            if node.bl_idname == "ShaderNodeBackground":
+                color = node.inputs["Color"].default_value
+                strength = node.inputs["Strength"].default_value
+                return np.array(color[:3], dtype=np.float64) * float(strength)
+    return np.array(world.color[:3], dtype=np.float64)
+
+
+# --- geometry ----------------------------------------------------------------------------
+
+
+def geometry_from_mesh(mesh):
+    """De-index a Blender mesh into flat triangle arrays, sorted by material slot.
+
+    Triangles with a non-finite vertex are dropped (NaN/Inf positions must not reach the GPU).
+    """
+    mesh.calc_loop_triangles()
+    tris = mesh.loop_triangles
+    n = len(tris)
+    if n == 0:
+        empty = np.zeros((0, 3), np.float32)
+        return Geometry(empty, empty, [], np.full((2, 3), np.nan))
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    vidx = np.empty(n * 3, np.int32)
+    tris.foreach_get("vertices", vidx)
+    nor = np.empty(n * 9, np.float32)
+    tris.foreach_get("split_normals", nor)
+    mat = np.empty(n, np.int32)
+    tris.foreach_get("material_index", mat)
+
+    pos = co[vidx].reshape(n, 3, 3)
+    nor = nor.reshape(n, 3, 3)
+    good = np.all(np.isfinite(pos), axis=(1, 2))
+    if not good.all():
+        print(
+            f"Penumbra: mesh '{mesh.name}': skipped {int((~good).sum())} triangle(s) with "
+            "non-finite vertices",
+            file=sys.stderr,
+        )
+        pos, nor, mat = pos[good], nor[good], mat[good]
+    nor = np.where(np.isfinite(nor), nor, 0.0).astype(np.float32)
+    order = np.argsort(mat, kind="stable")
+    pos, nor, mat = pos[order], nor[order], mat[order]
+    ranges = []
+    if len(mat):
+        slots, starts, counts = np.unique(mat, return_index=True, return_counts=True)
+        ranges = [(int(s), int(a) * 3, int(c) * 3) for s, a, c in zip(slots, starts, counts)]
+    flat = pos.reshape(-1, 3)
+    bounds = np.stack([flat.min(axis=0), flat.max(axis=0)]) if len(flat) else np.full((2, 3), np.nan)
+    return Geometry(
+        np.ascontiguousarray(flat, np.float32),
+        np.ascontiguousarray(nor.reshape(-1, 3), np.float32),
+        ranges,
+        bounds.astype(np.float64),
+    )
+
+
+def _geometry_key(inst, ob):
+    """Cache key and the datablock names whose geometry updates invalidate it."""
+    orig = ob.original
+    data = ob.data
+    data_name = data.original.name_full if data is not None and data.original is not None else ""
+    if inst.is_instance and orig is not None and orig.data is not None and orig.data.original != data.original:
+        # Geometry-nodes instance of bare mesh data: depends on the instancer too.
+        parent = inst.parent.original.name_full if inst.parent is not None else ""
+        return ("GN", parent, data_name), frozenset({parent, data_name})
+    name = orig.name_full if orig is not None else ob.name_full
+    if ob.type == "MESH" and orig is not None and len(orig.modifiers) == 0 and not _has_shape_keys(orig):
+        return ("ME", data_name), frozenset({data_name, name})
+    return ("OB", name), frozenset({name, data_name})
+
+
+def _has_shape_keys(ob):
+    data = ob.data
+    return getattr(data, "shape_keys", None) is not None
+
+
+class SceneCache:
+    """Geometry cache of one engine instance, keyed by datablock, invalidated by updates."""
+
+    def __init__(self):
+        self.geometry = {}
+        self.built = 0  # geometries extracted since creation (tests and stats read it)
+
+    def apply_updates(self, depsgraph):
+        """Drop the geometry of every datablock whose geometry the depsgraph says changed."""
+        changed = set()
+        for update in depsgraph.updates:
+            if update.is_updated_geometry:
+                id_orig = update.id.original if update.id.original is not None else update.id
+                changed.add(id_orig.name_full)
+        if changed:
+            self.invalidate(changed)
+
+    def invalidate(self, names):
+        for key in [k for k, g in self.geometry.items() if g.deps & names]:
+            del self.geometry[key]
+
+    def clear(self):
+        self.geometry.clear()
+
+    def _geometry_for(self, inst, ob, key, deps):
+        geo = self.geometry.get(key)
+        if geo is not None:
+            return geo
+        if ob.type == "MESH":
+            geo = geometry_from_mesh(ob.data)
+        else:
+            mesh = ob.to_mesh()
+            try:
+                geo = geometry_from_mesh(mesh) if mesh is not None else None
+            finally:
+                ob.to_mesh_clear()
+            if geo is None:
+                return None
+        geo.deps = deps
+        self.geometry[key] = geo
+        self.built += 1
+        return geo
+
+    def snapshot(self, depsgraph):
+        scene = depsgraph.scene
+        instances = []
+        lights = []
+        used = set()
+        for inst in depsgraph.object_instances:
+            ob = inst.object
+            if ob.type == "LIGHT":
+                light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
+                if light is not None:
+                    lights.append(light)
+                continue
+            if ob.type not in GEOMETRY_TYPES:
+                continue
+            matrix = matrix_np(inst.matrix_world)
+            if not np.all(np.isfinite(matrix)):
+                print(f"Penumbra: object '{ob.name}' has a non-finite matrix; skipped", file=sys.stderr)
+                continue
+            key, deps = _geometry_key(inst, ob)
+            geo = self._geometry_for(inst, ob, key, deps)
+            if geo is None or geo.triangle_count == 0:
+                continue
+            used.add(key)
+            materials = [material_from_blender(slot.material) for slot in ob.material_slots]
+            instances.append(MeshInstance(key=key, matrix=matrix, materials=materials))
+        # Forget geometry no longer in the scene so its GPU buffers are freed.
+        for key in [k for k in self.geometry if k not in used]:
+            del self.geometry[key]
+        return Snapshot(
+            instances=instances,
+            lights=lights,
+            world_color=world_color(scene),
+            geometry=self.geometry,
+        )
+
+
+def light_from_blender(data, matrix):
+    color = np.array(data.color[:3], dtype=np.float64) * float(data.energy)
+    color *= 2.0 ** float(getattr(data, "exposure", 0.0))
+    if not np.all(np.isfinite(color)) or not np.all(np.isfinite(matrix)):
+        return None
+    radius = float(getattr(data, "shadow_soft_size", 0.0))
+    if not getattr(data, "use_soft_falloff", True):
+        radius = 0.0
+    light = Light(type=data.type, color=color, matrix=matrix, radius=radius, use_shadow=bool(data.use_shadow))
+    if data.type == "SPOT":
+        light.spot_size = float(data.spot_size)
+        light.spot_blend = float(data.spot_blend)
+    elif data.type == "SUN":
+        light.angle = float(data.angle)
+    elif data.type == "AREA":
+        light.radius = 0.0
+    return light

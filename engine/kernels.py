@@ -1,0 +1,44 @@
+"""Filter kernels: plain numpy, no bpy and no gpu.
+
+Every kernel is normalised here once and handed to the shaders as data, so the GLSL never
+re-derives weights (and a Gaussian typo cannot hide in a shader).
+"""
+
+import numpy as np
+
+
+def gaussian_1d(radius, sigma=None):
+    """Normalised 1-D Gaussian weights for offsets ``-radius..radius``.
+
+    ``sigma`` defaults to ``radius / 2`` (the kernel then spans +-2 sigma). A radius of 0, or a
+    sigma of 0, is the identity kernel ``[1]``.
+    """
+    radius = max(0, int(radius))
+    if sigma is None:
+        sigma = radius / 2.0
+    if radius == 0 or sigma <= 0.0:
+        w = np.zeros(2 * radius + 1)
+        w[radius] = 1.0
+        return w
+    x = np.arange(-radius, radius + 1, dtype=np.float64)
+    w = np.exp(-(x * x) / (2.0 * sigma * sigma))
+    return w / w.sum()
+
+
+def pcf_kernel(size, sigma=None):
+    """Normalised ``size`` x ``size`` Gaussian weights (the seeds' 5x5 kernel, generalised).
+
+    Returns an array of rows ``(dx, dy, weight)`` with integer texel offsets. ``size`` is made
+    odd; ``sigma`` defaults to ``size / 4`` (seed 000's 5x5 table has sigma close to 1.25).
+    """
+    size = max(1, int(size))
+    if size % 2 == 0:
+        size += 1
+    r = size // 2
+    if sigma is None:
+        sigma = max(size / 4.0, 1e-6)
+    w1 = gaussian_1d(r, sigma) if r > 0 else np.ones(1)
+    w2 = np.outer(w1, w1)
+    w2 /= w2.sum()
+    dy, dx = np.mgrid[-r : r + 1, -r : r + 1]
+    return np.stack([dx.ravel(), dy.ravel(), w2.ravel()], axis=1)

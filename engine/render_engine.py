@@ -1,0 +1,153 @@
+"""The RenderEngine subclass: thin glue from Blender's callbacks to the Renderer."""
+
+import sys
+import traceback
+
+import bpy
+
+from .extract import SceneCache, camera_from_scene, camera_from_view
+
+
+class PenumbraRenderEngine(bpy.types.RenderEngine):
+    bl_idname = "PENUMBRA"
+    bl_label = "Penumbra"
+    bl_use_preview = False
+    bl_use_gpu_context = True
+    bl_use_shading_nodes_custom = False
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.cache = SceneCache()
+        self.renderer = None
+        self.last_stats = None
+        self._reported = None
+
+    def __del__(self):
+        # GPU resources belong to this instance; dropping the references frees them.
+        self.renderer = None
+        self.cache = None
+
+    # --- shared ---------------------------------------------------------------------------
+
+    def render_frame(self, depsgraph, camera, width, height):
+        """Extract, then render one frame; returns the renderer's FrameOutput."""
+        from .renderer import Renderer
+
+        if self.renderer is None:
+            self.renderer = Renderer()
+        scene = depsgraph.scene
+        snapshot = self.cache.snapshot(depsgraph)
+        settings = scene.penumbra.render_settings(frame=scene.frame_current)
+        settings.film_transparent = scene.render.film_transparent
+        out = self.renderer.render(snapshot, camera, settings, width, height)
+        self.last_stats = out.stats
+        return out
+
+    def draw_display(self, scene, texture, width, height):
+        """Draw a scene-linear texture through Blender's colour management (view transform,
+        look, exposure, gamma): the viewport shows what the final render saves."""
+        import gpu
+        from gpu_extras.presets import draw_texture_2d
+
+        gpu.state.blend_set("ALPHA_PREMULT")
+        self.bind_display_space_shader(scene)
+        draw_texture_2d(texture, (0, 0), width, height)
+        self.unbind_display_space_shader()
+        gpu.state.blend_set("NONE")
+
+    # --- final render ---------------------------------------------------------------------
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        if renderlayer.use_pass_z:
+            self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
+
+    def render(self, depsgraph):
+        scene = depsgraph.scene
+        scale = scene.render.resolution_percentage / 100.0
+        width = max(1, int(scene.render.resolution_x * scale))
+        height = max(1, int(scene.render.resolution_y * scale))
+        if scene.camera is None:
+            self.report({"ERROR"}, f"Penumbra: scene '{scene.name}' has no active camera; set one in Scene Properties")
+            return
+        try:
+            camera = camera_from_scene(depsgraph, scene, width, height)
+            out = self.render_frame(depsgraph, camera, width, height)
+            color = out.color_array()
+            depth = out.depth_array()
+        except Exception as exc:  # a render must end with a message, never a crash
+            traceback.print_exc(file=sys.stderr)
+            self.report({"ERROR"}, f"Penumbra: render failed: {exc}")
+            return
+        result = self.begin_result(0, 0, width, height)
+        layer = result.layers[0]
+        layer.passes["Combined"].rect.foreach_set(color.ravel())
+        depth_pass = layer.passes.get("Depth")
+        if depth_pass is not None:
+            depth_pass.rect.foreach_set(depth.ravel())
+        self.end_result(result)
+
+    # --- viewport -------------------------------------------------------------------------
+
+    def view_update(self, context, depsgraph):
+        self.cache.apply_updates(depsgraph)
+
+    def view_draw(self, context, depsgraph):
+        region = context.region
+        rv3d = context.region_data
+        width, height = region.width, region.height
+        try:
+            camera = camera_from_view(rv3d.view_matrix, rv3d.window_matrix)
+            out = self.render_frame(depsgraph, camera, width, height)
+        except Exception as exc:
+            message = f"Penumbra: viewport draw failed: {exc}"
+            if message != self._reported:  # once per distinct error, not every redraw
+                traceback.print_exc(file=sys.stderr)
+                self._reported = message
+            return
+        self._reported = None
+        self.draw_display(depsgraph.scene, out.color, width, height)
+
+
+def _compat_panels():
+    """Blender's own panels that work for Penumbra too (light, camera, output, colour...)."""
+    wanted = {
+        "RENDER_PT_color_management",
+        "RENDER_PT_color_management_curves",
+        "RENDER_PT_color_management_display_settings",
+        "RENDER_PT_color_management_white_balance",
+        "RENDER_PT_format",
+        "RENDER_PT_frame_range",
+        "RENDER_PT_output",
+        "RENDER_PT_film",
+        "DATA_PT_light",
+        "DATA_PT_EEVEE_light",
+        "DATA_PT_spot",
+        "DATA_PT_context_light",
+        "DATA_PT_lens",
+        "DATA_PT_camera",
+        "DATA_PT_camera_dof",
+        "DATA_PT_context_camera",
+        "MATERIAL_PT_preview",
+        "EEVEE_MATERIAL_PT_surface",
+        "EEVEE_MATERIAL_PT_context_material",
+        "MATERIAL_PT_viewport",
+        "WORLD_PT_context_world",
+        "EEVEE_WORLD_PT_surface",
+        "WORLD_PT_viewport_display",
+    }
+    for panel in bpy.types.Panel.__subclasses__():
+        if panel.__name__ in wanted and hasattr(panel, "COMPAT_ENGINES"):
+            yield panel
+
+
+def register():
+    bpy.utils.register_class(PenumbraRenderEngine)
+    for panel in _compat_panels():
+        panel.COMPAT_ENGINES.add(PenumbraRenderEngine.bl_idname)
+
+
+def unregister():
+    for panel in _compat_panels():
+        panel.COMPAT_ENGINES.discard(PenumbraRenderEngine.bl_idname)
+    bpy.utils.unregister_class(PenumbraRenderEngine)

@@ -1,0 +1,13 @@
+from . import layers
+
+modules = (layers,)
+
+
+def register():
+    for m in modules:
+        m.register()
+
+
+def unregister():
+    for m in reversed(modules):
+        m.unregister()

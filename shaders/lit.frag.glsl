@@ -1,0 +1,61 @@
+/* Forward lighting: Lambert diffuse + normalised Blinn or Phong specular, world colour as
+ * ambient (albedo * world, what Cycles gives an unoccluded surface), each light attenuated
+ * by its shadow visibility. Back faces of a light (N.L <= 0) skip the shadow filter. */
+void main()
+{
+  vec3 P = v_world;
+  vec3 N = v_normal;
+  float nlen = length(N);
+  if (!(nlen > 1e-20)) {
+    /* Degenerate normal (zero-scale or broken mesh): fall back to the face normal. */
+    N = cross(dFdx(P), dFdy(P));
+    nlen = length(N);
+  }
+  N = (nlen > 1e-30) ? N / nlen : vec3(0.0, 0.0, 1.0);
+
+  vec3 V = (frame.camera_position.w > 0.5) ? -frame.camera_forward.xyz :
+                                             normalize(frame.camera_position.xyz - P);
+  if (dot(N, V) < 0.0) {
+    N = -N; /* two-sided, as Blender draws meshes */
+  }
+
+  vec3 base = base_color.rgb;
+  float roughness = clamp(material.x, 0.0, 1.0);
+  float specular = max(material.y, 0.0);
+  float metallic = clamp(material.z, 0.0, 1.0);
+  vec3 albedo = base * (1.0 - metallic);
+  vec3 f0 = mix(vec3(0.08 * specular), base, metallic);
+  float alpha = max(roughness * roughness, 0.02);
+  float shininess = 2.0 / (alpha * alpha) - 2.0;
+
+  vec3 color = albedo * frame.world_color.rgb;
+  int light_count = int(frame.counts.x);
+  for (int i = 0; i < light_count; i++) {
+    LightData L = lights[i];
+    vec3 to_light;
+    float irradiance;
+    light_incident(L, P, to_light, irradiance);
+    float NdotL = dot(N, to_light);
+    if (NdotL <= 0.0 || irradiance <= 0.0) {
+      continue;
+    }
+    float visibility = 1.0;
+    if (L.params.y >= 0.0) {
+      visibility = shadow_visibility(L, P, N, NdotL);
+      if (visibility <= 0.0) {
+        continue;
+      }
+    }
+#if SPECULAR_MODEL == SPECULAR_BLINN
+    vec3 H = normalize(to_light + V);
+    float spec = (shininess + 8.0) / (8.0 * M_PI) * pow(max(dot(N, H), 0.0), shininess);
+#else
+    vec3 R = reflect(-to_light, N);
+    float spec = (shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, V), 0.0), shininess);
+#endif
+    vec3 E = L.color.rgb * (irradiance * NdotL * visibility);
+    color += E * (albedo / M_PI + f0 * spec);
+  }
+  out_color = vec4(color, 1.0);
+  out_depth = v_view_depth;
+}

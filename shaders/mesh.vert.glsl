@@ -1,0 +1,14 @@
+/* World-space position and normal for the lit pass. The normal matrix is the cofactor of the
+ * model matrix (det * inverse-transpose): defined for zero scale, and its sign flip keeps
+ * normals outward under negative scale. */
+void main()
+{
+  vec4 wp = model * vec4(pos, 1.0);
+  mat3 m = mat3(model);
+  mat3 cof = mat3(cross(m[1], m[2]), cross(m[2], m[0]), cross(m[0], m[1]));
+  float det = dot(m[0], cof[0]);
+  v_normal = cof * nor * (det < 0.0 ? -1.0 : 1.0);
+  v_world = wp.xyz;
+  v_view_depth = -(frame.view * wp).z;
+  gl_Position = frame.view_proj * wp;
+}

@@ -1,0 +1,4 @@
+void main()
+{
+  gl_Position = light_view_proj * model * vec4(pos, 1.0);
+}

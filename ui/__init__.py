@@ -1,0 +1,13 @@
+from . import panels
+
+modules = (panels,)
+
+
+def register():
+    for m in modules:
+        m.register()
+
+
+def unregister():
+    for m in reversed(modules):
+        m.unregister()
