@@ -29,14 +29,15 @@ def pcf_kernel(size, sigma=None):
     """Normalised ``size`` x ``size`` Gaussian weights (the seeds' 5x5 kernel, generalised).
 
     Returns an array of rows ``(dx, dy, weight)`` with integer texel offsets. ``size`` is made
-    odd; ``sigma`` defaults to ``size / 4`` (seed 000's 5x5 table has sigma close to 1.25).
+    odd; ``sigma`` defaults to ``size / 5``, which for 5x5 reproduces seed 000's table
+    (centre 0.1621, (1, 0) 0.0983, (2, 1) 0.0133) to four decimals.
     """
     size = max(1, int(size))
     if size % 2 == 0:
         size += 1
     r = size // 2
     if sigma is None:
-        sigma = max(size / 4.0, 1e-6)
+        sigma = max(size / 5.0, 1e-6)
     w1 = gaussian_1d(r, sigma) if r > 0 else np.ones(1)
     w2 = np.outer(w1, w1)
     w2 /= w2.sum()

@@ -41,3 +41,59 @@ def penumbra():
 @pytest.fixture
 def tmp(tmp_path):
     return tmp_path
+
+
+class _GpuHarness:
+    """Runs a callable inside a RenderEngine.render() call, where the gpu module can draw in
+    background mode. ``gpu_call(fn)`` returns what ``fn(engine)`` returned."""
+
+    engine_cls = None
+    job = None
+    result = None
+    error = None
+
+
+def _make_harness(base):
+    class PENUMBRA_TEST_HARNESS(base):
+        bl_idname = "PENUMBRA_TEST_HARNESS"
+        bl_label = "Penumbra test harness"
+        bl_use_gpu_context = True
+
+        def render(self, depsgraph):
+            try:
+                _GpuHarness.result = _GpuHarness.job(self, depsgraph)
+            except Exception as exc:  # handed back to the test
+                _GpuHarness.error = exc
+
+        def update_render_passes(self, scene=None, renderlayer=None):
+            self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+
+    return PENUMBRA_TEST_HARNESS
+
+
+@pytest.fixture(scope="session")
+def gpu_call(penumbra):
+    """``gpu_call(fn)``: run ``fn(engine, depsgraph)`` in a GPU context, on the current scene.
+
+    The harness engine subclasses Penumbra's real engine, so ``engine.render_frame`` and
+    ``engine.draw_display`` are the production code paths."""
+    from penumbra.engine.render_engine import PenumbraRenderEngine
+
+    cls = _make_harness(PenumbraRenderEngine)
+    bpy.utils.register_class(cls)
+
+    def call(fn):
+        scene = bpy.context.scene
+        old = scene.render.engine
+        scene.render.engine = cls.bl_idname
+        _GpuHarness.job, _GpuHarness.result, _GpuHarness.error = fn, None, None
+        try:
+            bpy.ops.render.render(write_still=False)
+        finally:
+            scene.render.engine = old
+        if _GpuHarness.error is not None:
+            raise _GpuHarness.error
+        return _GpuHarness.result
+
+    yield call
+    bpy.utils.unregister_class(cls)

@@ -22,9 +22,8 @@ def empty_scene(width=320, height=180, engine="PENUMBRA"):
     scene.view_settings.exposure = 0.0
     scene.view_settings.gamma = 1.0
     scene.render.dither_intensity = 0.0
-    world = bpy.data.worlds.new("World")
-    world.color = (0.0, 0.0, 0.0)
-    scene.world = world
+    scene.world = bpy.data.worlds.new("World")
+    set_world(scene, (0.0, 0.0, 0.0))
     return scene
 
 

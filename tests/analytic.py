@@ -1,0 +1,58 @@
+"""Analytic references: camera rays, plane hits and box shadows computed in numpy."""
+
+import numpy as np
+
+
+def camera_matrices(scene, depsgraph=None):
+    """(view, projection) of the scene camera as numpy arrays, as Penumbra computes them."""
+    import bpy
+
+    depsgraph = depsgraph or bpy.context.evaluated_depsgraph_get()
+    cam = scene.camera.evaluated_get(depsgraph)
+    r = scene.render
+    w = int(r.resolution_x * r.resolution_percentage / 100)
+    h = int(r.resolution_y * r.resolution_percentage / 100)
+    proj = np.array(cam.calc_matrix_camera(depsgraph, x=w, y=h, scale_x=r.pixel_aspect_x, scale_y=r.pixel_aspect_y))
+    view = np.array(cam.matrix_world.inverted())
+    return view, proj, w, h
+
+
+def plane_hits(view, proj, w, h, z=0.0):
+    """World point where each pixel centre's ray meets the plane z = ``z``, and its view depth.
+
+    Arrays are (h, w[, 3]) with row 0 at the bottom of the image."""
+    inv = np.linalg.inv(proj @ view)
+    xs = (np.arange(w) + 0.5) / w * 2 - 1
+    ys = (np.arange(h) + 0.5) / h * 2 - 1
+    X, Y = np.meshgrid(xs, ys)
+
+    def unproject(zn):
+        p = np.stack([X, Y, np.full_like(X, zn), np.ones_like(X)], axis=-1) @ inv.T
+        return p[..., :3] / p[..., 3:4]
+
+    o = unproject(-1.0)
+    d = unproject(1.0) - o
+    t = (z - o[..., 2]) / d[..., 2]
+    p = o + t[..., None] * d
+    depth = -(p @ view[:3, :3].T + view[:3, 3])[..., 2]
+    return p, depth
+
+
+def ray_hits_box(origins, direction, lo, hi):
+    """Whether rays ``origins + s * direction`` (s > 0) hit the box [lo, hi] (slab test)."""
+    o = np.asarray(origins, float)
+    d = np.asarray(direction, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / d
+        t1 = (np.asarray(lo) - o) * inv
+        t2 = (np.asarray(hi) - o) * inv
+    tmin = np.nanmax(np.minimum(t1, t2), axis=-1)
+    tmax = np.nanmin(np.maximum(t1, t2), axis=-1)
+    return (tmax >= np.maximum(tmin, 0.0)) & (tmax > 0)
+
+
+def iou(a, b):
+    a = np.asarray(a, bool)
+    b = np.asarray(b, bool)
+    union = (a | b).sum()
+    return float((a & b).sum() / union) if union else 1.0
