@@ -8,12 +8,10 @@ import bpy
 from .extract import SceneCache, camera_from_scene, camera_from_view
 
 
-class PenumbraRenderEngine(bpy.types.RenderEngine):
-    bl_idname = "PENUMBRA"
-    bl_label = "Penumbra"
-    bl_use_preview = False
-    bl_use_gpu_context = True
-    bl_use_shading_nodes_custom = False
+class PenumbraEngineCore:
+    """What the viewport and final renders share. Kept apart from the registered class so
+    other RenderEngine classes (the test harness) can reuse it without subclassing a
+    registered type."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
@@ -26,8 +24,6 @@ class PenumbraRenderEngine(bpy.types.RenderEngine):
         # GPU resources belong to this instance; dropping the references frees them.
         self.renderer = None
         self.cache = None
-
-    # --- shared ---------------------------------------------------------------------------
 
     def render_frame(self, depsgraph, camera, width, height):
         """Extract, then render one frame; returns the renderer's FrameOutput."""
@@ -54,6 +50,14 @@ class PenumbraRenderEngine(bpy.types.RenderEngine):
         draw_texture_2d(texture, (0, 0), width, height)
         self.unbind_display_space_shader()
         gpu.state.blend_set("NONE")
+
+
+class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
+    bl_idname = "PENUMBRA"
+    bl_label = "Penumbra"
+    bl_use_preview = False
+    bl_use_gpu_context = True
+    bl_use_shading_nodes_custom = False
 
     # --- final render ---------------------------------------------------------------------
 

@@ -53,8 +53,8 @@ class _GpuHarness:
     error = None
 
 
-def _make_harness(base):
-    class PENUMBRA_TEST_HARNESS(base):
+def _make_harness(core):
+    class PENUMBRA_TEST_HARNESS(core, bpy.types.RenderEngine):
         bl_idname = "PENUMBRA_TEST_HARNESS"
         bl_label = "Penumbra test harness"
         bl_use_gpu_context = True
@@ -75,11 +75,11 @@ def _make_harness(base):
 def gpu_call(penumbra):
     """``gpu_call(fn)``: run ``fn(engine, depsgraph)`` in a GPU context, on the current scene.
 
-    The harness engine subclasses Penumbra's real engine, so ``engine.render_frame`` and
+    The harness engine is built on Penumbra's engine core, so ``engine.render_frame`` and
     ``engine.draw_display`` are the production code paths."""
-    from penumbra.engine.render_engine import PenumbraRenderEngine
+    from penumbra.engine.render_engine import PenumbraEngineCore
 
-    cls = _make_harness(PenumbraRenderEngine)
+    cls = _make_harness(PenumbraEngineCore)
     bpy.utils.register_class(cls)
 
     def call(fn):
