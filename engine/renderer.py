@@ -300,7 +300,12 @@ def _box_corners(bounds):
 
 
 def _clamp_map_size(size):
+    import sys
+
     import gpu
 
     limit = gpu.capabilities.max_texture_size_get()
-    return int(min(max(int(size), 1), limit))
+    clamped = int(min(max(int(size), 1), limit))
+    if clamped != int(size):
+        print(f"Penumbra: shadow map size {size} clamped to {clamped} (GPU limit)", file=sys.stderr)
+    return clamped

@@ -1,0 +1,83 @@
+"""Bad or degenerate input renders with a clear message, never a crash or a traceback."""
+
+import math
+
+import bpy
+import numpy as np
+import pytest
+
+import scenes
+from helpers import render
+
+
+def _lit_scene(size=48):
+    scene = scenes.empty_scene(size, size)
+    scenes.set_world(scene, (0.1, 0.1, 0.1))
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(30), 0, 0))
+    scenes.top_camera(scene, height=10.0, ortho_scale=6.0)
+    return scene
+
+
+def test_missing_camera_is_a_clear_error(penumbra):
+    scene = scenes.empty_scene(16, 16)
+    scenes.plane(scene)
+    with pytest.raises(RuntimeError, match="(?i)camera"):
+        bpy.ops.render.render()
+
+
+def test_empty_scene_renders_world_colour(penumbra):
+    scene = _lit_scene()
+    c = render(scene, passes=("Combined", "Depth"))
+    np.testing.assert_allclose(c["Combined"][..., :3], 0.1, rtol=1e-6)
+    assert np.all(c["Depth"] == 1e10)
+
+
+def test_meshes_without_faces_and_zero_scale(penumbra):
+    scene = _lit_scene()
+    scenes.mesh_object(scene, "Edges", [(0, 0, 0), (1, 0, 0), (1, 1, 0)], [])
+    flat = scenes.box(scene, "Flat", center=(0, 0, 1))
+    flat.scale = (0.0, 0.0, 0.0)
+    squashed = scenes.box(scene, "Squashed", center=(1.5, 0, 1), size=(1, 1, 1))
+    squashed.scale = (1.0, 1.0, 0.0)  # a zero-thickness box: normals must stay finite
+    c = render(scene)["Combined"]
+    assert np.all(np.isfinite(c))
+    # The squashed box is a visible, lit square (its top normal survives zero z-scale).
+    assert c[..., 0].max() > 0.5
+
+
+def test_nan_vertices_are_skipped_with_a_message(penumbra, capfd):
+    scene = _lit_scene()
+    ob = scenes.box(scene, "Broken", center=(0, 0, 1))
+    ob.data.vertices[0].co = (float("nan"), 0.0, 0.0)
+    ob.data.vertices[1].co = (float("inf"), 0.0, 0.0)
+    scenes.plane(scene, mat=scenes.material("W", (0.8, 0.8, 0.8), specular=0.0))
+    c = render(scene)["Combined"]
+    assert np.all(np.isfinite(c))
+    assert "non-finite" in capfd.readouterr().err
+
+
+def test_curves_and_text_render_as_meshes(penumbra):
+    scene = _lit_scene(64)
+    text = bpy.data.curves.new("Text", "FONT")
+    text.body = "P"
+    text.size = 4.0
+    ob = bpy.data.objects.new("Text", text)
+    ob.location = (-1.2, -1.5, 0.5)
+    scene.collection.objects.link(ob)
+    c = render(scene)["Combined"]
+    bg = 0.1
+    covered = np.abs(c[..., 0] - bg) > 0.05
+    assert 0.03 < covered.mean() < 0.6  # the glyph shows up, lit
+
+
+def test_huge_shadow_map_is_clamped_with_a_message(penumbra, capfd):
+    scene = _lit_scene()
+    scenes.plane(scene)
+    scenes.box(scene, center=(0, 0, 1))
+    scene.penumbra.shadow_map_size = 1_000_000  # above any GPU's maximum
+    c = render(scene)["Combined"]
+    assert np.all(np.isfinite(c))
+    assert "clamped" in capfd.readouterr().err
+    scene.penumbra.shadow_map_size = 1
+    c = render(scene)["Combined"]
+    assert np.all(np.isfinite(c))
