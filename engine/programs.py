@@ -11,6 +11,7 @@ SHADOW_FILTERS = {"NONE": 0, "PCF": 1}
 SPECULAR_MODELS = {"BLINN": 0, "PHONG": 1}
 MAX_LIGHTS = 64
 MAX_PCF_TAPS = 15 * 15
+SHADOW_SAMPLER = "shadow_atlas"
 
 LIGHT_STRUCT = Struct(
     "LightData",
@@ -18,7 +19,7 @@ LIGHT_STRUCT = Struct(
         ("VEC4", "color"),  # rgb: colour * energy * 2^exposure, a: type
         ("VEC4", "position"),  # xyz, w: radius (soft falloff)
         ("VEC4", "direction"),  # xyz: where the light points, w: cos(spot_size / 2)
-        ("VEC4", "params"),  # x: spot smooth width, y: shadow layer or -1, z: texel size, w: depth/world
+        ("VEC4", "params"),  # x: spot smooth width, y: shadow atlas tile or -1, z: texel size, w: depth/world
         ("MAT4", "shadow_matrix"),  # world -> shadow texture space [0, 1]^3
     ),
 )
@@ -33,7 +34,7 @@ FRAME_STRUCT = Struct(
         ("VEC4", "world_color"),
         ("VEC4", "counts"),  # x: light count
         ("VEC4", "shadow_params"),  # x: constant bias, y: slope bias, z: normal offset, w: spacing
-        ("VEC4", "shadow_size"),  # x: map size in texels
+        ("VEC4", "shadow_size"),  # x: tile size in texels, y: atlas columns
     ),
 )
 
@@ -58,7 +59,7 @@ LIT = Program(
         ("smooth", "FLOAT", "v_view_depth"),
     ),
     push_constants=(("MAT4", "model"), ("VEC4", "base_color"), ("VEC4", "material")),
-    samplers=(("FLOAT_2D_ARRAY", "shadow_maps"),),
+    samplers=(("FLOAT_2D", SHADOW_SAMPLER),),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
         (LIGHT_STRUCT, "lights", MAX_LIGHTS),

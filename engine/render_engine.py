@@ -20,10 +20,11 @@ class PenumbraEngineCore:
         self.last_stats = None
         self._reported = None
 
-    def __del__(self):
-        # GPU resources belong to this instance; dropping the references frees them.
+    def free_gpu(self):
+        """Release this instance's GPU resources. Call it while the GPU context is active:
+        freeing GPU objects later, from a destructor without a context, aborts Blender 4.5."""
         self.renderer = None
-        self.cache = None
+        self.cache.clear()
 
     def render_frame(self, depsgraph, camera, width, height):
         """Extract, then render one frame; returns the renderer's FrameOutput."""
@@ -83,6 +84,9 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             traceback.print_exc(file=sys.stderr)
             self.report({"ERROR"}, f"Penumbra: render failed: {exc}")
             return
+        finally:
+            # A final-render engine instance renders one frame; free while the context lives.
+            self.free_gpu()
         result = self.begin_result(0, 0, width, height)
         layer = result.layers[0]
         layer.passes["Combined"].rect.foreach_set(color.ravel())

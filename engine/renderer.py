@@ -16,6 +16,7 @@ from .programs import (
     MAX_LIGHTS,
     MAX_PCF_TAPS,
     SHADOW_FILTERS,
+    SHADOW_SAMPLER,
     TAP_STRUCT,
     lit_defines,
 )
@@ -150,7 +151,7 @@ class Renderer:
         import gpu
 
         if self._dummy_shadow is None:
-            self._dummy_shadow = gpu.types.GPUTexture((1, 1), layers=1, format="R32F")
+            self._dummy_shadow = gpu.types.GPUTexture((1, 1), format="R32F")
             self._dummy_shadow.clear(format="FLOAT", value=(1.0,))
         return self._dummy_shadow
 
@@ -178,8 +179,9 @@ class Renderer:
             world_points.append(corners @ inst.matrix[:3, :3].T + inst.matrix[:3, 3])
         world_points = np.concatenate(world_points) if world_points else np.zeros((0, 3))
 
-        # Shadow passes: only lights that cast shadows and have casters in reach.
-        map_size = _clamp_map_size(settings.shadow_map_size)
+        # Shadow passes: only lights that cast shadows and have casters in reach. Planning
+        # uses the requested size; the atlas may clamp it to fit the GPU's texture limit.
+        map_size = max(1, int(settings.shadow_map_size))
         lights = snapshot.lights[:MAX_LIGHTS]
         shadow_views = {}
         plans = []
@@ -190,12 +192,15 @@ class Renderer:
             if plan is not None:
                 plans.append((i, plan))
         if plans:
+            columns, _rows = self.shadows.grid(len(plans))
+            map_size = _clamp_map_size(settings.shadow_map_size, columns)
             self.shadows.ensure(map_size, len(plans))
+            self.shadows.clear()
             shadow_draws = [(whole, model, det) for (_i, _g, whole, _p, model, det) in draws]
-            for layer, (i, (view, proj, texel, depth_per_world)) in enumerate(plans):
+            for tile, (i, (view, proj, texel, depth_per_world)) in enumerate(plans):
                 vp = proj @ view
-                self.shadows.render_layer(layer, vp, shadow_draws, self.shaders, settings.shadow_cull_front, stats)
-                shadow_views[i] = ShadowView(layer, vp, texel, depth_per_world)
+                self.shadows.render_tile(tile, vp, shadow_draws, self.shaders, settings.shadow_cull_front, stats)
+                shadow_views[i] = ShadowView(tile, vp, texel, depth_per_world)
         shadow_tex = self.shadows.texture if plans else self._shadow_dummy()
 
         # Frame constants.
@@ -211,7 +216,7 @@ class Renderer:
                     "direction": (*light.direction, cos_half if light.type == "SPOT" else -2.0),
                     "params": (
                         (1.0 - cos_half) * max(light.spot_blend, 0.0),
-                        sv.layer if sv else -1.0,
+                        sv.tile if sv else -1.0,
                         sv.texel_world if sv else 0.0,
                         sv.depth_per_world if sv else 0.0,
                     ),
@@ -232,7 +237,7 @@ class Renderer:
                 settings.shadow_normal_offset,
                 settings.pcf_spacing,
             ),
-            "shadow_size": (map_size, 1.0 / map_size, 0.0, 0.0),
+            "shadow_size": (self.shadows.size if plans else 1, self.shadows.columns, 0.0, 0.0),
         }
         filt = settings.shadow_filter if settings.shadow_filter in SHADOW_FILTERS else "PCF"
         taps = kernels.pcf_kernel(min(settings.pcf_kernel_size, 15)) if filt == "PCF" else np.zeros((1, 3))
@@ -259,7 +264,7 @@ class Renderer:
             shader.uniform_block("frame", frame_ubo)
             shader.uniform_block("lights", light_ubo)
             shader.uniform_block("pcf_taps", tap_ubo)
-            shader.uniform_sampler("shadow_maps", shadow_tex)
+            shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
             for inst, _geo, _whole, parts, model, _det in draws:
                 shader.uniform_float("model", model)
                 for mat_index, batch in parts:
@@ -299,12 +304,12 @@ def _box_corners(bounds):
     return box_corners(bounds[0], bounds[1])
 
 
-def _clamp_map_size(size):
+def _clamp_map_size(size, columns=1):
     import sys
 
     import gpu
 
-    limit = gpu.capabilities.max_texture_size_get()
+    limit = gpu.capabilities.max_texture_size_get() // max(1, columns)
     clamped = int(min(max(int(size), 1), limit))
     if clamped != int(size):
         print(f"Penumbra: shadow map size {size} clamped to {clamped} (GPU limit)", file=sys.stderr)

@@ -64,6 +64,8 @@ def _make_harness(core):
                 _GpuHarness.result = _GpuHarness.job(self, depsgraph)
             except Exception as exc:  # handed back to the test
                 _GpuHarness.error = exc
+            finally:
+                self.free_gpu()
 
         def update_render_passes(self, scene=None, renderlayer=None):
             self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")

@@ -2,18 +2,22 @@
 #define SHADOW_FILTERS_GLSL
 
 /* Shadow visibility of world point P for light L (1 = lit, 0 = shadowed).
- * Maps hold the light's normalised depth (0 near, 1 far) in layer params.y of shadow_maps.
+ * Each map is a square tile (params.y) of shadow_atlas holding the light's normalised depth
+ * (0 near, 1 far); tiles are shadow_size.x texels wide, shadow_size.y to a row.
  * Bias is expressed in shadow-map texels so one setting holds at every scene scale:
  *   normal offset  moves P along N by shadow_params.z texels * sin(theta)
  *   constant       shadow_params.x texels of depth
  *   slope-scaled   shadow_params.y texels * tan(theta), tan clamped to 10. */
-float shadow_compare(float layer, ivec2 texel, float ref)
+float shadow_compare(float tile, ivec2 texel, float ref)
 {
-  ivec2 size = textureSize(shadow_maps, 0).xy;
-  if (texel.x < 0 || texel.y < 0 || texel.x >= size.x || texel.y >= size.y) {
-    return 1.0;
+  int size = int(frame.shadow_size.x);
+  if (texel.x < 0 || texel.y < 0 || texel.x >= size || texel.y >= size) {
+    return 1.0; /* outside the fitted frustum: nothing casts there */
   }
-  float stored = texelFetch(shadow_maps, ivec3(texel, int(layer)), 0).r;
+  int t = int(tile);
+  int columns = int(frame.shadow_size.y);
+  ivec2 origin = ivec2(t % columns, t / columns) * size;
+  float stored = texelFetch(shadow_atlas, origin + texel, 0).r;
   return (ref <= stored) ? 1.0 : 0.0;
 }
 
