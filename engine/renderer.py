@@ -63,10 +63,24 @@ class FrameOutput:
     height: int
 
     def color_array(self):
-        return np.asarray(self.color.read(), dtype=np.float32).reshape(self.height, self.width, 4)
+        return texture_array(self.color, 4)
 
     def depth_array(self):
-        return np.asarray(self.depth.read(), dtype=np.float32).reshape(self.height, self.width)
+        return texture_array(self.depth, 1)[..., 0]
+
+
+def buffer_array(buf):
+    """A ``gpu.types.Buffer`` as a C-ordered numpy array of its dimensions.
+
+    Blender 4.5's buffer protocol reports reversed strides, so ``np.asarray`` alone scrambles
+    multi-dimensional data there; reading the memory in its own order is right on every line."""
+    a = np.asarray(buf)
+    return a.ravel(order="K").reshape(tuple(buf.dimensions))
+
+
+def texture_array(texture, channels):
+    """Read a float texture back as an array (height, width, channels), row 0 at the bottom."""
+    return buffer_array(texture.read()).astype(np.float32, copy=False).reshape(texture.height, texture.width, channels)
 
 
 def pack_struct(struct, rows):

@@ -99,3 +99,20 @@ def gpu_call(penumbra):
 
     yield call
     bpy.utils.unregister_class(cls)
+
+
+_exit_status = 0
+
+
+def pytest_sessionfinish(session, exitstatus):
+    global _exit_status
+    _exit_status = int(exitstatus)
+
+
+def pytest_unconfigure(config):
+    """bpy 4.5 as a module can hang in its own shutdown after GPU work (seen here on
+    llvmpipe); once pytest has reported everything, leave with its exit status."""
+    if bpy.app.version < (5, 0, 0):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(_exit_status)

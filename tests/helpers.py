@@ -8,6 +8,9 @@ import numpy as np
 import OpenImageIO as oiio
 
 
+_CHANNEL_ORDER = "RGBAVXYZ"
+
+
 def read_exr(path):
     """{pass name: float32 array (h, w, channels)} of a (multilayer, multi-part) EXR, top row
     first. Blender writes each pass of a multilayer EXR as its own part (an OIIO subimage)."""
@@ -24,6 +27,8 @@ def read_exr(path):
             parts = name.split(".")
             groups.setdefault(parts[-2] if len(parts) >= 2 else "Combined", []).append(i)
         for key, idx in groups.items():
+            # Files may store channels alphabetically (A, B, G, R): put them in RGBA order.
+            idx.sort(key=lambda i: _CHANNEL_ORDER.find(spec.channelnames[i].split(".")[-1]))
             passes[key] = pixels[:, :, idx]
         sub += 1
     inp.close()

@@ -47,6 +47,9 @@ def test_demo_then_batch_animation_matches(tmp_path):
         scene.render.image_settings.color_depth = "32"
         scene.render.filepath = {str(tmp_path / 'frame_####')!r}
         bpy.ops.render.render(animation=True)
+        import os
+        sys.stdout.flush()
+        os._exit(0)  # bpy 4.5 can hang in its own shutdown after GPU work
         """
     )
     run(["-c", script], env={**os.environ})

@@ -23,7 +23,9 @@ def run_layers(gpu_call, image, layers):
         stats = FrameStats()
         ctx = PostContext(ShaderCache(), w, h, stats=stats)
         out = PostStack().run(ctx, src, layers)
-        return np.asarray(out.read(), np.float32).reshape(h, w, 4).copy(), stats
+        from penumbra.engine.renderer import texture_array
+
+        return texture_array(out, 4).copy(), stats
 
     scenes.top_camera(scenes.empty_scene(8, 8))
     return gpu_call(job)

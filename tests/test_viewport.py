@@ -38,7 +38,9 @@ def _viewport_frame(gpu_call, scene):
                 proj = Matrix(((2 / w, 0, 0, -1), (0, 2 / h, 0, -1), (0, 0, -1, 0), (0, 0, 0, 1)))
                 gpu.matrix.load_projection_matrix(proj)
                 engine.draw_display(scene, out.color, w, h)
-            display = np.asarray(fb.read_color(0, 0, w, h, 4, 0, "FLOAT"), np.float32).copy()
+            from penumbra.engine.renderer import buffer_array
+
+            display = buffer_array(fb.read_color(0, 0, w, h, 4, 0, "FLOAT")).reshape(h, w, 4).copy()
         offscreen.free()
         return linear, display
 

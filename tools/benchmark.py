@@ -23,7 +23,9 @@ with status 1 if any engine failed to render (its row is still written, with emp
 """
 
 import argparse
+import contextlib
 import csv
+import os
 import statistics
 import sys
 import time
@@ -138,6 +140,21 @@ def time_engine(setup, width, height, runs):
 # --- output -------------------------------------------------------------------------------
 
 
+@contextlib.contextmanager
+def stdout_to_stderr():
+    """Send file descriptor 1 to stderr for the duration: Blender's render progress and reports
+    ("Fra:1 Mem:..." lines) are printed by C code straight to it, and stdout is kept for the table."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def fmt(value, digits=3):
     return "" if value is None else f"{value:.{digits}f}"
 
@@ -228,7 +245,8 @@ def main(argv=None):
         row = {"label": label, "median": None, "min": None, "ratio": None, "error": None}
         print(f"benchmark: {label}: 1 warm-up + {args.runs} timed renders", file=sys.stderr, flush=True)
         try:
-            times = time_engine(setup, args.width, args.height, args.runs)
+            with stdout_to_stderr():
+                times = time_engine(setup, args.width, args.height, args.runs)
             row["median"], row["min"] = statistics.median(times), min(times)
         except Exception as exc:  # keep going: one broken engine should not hide the others
             row["error"] = str(exc)
@@ -250,4 +268,9 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    status = main()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    # Leave without running the interpreter's and bpy's exit handlers: with Blender 4.5 as a
+    # module, a static destructor can wait forever on a GPU/file worker thread at exit.
+    os._exit(status)

@@ -52,3 +52,9 @@ def main():
 
 if __name__ == "__main__":
     main()
+    # bpy 4.5 as a module can hang in its own shutdown after GPU work; everything is written.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    import os
+
+    os._exit(0)
