@@ -51,7 +51,7 @@ def test_box_shadow_matches_projected_footprint(penumbra, tilt, shadow_filter):
     shadow = lum < 0.5 * lit_value
     assert analytic[on_plane].sum() > 200  # the shadow is in view
     score = iou(shadow[on_plane], analytic[on_plane])
-    assert score > 0.93, f"IoU {score:.3f}"
+    assert score > 0.98, f"IoU {score:.3f}"  # measured: 1.000 (NONE), 0.9945 (PCF at 45°)
     # Lit plane far from the shadow edge has exactly Blender's sun irradiance (albedo/pi*E*cos).
     interior_lit = on_plane & ~analytic
     np.testing.assert_allclose(np.median(lum[interior_lit]), lit_value, rtol=0.01)
@@ -65,7 +65,7 @@ def test_box_shadow_holds_at_extreme_scales(penumbra, scale):
     on_plane, analytic, lum, lit_value = measure(scene, 45.0, scale)
     shadow = lum < 0.5 * lit_value
     score = iou(shadow[on_plane], analytic[on_plane])
-    assert score > 0.93, f"IoU {score:.3f} at scale {scale}"
+    assert score > 0.98, f"IoU {score:.3f} at scale {scale}"
     # No acne: the lit part of the plane is lit everywhere but within 2 px of the edge.
     acne = (on_plane & ~analytic & shadow).sum() / max((on_plane & ~analytic).sum(), 1)
     assert acne < 0.01
