@@ -81,3 +81,32 @@ def test_huge_shadow_map_is_clamped_with_a_message(penumbra, capfd):
     scene.penumbra.shadow_map_size = 1
     c = render(scene)["Combined"]
     assert np.all(np.isfinite(c))
+
+
+def test_negative_scale_and_instances_render_like_originals(penumbra):
+    """A mirrored (negative-scale) box and a collection instance of a box shade exactly like
+    the plain box: normals stay outward, instance matrices are applied."""
+    scene = scenes.empty_scene(96, 32)
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(20), math.radians(10), 0))
+    scenes.camera(scene, (0, 0, 10), (0, 0, 0), ortho_scale=9.0, clip=(0.1, 20))
+    mat = scenes.material("M", (0.6, 0.6, 0.6), roughness=1.0, specular=0.0)
+    scenes.box(scene, "Plain", center=(-3, 0, 0), mat=mat)
+    mirrored = scenes.box(scene, "Mirrored", center=(0, 0, 0), mat=mat)
+    mirrored.scale = (-1.0, 1.0, 1.0)
+    coll = bpy.data.collections.new("Src")
+    src = scenes.box(scene, "Source", center=(0, 0, 0), mat=mat)
+    scene.collection.objects.unlink(src)
+    coll.objects.link(src)
+    inst = bpy.data.objects.new("Instance", None)
+    inst.instance_type = "COLLECTION"
+    inst.instance_collection = coll
+    inst.location = (3, 0, 0)
+    scene.collection.objects.link(inst)
+    scene.penumbra.shadow_filter = "NONE"
+    c = render(scene)["Combined"][..., 0]
+    # Pixel columns at the three box centres (ortho scale 9 over 96 px: 1 m = 96/9 px).
+    px = lambda x: int(round((x + 4.5) * 96 / 9.0))  # noqa: E731
+    plain, mirror, instance = c[16, px(-3)], c[16, px(0)], c[16, px(3)]
+    assert plain > 0.1
+    assert mirror == pytest.approx(plain, rel=1e-5)
+    assert instance == pytest.approx(plain, rel=1e-5)
