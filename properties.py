@@ -62,6 +62,8 @@ def _property_for(param):
         )
     if param.type == "ENUM":
         return EnumProperty(items=param.items, default=param.default, **kw)
+    if param.type == "IMAGE":
+        return PointerProperty(type=bpy.types.Image, **kw)
     raise ValueError(f"unknown parameter type {param.type!r}")
 
 

@@ -1,15 +1,33 @@
 """Screen-space post-process layers.
 
-Every effect is one module here plus one GLSL file in ``shaders/post/``, with one interface:
-it declares its parameters as data (``Param``), and ``execute(ctx, src, params, mix)`` returns
-the texture holding its result. The layer properties and the sidebar UI are generated from
-the declarations (see ``properties.py`` and ``ui/``), so adding an effect needs no other code.
+Every effect is one module here (exposing ``EFFECT``, a ``PostEffect`` subclass) plus one GLSL
+file in ``shaders/post/``, with one interface: it declares its parameters as data (``Param``),
+and ``execute(ctx, src, params, mix)`` returns the texture holding its result. The layer
+properties and the sidebar UI are generated from the declarations, so adding an effect is one
+module, one shader and one name in ``MODULES``.
 """
 
-from . import blur, vignette
+import importlib
+
 from .base import Param, PostContext, PostEffect, PostStack
 
 # Order = order of the "add layer" menu.
-EFFECTS = {cls.id: cls for cls in (blur.Blur, vignette.Vignette)}
+MODULES = ("blur", "glow", "scanlines", "vignette", "colorizer", "fisheye", "pixelate", "sepia", "noise", "lens_flare")
 
-__all__ = ["EFFECTS", "Param", "PostContext", "PostEffect", "PostStack"]
+
+def _load():
+    effects = {}
+    for name in MODULES:
+        try:
+            module = importlib.import_module(f".{name}", __name__)
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+            continue  # not written yet
+        effects[module.EFFECT.id] = module.EFFECT
+    return effects
+
+
+EFFECTS = _load()
+
+__all__ = ["EFFECTS", "MODULES", "Param", "PostContext", "PostEffect", "PostStack"]

@@ -11,7 +11,7 @@ class Param:
     """One effect parameter; properties and UI are generated from these."""
 
     name: str
-    type: str  # 'FLOAT' | 'INT' | 'BOOL' | 'COLOR' | 'ENUM'
+    type: str  # 'FLOAT' | 'INT' | 'BOOL' | 'COLOR' | 'ENUM' | 'IMAGE' (an Image datablock or None)
     default: object
     description: str = ""
     min: float = None

@@ -70,3 +70,4 @@ class Blur(PostEffect):
             uniforms={"direction": (0.0, 1.0), "radius": radius, "mix_factor": mix},
             blocks={"weights": self._ubo},
         )
+EFFECT = Blur

@@ -53,3 +53,4 @@ class Vignette(PostEffect):
                 "shape": (params.radius, params.softness, params.roundness, 0.0),
             },
         )
+EFFECT = Vignette
