@@ -33,8 +33,18 @@ SPECULAR_ITEMS = (
 )
 
 
+def _redraw(self, context):
+    """Property update: redraw every 3D viewport so Rendered shading shows the change at once."""
+    screen = getattr(context, "screen", None)
+    if screen is None:
+        return
+    for area in screen.areas:
+        if area.type == "VIEW_3D":
+            area.tag_redraw()
+
+
 def _property_for(param):
-    kw = {"name": param.label, "description": param.description}
+    kw = {"name": param.label, "description": param.description, "update": _redraw}
     if param.type == "FLOAT":
         kw["default"] = param.default
         kw["subtype"] = param.subtype
@@ -85,10 +95,16 @@ class PENUMBRA_PG_layer(bpy.types.PropertyGroup):
     """One post-process layer: an effect, its switches and its parameters."""
 
     __annotations__ = {
-        "name": StringProperty(name="Name", description="Layer name shown in the stack"),
-        "effect": EnumProperty(name="Effect", items=EFFECT_ITEMS, description="What this layer does"),
-        "enabled": BoolProperty(name="Enabled", default=True, description="Run this layer"),
-        "mix": FloatProperty(
+        "name": StringProperty(update=_redraw, name="Name", description="Layer name shown in the stack"),
+        "effect": EnumProperty(update=_redraw, name="Effect", items=EFFECT_ITEMS, description="What this layer does"),
+        "enabled": BoolProperty(update=_redraw, name="Enabled", default=True, description="Run this layer"),
+        "solo": BoolProperty(
+            update=_redraw,
+            name="Solo",
+            default=False,
+            description="Show only the soloed layers (their enable switches are ignored)",
+        ),
+        "mix": FloatProperty(update=_redraw, 
             name="Mix",
             default=1.0,
             min=0.0,
@@ -106,61 +122,66 @@ class PENUMBRA_PG_layer(bpy.types.PropertyGroup):
 class PENUMBRA_PG_scene(bpy.types.PropertyGroup):
     """Scene-wide Penumbra settings (``scene.penumbra``)."""
 
-    shadow_filter: EnumProperty(
+    shadow_filter: EnumProperty(update=_redraw, 
         name="Shadow Filter", items=SHADOW_FILTER_ITEMS, default="PCF", description="How shadow edges are filtered"
     )
-    shadow_map_size: IntProperty(
+    shadow_map_size: IntProperty(update=_redraw, 
         name="Shadow Map Size",
         default=2048,
         min=1,
         soft_max=8192,
         description="Texels per side of each shadow map (clamped to the GPU's maximum)",
     )
-    shadow_samples: IntProperty(
+    shadow_samples: IntProperty(update=_redraw, 
         name="Shadow Samples", default=16, min=1, max=64, description="Samples for disk-based shadow filters"
     )
-    pcf_kernel_size: IntProperty(
+    pcf_kernel_size: IntProperty(update=_redraw, 
         name="PCF Kernel", default=5, min=1, max=15, description="Width N of the NxN PCF kernel (made odd)"
     )
-    pcf_spacing: FloatProperty(
+    pcf_spacing: FloatProperty(update=_redraw, 
         name="PCF Spacing", default=1.0, min=0.0, soft_max=8.0, description="Distance between PCF taps, in texels"
     )
-    shadow_bias: FloatProperty(
+    shadow_bias: FloatProperty(update=_redraw, 
         name="Constant Bias", default=0.5, min=0.0, soft_max=10.0, description="Depth bias in shadow-map texels"
     )
-    shadow_slope_bias: FloatProperty(
+    shadow_slope_bias: FloatProperty(update=_redraw, 
         name="Slope Bias",
         default=1.0,
         min=0.0,
         soft_max=10.0,
         description="Extra depth bias in texels per unit of tan(angle to the light)",
     )
-    shadow_normal_offset: FloatProperty(
+    shadow_normal_offset: FloatProperty(update=_redraw, 
         name="Normal Offset",
         default=1.0,
         min=0.0,
         soft_max=10.0,
         description="Offset of the lookup along the surface normal, in texels",
     )
-    shadow_cull_front: BoolProperty(
+    shadow_cull_front: BoolProperty(update=_redraw, 
         name="Cull Front Faces",
         default=False,
         description="Draw only back faces into shadow maps (less acne on closed meshes)",
     )
-    specular_model: EnumProperty(name="Specular", items=SPECULAR_ITEMS, default="BLINN")
+    specular_model: EnumProperty(update=_redraw, name="Specular", items=SPECULAR_ITEMS, default="BLINN")
     layers: CollectionProperty(type=PENUMBRA_PG_layer, name="Post Layers")
-    active_layer_index: IntProperty(name="Active Layer", default=0, min=0)
+    active_layer_index: IntProperty(update=_redraw, name="Active Layer", default=0, min=0)
 
     def render_settings(self, frame):
         """The plain settings a frame needs (the renderer never reads Blender properties)."""
         layers = []
+        soloing = any(layer.solo for layer in self.layers)
         for layer in self.layers:
+            enabled = layer.solo if soloing else layer.enabled
+            if not enabled:
+                layers.append((layer.effect, False, layer.mix, None))
+                continue
             params = layer.params()
             values = {}
             for p in EFFECTS[layer.effect].params:
                 v = getattr(params, p.name)
                 values[p.name] = tuple(v) if p.type == "COLOR" else v
-            layers.append((layer.effect, layer.enabled, layer.mix, SimpleNamespace(**values)))
+            layers.append((layer.effect, True, layer.mix, SimpleNamespace(**values)))
         return RenderSettings(
             shadow_filter=self.shadow_filter,
             shadow_map_size=self.shadow_map_size,

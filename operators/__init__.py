@@ -1,6 +1,6 @@
-from . import layers
+from . import layers, presets
 
-modules = (layers,)
+modules = (layers, presets)
 
 
 def register():

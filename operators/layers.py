@@ -3,7 +3,7 @@
 import bpy
 from bpy.props import EnumProperty
 
-from ..properties import EFFECT_ITEMS
+from ..properties import EFFECT_ITEMS, _redraw
 
 
 def _settings(context):
@@ -24,6 +24,10 @@ def _copy_group(src, dst):
 
 class _LayerOperator:
     bl_options = {"REGISTER", "UNDO"}
+
+    def finish(self, context):
+        _redraw(self, context)
+        return {"FINISHED"}
 
     @classmethod
     def poll(cls, context):
@@ -56,7 +60,7 @@ class PENUMBRA_OT_layer_add(_LayerOperator, bpy.types.Operator):
         target = min(s.active_layer_index, new) if len(s.layers) > 1 else 0
         s.layers.move(new, target)
         s.active_layer_index = target
-        return {"FINISHED"}
+        return self.finish(context)
 
 
 class PENUMBRA_OT_layer_remove(_ActiveLayerOperator, bpy.types.Operator):
@@ -69,7 +73,7 @@ class PENUMBRA_OT_layer_remove(_ActiveLayerOperator, bpy.types.Operator):
         s = _settings(context)
         s.layers.remove(s.active_layer_index)
         s.active_layer_index = max(0, min(s.active_layer_index, len(s.layers) - 1))
-        return {"FINISHED"}
+        return self.finish(context)
 
 
 class PENUMBRA_OT_layer_move(_ActiveLayerOperator, bpy.types.Operator):
@@ -90,7 +94,7 @@ class PENUMBRA_OT_layer_move(_ActiveLayerOperator, bpy.types.Operator):
             return {"CANCELLED"}
         s.layers.move(i, j)
         s.active_layer_index = j
-        return {"FINISHED"}
+        return self.finish(context)
 
 
 class PENUMBRA_OT_layer_duplicate(_ActiveLayerOperator, bpy.types.Operator):
@@ -107,7 +111,7 @@ class PENUMBRA_OT_layer_duplicate(_ActiveLayerOperator, bpy.types.Operator):
         new.name = s.layers[i].name + " copy"
         s.layers.move(len(s.layers) - 1, i + 1)
         s.active_layer_index = i + 1
-        return {"FINISHED"}
+        return self.finish(context)
 
 
 classes = (PENUMBRA_OT_layer_add, PENUMBRA_OT_layer_remove, PENUMBRA_OT_layer_move, PENUMBRA_OT_layer_duplicate)

@@ -8,7 +8,14 @@ import sys
 import tempfile
 from pathlib import Path
 
-import bpy
+# Never touch a real user's Blender config: presets and preferences go to a throw-away HOME.
+_HOME = tempfile.mkdtemp(prefix="penumbra-test-home-")
+os.environ["HOME"] = _HOME
+os.environ["BLENDER_USER_RESOURCES"] = os.path.join(_HOME, "blender")
+for _var in ("BLENDER_USER_CONFIG", "BLENDER_USER_SCRIPTS", "BLENDER_USER_EXTENSIONS", "BLENDER_USER_DATAFILES"):
+    os.environ.pop(_var, None)
+
+import bpy  # noqa: E402
 import numpy as np
 import pytest
 

@@ -61,7 +61,7 @@ def test_unregister_removes_everything_then_register_restores(penumbra):
     from penumbra import operators, properties, ui
     from penumbra.engine import render_engine
 
-    names = [c.__name__ for m in (properties, operators.layers, ui.panels) for c in m.classes]
+    names = [c.__name__ for m in (properties, operators.layers, operators.presets, ui.panels) for c in m.classes]
     names.append("PENUMBRA_PT_shadows")
 
     def engines():

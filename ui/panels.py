@@ -56,6 +56,7 @@ class PENUMBRA_UL_layers(bpy.types.UIList):
         row = layout.row(align=True)
         row.prop(item, "enabled", text="")
         row.prop(item, "name", text="", emboss=False, icon=effect.icon if effect else "NONE")
+        row.prop(item, "solo", text="", icon="SOLO_ON" if item.solo else "SOLO_OFF", emboss=False)
 
 
 class PENUMBRA_MT_layer_add(bpy.types.Menu):
@@ -68,6 +69,10 @@ class PENUMBRA_MT_layer_add(bpy.types.Menu):
 
 def draw_layer_stack(layout, context):
     s = context.scene.penumbra
+    row = layout.row(align=True)
+    row.menu("PENUMBRA_MT_post_presets", text=bpy.types.PENUMBRA_MT_post_presets.bl_label)
+    row.operator("penumbra.post_preset_add", text="", icon="ADD")
+    row.operator("penumbra.post_preset_add", text="", icon="REMOVE").remove_active = True
     row = layout.row()
     row.template_list("PENUMBRA_UL_layers", "", s, "layers", s, "active_layer_index", rows=4)
     col = row.column(align=True)
