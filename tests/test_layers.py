@@ -145,3 +145,16 @@ def test_geometry_cache_rebuilds_only_changed_meshes(penumbra, gpu_call):
 
     first, second, third = gpu_call(job)
     assert first == 5 and second == 0 and third == 1
+
+
+def test_solo_shows_only_soloed_layers(penumbra, gpu_call):
+    scene = scenes.demo_scene(64, 36)
+    blur, vig = scene.penumbra.layers
+    blur.enabled = False
+    blur.solo = True  # solo overrides the enable switch, and hides the other layers
+    stats, img_solo = _stats(gpu_call, scene)
+    assert stats.post_passes == 2
+    vig.enabled, blur.solo = False, False
+    blur.enabled = True
+    stats, img_blur_only = _stats(gpu_call, scene)
+    np.testing.assert_array_equal(img_solo, img_blur_only)
