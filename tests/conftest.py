@@ -1,8 +1,7 @@
 """Test harness: loads the repository as the ``penumbra`` package inside the bpy module and
-offers helpers to render and read back images. Tests use real Blender and the real gpu module
+runs code in a GPU context (``tools/devkit.py``). Tests use real Blender and the real gpu module
 (Mesa llvmpipe via EGL); nothing is mocked."""
 
-import importlib.util
 import os
 import sys
 import tempfile
@@ -16,25 +15,13 @@ for _var in ("BLENDER_USER_CONFIG", "BLENDER_USER_SCRIPTS", "BLENDER_USER_EXTENS
     os.environ.pop(_var, None)
 
 import bpy  # noqa: E402
-import numpy as np
-import pytest
+import pytest  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(ROOT / "tests"))
 
-
-def load_penumbra():
-    """Import the repository root as the package ``penumbra`` (its folder name may differ)."""
-    if "penumbra" in sys.modules:
-        return sys.modules["penumbra"]
-    spec = importlib.util.spec_from_file_location(
-        "penumbra", ROOT / "__init__.py", submodule_search_locations=[str(ROOT)]
-    )
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["penumbra"] = module
-    spec.loader.exec_module(module)
-    return module
+from devkit import GpuRunner, load_penumbra  # noqa: E402,F401  (load_penumbra: used by tests)
 
 
 @pytest.fixture(scope="session")
@@ -45,67 +32,14 @@ def penumbra():
     module.unregister()
 
 
-@pytest.fixture
-def tmp(tmp_path):
-    return tmp_path
-
-
-class _GpuHarness:
-    """Runs a callable inside a RenderEngine.render() call, where the gpu module can draw in
-    background mode. ``gpu_call(fn)`` returns what ``fn(engine)`` returned."""
-
-    engine_cls = None
-    job = None
-    result = None
-    error = None
-
-
-def _make_harness(core):
-    class PENUMBRA_TEST_HARNESS(core, bpy.types.RenderEngine):
-        bl_idname = "PENUMBRA_TEST_HARNESS"
-        bl_label = "Penumbra test harness"
-        bl_use_gpu_context = True
-
-        def render(self, depsgraph):
-            try:
-                _GpuHarness.result = _GpuHarness.job(self, depsgraph)
-            except Exception as exc:  # handed back to the test
-                _GpuHarness.error = exc
-            finally:
-                self.free_gpu()
-
-        def update_render_passes(self, scene=None, renderlayer=None):
-            self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
-
-    return PENUMBRA_TEST_HARNESS
-
-
 @pytest.fixture(scope="session")
 def gpu_call(penumbra):
-    """``gpu_call(fn)``: run ``fn(engine, depsgraph)`` in a GPU context, on the current scene.
-
-    The harness engine is built on Penumbra's engine core, so ``engine.render_frame`` and
-    ``engine.draw_display`` are the production code paths."""
-    from penumbra.engine.render_engine import PenumbraEngineCore
-
-    cls = _make_harness(PenumbraEngineCore)
-    bpy.utils.register_class(cls)
-
-    def call(fn):
-        scene = bpy.context.scene
-        old = scene.render.engine
-        scene.render.engine = cls.bl_idname
-        _GpuHarness.job, _GpuHarness.result, _GpuHarness.error = fn, None, None
-        try:
-            bpy.ops.render.render(write_still=False)
-        finally:
-            scene.render.engine = old
-        if _GpuHarness.error is not None:
-            raise _GpuHarness.error
-        return _GpuHarness.result
-
-    yield call
-    bpy.utils.unregister_class(cls)
+    """``gpu_call(fn)``: run ``fn(engine, depsgraph)`` in a GPU context, on the current scene
+    (see ``devkit.GpuRunner``: the production engine core, a real GPU context)."""
+    runner = GpuRunner()
+    runner.register()
+    yield runner
+    runner.unregister()
 
 
 _exit_status = 0

@@ -35,7 +35,7 @@ def test_demo_then_batch_animation_matches(tmp_path):
         f"""
         import sys
         sys.path[:0] = [{str(ROOT / 'tests')!r}, {str(ROOT / 'tools')!r}]
-        from conftest import load_penumbra
+        from devkit import load_penumbra
         import bpy
         load_penumbra().register()
         bpy.ops.wm.open_mainfile(filepath={str(tmp_path / 'demo.blend')!r})

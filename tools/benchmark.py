@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from conftest import load_penumbra  # noqa: E402  (needs the sys.path entries above)
+from devkit import load_penumbra  # noqa: E402  (needs the sys.path entries above)
 from scenes import demo_scene  # noqa: E402
 
 EEVEE_SAMPLES = 16

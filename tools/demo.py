@@ -14,7 +14,7 @@ sys.path[:0] = [str(ROOT / "tools"), str(ROOT / "tests")]
 
 import bpy  # noqa: E402
 
-from conftest import load_penumbra  # noqa: E402
+from devkit import load_penumbra  # noqa: E402
 import scenes  # noqa: E402
 
 
