@@ -1,0 +1,92 @@
+"""Contact sheet of every post layer on the demo scene: docs/contact_sheet.png.
+
+    .venv/blender-5.2/bin/python tools/contact_sheet.py --out docs
+
+Each tile is the demo scene rendered by Penumbra with one layer (default parameters, mix 1),
+saved through Blender's colour management (AgX), the first tile without any layer. Tiles are
+laid out with matplotlib.
+"""
+
+import argparse
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT / "tools")]
+
+import bpy  # noqa: E402
+
+import scenes  # noqa: E402
+from devkit import load_penumbra  # noqa: E402
+
+# Parameters that make an effect readable at thumbnail size (others keep their defaults).
+SHOWCASE = {
+    "BLUR": {"radius": 6},
+    "PIXELATE": {"size": 12},
+}
+
+
+def render_png(scene, path):
+    settings = scene.render.image_settings
+    if hasattr(settings, "media_type"):
+        settings.media_type = "IMAGE"
+    settings.file_format = "PNG"
+    settings.color_depth = "8"
+    scene.render.filepath = str(path)
+    scene.render.use_file_extension = False
+    bpy.ops.render.render(write_still=True)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default="docs")
+    ap.add_argument("--width", type=int, default=384)
+    ap.add_argument("--height", type=int, default=216)
+    args = ap.parse_args()
+    out = Path(args.out).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import OpenImageIO as oiio
+
+    load_penumbra().register()
+    from penumbra.engine.post import EFFECTS
+
+    tiles = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for eid in [None, *EFFECTS]:
+            scene = scenes.demo_scene(args.width, args.height)
+            scene.view_settings.view_transform = "AgX"
+            s = scene.penumbra
+            s.layers.clear()
+            if eid is not None:
+                layer = s.layers.add()
+                layer.effect = eid
+                for name, value in SHOWCASE.get(eid, {}).items():
+                    setattr(layer.params(), name, value)
+            path = Path(tmp) / f"{eid or 'none'}.png"
+            render_png(scene, path)
+            tiles.append((EFFECTS[eid].label if eid else "No layer", oiio.ImageBuf(str(path)).get_pixels(oiio.FLOAT)))
+
+    cols = 4
+    rows = (len(tiles) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(cols * 3.2, rows * 2.0), dpi=120)
+    for ax in axes.ravel():
+        ax.axis("off")
+    for ax, (label, px) in zip(axes.ravel(), tiles):
+        ax.imshow(px[..., :3].clip(0, 1))
+        ax.set_title(label, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out / "contact_sheet.png")
+    print(f"wrote {out / 'contact_sheet.png'} ({len(tiles)} tiles)")
+
+
+if __name__ == "__main__":
+    main()
+    sys.stdout.flush()
+    os._exit(0)  # bpy 4.5 can hang in its own shutdown after GPU work
