@@ -24,7 +24,16 @@ from .engine.renderer import RenderSettings
 
 SHADOW_FILTER_ITEMS = (
     ("NONE", "None", "One depth comparison per pixel: hard, aliased edges"),
+    ("HARDWARE", "Hardware 2x2", "Bilinear-weighted 2x2 comparison, as a filtering compare sampler gives"),
     ("PCF", "PCF", "Percentage-closer filtering with an NxN Gaussian-weighted kernel"),
+    ("JITTER", "Jittered Disk", "Disk samples jittered per pixel, with an early out where the outer ring agrees"),
+    ("PCSS", "PCSS", "Contact-hardening soft shadows: penumbra width from the light's size and the blocker distance"),
+)
+
+DEPTH_FORMAT_ITEMS = (
+    ("FLOAT32", "Float 32", "32-bit float depth"),
+    ("FLOAT16", "Float 16", "16-bit float depth: half the memory, less precision"),
+    ("RGBA8", "RGBA8 Packed", "Depth packed into four 8-bit channels (the classic encoding)"),
 )
 
 SPECULAR_ITEMS = (
@@ -104,7 +113,8 @@ class PENUMBRA_PG_layer(bpy.types.PropertyGroup):
             default=False,
             description="Show only the soloed layers (their enable switches are ignored)",
         ),
-        "mix": FloatProperty(update=_redraw, 
+        "mix": FloatProperty(
+        update=_redraw,
             name="Mix",
             default=1.0,
             min=0.0,
@@ -122,43 +132,75 @@ class PENUMBRA_PG_layer(bpy.types.PropertyGroup):
 class PENUMBRA_PG_scene(bpy.types.PropertyGroup):
     """Scene-wide Penumbra settings (``scene.penumbra``)."""
 
-    shadow_filter: EnumProperty(update=_redraw, 
+    shadow_filter: EnumProperty(
+        update=_redraw,
         name="Shadow Filter", items=SHADOW_FILTER_ITEMS, default="PCF", description="How shadow edges are filtered"
     )
-    shadow_map_size: IntProperty(update=_redraw, 
+    shadow_map_size: IntProperty(
+        update=_redraw,
         name="Shadow Map Size",
         default=2048,
         min=1,
         soft_max=8192,
         description="Texels per side of each shadow map (clamped to the GPU's maximum)",
     )
-    shadow_samples: IntProperty(update=_redraw, 
-        name="Shadow Samples", default=16, min=1, max=64, description="Samples for disk-based shadow filters"
+    shadow_samples: IntProperty(
+        update=_redraw,
+        name="Shadow Samples",
+        default=16,
+        min=8,
+        max=64,
+        step=8,
+        description="Samples of the jittered-disk and PCSS filters (rounded down to a multiple of 8)",
     )
-    pcf_kernel_size: IntProperty(update=_redraw, 
+    shadow_filter_radius: FloatProperty(
+        update=_redraw,
+        name="Filter Radius",
+        default=2.0,
+        min=0.0,
+        soft_max=16.0,
+        max=32.0,
+        description="Radius of the jittered-disk filter, in shadow-map texels",
+    )
+    shadow_depth_format: EnumProperty(
+        update=_redraw, name="Depth Format", items=DEPTH_FORMAT_ITEMS, default="FLOAT32", description="How shadow depth is stored"
+    )
+    shadow_early_out: BoolProperty(
+        update=_redraw,
+        name="Early Out",
+        default=True,
+        description="Jittered disk: skip the inner samples where the outer ring agrees",
+    )
+    pcf_kernel_size: IntProperty(
+        update=_redraw,
         name="PCF Kernel", default=5, min=1, max=15, description="Width N of the NxN PCF kernel (made odd)"
     )
-    pcf_spacing: FloatProperty(update=_redraw, 
+    pcf_spacing: FloatProperty(
+        update=_redraw,
         name="PCF Spacing", default=1.0, min=0.0, soft_max=8.0, description="Distance between PCF taps, in texels"
     )
-    shadow_bias: FloatProperty(update=_redraw, 
+    shadow_bias: FloatProperty(
+        update=_redraw,
         name="Constant Bias", default=0.5, min=0.0, soft_max=10.0, description="Depth bias in shadow-map texels"
     )
-    shadow_slope_bias: FloatProperty(update=_redraw, 
+    shadow_slope_bias: FloatProperty(
+        update=_redraw,
         name="Slope Bias",
         default=1.0,
         min=0.0,
         soft_max=10.0,
         description="Extra depth bias in texels per unit of tan(angle to the light)",
     )
-    shadow_normal_offset: FloatProperty(update=_redraw, 
+    shadow_normal_offset: FloatProperty(
+        update=_redraw,
         name="Normal Offset",
         default=1.0,
         min=0.0,
         soft_max=10.0,
         description="Offset of the lookup along the surface normal, in texels",
     )
-    shadow_cull_front: BoolProperty(update=_redraw, 
+    shadow_cull_front: BoolProperty(
+        update=_redraw,
         name="Cull Front Faces",
         default=False,
         description="Draw only back faces into shadow maps (less acne on closed meshes)",
@@ -191,21 +233,40 @@ class PENUMBRA_PG_scene(bpy.types.PropertyGroup):
             shadow_slope_bias=self.shadow_slope_bias,
             shadow_normal_offset=self.shadow_normal_offset,
             shadow_cull_front=self.shadow_cull_front,
+            shadow_samples=self.shadow_samples,
+            shadow_filter_radius=self.shadow_filter_radius,
+            shadow_depth_format=self.shadow_depth_format,
+            shadow_early_out=self.shadow_early_out,
             specular_model=self.specular_model,
             frame=frame,
             layers=layers,
         )
 
 
-classes = (*EFFECT_GROUPS.values(), PENUMBRA_PG_layer, PENUMBRA_PG_scene)
+class PENUMBRA_PG_light(bpy.types.PropertyGroup):
+    """Per-light Penumbra settings (``light.penumbra``)."""
+
+    bias_scale: FloatProperty(
+        update=_redraw,
+        name="Bias Scale",
+        default=1.0,
+        min=0.0,
+        soft_max=10.0,
+        description="Multiplies the scene's shadow biases for this light",
+    )
+
+
+classes = (*EFFECT_GROUPS.values(), PENUMBRA_PG_layer, PENUMBRA_PG_scene, PENUMBRA_PG_light)
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(classes)
 
 
 def register():
     _register_classes()
     bpy.types.Scene.penumbra = PointerProperty(type=PENUMBRA_PG_scene, name="Penumbra")
+    bpy.types.Light.penumbra = PointerProperty(type=PENUMBRA_PG_light, name="Penumbra")
 
 
 def unregister():
+    del bpy.types.Light.penumbra
     del bpy.types.Scene.penumbra
     _unregister_classes()

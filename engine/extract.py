@@ -31,6 +31,7 @@ class Geometry:
     ranges: list  # (material index, first vertex, vertex count)
     bounds: np.ndarray  # (2, 3) local min/max; NaN when empty
     deps: frozenset = frozenset()
+    serial: int = 0  # distinguishes rebuilt geometry of the same key
     gpu: dict = field(default_factory=dict)  # GPU batches, filled by the renderer
 
     @property
@@ -55,6 +56,14 @@ class Light:
     spot_blend: float = 0.15
     angle: float = 0.0
     use_shadow: bool = True
+    size: float = 0.0  # area lights: the larger side (for PCSS softness)
+    bias_scale: float = 1.0  # light.penumbra.bias_scale
+
+    @property
+    def shadow_radius(self):
+        """Radius of the emitter for soft shadows: Blender's shadow_soft_size, or half an area
+        light's size."""
+        return 0.5 * self.size if self.type == "AREA" else self.radius
 
     @property
     def position(self):
@@ -299,6 +308,7 @@ class SceneCache:
         geo.deps = deps
         self.geometry[key] = geo
         self.built += 1
+        geo.serial = self.built
         return geo
 
     def snapshot(self, depsgraph):
@@ -353,4 +363,11 @@ def light_from_blender(data, matrix):
         light.angle = float(data.angle)
     elif data.type == "AREA":
         light.radius = 0.0
+        sizes = [float(data.size)]
+        if data.shape in {"RECTANGLE", "ELLIPSE"}:
+            sizes.append(float(data.size_y))
+        light.size = max(sizes)
+    settings = getattr(data, "penumbra", None)
+    if settings is not None:
+        light.bias_scale = float(settings.bias_scale)
     return light

@@ -43,3 +43,28 @@ def pcf_kernel(size, sigma=None):
     w2 /= w2.sum()
     dy, dx = np.mgrid[-r : r + 1, -r : r + 1]
     return np.stack([dx.ravel(), dy.ravel(), w2.ravel()], axis=1)
+
+
+RING = 8  # samples per ring of the jittered disk; the outer ring is evaluated first
+
+
+def jitter_disk(size=32, samples=16, seed=1):
+    """Per-pixel jittered disk samples (seed 003 / stratified polar warping).
+
+    Returns (size, size, samples, 2) offsets inside the unit disk. Samples come in rings of
+    ``RING``, outermost ring first, so a shader can test the outer ring and stop early when it
+    agrees. Strata: ring i covers radii sqrt((i..i+1)/rings) (equal areas), angle sector k covers
+    2*pi*(k..k+1)/RING; each sample is jittered inside its stratum, independently per pixel.
+    Deterministic for a given seed, so frames are reproducible across machines.
+    """
+    samples = max(RING, int(samples) // RING * RING)
+    rings = samples // RING
+    rng = np.random.default_rng(seed)
+    ju = rng.random((size, size, rings, RING))
+    jv = rng.random((size, size, rings, RING))
+    i = np.arange(rings)[::-1][None, None, :, None]  # outer ring first
+    k = np.arange(RING)[None, None, None, :]
+    r = np.sqrt((i + ju) / rings)
+    a = 2.0 * np.pi * (k + jv) / RING
+    out = np.stack([r * np.cos(a), r * np.sin(a)], axis=-1)
+    return out.reshape(size, size, samples, 2)

@@ -106,13 +106,30 @@ def normal_matrix(model):
     return cof * sign
 
 
+class Fit:
+    """A fitted light view: ``view`` (world -> light view), ``proj`` (view -> clip), the linear
+    depth range [near, far] along the view axis, and the world size of one texel: constant for
+    orthographic maps (``texel``), proportional to distance for perspective ones
+    (``texel_per_distance``)."""
+
+    __slots__ = ("view", "proj", "near", "far", "texel", "texel_per_distance")
+
+    def __init__(self, view, proj, near, far, texel=0.0, texel_per_distance=0.0):
+        self.view, self.proj, self.near, self.far = view, proj, float(near), float(far)
+        self.texel, self.texel_per_distance = float(texel), float(texel_per_distance)
+
+    @property
+    def view_proj(self):
+        return self.proj @ self.view
+
+
 def fit_sun_ortho(direction, points, map_size, padding_texels=2.0):
     """Fit an orthographic light frustum for a sun shining along ``direction`` around ``points``.
 
-    Returns ``(view, projection, texel_world_size)``. The frustum's x/y extent is snapped to
-    whole texels in light space, and its size to a power-of-two-friendly quantum, so moving
-    the camera or the fitted set slightly does not make shadow edges shimmer. Depth range
-    covers every point with a margin so casters behind the receivers are kept.
+    Returns a ``Fit`` (or ``None`` without finite points). The frustum's x/y extent is
+    quantised and its origin snapped to whole texels in light space, so moving the camera or
+    the fitted set slightly does not make shadow edges shimmer. The depth range covers every
+    point with a margin so casters behind the receivers are kept.
     """
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     pts = pts[np.all(np.isfinite(pts), axis=1)]
@@ -140,4 +157,50 @@ def fit_sun_ortho(direction, points, map_size, padding_texels=2.0):
     near = -hi[2] - margin
     far = -lo[2] + margin
     proj = orthographic(cx - half, cx + half, cy - half, cy + half, near, far)
-    return view, proj, texel
+    return Fit(view, proj, near, far, texel=texel)
+
+
+def fit_perspective(position, forward, fov, points, map_size, min_near_ratio=1e-4):
+    """Perspective light view at ``position`` looking along ``forward`` with a square ``fov``
+    (radians), near/far fitted to the ``points`` in front of it. ``None`` when no point lies in
+    front (nothing can cast a shadow into the cone)."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    pts = pts[np.all(np.isfinite(pts), axis=1)]
+    view = look_at(position, forward)
+    z = -transform_points(view, pts)[:, 2] if len(pts) else np.zeros(0)
+    z = z[z > 0.0]
+    if len(z) == 0:
+        return None
+    far = float(z.max()) * 1.01
+    near = max(float(z.min()) * 0.99, far * min_near_ratio)
+    fov = float(np.clip(fov, 1e-3, np.pi - 1e-3))
+    proj = perspective(fov, 1.0, near, far)
+    return Fit(view, proj, near, far, texel_per_distance=2.0 * np.tan(fov / 2.0) / max(1, int(map_size)))
+
+
+# Cube-map faces: +X, -X, +Y, -Y, +Z, -Z. The GLSL face selection (cube_face) uses this order.
+CUBE_FORWARDS = np.array(
+    [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64
+)
+
+
+def cube_face(direction):
+    """Index into CUBE_FORWARDS of the face that sees ``direction`` (its major axis)."""
+    d = np.asarray(direction, dtype=np.float64)
+    axis = int(np.argmax(np.abs(d)))
+    return 2 * axis + (0 if d[axis] >= 0.0 else 1)
+
+
+def boxes_in_frustum(view_proj, corners):
+    """For (N, 8, 3) box corners, whether each box may intersect the clip volume of
+    ``view_proj`` (conservative: a box is out only when all its corners are beyond one plane)."""
+    c = np.asarray(corners, dtype=np.float64)
+    if c.size == 0:
+        return np.zeros(0, dtype=bool)
+    h = c @ view_proj[:3, :3].T + view_proj[:3, 3]
+    w = c @ view_proj[3, :3] + view_proj[3, 3]
+    out = np.zeros(c.shape[0], dtype=bool)
+    for axis in range(3):
+        out |= np.all(h[..., axis] > w, axis=1)
+        out |= np.all(h[..., axis] < -w, axis=1)
+    return ~out

@@ -7,10 +7,15 @@ generated struct source, so the CPU packing and the shader layout agree by const
 from ..shaders.loader import Program, Struct
 
 LIGHT_TYPES = {"SUN": 0, "POINT": 1, "SPOT": 2, "AREA": 3}
-SHADOW_FILTERS = {"NONE": 0, "PCF": 1}
+SHADOW_FILTERS = {"NONE": 0, "HARDWARE": 1, "PCF": 2, "JITTER": 3, "PCSS": 4}
+DEPTH_FORMATS = {"FLOAT32": 0, "FLOAT16": 1, "RGBA8": 2}  # atlas texel encodings
+SHADOW_MODES = {"NONE": -1, "SINGLE": 0, "CUBE": 1}
 SPECULAR_MODELS = {"BLINN": 0, "PHONG": 1}
 MAX_LIGHTS = 64
 MAX_PCF_TAPS = 15 * 15
+MAX_SHADOW_TILES = 48
+JITTER_SIZE = 32  # the jitter texture repeats every 32x32 pixels
+MAX_DISK_SAMPLES = 64
 SHADOW_SAMPLER = "shadow_atlas"
 
 LIGHT_STRUCT = Struct(
@@ -19,8 +24,20 @@ LIGHT_STRUCT = Struct(
         ("VEC4", "color"),  # rgb: colour * energy * 2^exposure, a: type
         ("VEC4", "position"),  # xyz, w: radius (soft falloff)
         ("VEC4", "direction"),  # xyz: where the light points, w: cos(spot_size / 2)
-        ("VEC4", "params"),  # x: spot smooth width, y: shadow atlas tile or -1, z: texel size, w: depth/world
-        ("MAT4", "shadow_matrix"),  # world -> shadow texture space [0, 1]^3
+        ("VEC4", "params"),  # x: spot smooth width, y: shadow mode, z: radius (world), w: tan(sun angle / 2)
+        ("VEC4", "tiles"),  # atlas tile per cube face 0..3 (or x for single maps); -1: no map
+        ("VEC4", "tiles2"),  # tiles of faces 4, 5; z: bias scale
+    ),
+)
+
+# One rendered shadow map (an atlas tile): world -> light view, view -> texture [0,1]^2, and
+# its linear depth range; stored depth is (distance along the view axis - near) / (far - near).
+TILE_STRUCT = Struct(
+    "ShadowTile",
+    (
+        ("MAT4", "view"),
+        ("MAT4", "proj_tex"),
+        ("VEC4", "range"),  # x: near, y: far, z: texel world size (ortho), w: texel size per distance
     ),
 )
 
@@ -34,7 +51,8 @@ FRAME_STRUCT = Struct(
         ("VEC4", "world_color"),
         ("VEC4", "counts"),  # x: light count
         ("VEC4", "shadow_params"),  # x: constant bias, y: slope bias, z: normal offset, w: spacing
-        ("VEC4", "shadow_size"),  # x: tile size in texels, y: atlas columns
+        ("VEC4", "shadow_size"),  # x: tile size in texels, y: atlas columns, z: disk samples
+        ("VEC4", "filter_params"),  # x: filter radius (texels), y: max penumbra (texels)
     ),
 )
 
@@ -51,7 +69,7 @@ LIT = Program(
     name="lit",
     vertex="mesh.vert.glsl",
     fragment="lit.frag.glsl",
-    libs=("lib/common.glsl", "lib/lights.glsl", "lib/shadow_filters.glsl"),
+    libs=("lib/common.glsl", "lib/lights.glsl", "lib/depth_encoding.glsl", "lib/shadow_filters.glsl"),
     vertex_in=MESH_VERTEX_IN,
     varyings=(
         ("smooth", "VEC3", "v_world"),
@@ -59,11 +77,12 @@ LIT = Program(
         ("smooth", "FLOAT", "v_view_depth"),
     ),
     push_constants=(("MAT4", "model"), ("VEC4", "base_color"), ("VEC4", "material")),
-    samplers=(("FLOAT_2D", SHADOW_SAMPLER),),
+    samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex")),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
         (LIGHT_STRUCT, "lights", MAX_LIGHTS),
         (TAP_STRUCT, "pcf_taps", MAX_PCF_TAPS),
+        (TILE_STRUCT, "shadow_tiles", MAX_SHADOW_TILES),
     ),
     outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth")),
 )
@@ -72,14 +91,23 @@ SHADOW_DEPTH = Program(
     name="shadow_depth",
     vertex="shadow_depth.vert.glsl",
     fragment="shadow_depth.frag.glsl",
+    libs=("lib/depth_encoding.glsl",),
     vertex_in=MESH_VERTEX_IN[:1],
-    push_constants=(("MAT4", "model"), ("MAT4", "light_view_proj")),
-    outputs=(("FLOAT", "out_depth"),),
+    varyings=(("smooth", "FLOAT", "v_distance"),),
+    push_constants=(("MAT4", "model"),),
+    uniform_blocks=((TILE_STRUCT, "tile", 0),),
+    outputs=(("VEC4", "out_depth"),),
 )
 
 
-def lit_defines(shadow_filter, pcf_taps, specular_model):
-    d = {}
+def depth_defines(depth_format):
+    d = enum_defines("DEPTH", DEPTH_FORMATS)
+    d["DEPTH_FORMAT"] = f"DEPTH_{depth_format}"
+    return d
+
+
+def lit_defines(shadow_filter, pcf_taps, specular_model, depth_format="FLOAT32", disk_samples=16, early_out=True):
+    d = depth_defines(depth_format)
     d.update(enum_defines("LIGHT", LIGHT_TYPES))
     d.update(enum_defines("FILTER", SHADOW_FILTERS))
     d.update(enum_defines("SPECULAR", SPECULAR_MODELS))
@@ -87,4 +115,8 @@ def lit_defines(shadow_filter, pcf_taps, specular_model):
     d["SPECULAR_MODEL"] = f"SPECULAR_{specular_model}"
     # Only the PCF variant depends on the tap count; others share one compiled shader.
     d["PCF_TAPS"] = pcf_taps if shadow_filter == "PCF" else 1
+    d.update(enum_defines("SHADOW_MODE", SHADOW_MODES))
+    d["JITTER_SIZE"] = JITTER_SIZE
+    d["DISK_SAMPLES"] = disk_samples if shadow_filter in ("JITTER", "PCSS") else 8
+    d["EARLY_OUT"] = bool(early_out)
     return d

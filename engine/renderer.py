@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import kernels
+from .kernels import RING
 from .post import PostContext, PostStack
 from .programs import (
     FRAME_STRUCT,
@@ -15,12 +16,17 @@ from .programs import (
     LIT,
     MAX_LIGHTS,
     MAX_PCF_TAPS,
+    MAX_DISK_SAMPLES,
+    MAX_SHADOW_TILES,
     SHADOW_FILTERS,
+    SHADOW_MODES,
     SHADOW_SAMPLER,
     TAP_STRUCT,
+    TILE_STRUCT,
+    JITTER_SIZE,
     lit_defines,
 )
-from .shadows import ShadowMaps, ShadowView, plan_sun
+from .shadows import ShadowAtlas, plan_shadows
 
 
 @dataclass
@@ -35,6 +41,10 @@ class RenderSettings:
     shadow_slope_bias: float = 1.0
     shadow_normal_offset: float = 1.0
     shadow_cull_front: bool = False
+    shadow_samples: int = 16
+    shadow_filter_radius: float = 2.0
+    shadow_depth_format: str = "FLOAT32"
+    shadow_early_out: bool = True
     specular_model: str = "BLINN"
     film_transparent: bool = False
     frame: int = 1
@@ -45,7 +55,8 @@ class RenderSettings:
 class FrameStats:
     """What a frame did: read by tests and the benchmark ("model only what a scene requires")."""
 
-    shadow_maps: int = 0
+    shadow_maps: int = 0  # maps drawn this frame
+    shadow_maps_reused: int = 0  # maps whose fit and casters did not change: not redrawn
     passes: int = 0
     post_passes: int = 0
     draws: int = 0
@@ -104,7 +115,8 @@ class Renderer:
         from ..shaders.loader import ShaderCache
 
         self.shaders = ShaderCache()
-        self.shadows = ShadowMaps()
+        self.shadows = ShadowAtlas()
+        self._jitter_tex = None
         self.post = PostStack()
         self._size = None
         self._color = self._depth = self._zbuffer = self._fb = None
@@ -161,6 +173,20 @@ class Renderer:
         geo.gpu["batches"] = (whole, parts)
         return geo.gpu["batches"]
 
+    def _jitter(self, samples):
+        """The jittered-disk texture: (JITTER_SIZE, JITTER_SIZE, samples / 2) RGBA, two 2-D
+        offsets per texel, outer ring first (kernels.jitter_disk)."""
+        import gpu
+
+        if self._jitter_tex is None or self._jitter_tex[0] != samples:
+            disk = kernels.jitter_disk(JITTER_SIZE, samples).astype(np.float32)
+            # (y, x, sample, 2) -> 3-D texture (x, y, sample pair) of RGBA: z slowest in memory.
+            data = disk.reshape(JITTER_SIZE, JITTER_SIZE, samples // 2, 4).transpose(2, 0, 1, 3)
+            buf = gpu.types.Buffer("FLOAT", data.size, data.ravel().tolist())
+            tex = gpu.types.GPUTexture((JITTER_SIZE, JITTER_SIZE, samples // 2), format="RGBA32F", data=buf)
+            self._jitter_tex = (samples, tex)
+        return self._jitter_tex[1]
+
     def _shadow_dummy(self):
         import gpu
 
@@ -180,7 +206,7 @@ class Renderer:
         self._ensure_targets(width, height)
 
         draws = []  # (instance, geometry, whole batch, parts, model Matrix, det)
-        world_points = []
+        corners = []
         for inst in snapshot.instances:
             geo = snapshot.geometry.get(inst.key)
             if geo is None:
@@ -189,40 +215,38 @@ class Renderer:
             det = float(np.linalg.det(inst.matrix[:3, :3]))
             draws.append((inst, geo, whole, parts, Matrix(inst.matrix.tolist()), det))
             stats.triangles += geo.triangle_count
-            corners = _box_corners(geo.bounds)
-            world_points.append(corners @ inst.matrix[:3, :3].T + inst.matrix[:3, 3])
-        world_points = np.concatenate(world_points) if world_points else np.zeros((0, 3))
+            box = _box_corners(geo.bounds)
+            corners.append(box @ inst.matrix[:3, :3].T + inst.matrix[:3, 3])
+        corners = np.stack(corners) if corners else np.zeros((0, 8, 3))
 
-        # Shadow passes: only lights that cast shadows and have casters in reach. Planning
-        # uses the requested size; the atlas may clamp it to fit the GPU's texture limit.
-        map_size = max(1, int(settings.shadow_map_size))
+        # Shadow passes: only lights that cast shadows and have casters in reach.
         lights = snapshot.lights[:MAX_LIGHTS]
-        shadow_views = {}
-        plans = []
-        for i, light in enumerate(lights):
-            if not light.use_shadow or light.type != "SUN" or len(world_points) == 0:
-                continue
-            plan = plan_sun(light, world_points, map_size)
-            if plan is not None:
-                plans.append((i, plan))
-        if plans:
-            columns, _rows = self.shadows.grid(len(plans))
-            map_size = _clamp_map_size(settings.shadow_map_size, columns)
-            self.shadows.ensure(map_size, len(plans))
-            self.shadows.clear()
-            shadow_draws = [(whole, model, det) for (_i, _g, whole, _p, model, det) in draws]
-            for tile, (i, (view, proj, texel, depth_per_world)) in enumerate(plans):
-                vp = proj @ view
-                self.shadows.render_tile(tile, vp, shadow_draws, self.shaders, settings.shadow_cull_front, stats)
-                shadow_views[i] = ShadowView(tile, vp, texel, depth_per_world)
-        shadow_tex = self.shadows.texture if plans else self._shadow_dummy()
+        map_size = max(1, int(settings.shadow_map_size))
+        plan = plan_shadows(lights, corners, map_size)
+        if plan.tiles:
+            columns, _rows = self.shadows.grid(len(plan.tiles))
+            clamped = _clamp_map_size(map_size, columns)
+            if clamped != map_size:
+                map_size = clamped
+                plan = plan_shadows(lights, corners, map_size)
+            self.shadows.ensure(map_size, len(plan.tiles), settings.shadow_depth_format)
+            shadow_draws = [
+                (whole, model, det, (inst.key, inst.matrix.tobytes(), geo.serial))
+                for (inst, geo, whole, _p, model, det) in draws
+            ]
+            self.shadows.render(plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats)
+        shadow_tex = self.shadows.texture if plan.tiles else self._shadow_dummy()
+        depth_format = self.shadows.depth_format if plan.tiles else "FLOAT32"
 
         # Frame constants.
         light_rows = []
         for i, light in enumerate(lights):
             half = 0.5 * min(max(light.spot_size, 0.0), np.pi)
             cos_half = float(np.cos(half))
-            sv = shadow_views.get(i)
+            entry = plan.lights.get(i)
+            mode = SHADOW_MODES[entry.mode] if entry else SHADOW_MODES["NONE"]
+            tiles = (entry.tiles if entry else []) + [-1] * 6
+            radius = light.shadow_radius
             light_rows.append(
                 {
                     "color": (*light.color, LIGHT_TYPES[light.type]),
@@ -230,13 +254,17 @@ class Renderer:
                     "direction": (*light.direction, cos_half if light.type == "SPOT" else -2.0),
                     "params": (
                         (1.0 - cos_half) * max(light.spot_blend, 0.0),
-                        sv.tile if sv else -1.0,
-                        sv.texel_world if sv else 0.0,
-                        sv.depth_per_world if sv else 0.0,
+                        mode,
+                        radius,
+                        float(np.tan(0.5 * min(max(light.angle, 0.0), np.pi * 0.99))),
                     ),
-                    "shadow_matrix": sv.matrix if sv else np.eye(4),
+                    "tiles": tiles[:4],
+                    "tiles2": (tiles[4], tiles[5], light.bias_scale, 0.0),
                 }
             )
+        tile_rows = [t.record() for t in plan.tiles]
+        filt = settings.shadow_filter if settings.shadow_filter in SHADOW_FILTERS else "PCF"
+        disk = int(np.clip(settings.shadow_samples // RING * RING, RING, MAX_DISK_SAMPLES))
         view_proj = camera.projection @ camera.view
         frame_row = {
             "view_proj": view_proj,
@@ -251,18 +279,21 @@ class Renderer:
                 settings.shadow_normal_offset,
                 settings.pcf_spacing,
             ),
-            "shadow_size": (self.shadows.size if plans else 1, self.shadows.columns, 0.0, 0.0),
+            "shadow_size": (self.shadows.size if plan.tiles else 1, self.shadows.columns, disk, 0.0),
+            "filter_params": (settings.shadow_filter_radius, MAX_FILTER_RADIUS, 0.0, 0.0),
         }
-        filt = settings.shadow_filter if settings.shadow_filter in SHADOW_FILTERS else "PCF"
         taps = kernels.pcf_kernel(min(settings.pcf_kernel_size, 15)) if filt == "PCF" else np.zeros((1, 3))
         tap_rows = np.zeros((MAX_PCF_TAPS, 4), np.float32)
         tap_rows[: len(taps), :3] = taps
         frame_ubo = self._ubo("frame", pack_struct(FRAME_STRUCT, [frame_row]))
+        tile_ubo = self._ubo("tiles", _pad_rows(pack_struct(TILE_STRUCT, tile_rows), MAX_SHADOW_TILES))
         light_ubo = self._ubo("lights", _pad_rows(pack_struct(LIGHT_STRUCT, light_rows), MAX_LIGHTS))
         tap_ubo = self._ubo("taps", tap_rows)
 
         # Lit pass.
-        shader = self.shaders.get(LIT, lit_defines(filt, len(taps), settings.specular_model))
+        shader = self.shaders.get(
+            LIT, lit_defines(filt, len(taps), settings.specular_model, depth_format, disk, settings.shadow_early_out)
+        )
         bg = snapshot.world_color
         alpha = 0.0 if settings.film_transparent else 1.0
         self._color.clear(format="FLOAT", value=(float(bg[0]), float(bg[1]), float(bg[2]), alpha))
@@ -278,7 +309,9 @@ class Renderer:
             shader.uniform_block("frame", frame_ubo)
             shader.uniform_block("lights", light_ubo)
             shader.uniform_block("pcf_taps", tap_ubo)
+            shader.uniform_block("shadow_tiles", tile_ubo)
             shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
+            shader.uniform_sampler("jitter_tex", self._jitter(disk))
             for inst, _geo, _whole, parts, model, _det in draws:
                 shader.uniform_float("model", model)
                 for mat_index, batch in parts:
@@ -304,6 +337,9 @@ class Renderer:
         stats.texture_bytes = width * height * (16 + 4 + 4) + self.shadows.memory_bytes + ctx.memory_bytes
         stats.shaders_compiled = self.shaders.compiled - compiled_before
         return FrameOutput(color, self._depth, stats, width, height)
+
+
+MAX_FILTER_RADIUS = 32.0  # texels: the widest JITTER/PCSS kernel
 
 
 def _pad_rows(rows, count):

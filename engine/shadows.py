@@ -1,56 +1,144 @@
-"""Shadow-map resources and the depth pass.
+"""Shadow planning (which maps a frame needs, fitted how) and the depth pass.
 
-All maps of a frame are tiles of one float texture (an atlas), so the lit pass binds a single
-sampler whatever the number of shadowed lights. A light that casts no shadow, or has no caster
-in reach, gets no tile and costs nothing.
+Every map of a frame is a square tile of one atlas texture, so the lit pass binds a single
+sampler whatever the number and kind of lights:
+  sun    one orthographic tile fitted to the geometry, texel-snapped;
+  spot   one perspective tile covering the cone, near/far fitted to the casters inside it;
+  point  up to six perspective tiles (cube faces); a face with no caster in reach is skipped;
+  area   shadowed like a point light at its centre (softness from its size).
+A light with ``use_shadow`` off, or with no caster in reach, gets no tile and costs nothing.
+Tiles whose fit and casters did not change since the last frame are not redrawn.
 """
 
 import math
-from dataclasses import dataclass
+import sys
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import lightspace
-from .programs import SHADOW_DEPTH
+from .programs import DEPTH_FORMATS, MAX_SHADOW_TILES, SHADOW_DEPTH, TILE_STRUCT, depth_defines
+
+_ATLAS_FORMATS = {"FLOAT32": "R32F", "FLOAT16": "R16F", "RGBA8": "RGBA8"}
 
 
 @dataclass
-class ShadowView:
-    """One rendered map: where it lives and how world points reach it."""
+class Tile:
+    fit: lightspace.Fit
+    casters: np.ndarray  # indices into the frame's draws that can cast into this tile
 
-    tile: int
-    view_proj: np.ndarray  # light view-projection (clip space)
-    texel_world: float  # size of one texel in world units at the map
-    depth_per_world: float  # normalised depth per world unit
-
-    @property
-    def matrix(self):
-        """World -> shadow texture space [0, 1]^3."""
-        return lightspace.BIAS_MATRIX @ self.view_proj
+    def record(self):
+        f = self.fit
+        return {
+            "view": f.view,
+            "proj_tex": lightspace.BIAS_MATRIX @ f.proj,
+            "range": (f.near, f.far, f.texel, f.texel_per_distance),
+        }
 
 
-def plan_sun(light, world_points, map_size):
-    """Light-space fit for a sun; ``None`` when there is nothing to cast a shadow."""
-    fit = lightspace.fit_sun_ortho(light.direction, world_points, map_size)
-    if fit is None:
+@dataclass
+class LightShadow:
+    mode: str  # 'SINGLE' | 'CUBE'
+    tiles: list = field(default_factory=list)  # per face (or one): index into plan.tiles, or -1
+
+
+@dataclass
+class ShadowPlan:
+    tiles: list = field(default_factory=list)
+    lights: dict = field(default_factory=dict)  # light index -> LightShadow
+
+
+def _near_bound(position, lo, hi, half_fov):
+    """A lower bound of the view-axis distance of any point of the boxes [lo, hi] inside a
+    square frustum of half-angle ``half_fov`` at ``position`` (distance to the box, shrunk by
+    the frustum's widest corner angle)."""
+    d = np.linalg.norm(np.maximum(0.0, np.maximum(lo - position, position - hi)), axis=1)
+    return float(d.min()) / math.sqrt(1.0 + 2.0 * math.tan(half_fov) ** 2)
+
+
+def _perspective_tile(position, forward, fov, corners, lo, hi, map_size):
+    """A perspective tile at ``position`` along ``forward``, or None without casters in it."""
+    reach = float(np.linalg.norm(corners.reshape(-1, 3) - position, axis=1).max()) * 1.01
+    if not np.isfinite(reach) or reach <= 0.0:
         return None
-    view, proj, texel = fit
-    depth_per_world = proj[2, 2] * -0.5  # ortho: NDC z spans 2/(far-near); [0,1] depth half that
-    return view, proj, texel, depth_per_world
+    view = lightspace.look_at(position, forward)
+    probe = lightspace.perspective(fov, 1.0, reach * 1e-6, reach) @ view
+    inside = np.nonzero(lightspace.boxes_in_frustum(probe, corners))[0]
+    if len(inside) == 0:
+        return None
+    z = -(corners[inside].reshape(-1, 3) @ view[:3, :3].T + view[:3, 3])[:, 2]
+    far = float(z.max()) * 1.01
+    if far <= 0.0:
+        return None
+    near = max(_near_bound(position, lo[inside], hi[inside], fov / 2.0) * 0.99, far * 1e-5)
+    proj = lightspace.perspective(fov, 1.0, near, far)
+    fit = lightspace.Fit(view, proj, near, far, texel_per_distance=2.0 * math.tan(fov / 2.0) / map_size)
+    return Tile(fit, inside)
 
 
-class ShadowMaps:
-    """The shadow atlas of one engine instance: every map of a frame is a square tile of one
-    float texture (tiles in a grid, ``columns`` wide), so the lit pass binds one sampler
-    whatever the number of shadowed lights, on every Blender line."""
+def plan_shadows(lights, corners, map_size):
+    """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
+    instance's bounds. Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are dropped with a
+    message (those lights render unshadowed)."""
+    plan = ShadowPlan()
+    corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
+    if len(corners) == 0:
+        return plan
+    lo = corners.min(axis=1)
+    hi = corners.max(axis=1)
+    everything = np.arange(len(corners))
+    dropped = 0
+    for i, light in enumerate(lights):
+        if not light.use_shadow:
+            continue
+        if light.type == "SUN":
+            fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), map_size)
+            tiles = [Tile(fit, everything)] if fit is not None else []
+            mode = "SINGLE"
+        elif light.type == "SPOT":
+            fov = min(light.spot_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
+            tile = _perspective_tile(light.position, light.direction, fov, corners, lo, hi, map_size)
+            tiles = [tile] if tile is not None else []
+            mode = "SINGLE"
+        else:  # POINT, AREA
+            tiles = [
+                _perspective_tile(light.position, fwd, math.pi / 2.0, corners, lo, hi, map_size)
+                for fwd in lightspace.CUBE_FORWARDS
+            ]
+            mode = "CUBE"
+        if not any(t is not None for t in tiles):
+            continue  # no caster in reach: no map at all
+        needed = sum(t is not None for t in tiles)
+        if len(plan.tiles) + needed > MAX_SHADOW_TILES:
+            dropped += 1
+            continue
+        entry = LightShadow(mode)
+        for t in tiles:
+            if t is None:
+                entry.tiles.append(-1)
+            else:
+                entry.tiles.append(len(plan.tiles))
+                plan.tiles.append(t)
+        plan.lights[i] = entry
+    if dropped:
+        print(f"Penumbra: {dropped} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps", file=sys.stderr)
+    return plan
+
+
+class ShadowAtlas:
+    """The atlas of one engine instance: square tiles in a grid ``columns`` wide, one depth
+    buffer, one framebuffer. Tiles remember what they hold so unchanged maps are reused."""
 
     def __init__(self):
         self.size = 0
         self.count = 0
         self.columns = 1
+        self.depth_format = "FLOAT32"
         self.texture = None
         self._zbuffer = None
         self._framebuffer = None
+        self._ubos = []
+        self._contents = []
 
     @staticmethod
     def grid(count):
@@ -58,64 +146,96 @@ class ShadowMaps:
         rows = max(1, math.ceil(count / columns))
         return columns, rows
 
-    def ensure(self, size, count):
+    def ensure(self, size, count, depth_format):
         import gpu
 
         count = max(1, count)
         columns, rows = self.grid(count)
-        if self.texture is not None and self.size == size and self.columns == columns and self.count >= count:
+        if (
+            self.texture is not None
+            and (self.size, self.columns, self.depth_format) == (size, columns, depth_format)
+            and self.count >= count
+        ):
             return
         self.free()
-        self.size, self.count, self.columns = size, columns * rows, columns
+        self.size, self.count, self.columns, self.depth_format = size, columns * rows, columns, depth_format
         dims = (columns * size, rows * size)
         # Read with texelFetch only, so the sampler's filter mode never matters.
-        self.texture = gpu.types.GPUTexture(dims, format="R32F")
+        self.texture = gpu.types.GPUTexture(dims, format=_ATLAS_FORMATS[depth_format])
         self._zbuffer = gpu.types.GPUTexture(dims, format="DEPTH_COMPONENT32F")
         self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self.texture,))
-
-    def tile_origin(self, tile):
-        return (tile % self.columns) * self.size, (tile // self.columns) * self.size
+        self._contents = [None] * self.count
 
     @property
     def memory_bytes(self):
         if self.texture is None:
             return 0
-        return self.texture.width * self.texture.height * 8
+        texel = {"FLOAT32": 4, "FLOAT16": 2, "RGBA8": 4}[self.depth_format]
+        return self.texture.width * self.texture.height * (texel + 4)
 
     def free(self):
         self._framebuffer = None
         self.texture = None
         self._zbuffer = None
+        self._ubos = []
+        self._contents = []
         self.size = self.count = 0
         self.columns = 1
 
-    def clear(self):
-        with self._framebuffer.bind():
-            self._framebuffer.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
-
-    def render_tile(self, tile, view_proj, draws, shaders, cull_front, stats):
-        """Rasterise ``draws`` [(batch, model Matrix, det)] into atlas tile ``tile``."""
+    def _tile_ubo(self, index, data):
         import gpu
-        from mathutils import Matrix
 
-        shader = shaders.get(SHADOW_DEPTH)
-        x0, y0 = self.tile_origin(tile)
+        raw = np.ascontiguousarray(data, np.float32).tobytes()
+        while len(self._ubos) <= index:
+            self._ubos.append(gpu.types.GPUUniformBuf(raw))
+        self._ubos[index].update(raw)
+        return self._ubos[index]
+
+    def render(self, plan, draws, shaders, cull_front, stats):
+        """Draw every tile of ``plan`` whose content changed. ``draws``: per instance
+        (batch, model Matrix, det, identity key); a tile's key is its fit and its casters."""
+        import gpu
+
+        from .renderer import pack_struct
+
+        shader = shaders.get(SHADOW_DEPTH, depth_defines(self.depth_format))
         with self._framebuffer.bind():
-            gpu.state.viewport_set(x0, y0, self.size, self.size)
-            gpu.state.depth_test_set("LESS")
-            gpu.state.depth_mask_set(True)
-            shader.bind()
-            shader.uniform_float("light_view_proj", Matrix(view_proj.tolist()))
-            for batch, model, det in draws:
-                if cull_front:
-                    gpu.state.face_culling_set("FRONT")
-                    gpu.state.front_facing_set(det < 0.0)
-                shader.uniform_float("model", model)
-                batch.draw(shader)
-                stats.draws += 1
-            gpu.state.face_culling_set("NONE")
-            gpu.state.front_facing_set(False)
-            gpu.state.depth_test_set("NONE")
-            gpu.state.depth_mask_set(False)
-        stats.passes += 1
-        stats.shadow_maps += 1
+            for index, tile in enumerate(plan.tiles):
+                key = (
+                    tile.fit.view_proj.tobytes(),
+                    tile.fit.near,
+                    tile.fit.far,
+                    cull_front,
+                    tuple(draws[c][3] for c in tile.casters),
+                )
+                if self._contents[index] == key:
+                    stats.shadow_maps_reused += 1
+                    continue
+                x0, y0 = (index % self.columns) * self.size, (index // self.columns) * self.size
+                gpu.state.viewport_set(x0, y0, self.size, self.size)
+                gpu.state.scissor_set(x0, y0, self.size, self.size)
+                gpu.state.scissor_test_set(True)
+                self._framebuffer.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
+                gpu.state.scissor_test_set(False)
+                gpu.state.depth_test_set("LESS")
+                gpu.state.depth_mask_set(True)
+                shader.bind()
+                shader.uniform_block("tile", self._tile_ubo(index, pack_struct(TILE_STRUCT, [tile.record()])))
+                for c in tile.casters:
+                    batch, model, det, _key = draws[c]
+                    if cull_front:
+                        gpu.state.face_culling_set("FRONT")
+                        gpu.state.front_facing_set(det < 0.0)
+                    shader.uniform_float("model", model)
+                    batch.draw(shader)
+                    stats.draws += 1
+                gpu.state.face_culling_set("NONE")
+                gpu.state.front_facing_set(False)
+                gpu.state.depth_test_set("NONE")
+                gpu.state.depth_mask_set(False)
+                self._contents[index] = key
+                stats.passes += 1
+                stats.shadow_maps += 1
+
+
+assert set(_ATLAS_FORMATS) == set(DEPTH_FORMATS)

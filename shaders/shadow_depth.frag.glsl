@@ -1,6 +1,7 @@
-/* Normalised light-space depth (0 near, 1 far) into a float colour target, so the lit pass can
- * compare it exactly with texelFetch. */
+/* Linear depth along the light's view axis, normalised to the tile's [near, far], in the
+ * selected encoding (float, or the seeds' RGBA8 packing). */
 void main()
 {
-  out_depth = gl_FragCoord.z;
+  float d = (v_distance - tile.range.x) / (tile.range.y - tile.range.x);
+  out_depth = encode_depth(clamp(d, 0.0, 1.0));
 }

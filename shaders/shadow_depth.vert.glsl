@@ -1,4 +1,9 @@
+/* Light-space depth pass. The tile's proj_tex maps to texture space; clip space is recovered
+ * from it (tex.xyz = 0.5 * clip.xyz + 0.5 * clip.w), so one tile record serves both passes. */
 void main()
 {
-  gl_Position = light_view_proj * model * vec4(pos, 1.0);
+  vec4 view_pos = tile.view * (model * vec4(pos, 1.0));
+  v_distance = -view_pos.z;
+  vec4 t = tile.proj_tex * view_pos;
+  gl_Position = vec4(2.0 * t.xyz - t.w, t.w);
 }

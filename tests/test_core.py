@@ -75,7 +75,8 @@ def test_sun_fit_contains_points_and_is_texel_snapped():
     rng = np.random.default_rng(1)
     pts = rng.uniform(-5, 5, (200, 3))
     d = np.array([0.3, -0.4, -0.8])
-    view, proj, texel = lightspace.fit_sun_ortho(d, pts, 1024)
+    fit = lightspace.fit_sun_ortho(d, pts, 1024)
+    view, proj, texel = fit.view, fit.proj, fit.texel
     ndc = lightspace.transform_points(proj @ view, pts)
     assert np.all(np.abs(ndc) <= 1.0)
     # Frustum edges lie on whole texels of light space: moving the points by less than a
@@ -93,9 +94,9 @@ def test_sun_fit_scale_invariant():
     a = lightspace.fit_sun_ortho(d, pts, 512)
     for s in (1e-3, 1e4):
         b = lightspace.fit_sun_ortho(d, pts * s, 512)
-        assert b[2] == pytest.approx(a[2] * s, rel=0.2)
-        ndc_a = lightspace.transform_points(a[1] @ a[0], pts)
-        ndc_b = lightspace.transform_points(b[1] @ b[0], pts * s)
+        assert b.texel == pytest.approx(a.texel * s, rel=0.2)
+        ndc_a = lightspace.transform_points(a.view_proj, pts)
+        ndc_b = lightspace.transform_points(b.view_proj, pts * s)
         assert np.all(np.abs(ndc_b) <= 1.0)
         np.testing.assert_allclose(ndc_b[:, 2], ndc_a[:, 2], atol=0.05)
 
@@ -104,7 +105,36 @@ def test_sun_fit_empty_and_nonfinite():
     assert lightspace.fit_sun_ortho((0, 0, -1), np.zeros((0, 3)), 512) is None
     assert lightspace.fit_sun_ortho((0, 0, -1), [[np.nan, 0, 0]], 512) is None
     one = lightspace.fit_sun_ortho((0, 0, -1), [[1, 2, 3]], 1)
-    assert one is not None and all(np.all(np.isfinite(m)) for m in one[:2])
+    assert one is not None and np.all(np.isfinite(one.view_proj)) and one.far > one.near
+
+
+def test_perspective_fit_covers_points_in_front_only():
+    pts = np.array([[0, 0, -2.0], [0.5, 0.5, -6.0], [0, 0, 5.0]])  # the last is behind
+    fit = lightspace.fit_perspective((0, 0, 0), (0, 0, -1), np.radians(90), pts, 256)
+    assert fit.near <= 2.0 * 0.99 + 1e-12 and fit.far >= 6.0
+    ndc = lightspace.transform_points(fit.view_proj, pts[:2])
+    assert np.all(np.abs(ndc) <= 1.0)
+    assert fit.texel_per_distance == pytest.approx(2.0 / 256)
+    assert lightspace.fit_perspective((0, 0, 0), (0, 0, -1), 1.0, pts[2:], 256) is None
+
+
+@pytest.mark.parametrize("face", range(6))
+def test_cube_faces_cover_their_axis(face):
+    fwd = lightspace.CUBE_FORWARDS[face]
+    assert lightspace.cube_face(fwd * 3 + 0.1) == face
+    view = lightspace.look_at((1, 2, 3), fwd)
+    ndc = lightspace.transform_points(lightspace.perspective(np.pi / 2, 1, 0.1, 10) @ view, [(1, 2, 3) + fwd * 2])
+    np.testing.assert_allclose(ndc[0, :2], 0, atol=1e-12)
+
+
+def test_boxes_in_frustum_is_conservative():
+    vp = lightspace.orthographic(-1, 1, -1, 1, 0.1, 10)
+    inside = lightspace.box_corners((-0.5, -0.5, -2), (0.5, 0.5, -1))
+    straddle = lightspace.box_corners((0.9, -0.1, -2), (3, 0.1, -1))
+    outside = lightspace.box_corners((2, 2, -2), (3, 3, -1))
+    behind = lightspace.box_corners((-0.5, -0.5, 1), (0.5, 0.5, 2))
+    got = lightspace.boxes_in_frustum(vp, np.stack([inside, straddle, outside, behind]))
+    assert got.tolist() == [True, True, False, False]
 
 
 @pytest.mark.parametrize("radius", [0, 1, 3, 10, 64])
@@ -132,3 +162,20 @@ def test_pcf_kernel_is_normalised_separable_gaussian():
     assert grid[3, 4] == pytest.approx(0.0133, abs=1e-4)
     assert kernels.pcf_kernel(4).shape == (25, 3)  # even sizes are made odd
     np.testing.assert_allclose(kernels.pcf_kernel(1), [[0, 0, 1]])
+
+
+def test_jitter_disk_rings_outer_first_and_stratified():
+    d = kernels.jitter_disk(size=8, samples=24, seed=3)
+    assert d.shape == (8, 8, 24, 2)
+    r = np.linalg.norm(d, axis=-1)
+    assert r.max() <= 1.0
+    rings = r.reshape(8, 8, 3, kernels.RING)
+    # Ring 0 (evaluated first) lies outside ring 1, which lies outside ring 2 (equal areas).
+    assert np.all(rings[..., 0, :] >= np.sqrt(2 / 3) - 1e-12)
+    assert np.all((rings[..., 1, :] >= np.sqrt(1 / 3) - 1e-12) & (rings[..., 1, :] <= np.sqrt(2 / 3) + 1e-12))
+    assert np.all(rings[..., 2, :] <= np.sqrt(1 / 3) + 1e-12)
+    # Deterministic per seed, different per pixel.
+    np.testing.assert_array_equal(d, kernels.jitter_disk(size=8, samples=24, seed=3))
+    assert not np.allclose(d[0, 0], d[0, 1])
+    # Samples cover the disk evenly: the mean offset is near the centre.
+    assert np.abs(d.reshape(-1, 2).mean(axis=0)).max() < 0.02

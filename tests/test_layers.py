@@ -119,8 +119,11 @@ def test_disabled_and_zero_mix_layers_cost_no_pass(penumbra, gpu_call):
 def test_light_without_shadow_gets_no_shadow_map(penumbra, gpu_call):
     scene = scenes.demo_scene(64, 36)
     stats, _ = _stats(gpu_call, scene)
-    assert stats.shadow_maps == 1  # the sun; spot shadows are not drawn yet
+    assert stats.shadow_maps == 2  # the sun and the spot
     scene.objects["Sun"].data.use_shadow = False
+    stats, _ = _stats(gpu_call, scene)
+    assert stats.shadow_maps == 1
+    scene.objects["Spot"].data.use_shadow = False
     stats, _ = _stats(gpu_call, scene)
     assert stats.shadow_maps == 0 and stats.passes == 1 + stats.post_passes
 

@@ -2,53 +2,174 @@
 #define SHADOW_FILTERS_GLSL
 
 /* Shadow visibility of world point P for light L (1 = lit, 0 = shadowed).
- * Each map is a square tile (params.y) of shadow_atlas holding the light's normalised depth
- * (0 near, 1 far); tiles are shadow_size.x texels wide, shadow_size.y to a row.
- * Bias is expressed in shadow-map texels so one setting holds at every scene scale:
+ *
+ * Every map is a square tile of shadow_atlas (frame.shadow_size.x texels wide, shadow_size.y
+ * tiles to a row) described by shadow_tiles[i]: its light view, its projection to texture
+ * space and its linear depth range. Stored depth is the distance along the light's view axis,
+ * normalised to [near, far], so every light type compares and biases the same way.
+ *
+ * Bias is in texels of the map at the receiver, so one setting holds at every scene scale:
  *   normal offset  moves P along N by shadow_params.z texels * sin(theta)
  *   constant       shadow_params.x texels of depth
- *   slope-scaled   shadow_params.y texels * tan(theta), tan clamped to 10. */
-float shadow_compare(float tile, ivec2 texel, float ref)
+ *   slope-scaled   shadow_params.y texels * tan(theta), tan clamped to 10
+ * scaled per light by tiles2.z (light.penumbra.bias_scale). */
+
+int cube_face(vec3 d)
+{
+  vec3 a = abs(d);
+  if (a.x >= a.y && a.x >= a.z) {
+    return d.x >= 0.0 ? 0 : 1;
+  }
+  if (a.y >= a.z) {
+    return d.y >= 0.0 ? 2 : 3;
+  }
+  return d.z >= 0.0 ? 4 : 5;
+}
+
+/* 1 when ref is in front of the stored depth at integer texel st of the tile. Texels outside
+ * the tile are lit: nothing was fitted to cast there. */
+float shadow_tap(ivec2 origin, ivec2 st, float ref)
 {
   int size = int(frame.shadow_size.x);
-  if (texel.x < 0 || texel.y < 0 || texel.x >= size || texel.y >= size) {
-    return 1.0; /* outside the fitted frustum: nothing casts there */
+  if (st.x < 0 || st.y < 0 || st.x >= size || st.y >= size) {
+    return 1.0;
   }
-  int t = int(tile);
-  int columns = int(frame.shadow_size.y);
-  ivec2 origin = ivec2(t % columns, t / columns) * size;
-  float stored = texelFetch(shadow_atlas, origin + texel, 0).r;
+  float stored = decode_depth(texelFetch(shadow_atlas, origin + st, 0));
   return (ref <= stored) ? 1.0 : 0.0;
+}
+
+float shadow_depth_at(ivec2 origin, ivec2 st)
+{
+  int size = int(frame.shadow_size.x);
+  st = clamp(st, ivec2(0), ivec2(size - 1));
+  return decode_depth(texelFetch(shadow_atlas, origin + st, 0));
+}
+
+/* Bilinear-weighted 2x2 comparison: exactly what a linear-filtered compare sampler returns. */
+float shadow_bilinear(ivec2 origin, vec2 st, float ref)
+{
+  vec2 p = st - 0.5;
+  vec2 f = fract(p);
+  ivec2 b = ivec2(floor(p));
+  float s00 = shadow_tap(origin, b, ref);
+  float s10 = shadow_tap(origin, b + ivec2(1, 0), ref);
+  float s01 = shadow_tap(origin, b + ivec2(0, 1), ref);
+  float s11 = shadow_tap(origin, b + ivec2(1, 1), ref);
+  return mix(mix(s00, s10, f.x), mix(s01, s11, f.x), f.y);
+}
+
+vec2 disk_sample(int i)
+{
+  ivec2 pix = ivec2(gl_FragCoord.xy) % JITTER_SIZE;
+  vec4 pair = texelFetch(jitter_tex, ivec3(pix, i / 2), 0);
+  return ((i & 1) == 0) ? pair.xy : pair.zw;
+}
+
+/* Disk PCF of radius r texels with the per-pixel jittered samples. With EARLY_OUT, the outer
+ * ring (the first 8 samples) decides alone when it agrees (fully lit or fully shadowed). */
+float shadow_disk(ivec2 origin, vec2 st, float ref, float r)
+{
+  float lit = 0.0;
+  for (int i = 0; i < 8; i++) {
+    lit += shadow_tap(origin, ivec2(floor(st + disk_sample(i) * r)), ref);
+  }
+#if EARLY_OUT
+  if (lit == 0.0 || lit == 8.0) {
+    return lit / 8.0;
+  }
+#endif
+  for (int i = 8; i < DISK_SAMPLES; i++) {
+    lit += shadow_tap(origin, ivec2(floor(st + disk_sample(i) * r)), ref);
+  }
+  return lit / float(DISK_SAMPLES);
 }
 
 float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
 {
-  float texel_world = L.params.z;
-  float depth_per_world = L.params.w;
+  int mode = int(L.params.y);
+  if (mode == SHADOW_MODE_NONE) {
+    return 1.0;
+  }
+  int tile;
+  if (mode == SHADOW_MODE_SINGLE) {
+    tile = int(L.tiles.x);
+  }
+  else {
+    int face = cube_face(P - L.position.xyz);
+    tile = int((face < 4) ? L.tiles[face] : L.tiles2[face - 4]);
+  }
+  if (tile < 0) {
+    return 1.0; /* a cube face with no caster in reach was not rendered */
+  }
+  ShadowTile T = shadow_tiles[tile];
+  float near = T.range.x, far = T.range.y;
+  float depth_scale = 1.0 / (far - near);
+  float bias_scale = L.tiles2.z;
+
   float cos_t = clamp(NdotL, 1e-4, 1.0);
   float sin_t = sqrt(1.0 - cos_t * cos_t);
   float tan_t = min(sin_t / cos_t, 10.0);
-  vec3 Po = P + N * (frame.shadow_params.z * texel_world * sin_t);
-  vec4 sc = L.shadow_matrix * vec4(Po, 1.0);
-  vec3 s = sc.xyz / sc.w;
-  if (s.z >= 1.0) {
+  float dist = max(-(T.view * vec4(P, 1.0)).z, 0.0);
+  float texel = T.range.z + T.range.w * dist;
+
+  vec3 Po = P + N * (frame.shadow_params.z * bias_scale * texel * sin_t);
+  vec4 vp = T.view * vec4(Po, 1.0);
+  vec4 t = T.proj_tex * vp;
+  if (t.w <= 0.0) {
     return 1.0;
   }
-  float bias = (frame.shadow_params.x + frame.shadow_params.y * tan_t) * texel_world *
-               depth_per_world;
-  float ref = s.z - bias;
-  float map_size = frame.shadow_size.x;
-  vec2 st = s.xy * map_size;
+  vec2 uv = t.xy / t.w;
+  float receiver = -vp.z;
+  float bias = (frame.shadow_params.x + frame.shadow_params.y * tan_t) * bias_scale * texel;
+  float ref = (receiver - bias - near) * depth_scale;
+  if (ref >= 1.0) {
+    return 1.0;
+  }
+  int size = int(frame.shadow_size.x);
+  int columns = int(frame.shadow_size.y);
+  ivec2 origin = ivec2(tile % columns, tile / columns) * size;
+  vec2 st = uv * float(size);
+
 #if SHADOW_FILTER == FILTER_NONE
-  return shadow_compare(L.params.y, ivec2(floor(st)), ref);
+  return shadow_tap(origin, ivec2(floor(st)), ref);
+#elif SHADOW_FILTER == FILTER_HARDWARE
+  return shadow_bilinear(origin, st, ref);
 #elif SHADOW_FILTER == FILTER_PCF
   float lit = 0.0;
   float spacing = frame.shadow_params.w;
   for (int i = 0; i < PCF_TAPS; i++) {
     vec4 tap = pcf_taps[i].v;
-    lit += tap.z * shadow_compare(L.params.y, ivec2(floor(st + tap.xy * spacing)), ref);
+    lit += tap.z * shadow_tap(origin, ivec2(floor(st + tap.xy * spacing)), ref);
   }
   return lit;
+#elif SHADOW_FILTER == FILTER_JITTER
+  return shadow_disk(origin, st, ref, frame.filter_params.x);
+#elif SHADOW_FILTER == FILTER_PCSS
+  /* 1. Blocker search: average depth of the texels that occlude P, over the region a light of
+   *    this size can shadow P from. 2. Penumbra width from similar triangles: sun
+   *    w = (d_r - d_b) * 2 tan(angle / 2); local light w = 2 r (d_r - d_b) / d_b.
+   *    3. Disk PCF of that width: hard at contact, soft far from the caster, as in Cycles. */
+  bool sun = int(L.color.a) == LIGHT_SUN;
+  float max_r = frame.filter_params.y;
+  float search_world = sun ? (receiver - near) * 2.0 * L.params.w :
+                             2.0 * L.params.z * (receiver - near) / max(receiver, 1e-30);
+  float search = clamp(0.5 * search_world / texel, 1.0, max_r);
+  float blockers = 0.0, blocker_sum = 0.0;
+  for (int i = 0; i < DISK_SAMPLES; i++) {
+    float d = shadow_depth_at(origin, ivec2(floor(st + disk_sample(i) * search)));
+    if (d < ref) {
+      blockers += 1.0;
+      blocker_sum += d;
+    }
+  }
+  if (blockers == 0.0) {
+    return 1.0;
+  }
+  float blocker = near + (blocker_sum / blockers) * (far - near);
+  float width = sun ? (receiver - blocker) * 2.0 * L.params.w :
+                      2.0 * L.params.z * (receiver - blocker) / max(blocker, 1e-30);
+  float r = clamp(0.5 * width / texel, 0.5, max_r);
+  return shadow_disk(origin, st, ref, r);
 #else
 #  error "unknown SHADOW_FILTER"
 #endif
