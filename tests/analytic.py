@@ -17,10 +17,9 @@ def camera_matrices(scene, depsgraph=None):
     return view, proj, w, h
 
 
-def plane_hits(view, proj, w, h, z=0.0):
-    """World point where each pixel centre's ray meets the plane z = ``z``, and its view depth.
-
-    Arrays are (h, w[, 3]) with row 0 at the bottom of the image."""
+def plane_hits(view, proj, w, h, z=0.0, axis=2):
+    """World point where each pixel centre's ray meets the plane {p[axis] = z}, and its view
+    depth. Arrays are (h, w[, 3]) with row 0 at the bottom of the image."""
     inv = np.linalg.inv(proj @ view)
     xs = (np.arange(w) + 0.5) / w * 2 - 1
     ys = (np.arange(h) + 0.5) / h * 2 - 1
@@ -32,7 +31,8 @@ def plane_hits(view, proj, w, h, z=0.0):
 
     o = unproject(-1.0)
     d = unproject(1.0) - o
-    t = (z - o[..., 2]) / d[..., 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (z - o[..., axis]) / d[..., axis]
     p = o + t[..., None] * d
     depth = -(p @ view[:3, :3].T + view[:3, 3])[..., 2]
     return p, depth

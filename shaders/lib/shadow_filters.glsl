@@ -11,7 +11,9 @@
  * Bias is in texels of the map at the receiver, so one setting holds at every scene scale:
  *   normal offset  moves P along N by shadow_params.z texels * sin(theta)
  *   constant       shadow_params.x texels of depth
- *   slope-scaled   shadow_params.y texels * tan(theta), tan clamped to 10
+ *   slope-scaled   shadow_params.y texels * tan(theta) * max(1, filter radius), tan clamped
+ *                  to 60 (89 degrees): a filter reading texels r away sees the tilted receiver r times
+ *                  deeper, so its slope bias grows with r (receiver-plane reasoning)
  * scaled per light by tiles2.z (light.penumbra.bias_scale). */
 
 int cube_face(vec3 d)
@@ -108,7 +110,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
 
   float cos_t = clamp(NdotL, 1e-4, 1.0);
   float sin_t = sqrt(1.0 - cos_t * cos_t);
-  float tan_t = min(sin_t / cos_t, 10.0);
+  float tan_t = min(sin_t / cos_t, 60.0);
   float dist = max(-(T.view * vec4(P, 1.0)).z, 0.0);
   float texel = T.range.z + T.range.w * dist;
 
@@ -120,9 +122,11 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
   }
   vec2 uv = t.xy / t.w;
   float receiver = -vp.z;
-  float bias = (frame.shadow_params.x + frame.shadow_params.y * tan_t) * bias_scale * texel;
-  float ref = (receiver - bias - near) * depth_scale;
-  if (ref >= 1.0) {
+  float constant_bias = frame.shadow_params.x * bias_scale * texel;
+  float slope_bias = frame.shadow_params.y * bias_scale * texel * tan_t;
+  /* Reference depth for a filter that reads texels up to r away. */
+#define SHADOW_REF(r) ((receiver - constant_bias - slope_bias * max(1.0, (r)) - near) * depth_scale)
+  if (SHADOW_REF(0.0) >= 1.0) {
     return 1.0;
   }
   int size = int(frame.shadow_size.x);
@@ -131,19 +135,21 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
   vec2 st = uv * float(size);
 
 #if SHADOW_FILTER == FILTER_NONE
-  return shadow_tap(origin, ivec2(floor(st)), ref);
+  return shadow_tap(origin, ivec2(floor(st)), SHADOW_REF(0.0));
 #elif SHADOW_FILTER == FILTER_HARDWARE
-  return shadow_bilinear(origin, st, ref);
+  return shadow_bilinear(origin, st, SHADOW_REF(1.0));
 #elif SHADOW_FILTER == FILTER_PCF
   float lit = 0.0;
   float spacing = frame.shadow_params.w;
+  float ref = SHADOW_REF(floor(sqrt(float(PCF_TAPS)) * 0.5) * spacing);
   for (int i = 0; i < PCF_TAPS; i++) {
     vec4 tap = pcf_taps[i].v;
     lit += tap.z * shadow_tap(origin, ivec2(floor(st + tap.xy * spacing)), ref);
   }
   return lit;
 #elif SHADOW_FILTER == FILTER_JITTER
-  return shadow_disk(origin, st, ref, frame.filter_params.x);
+  float r = frame.filter_params.x;
+  return shadow_disk(origin, st, SHADOW_REF(r), r);
 #elif SHADOW_FILTER == FILTER_PCSS
   /* 1. Blocker search: average depth of the texels that occlude P, over the region a light of
    *    this size can shadow P from. 2. Penumbra width from similar triangles: sun
@@ -154,6 +160,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
   float search_world = sun ? (receiver - near) * 2.0 * L.params.w :
                              2.0 * L.params.z * (receiver - near) / max(receiver, 1e-30);
   float search = clamp(0.5 * search_world / texel, 1.0, max_r);
+  float ref = SHADOW_REF(search);
   float blockers = 0.0, blocker_sum = 0.0;
   for (int i = 0; i < DISK_SAMPLES; i++) {
     float d = shadow_depth_at(origin, ivec2(floor(st + disk_sample(i) * search)));
@@ -169,10 +176,11 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
   float width = sun ? (receiver - blocker) * 2.0 * L.params.w :
                       2.0 * L.params.z * (receiver - blocker) / max(blocker, 1e-30);
   float r = clamp(0.5 * width / texel, 0.5, max_r);
-  return shadow_disk(origin, st, ref, r);
+  return shadow_disk(origin, st, SHADOW_REF(r), r);
 #else
 #  error "unknown SHADOW_FILTER"
 #endif
+#undef SHADOW_REF
 }
 
 #endif
