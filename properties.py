@@ -165,6 +165,16 @@ class PENUMBRA_PG_scene(bpy.types.PropertyGroup):
     shadow_depth_format: EnumProperty(
         update=_redraw, name="Depth Format", items=DEPTH_FORMAT_ITEMS, default="FLOAT32", description="How shadow depth is stored"
     )
+    shadow_sun_fit: EnumProperty(
+        update=_redraw,
+        name="Sun Fit",
+        items=(
+            ("VIEW", "View", "Fit sun maps to what the camera sees: sharpest, redrawn when the view changes the fit"),
+            ("SCENE", "Scene", "Fit sun maps to the whole scene: never redrawn for camera moves, coarser in large scenes"),
+        ),
+        default="VIEW",
+        description="What a sun's shadow map covers",
+    )
     shadow_early_out: BoolProperty(
         update=_redraw,
         name="Early Out",
@@ -237,6 +247,7 @@ class PENUMBRA_PG_scene(bpy.types.PropertyGroup):
             shadow_filter_radius=self.shadow_filter_radius,
             shadow_depth_format=self.shadow_depth_format,
             shadow_early_out=self.shadow_early_out,
+            shadow_sun_fit=self.shadow_sun_fit,
             specular_model=self.specular_model,
             frame=frame,
             layers=layers,

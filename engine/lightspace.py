@@ -126,38 +126,74 @@ class Fit:
 def fit_sun_ortho(direction, points, map_size, padding_texels=2.0):
     """Fit an orthographic light frustum for a sun shining along ``direction`` around ``points``.
 
-    Returns a ``Fit`` (or ``None`` without finite points). The frustum's x/y extent is
-    quantised and its origin snapped to whole texels in light space, so moving the camera or
-    the fitted set slightly does not make shadow edges shimmer. The depth range covers every
-    point with a margin so casters behind the receivers are kept.
-    """
+    Returns a ``Fit`` (or ``None`` without finite points). See ``_ortho_fit``."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     pts = pts[np.all(np.isfinite(pts), axis=1)]
     if len(pts) == 0:
         return None
-    map_size = max(1, int(map_size))
     view = look_at((0.0, 0.0, 0.0), direction)
     ls = transform_points(view, pts)
-    lo = ls.min(axis=0)
-    hi = ls.max(axis=0)
+    return _ortho_fit(view, ls.min(axis=0), ls.max(axis=0), float(np.abs(ls).max()), map_size, padding_texels)
+
+
+def _ortho_fit(view, lo, hi, scale, map_size, padding_texels=2.0):
+    """Orthographic fit of the light-space box [lo, hi]. Its x/y extent is quantised to steps
+    of 2^(1/4) (at most 19% wasted per axis) and its origin snapped to whole texels, so small
+    changes of the fitted set or of the camera do not move texel boundaries (no shimmering).
+    The depth range covers the box with a margin so casters behind receivers are kept."""
+    map_size = max(1, int(map_size))
+    scale = max(float(scale), 1e-30)
     extent = float(max(hi[0] - lo[0], hi[1] - lo[1]))
-    scale = float(max(np.abs(ls).max(), 1e-30))
     extent = max(extent, scale * 1e-6, 1e-30)
-    # Quantise the extent up to steps of 2^(1/4) (at most 19% wasted per axis) so small
-    # changes in the fitted set keep the same texel size; then pad by whole texels.
     extent = 2.0 ** (np.ceil(np.log2(extent) * 4.0) / 4.0)
     texel = extent / max(map_size - 2.0 * padding_texels, 1.0)
     half = 0.5 * texel * map_size
-    cx = 0.5 * (lo[0] + hi[0])
-    cy = 0.5 * (lo[1] + hi[1])
-    cx = np.floor(cx / texel) * texel
-    cy = np.floor(cy / texel) * texel
+    cx = np.floor(0.5 * (lo[0] + hi[0]) / texel) * texel
+    cy = np.floor(0.5 * (lo[1] + hi[1]) / texel) * texel
     depth = float(hi[2] - lo[2])
     margin = max(depth * 0.01, texel * 4.0, scale * 1e-6)
     near = -hi[2] - margin
     far = -lo[2] + margin
     proj = orthographic(cx - half, cx + half, cy - half, cy + half, near, far)
     return Fit(view, proj, near, far, texel=texel)
+
+
+def frustum_corners(view_proj):
+    """World-space corners (8, 3) of the clip volume of ``view_proj``."""
+    inv = np.linalg.inv(view_proj)
+    ndc = box_corners((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
+    h = np.concatenate([ndc, np.ones((8, 1))], axis=1) @ inv.T
+    return h[:, :3] / h[:, 3:4]
+
+
+def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2.0):
+    """Tight sun fit (seed 002: a loose box wastes the map): the map covers only the receivers
+    the camera can see, and reaches towards the light far enough to keep every caster that can
+    shadow them. ``corners``: (N, 8, 3) world box corners of all geometry; ``view_corners``: the
+    camera frustum's 8 world corners. Returns ``(Fit, caster indices)`` or ``None`` when the
+    camera sees no geometry."""
+    boxes = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
+    if len(boxes) == 0:
+        return None
+    view = look_at((0.0, 0.0, 0.0), direction)
+    ls = boxes @ view[:3, :3].T + view[:3, 3]
+    blo, bhi = ls.min(axis=1), ls.max(axis=1)
+    cam = transform_points(view, view_corners)
+    clo, chi = cam.min(axis=0), cam.max(axis=0)
+    seen = np.all((blo <= chi) & (bhi >= clo), axis=1)  # boxes overlapping the camera volume
+    if not seen.any():
+        return None
+    lo = np.maximum(blo[seen].min(axis=0), clo)
+    hi = np.minimum(bhi[seen].max(axis=0), chi)
+    # Casters: anything whose light-space footprint overlaps the fitted region, at any depth
+    # towards the light; the depth range grows to hold them.
+    casters = np.nonzero(np.all((blo[:, :2] <= hi[:2]) & (bhi[:, :2] >= lo[:2]), axis=1))[0]
+    hi = hi.copy()
+    lo = lo.copy()
+    hi[2] = max(hi[2], bhi[casters, 2].max())
+    lo[2] = max(min(lo[2], hi[2]), blo[seen, 2].min())
+    scale = float(np.abs(np.concatenate([lo, hi])).max())
+    return _ortho_fit(view, lo, hi, scale, map_size, padding_texels), casters
 
 
 def fit_perspective(position, forward, fov, points, map_size, min_near_ratio=1e-4):

@@ -45,6 +45,7 @@ class RenderSettings:
     shadow_filter_radius: float = 2.0
     shadow_depth_format: str = "FLOAT32"
     shadow_early_out: bool = True
+    shadow_sun_fit: str = "VIEW"  # 'VIEW' | 'SCENE'
     specular_model: str = "BLINN"
     film_transparent: bool = False
     frame: int = 1
@@ -222,13 +223,14 @@ class Renderer:
         # Shadow passes: only lights that cast shadows and have casters in reach.
         lights = snapshot.lights[:MAX_LIGHTS]
         map_size = max(1, int(settings.shadow_map_size))
-        plan = plan_shadows(lights, corners, map_size)
+        view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
+        plan = plan_shadows(lights, corners, map_size, view_corners)
         if plan.tiles:
             columns, _rows = self.shadows.grid(len(plan.tiles))
             clamped = _clamp_map_size(map_size, columns)
             if clamped != map_size:
                 map_size = clamped
-                plan = plan_shadows(lights, corners, map_size)
+                plan = plan_shadows(lights, corners, map_size, view_corners)
             self.shadows.ensure(map_size, len(plan.tiles), settings.shadow_depth_format)
             shadow_draws = [
                 (whole, model, det, (inst.key, inst.matrix.tobytes(), geo.serial))
@@ -346,6 +348,17 @@ def _pad_rows(rows, count):
     out = np.zeros((count, rows.shape[1]), np.float32)
     out[: min(len(rows), count)] = rows[:count]
     return out
+
+
+def _view_corners(camera):
+    """The camera frustum's world corners, or None when its matrices are degenerate."""
+    from .lightspace import frustum_corners
+
+    try:
+        c = frustum_corners(camera.projection @ camera.view)
+    except np.linalg.LinAlgError:
+        return None
+    return c if np.all(np.isfinite(c)) else None
 
 
 def _box_corners(bounds):

@@ -2,7 +2,8 @@
 
 Every map of a frame is a square tile of one atlas texture, so the lit pass binds a single
 sampler whatever the number and kind of lights:
-  sun    one orthographic tile fitted to the geometry, texel-snapped;
+  sun    one orthographic tile fitted to the receivers the camera sees and the casters that
+         can shadow them, texel-snapped;
   spot   one perspective tile covering the cone, near/far fitted to the casters inside it;
   point  up to six perspective tiles (cube faces); a face with no caster in reach is skipped;
   area   shadowed like a point light at its centre (softness from its size).
@@ -76,10 +77,11 @@ def _perspective_tile(position, forward, fov, corners, lo, hi, map_size):
     return Tile(fit, inside)
 
 
-def plan_shadows(lights, corners, map_size):
+def plan_shadows(lights, corners, map_size, view_corners=None):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
-    instance's bounds. Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are dropped with a
-    message (those lights render unshadowed)."""
+    instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
+    what the camera sees (all geometry when None). Returns a ShadowPlan; tiles beyond
+    MAX_SHADOW_TILES are dropped with a message (those lights render unshadowed)."""
     plan = ShadowPlan()
     corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(corners) == 0:
@@ -92,8 +94,12 @@ def plan_shadows(lights, corners, map_size):
         if not light.use_shadow:
             continue
         if light.type == "SUN":
-            fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), map_size)
-            tiles = [Tile(fit, everything)] if fit is not None else []
+            if view_corners is None:
+                fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), map_size)
+                tiles = [Tile(fit, everything)] if fit is not None else []
+            else:
+                fitted = lightspace.fit_sun_to_view(light.direction, corners, view_corners, map_size)
+                tiles = [Tile(*fitted)] if fitted is not None else []
             mode = "SINGLE"
         elif light.type == "SPOT":
             fov = min(light.spot_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))

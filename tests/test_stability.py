@@ -110,21 +110,50 @@ def test_no_caster_no_shadow_map(penumbra, gpu_call):
     assert stats.shadow_maps == 0
 
 
-def test_moving_the_camera_reuses_the_shadow_maps(penumbra, gpu_call):
+def _two_frames(gpu_call, scene, move):
     from penumbra.engine.extract import camera_from_scene
-
-    scene = shadow_scene("SUN", "PCF", size=64)
 
     def job(engine, depsgraph):
         first = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 64, 64), 64, 64).stats
-        scene.camera.location.x += 1.0
+        move()
         depsgraph.update()
         second = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 64, 64), 64, 64).stats
         return first, second
 
-    first, second = gpu_call(job)
+    return gpu_call(job)
+
+
+def test_camera_moves_redraw_sun_maps_only_when_the_fit_changes(penumbra, gpu_call):
+    scene = shadow_scene("SUN", "PCF", size=64)
+    scene.camera.data.ortho_scale = 60.0  # the camera sees the whole 30 m plane
+
+    def nudge():
+        scene.camera.location.x += 0.5
+
+    first, second = _two_frames(gpu_call, scene, nudge)
     assert (first.shadow_maps, first.shadow_maps_reused) == (1, 0)
+    assert (second.shadow_maps, second.shadow_maps_reused) == (0, 1)  # same receivers, same fit
+    scene.camera.data.ortho_scale = 8.0  # now the view crops the plane: the fit follows it
+    first, second = _two_frames(gpu_call, scene, nudge)
+    assert second.shadow_maps == 1
+    scene.penumbra.shadow_sun_fit = "SCENE"  # camera-independent: never redrawn for moves
+    first, second = _two_frames(gpu_call, scene, nudge)
     assert (second.shadow_maps, second.shadow_maps_reused) == (0, 1)
+
+
+@pytest.mark.parametrize("fit, bound", [("VIEW", 0.95), ("SCENE", None)])
+def test_tight_sun_fit_keeps_shadows_sharp_in_a_huge_scene(penumbra, fit, bound):
+    """Seed 002: a map fitted to a 2 km ground leaves a 1 m box a texel wide; fitted to the
+    view it stays exact. The loose fit's IoU is measured to show the difference."""
+    scene = shadow_scene("SUN", "NONE", size=128)
+    scene.objects["Plane"].scale = (70.0, 70.0, 1.0)  # 2.1 km
+    scene.penumbra.shadow_sun_fit = fit
+    _lum, visibility, on_plane, shadowed = analytic_shadow(scene, scene.objects["L"])
+    score = iou((visibility < 0.5)[on_plane], shadowed[on_plane])
+    if bound is not None:
+        assert score > bound, f"IoU {score:.3f}"
+    else:
+        assert score < 0.8, f"the whole-scene fit should be visibly coarse here (IoU {score:.3f})"
 
 
 def test_grazing_sun_no_acne_and_bounded_peter_panning(penumbra):

@@ -26,15 +26,44 @@ class PENUMBRA_PT_shadows(PenumbraPanel, bpy.types.Panel):
         s = context.scene.penumbra
         layout.prop(s, "shadow_filter")
         layout.prop(s, "shadow_map_size")
+        layout.prop(s, "shadow_depth_format")
+        layout.prop(s, "shadow_sun_fit")
         col = layout.column()
         col.active = s.shadow_filter == "PCF"
         col.prop(s, "pcf_kernel_size")
         col.prop(s, "pcf_spacing")
+        col = layout.column()
+        col.active = s.shadow_filter in {"JITTER", "PCSS"}
+        col.prop(s, "shadow_samples")
+        sub = col.column()
+        sub.active = s.shadow_filter == "JITTER"
+        sub.prop(s, "shadow_filter_radius")
+        sub.prop(s, "shadow_early_out")
         col = layout.column(align=True)
         col.prop(s, "shadow_bias")
         col.prop(s, "shadow_slope_bias")
         col.prop(s, "shadow_normal_offset")
         layout.prop(s, "shadow_cull_front")
+
+
+class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
+    bl_label = "Penumbra"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "data"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.light is not None
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(context.light, "use_shadow")
+        col = layout.column()
+        col.active = context.light.use_shadow
+        col.prop(context.light.penumbra, "bias_scale")
 
 
 class PENUMBRA_PT_lighting(PenumbraPanel, bpy.types.Panel):
@@ -118,6 +147,7 @@ class PENUMBRA_PT_render_layers(PenumbraPanel, bpy.types.Panel):
 
 classes = (
     PENUMBRA_PT_shadows,
+    PENUMBRA_PT_light,
     PENUMBRA_PT_lighting,
     PENUMBRA_UL_layers,
     PENUMBRA_MT_layer_add,
