@@ -176,22 +176,25 @@ def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2
     if len(boxes) == 0:
         return None
     view = look_at((0.0, 0.0, 0.0), direction)
-    ls = boxes @ view[:3, :3].T + view[:3, 3]
-    blo, bhi = ls.min(axis=1), ls.max(axis=1)
-    cam = transform_points(view, view_corners)
-    clo, chi = cam.min(axis=0), cam.max(axis=0)
-    seen = np.all((blo <= chi) & (bhi >= clo), axis=1)  # boxes overlapping the camera volume
+    # Receivers the camera can see: boxes overlapping the frustum's world bounds, cropped to
+    # those bounds in world space (a ground plane crops to the frustum's footprint on it).
+    wlo, whi = boxes.min(axis=1), boxes.max(axis=1)
+    vc = np.asarray(view_corners, dtype=np.float64)
+    flo, fhi = vc.min(axis=0), vc.max(axis=0)
+    seen = np.all((wlo <= fhi) & (whi >= flo), axis=1)
     if not seen.any():
         return None
-    lo = np.maximum(blo[seen].min(axis=0), clo)
-    hi = np.minimum(bhi[seen].max(axis=0), chi)
+    region = box_corners(np.maximum(wlo[seen].min(axis=0), flo), np.minimum(whi[seen].max(axis=0), fhi))
+    ls = boxes @ view[:3, :3].T + view[:3, 3]
+    blo, bhi = ls.min(axis=1), ls.max(axis=1)
+    rls = transform_points(view, region)
+    lo, hi = rls.min(axis=0), rls.max(axis=0)
     # Casters: anything whose light-space footprint overlaps the fitted region, at any depth
     # towards the light; the depth range grows to hold them.
     casters = np.nonzero(np.all((blo[:, :2] <= hi[:2]) & (bhi[:, :2] >= lo[:2]), axis=1))[0]
     hi = hi.copy()
     lo = lo.copy()
     hi[2] = max(hi[2], bhi[casters, 2].max())
-    lo[2] = max(min(lo[2], hi[2]), blo[seen, 2].min())
     scale = float(np.abs(np.concatenate([lo, hi])).max())
     return _ortho_fit(view, lo, hi, scale, map_size, padding_texels), casters
 

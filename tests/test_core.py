@@ -179,3 +179,17 @@ def test_jitter_disk_rings_outer_first_and_stratified():
     assert not np.allclose(d[0, 0], d[0, 1])
     # Samples cover the disk evenly: the mean offset is near the centre.
     assert np.abs(d.reshape(-1, 2).mean(axis=0)).max() < 0.02
+
+
+def test_sun_fit_to_view_covers_visible_receivers_and_their_casters():
+    ground = lightspace.box_corners((-1000, -1000, -0.1), (1000, 1000, 0.0))
+    caster = lightspace.box_corners((-0.5, -0.5, 1.0), (0.5, 0.5, 2.0))
+    far_away = lightspace.box_corners((500, 500, 0), (501, 501, 1))
+    view = lightspace.look_at((0, -10, 10), (0, 1, -1))
+    cam = lightspace.orthographic(-4, 4, -4, 4, 0.1, 40) @ view
+    fit, casters = lightspace.fit_sun_to_view((0.2, 0.1, -1.0), np.stack([ground, caster, far_away]), lightspace.frustum_corners(cam), 1024)
+    assert sorted(casters.tolist()) == [0, 1]  # the far box cannot shadow what the camera sees
+    whole = lightspace.fit_sun_ortho((0.2, 0.1, -1.0), np.concatenate([ground, caster, far_away]), 1024)
+    assert fit.texel < whole.texel / 50  # the view-fitted map is far sharper
+    ndc = lightspace.transform_points(fit.view_proj, caster)
+    assert np.all(np.abs(ndc) <= 1.0)
