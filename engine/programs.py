@@ -84,7 +84,7 @@ LIT = Program(
         (TAP_STRUCT, "pcf_taps", MAX_PCF_TAPS),
         (TILE_STRUCT, "shadow_tiles", MAX_SHADOW_TILES),
     ),
-    outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth")),
+    outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth"), ("FLOAT", "out_shadow")),
 )
 
 SHADOW_DEPTH = Program(

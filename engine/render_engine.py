@@ -66,6 +66,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
         if renderlayer.use_pass_z:
             self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
+        self.register_pass(scene, renderlayer, "Shadow", 1, "X", "VALUE")
 
     def render(self, depsgraph):
         scene = depsgraph.scene
@@ -80,6 +81,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             out = self.render_frame(depsgraph, camera, width, height)
             color = out.color_array()
             depth = out.depth_array()
+            shadow = out.shadow_array()
         except Exception as exc:  # a render must end with a message, never a crash
             traceback.print_exc(file=sys.stderr)
             self.report({"ERROR"}, f"Penumbra: render failed: {exc}")
@@ -93,6 +95,9 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         depth_pass = layer.passes.get("Depth")
         if depth_pass is not None:
             depth_pass.rect.foreach_set(depth.ravel())
+        shadow_pass = layer.passes.get("Shadow")
+        if shadow_pass is not None:
+            shadow_pass.rect.foreach_set(shadow.ravel())
         self.end_result(result)
 
     # --- viewport -------------------------------------------------------------------------

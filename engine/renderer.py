@@ -70,6 +70,7 @@ class FrameStats:
 class FrameOutput:
     color: object  # GPUTexture, scene-linear RGBA float
     depth: object  # GPUTexture, view-space distance along the camera axis
+    shadow: object  # GPUTexture, fraction of direct light not blocked (1 for background)
     stats: FrameStats
     width: int
     height: int
@@ -79,6 +80,9 @@ class FrameOutput:
 
     def depth_array(self):
         return texture_array(self.depth, 1)[..., 0]
+
+    def shadow_array(self):
+        return texture_array(self.shadow, 1)[..., 0]
 
 
 def buffer_array(buf):
@@ -134,8 +138,9 @@ class Renderer:
             return
         self._color = gpu.types.GPUTexture((width, height), format="RGBA32F")
         self._depth = gpu.types.GPUTexture((width, height), format="R32F")
+        self._shadow = gpu.types.GPUTexture((width, height), format="R32F")
         self._zbuffer = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
-        self._fb = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self._color, self._depth))
+        self._fb = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow))
         self._post_ctx = PostContext(self.shaders, width, height)
         self._size = (width, height)
 
@@ -302,6 +307,7 @@ class Renderer:
         # The second attachment holds view distance; the background is "infinitely" far, as in
         # Blender's own Depth pass.
         self._depth.clear(format="FLOAT", value=(1e10,))
+        self._shadow.clear(format="FLOAT", value=(1.0,))
         with self._fb.bind():
             gpu.state.viewport_set(0, 0, width, height)
             self._fb.clear(depth=1.0)
@@ -336,9 +342,9 @@ class Renderer:
         ctx.stats = stats
         color = self.post.run(ctx, self._color, settings.layers)
 
-        stats.texture_bytes = width * height * (16 + 4 + 4) + self.shadows.memory_bytes + ctx.memory_bytes
+        stats.texture_bytes = width * height * (16 + 4 + 4 + 4) + self.shadows.memory_bytes + ctx.memory_bytes
         stats.shaders_compiled = self.shaders.compiled - compiled_before
-        return FrameOutput(color, self._depth, stats, width, height)
+        return FrameOutput(color, self._depth, self._shadow, stats, width, height)
 
 
 MAX_FILTER_RADIUS = 32.0  # texels: the widest JITTER/PCSS kernel

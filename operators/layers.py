@@ -16,7 +16,7 @@ def _copy_group(src, dst):
         ident = prop.identifier
         if ident == "rna_type":
             continue
-        if prop.type == "POINTER":
+        if prop.type == "POINTER" and isinstance(getattr(src, ident), bpy.types.PropertyGroup):
             _copy_group(getattr(src, ident), getattr(dst, ident))
         elif not prop.is_readonly:
             setattr(dst, ident, getattr(src, ident))

@@ -29,6 +29,9 @@ void main()
   float shininess = 2.0 / (alpha * alpha) - 2.0;
 
   vec3 color = albedo * frame.world_color.rgb;
+  /* Shadow pass: direct light that arrives over direct light that would arrive unshadowed,
+   * each light weighted by the luminance of its irradiance here (1 where no light reaches). */
+  float arriving = 0.0, unshadowed = 0.0;
   int light_count = int(frame.counts.x);
   for (int i = 0; i < light_count; i++) {
     LightData L = lights[i];
@@ -39,12 +42,12 @@ void main()
     if (NdotL <= 0.0 || irradiance <= 0.0) {
       continue;
     }
-    float visibility = 1.0;
-    if (L.params.y >= 0.0) {
-      visibility = shadow_visibility(L, P, N, NdotL);
-      if (visibility <= 0.0) {
-        continue;
-      }
+    float weight = dot(L.color.rgb, vec3(0.2126, 0.7152, 0.0722)) * irradiance * NdotL;
+    float visibility = shadow_visibility(L, P, N, NdotL);
+    unshadowed += weight;
+    arriving += weight * visibility;
+    if (visibility <= 0.0) {
+      continue;
     }
 #if SPECULAR_MODEL == SPECULAR_BLINN
     vec3 H = normalize(to_light + V);
@@ -58,4 +61,5 @@ void main()
   }
   out_color = vec4(color, 1.0);
   out_depth = v_view_depth;
+  out_shadow = (unshadowed > 0.0) ? arriving / unshadowed : 1.0;
 }

@@ -275,3 +275,13 @@ def test_depth_encodings_cast_the_same_shadow(penumbra, fmt):
     score = iou(measured[on_plane], shadowed[on_plane])
     acne = (lit & measured).sum() / lit.sum()
     assert score > 0.95 and acne < 0.01, f"{fmt}: IoU {score:.3f}, acne {acne:.2%}"
+
+
+def test_shadow_pass_is_the_visibility_of_direct_light(penumbra):
+    """The Shadow render pass equals (render with shadows) / (render without) for one light."""
+    scene = shadow_scene("SPOT", "PCF")
+    shadow = render(scene, passes=("Combined", "Depth"))["Shadow"][..., 0]
+    _lum, visibility, on_plane, shadowed = analytic_shadow(scene, scene.objects["L"])
+    np.testing.assert_allclose(shadow[on_plane], visibility[on_plane], atol=1e-5)
+    assert iou((shadow < 0.5)[on_plane], shadowed[on_plane]) > 0.95
+    assert np.all((shadow >= 0.0) & (shadow <= 1.0))
