@@ -1,0 +1,102 @@
+"""GLOW: bright-pass -> separable Gaussian -> added back to the image (bloom).
+
+Two passes. The horizontal one applies the bright-pass to every tap it reads (so the
+bright-pass costs no pass of its own) and blurs; the vertical one finishes the blur and adds
+the result, scaled by ``intensity``, to the layer's input. The weights are blur.py's
+(``kernels.gaussian_1d``, normalised), so away from the image edges the light added equals
+the bright-pass energy times ``intensity``.
+"""
+
+import numpy as np
+
+from .. import kernels
+from .base import Param, PostEffect, post_program
+from .blur import MAX_RADIUS, WEIGHT_VEC4S, WEIGHTS
+
+PROGRAM = post_program(
+    "post_glow",
+    "post/glow.frag.glsl",
+    # glow = (threshold, knee in colour units, intensity, square samples 0/1)
+    push_constants=(("VEC4", "glow"), ("INT", "radius")),
+    samplers=(("FLOAT_2D", "input_tex"),),
+    uniform_blocks=((WEIGHTS, "weights", WEIGHT_VEC4S),),
+)
+
+
+def bright_pass(rgb, threshold, knee):
+    """Reference of the shader's bright-pass, numpy-ready (``rgb``: (..., 3)).
+
+    The standard soft-knee curve on ``b = max(r, g, b)``: nothing below ``threshold - knee``,
+    ``b - threshold`` above ``threshold + knee``, a quadratic in between; the colour is scaled
+    so its maximum component follows the curve. ``knee`` is in colour units (the effect passes
+    ``threshold * knee fraction``, so the curve is 0 at black). Negative components (out of
+    gamut) are clamped to 0 first: they do not glow.
+    """
+    c = np.maximum(np.asarray(rgb, dtype=np.float64), 0.0)
+    b = c.max(axis=-1, keepdims=True)
+    soft = np.clip(b - threshold + knee, 0.0, 2.0 * knee)
+    soft = soft * soft / (4.0 * knee + 1e-5)
+    contribution = np.maximum(soft, b - threshold) / np.maximum(b, 1e-5)
+    return c * contribution
+
+
+class Glow(PostEffect):
+    id = "GLOW"
+    label = "Glow"
+    icon = "LIGHT_SUN"
+    description = "Bloom: blur the highlights above a threshold and add them back"
+    params = (
+        Param("threshold", "FLOAT", 1.0, "Brightness (largest RGB component) above which pixels glow", min=0.0, soft_max=10.0),
+        Param("knee", "FLOAT", 0.5, "Softness of the threshold as a fraction of it: 0 is a hard cut, 1 fades in from black", min=0.0, max=1.0, subtype="FACTOR"),
+        Param("intensity", "FLOAT", 0.5, "Scale of the glow added to the image; 0 turns the layer off", min=0.0, soft_max=4.0),
+        Param("radius", "INT", 16, "Blur half-width in pixels (clamped to 256); sigma is radius / 2", min=0, max=MAX_RADIUS, soft_max=64),
+        Param("square_samples", "BOOL", False, "Square each bright-pass sample before blurring: favours the strongest highlights"),
+    )
+
+    def __init__(self):
+        self._ubo = None
+        self._radius = None
+
+    def is_identity(self, params):
+        return float(params.intensity) <= 0.0
+
+    def _weights(self, radius):
+        """Upload the Gaussian weights when the radius changed."""
+        import gpu
+
+        if radius == self._radius:
+            return
+        packed = np.zeros(WEIGHT_VEC4S * 4, np.float32)
+        w = kernels.gaussian_1d(radius)
+        packed[: len(w)] = w
+        if self._ubo is None:
+            self._ubo = gpu.types.GPUUniformBuf(packed.tobytes())
+        else:
+            self._ubo.update(packed.tobytes())
+        self._radius = radius
+
+    def execute(self, ctx, src, params, mix):
+        radius = min(max(int(params.radius), 0), MAX_RADIUS)
+        self._weights(radius)
+        threshold = max(float(params.threshold), 0.0)
+        knee = threshold * min(max(float(params.knee), 0.0), 1.0)
+        glow = (threshold, knee, float(params.intensity), 1.0 if params.square_samples else 0.0)
+        tmp = ctx.acquire(src)
+        ctx.fullscreen(
+            PROGRAM,
+            tmp,
+            defines={"GLOW_COMPOSITE": False},
+            samplers={"source_tex": src, "input_tex": src},
+            uniforms={"glow": glow, "radius": radius, "mix_factor": 1.0},
+            blocks={"weights": self._ubo},
+        )
+        dst = ctx.acquire(src, tmp.texture)
+        return ctx.fullscreen(
+            PROGRAM,
+            dst,
+            defines={"GLOW_COMPOSITE": True},
+            samplers={"source_tex": src, "input_tex": tmp.texture},
+            uniforms={"glow": glow, "radius": radius, "mix_factor": mix},
+            blocks={"weights": self._ubo},
+        )
+EFFECT = Glow

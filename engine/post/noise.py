@@ -1,0 +1,79 @@
+"""NOISE: animated film grain, reproducible from the frame number.
+
+Each ``size`` x ``size`` cell of pixels (anchored at pixel (0, 0)) draws, per channel, a value
+``g`` uniform in (-1, 1) from an integer hash of (cell x, cell y, frame, seed, channel), and
+the colour becomes ``c + amount * g``: additive, zero-mean grain of the same strength in
+shadows and highlights. The result is not clamped, so dark pixels may go slightly negative
+and the image mean is preserved. ``monochrome`` uses channel 0's value for R, G and B. Alpha
+is untouched. The hash is PCG (O'Neill's permuted congruential output function) chained over
+the inputs; ``grain_reference`` is its numpy twin.
+"""
+
+from .base import Param, PostEffect, post_program
+
+PROGRAM = post_program(
+    "post_noise",
+    "post/noise.frag.glsl",
+    push_constants=(("FLOAT", "amount"), ("INT", "grain_size"), ("INT", "frame"), ("INT", "seed"), ("INT", "monochrome")),
+)
+
+
+def _pcg(v):
+    import numpy as np
+
+    state = v * np.uint32(747796405) + np.uint32(2891336453)
+    word = ((state >> ((state >> np.uint32(28)) + np.uint32(4))) ^ state) * np.uint32(277803737)
+    return (word >> np.uint32(22)) ^ word
+
+
+def grain_reference(width, height, frame, size=1, seed=0, monochrome=False):
+    """The shader's grain ``g`` in (-1, 1) as an array (height, width, 3), row 0 at the bottom."""
+    import numpy as np
+
+    def u32(x):
+        return np.asarray(np.asarray(x, dtype=np.int64) & 0xFFFFFFFF, dtype=np.uint32)
+
+    y, x = np.mgrid[0:height, 0:width]
+    cx, cy = u32(x // size), u32(y // size)
+    out = np.empty((height, width, 3), np.float64)
+    with np.errstate(over="ignore"):
+        for ch in range(3):
+            channel = 0 if monochrome else ch
+            h = _pcg(u32(frame) + _pcg(u32(seed) * np.uint32(4) + np.uint32(channel)))
+            h = _pcg(cx + _pcg(cy + h))
+            k = (h >> np.uint32(8)).astype(np.int64) - 8388608
+            out[..., ch] = (k + 0.5) / 8388608.0
+    return out
+
+
+class Noise(PostEffect):
+    id = "NOISE"
+    label = "Noise"
+    icon = "MOD_NOISE"
+    description = "Animated film grain (the same frame always gives the same grain)"
+    params = (
+        Param("amount", "FLOAT", 0.05, "Grain strength: each channel moves by up to this much", min=0.0, soft_max=1.0),
+        Param("size", "INT", 1, "Grain size in pixels", min=1, soft_max=16),
+        Param("monochrome", "BOOL", True, "Same grain in R, G and B (luminance grain) instead of per channel"),
+        Param("seed", "INT", 0, "Pattern variant, so stacked noise layers differ"),
+    )
+
+    def is_identity(self, params):
+        return float(params.amount) <= 0.0
+
+    def execute(self, ctx, src, params, mix):
+        dst = ctx.acquire(src)
+        return ctx.fullscreen(
+            PROGRAM,
+            dst,
+            samplers={"source_tex": src},
+            uniforms={
+                "mix_factor": mix,
+                "amount": float(params.amount),
+                "grain_size": max(int(params.size), 1),
+                "frame": int(ctx.frame),
+                "seed": int(params.seed),
+                "monochrome": 1 if params.monochrome else 0,
+            },
+        )
+EFFECT = Noise

@@ -1,0 +1,68 @@
+"""PIXELATE: replace the image by square cells of one colour each.
+
+Cells are ``size`` pixels wide, anchored at the bottom-left pixel (0, 0); cells at the
+right and top edges may be partial. Every channel, alpha included, is resampled.
+
+CENTER takes one pixel per cell: along each axis, with ``n`` the number of the cell's pixels
+that exist (``size`` for whole cells), the pixel at ``origin + n // 2`` -- the exact
+centre for odd ``n``, the upper/right one of the two middle pixels for even ``n``. One pass.
+
+AVERAGE is the mean of the pixels of the cell that exist. Three passes, each O(1) work per
+pixel on average whatever the cell size: row sums per cell into a compact grid at the
+bottom-left of a target, column sums of those, then every pixel reads its cell's mean.
+
+A cell larger than the image is one cell covering it; sizes are clamped to the image's
+larger side, which gives the same result.
+"""
+
+from .base import Param, PostEffect, post_program
+
+PROGRAM = post_program(
+    "post_pixelate",
+    "post/pixelate.frag.glsl",
+    push_constants=(("INT", "cell_size"),),
+    samplers=(("FLOAT_2D", "input_tex"),),
+)
+
+# PIXELATE_PASS values (see pixelate.frag.glsl).
+PASS_CENTER, PASS_ROWS, PASS_COLUMNS, PASS_EXPAND = 0, 1, 2, 3
+
+SAMPLING_ITEMS = (
+    ("CENTER", "Center", "Each cell takes the colour of its centre pixel (sharp, cheap)"),
+    ("AVERAGE", "Average", "Each cell takes the mean colour of its pixels (smooth, less shimmer)"),
+)
+
+
+class Pixelate(PostEffect):
+    id = "PIXELATE"
+    label = "Pixelate"
+    icon = "MESH_GRID"
+    description = "Mosaic of square cells of one colour"
+    params = (
+        Param("size", "INT", 8, "Cell width in pixels; 1 leaves the image unchanged", min=1, soft_max=64),
+        Param("sampling", "ENUM", "AVERAGE", "How a cell's colour is chosen", items=SAMPLING_ITEMS),
+    )
+
+    def is_identity(self, params):
+        return int(params.size) <= 1
+
+    def execute(self, ctx, src, params, mix):
+        size = min(int(params.size), max(ctx.width, ctx.height))
+
+        def run(pass_id, target, input_tex, mix_factor):
+            return ctx.fullscreen(
+                PROGRAM,
+                target,
+                defines={"PIXELATE_PASS": pass_id},
+                samplers={"source_tex": src, "input_tex": input_tex},
+                uniforms={"mix_factor": mix_factor, "cell_size": size},
+            )
+
+        if params.sampling == "CENTER":
+            return run(PASS_CENTER, ctx.acquire(src), src, mix)
+        rows = ctx.acquire(src)
+        run(PASS_ROWS, rows, src, 1.0)
+        cells = ctx.acquire(src, rows.texture)
+        run(PASS_COLUMNS, cells, rows.texture, 1.0)
+        return run(PASS_EXPAND, ctx.acquire(src, cells.texture), cells.texture, mix)
+EFFECT = Pixelate
