@@ -57,3 +57,42 @@ def test_demo_then_batch_animation_matches(tmp_path):
     assert [f.name for f in frames] == ["frame_0001.exr", "frame_0002.exr"]
     batch = read_exr(frames[0])
     np.testing.assert_array_equal(batch["Combined"], exr["Combined"])
+
+
+ANIMATED = """
+import sys
+sys.path[:0] = [{tests!r}, {tools!r}]
+from devkit import load_penumbra
+import bpy
+load_penumbra().register()
+import scenes
+from helpers import render
+import numpy as np
+scene = scenes.demo_scene(96, 54)
+for effect in ("NOISE", "SCANLINES", "LENS_FLARE"):
+    if effect in {{e.identifier for e in scene.penumbra.layers.add().bl_rna.properties["effect"].enum_items}}:
+        scene.penumbra.layers[-1].effect = effect
+    else:
+        scene.penumbra.layers.remove(len(scene.penumbra.layers) - 1)
+out = {{}}
+for frame in (5, 6):
+    scene.frame_set(frame)
+    out[frame] = render(scene)["Combined"]
+np.savez({path!r}, **{{str(k): v for k, v in out.items()}})
+sys.stdout.flush()
+import os
+os._exit(0)
+"""
+
+
+def test_animated_layers_are_a_pure_function_of_the_frame(tmp_path):
+    """Two separate processes render frames 5 and 6 of a stack with animated layers (noise,
+    scrolling scanlines): the same frame is bit-identical across runs, different frames differ."""
+    runs = []
+    for i in range(2):
+        path = tmp_path / f"run{i}.npz"
+        run(["-c", ANIMATED.format(tests=str(ROOT / "tests"), tools=str(ROOT / "tools"), path=str(path))])
+        runs.append(np.load(path))
+    np.testing.assert_array_equal(runs[0]["5"], runs[1]["5"])
+    np.testing.assert_array_equal(runs[0]["6"], runs[1]["6"])
+    assert np.abs(runs[0]["5"] - runs[0]["6"]).mean() > 1e-3

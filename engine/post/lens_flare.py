@@ -1,0 +1,149 @@
+"""LENS_FLARE: procedural ghosts and a halo from the bright parts of the image, one pass.
+
+The flare ``f`` at the output pixel centre ``x`` (pixels) is defined as follows, with the centre
+``C = size / 2``, ``R = |C|`` (the half-diagonal), ``u = x - C`` and ``r = |u| / R``:
+
+* bright pass, per texel: ``B = max(c.rgb - threshold, 0)`` on the NaN-free input; ``B(q)`` is
+  its bilinear read at position ``q`` (texel centres at i + 0.5), black outside the image;
+* ghost ``i`` (0 <= i < ``ghosts``) reads ``q_i = C + u * (ghost_spacing * i - 1)``: ghost 0 is
+  the mirror image through the centre, later ghosts march along the same line. Each is weighted
+  by ``w(q) = (1 - min(|q - C| / R, 1)) ** 3``, so sources near the centre flare most. A light at
+  ``b`` therefore shows ghost ``i`` centred on ``C + (b - C) / (ghost_spacing * i - 1)``
+  (``ghost_positions``), scaled by ``1 / |ghost_spacing * i - 1|``;
+* the halo is a ring about the centre: the profile ``ring = t * t * (3 - 2 * t)`` with
+  ``t = clamp(1 - |r - halo_radius| / halo_width, 0, 1)`` (radii in units of ``R``; width 0 =
+  no halo) times ``B`` at ``q_h = C + u / |u| * (halo_radius * R - |u|)`` (``u / |u|`` read as
+  0 at the centre), so a bright area near the centre lights the ring and an off-centre one
+  lights arcs of it;
+* ``f = intensity * (sum_i w(q_i) B(q_i) + ring * B(q_h)) * T``, where the lens texture ``T``
+  is the ``image`` if one is set (RGB, stretched over the frame, bilinear, clamped at its
+  borders: a lens-dirt or flare-colour texture multiplying the flare), otherwise the built-in
+  radial colour ramp ``LENS_RAMP`` read at ``r`` (texel coordinate ``r * (N - 1)``).
+
+``mode`` merges ``f`` into the input colour ``c`` (alpha is kept):
+
+* ADD: ``c + f`` (the physically plain choice for scene-linear HDR);
+* SCREEN: ``1 - (1 - c') * (1 - f')`` with ``c' = max(c, 0)``, ``f' = max(f, 0)``, per channel.
+  Screen is a display-range operator: it brightens only where the input is at most 1. Where
+  the input exceeds 1 a flare below 1 darkens it (c = 2, f = 0.5 gives 1.5), and where both
+  exceed 1 the product turns positive, so the result can go negative (c = f = 3 gives -3).
+  Prefer ADD for HDR light sources;
+* AVERAGE: ``(c + f) / 2``; where there is no flare this halves the image;
+* DIFFERENCE: ``|c - f|``.
+
+A flare that is empty by its parameters (``intensity`` 0, or no ghosts and no halo) skips the
+layer in every mode; a flare that is empty because nothing exceeds the threshold still merges
+(ADD, SCREEN and DIFFERENCE then return the input, AVERAGE halves it).
+"""
+
+import numpy as np
+
+from .base import Param, PostEffect, post_program
+
+PROGRAM = post_program(
+    "post_lens_flare",
+    "post/lens_flare.frag.glsl",
+    push_constants=(
+        ("VEC4", "flare"),  # (threshold, intensity, ghost_spacing, unused)
+        ("VEC2", "halo"),  # (halo_radius, halo_width)
+        ("INT", "ghosts"),
+        ("INT", "merge_mode"),
+        ("INT", "lens_image"),  # 1: lens_tex is the user's image, 0: the built-in ramp
+    ),
+    samplers=(("FLOAT_2D", "lens_tex"),),
+)
+
+MAX_GHOSTS = 16
+
+MODE_ITEMS = (
+    ("ADD", "Add", "Input plus flare"),
+    ("SCREEN", "Screen", "1 - (1 - input)(1 - flare) on values clamped to >= 0; meant for display-range values"),
+    ("AVERAGE", "Average", "(input + flare) / 2"),
+    ("DIFFERENCE", "Difference", "|input - flare|"),
+)
+MERGE_MODES = {identifier: i for i, (identifier, _, _) in enumerate(MODE_ITEMS)}
+
+# Built-in lens texture: an RGB ramp from the image centre (first entry) to the corners (last),
+# the warm-to-violet tint of coated lens ghosts.
+LENS_RAMP = np.array(
+    [(1.00, 0.92, 0.80), (0.95, 1.00, 0.90), (0.75, 0.90, 1.00), (0.85, 0.70, 1.00)],
+    dtype=np.float32,
+)
+
+
+def ghost_positions(bx, by, width, height, ghosts, spacing):
+    """Where the ghosts of a light at pixel position (``bx``, ``by``) are centred: a list of
+    ``(i, x, y, scale)`` for every ghost ``i`` whose line factor ``spacing * i - 1`` is not 0;
+    ``scale`` is the ghost's size relative to the light."""
+    cx, cy = width * 0.5, height * 0.5
+    out = []
+    for i in range(min(int(ghosts), MAX_GHOSTS)):
+        k = spacing * i - 1.0
+        if k != 0.0:
+            out.append((i, cx + (bx - cx) / k, cy + (by - cy) / k, 1.0 / abs(k)))
+    return out
+
+
+def merge(c, f, mode):
+    """Reference of the merge modes, numpy-ready (``c``, ``f``: RGB arrays)."""
+    c = np.asarray(c, dtype=np.float64)
+    f = np.asarray(f, dtype=np.float64)
+    if mode == "SCREEN":
+        return 1.0 - (1.0 - np.maximum(c, 0.0)) * (1.0 - np.maximum(f, 0.0))
+    if mode == "AVERAGE":
+        return (c + f) * 0.5
+    if mode == "DIFFERENCE":
+        return np.abs(c - f)
+    return c + f
+
+
+class LensFlare(PostEffect):
+    id = "LENS_FLARE"
+    label = "Lens Flare"
+    icon = "LIGHT_SUN"
+    description = "Ghosts and a halo from the bright parts of the image"
+    params = (
+        Param("threshold", "FLOAT", 1.0, "Only colour above this value (per channel) flares", min=0.0, soft_max=10.0),
+        Param("intensity", "FLOAT", 1.0, "Brightness of the flare; 0 turns the layer off", min=0.0, soft_max=10.0),
+        Param("mode", "ENUM", "ADD", "How the flare is merged into the image", items=MODE_ITEMS),
+        Param("ghosts", "INT", 4, "Number of ghost images along the line through the centre", min=0, max=MAX_GHOSTS),
+        Param("ghost_spacing", "FLOAT", 0.4, "Step between ghosts along the line through the centre", min=0.0, soft_max=2.0),
+        Param("halo_radius", "FLOAT", 0.6, "Radius of the halo ring (1 = the image corners)", min=0.0, soft_max=1.5),
+        Param("halo_width", "FLOAT", 0.1, "Half-width of the halo ring; 0 = no halo", min=0.0, soft_max=0.5),
+        Param("image", "IMAGE", None, "Lens dirt / colour texture multiplying the flare; empty uses a built-in radial ramp"),
+    )
+
+    def __init__(self):
+        self._ramp = None
+
+    def is_identity(self, params):
+        no_flare = int(params.ghosts) <= 0 and float(params.halo_width) <= 0.0
+        return float(params.intensity) <= 0.0 or no_flare
+
+    def _lens_texture(self, image):
+        import gpu
+
+        if image is not None:
+            return gpu.texture.from_image(image)
+        if self._ramp is None:
+            rgba = np.concatenate([LENS_RAMP, np.ones((len(LENS_RAMP), 1), np.float32)], axis=-1)
+            buf = gpu.types.Buffer("FLOAT", rgba.size, rgba.ravel().tolist())
+            self._ramp = gpu.types.GPUTexture((len(LENS_RAMP), 1), format="RGBA32F", data=buf)
+        return self._ramp
+
+    def execute(self, ctx, src, params, mix):
+        dst = ctx.acquire(src)
+        return ctx.fullscreen(
+            PROGRAM,
+            dst,
+            samplers={"source_tex": src, "lens_tex": self._lens_texture(params.image)},
+            uniforms={
+                "mix_factor": mix,
+                "flare": (max(float(params.threshold), 0.0), float(params.intensity), float(params.ghost_spacing), 0.0),
+                "halo": (float(params.halo_radius), max(float(params.halo_width), 0.0)),
+                "ghosts": min(max(int(params.ghosts), 0), MAX_GHOSTS),
+                "merge_mode": MERGE_MODES.get(params.mode, 0),
+                "lens_image": int(params.image is not None),
+            },
+        )
+EFFECT = LensFlare

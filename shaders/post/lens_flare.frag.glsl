@@ -1,0 +1,97 @@
+/* Ghosts and halo from the bright parts of the input, merged into it; lens_flare.py defines the
+ * flare and the merge modes exactly.
+ * flare = (threshold, intensity, ghost_spacing, unused); halo = (radius, width), radii in units
+ * of the half-diagonal. merge_mode: 0 add, 1 screen, 2 average, 3 difference. */
+
+#define MERGE_ADD 0
+#define MERGE_SCREEN 1
+#define MERGE_AVERAGE 2
+#define MERGE_DIFFERENCE 3
+
+/* Bright pass of one input texel; black outside the image. */
+vec3 bright_texel(ivec2 i, ivec2 size)
+{
+  if (any(lessThan(i, ivec2(0))) || any(greaterThanEqual(i, size))) {
+    return vec3(0.0);
+  }
+  return max(sanitize(texelFetch(source_tex, i, 0)).rgb - flare.x, vec3(0.0));
+}
+
+/* Bilinear read of the bright pass at position p in pixels (texel centres at i + 0.5). */
+vec3 bright_sample(vec2 p)
+{
+  ivec2 size = textureSize(source_tex, 0);
+  vec2 t = p - 0.5;
+  vec2 t0 = floor(t);
+  vec2 f = t - t0;
+  ivec2 i0 = ivec2(t0);
+  vec3 c00 = bright_texel(i0, size);
+  vec3 c10 = bright_texel(i0 + ivec2(1, 0), size);
+  vec3 c01 = bright_texel(i0 + ivec2(0, 1), size);
+  vec3 c11 = bright_texel(i0 + ivec2(1, 1), size);
+  return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
+}
+
+/* Bilinear read of lens_tex at texel coordinate t (0 = centre of the first texel), clamped. */
+vec3 lens_sample(vec2 t)
+{
+  ivec2 size = textureSize(lens_tex, 0);
+  t = clamp(t, vec2(0.0), vec2(size - 1));
+  ivec2 i0 = ivec2(floor(t));
+  ivec2 i1 = min(i0 + 1, size - 1);
+  vec2 f = t - vec2(i0);
+  vec3 c00 = sanitize(texelFetch(lens_tex, i0, 0)).rgb;
+  vec3 c10 = sanitize(texelFetch(lens_tex, ivec2(i1.x, i0.y), 0)).rgb;
+  vec3 c01 = sanitize(texelFetch(lens_tex, ivec2(i0.x, i1.y), 0)).rgb;
+  vec3 c11 = sanitize(texelFetch(lens_tex, i1, 0)).rgb;
+  return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
+}
+
+void main()
+{
+  vec4 c = post_source();
+  vec2 centre = 0.5 * target_size;
+  float diag = length(centre);
+  vec2 u = gl_FragCoord.xy - centre;
+  float dist = length(u);
+  float r = dist / diag;
+
+  vec3 f = vec3(0.0);
+  for (int i = 0; i < ghosts; i++) {
+    vec2 q = centre + u * (flare.z * float(i) - 1.0);
+    float a = 1.0 - saturate(length(q - centre) / diag);
+    f += (a * a * a) * bright_sample(q);
+  }
+  if (halo.y > 0.0) {
+    float t = saturate(1.0 - abs(r - halo.x) / halo.y);
+    float ring = t * t * (3.0 - 2.0 * t);
+    if (ring > 0.0) {
+      vec2 dir = (dist > 0.0) ? u / dist : vec2(0.0);
+      f += ring * bright_sample(centre + dir * (halo.x * diag - dist));
+    }
+  }
+
+  vec3 tint;
+  if (lens_image != 0) {
+    tint = lens_sample(gl_FragCoord.xy / target_size * vec2(textureSize(lens_tex, 0)) - 0.5);
+  }
+  else {
+    tint = lens_sample(vec2(r * float(textureSize(lens_tex, 0).x - 1), 0.0));
+  }
+  f *= flare.y * tint;
+
+  vec3 merged;
+  if (merge_mode == MERGE_SCREEN) {
+    merged = 1.0 - (1.0 - max(c.rgb, 0.0)) * (1.0 - max(f, 0.0));
+  }
+  else if (merge_mode == MERGE_AVERAGE) {
+    merged = 0.5 * (c.rgb + f);
+  }
+  else if (merge_mode == MERGE_DIFFERENCE) {
+    merged = abs(c.rgb - f);
+  }
+  else {
+    merged = c.rgb + f;
+  }
+  out_color = post_mix(vec4(merged, c.a));
+}
