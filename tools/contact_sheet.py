@@ -3,8 +3,8 @@
     .venv/blender-5.2/bin/python tools/contact_sheet.py --out docs
 
 Each tile is the demo scene rendered by Penumbra with one layer (default parameters, mix 1),
-saved through Blender's colour management (AgX), the first tile without any layer. Tiles are
-laid out with matplotlib.
+saved through Blender's colour management (AgX), the first tile without any layer; then one
+tile per shipped preset look. Tiles are laid out with matplotlib.
 """
 
 import argparse
@@ -56,6 +56,7 @@ def main():
 
     load_penumbra().register()
     from penumbra.engine.post import EFFECTS
+    from penumbra.operators.presets import SHIPPED_DIR
 
     tiles = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -72,6 +73,13 @@ def main():
             path = Path(tmp) / f"{eid or 'none'}.png"
             render_png(scene, path)
             tiles.append((EFFECTS[eid].label if eid else "No layer", oiio.ImageBuf(str(path)).get_pixels(oiio.FLOAT)))
+        for preset in sorted(SHIPPED_DIR.glob("*.py")):
+            scene = scenes.demo_scene(args.width, args.height)
+            scene.view_settings.view_transform = "AgX"
+            bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="PENUMBRA_MT_post_presets")
+            path = Path(tmp) / f"preset_{preset.stem}.png"
+            render_png(scene, path)
+            tiles.append((f"Preset: {bpy.path.display_name(preset.stem)}", oiio.ImageBuf(str(path)).get_pixels(oiio.FLOAT)))
 
     cols = 4
     rows = (len(tiles) + cols - 1) // cols

@@ -18,12 +18,7 @@ MODULES = ("blur", "glow", "scanlines", "vignette", "colorizer", "fisheye", "pix
 def _load():
     effects = {}
     for name in MODULES:
-        try:
-            module = importlib.import_module(f".{name}", __name__)
-        except ModuleNotFoundError as exc:
-            if exc.name != f"{__name__}.{name}":
-                raise
-            continue  # not written yet
+        module = importlib.import_module(f".{name}", __name__)
         effects[module.EFFECT.id] = module.EFFECT
     return effects
 
