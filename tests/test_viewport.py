@@ -47,8 +47,16 @@ def _viewport_frame(gpu_call, scene):
     return gpu_call(job)
 
 
-def test_viewport_matches_final_render(penumbra, gpu_call):
+@pytest.mark.parametrize("stack", ["demo", "every effect"])
+def test_viewport_matches_final_render(penumbra, gpu_call, stack):
     scene = scenes.demo_scene(160, 90)
+    if stack == "every effect":
+        from penumbra.engine.post import EFFECTS
+
+        for eid in EFFECTS:
+            layer = scene.penumbra.layers.add()
+            layer.effect, layer.mix = eid, 0.5
+        scene.frame_set(7)  # animated layers read the frame in both paths
     scene.view_settings.view_transform = "AgX"
     scene.view_settings.exposure = 0.5
     final = render(scene)["Combined"]
