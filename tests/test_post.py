@@ -128,3 +128,34 @@ def test_post_layers_on_degenerate_image_sizes(penumbra, gpu_call, size):
     img = np.full((*size, 4), 0.5, np.float32)
     out, _ = run_layers(gpu_call, img, [blur_layer(12), vignette_layer()])
     assert np.all(np.isfinite(out)) and out.shape == img.shape
+
+
+def test_8k_frame_through_cheap_and_separable_layers(penumbra, gpu_call):
+    """An 8K (7680x4320) HDR frame through a blur and a vignette: the stack allocates its
+    targets at that size, and the result matches the references at sampled pixels."""
+    from penumbra.engine.post.vignette import vignette_factor
+
+    h, w = 4320, 7680
+    color = (2.0, 1.0, 0.5, 1.0)
+
+    def job(engine, depsgraph):
+        import gpu
+        from penumbra.engine.post import PostContext, PostStack
+        from penumbra.engine.renderer import FrameStats, texture_array
+        from penumbra.shaders.loader import ShaderCache
+
+        src = gpu.types.GPUTexture((w, h), format="RGBA32F")
+        src.clear(format="FLOAT", value=color)  # no 500 MB upload from Python
+        stats = FrameStats()
+        ctx = PostContext(ShaderCache(), w, h, stats=stats)
+        out = PostStack().run(ctx, src, [blur_layer(3), vignette_layer(0.9, 0.4)])
+        return texture_array(out, 4)[::60, ::60].copy(), stats
+
+    scenes.top_camera(scenes.empty_scene(8, 8))
+    sampled, stats = gpu_call(job)
+    assert stats.post_passes == 3
+    rows = np.arange(0, h, 60)[:, None] + 0.5
+    cols = np.arange(0, w, 60)[None, :] + 0.5
+    f = vignette_factor(cols, rows, w, h, 0.9, 0.4, 1.0)
+    expected = np.array(color[:3]) * (1 - f)[..., None]  # a blur of a flat image is the image
+    np.testing.assert_allclose(sampled[..., :3], expected, rtol=1e-5, atol=1e-6)
