@@ -59,7 +59,7 @@ def test_box_shadow_matches_projected_footprint(penumbra, tilt, shadow_filter):
     assert np.median(lum[on_plane & analytic]) < 0.02 * lit_value
 
 
-@pytest.mark.parametrize("scale", [1e-3, 1e3])
+@pytest.mark.parametrize("scale", [1e-3, 1e3, 1e4])
 def test_box_shadow_holds_at_extreme_scales(penumbra, scale):
     scene = box_over_plane(45.0, scale=scale)
     on_plane, analytic, lum, lit_value = measure(scene, 45.0, scale)
