@@ -21,7 +21,6 @@ from .programs import (
     SHADOW_FILTERS,
     SHADOW_MODES,
     SHADOW_SAMPLER,
-    TAP_STRUCT,
     TILE_STRUCT,
     JITTER_SIZE,
     lit_defines,

@@ -5,7 +5,6 @@ import numpy as np
 import pytest
 
 import scenes
-from helpers import render
 
 
 def _effects(scene):

@@ -8,27 +8,39 @@ import pytest
 import scenes
 
 
-def run_layers(gpu_call, image, layers):
-    """Upload ``image`` (h, w, 4 float32), run ``layers`` through the post stack, read back."""
+def run_stack(gpu_call, image, layers=None, frames=(0,), make_layers=None):
+    """Upload ``image`` (h, w, 4 float32) and run the post stack on it once per frame number
+    in ``frames`` (fresh context and stack each time); returns [(array, FrameStats)].
+
+    ``make_layers()``, when given, builds the layers after the file is reset (for layers that
+    reference Blender images)."""
 
     def job(engine, depsgraph):
         import gpu
         from penumbra.engine.post import PostContext, PostStack
-        from penumbra.engine.renderer import FrameStats
+        from penumbra.engine.renderer import FrameStats, texture_array
         from penumbra.shaders.loader import ShaderCache
 
         h, w = image.shape[:2]
         buf = gpu.types.Buffer("FLOAT", image.size, image.ravel().tolist())
         src = gpu.types.GPUTexture((w, h), format="RGBA32F", data=buf)
-        stats = FrameStats()
-        ctx = PostContext(ShaderCache(), w, h, stats=stats)
-        out = PostStack().run(ctx, src, layers)
-        from penumbra.engine.renderer import texture_array
-
-        return texture_array(out, 4).copy(), stats
+        shaders = ShaderCache()
+        results = []
+        for frame in frames:
+            stats = FrameStats()
+            ctx = PostContext(shaders, w, h, frame=frame, stats=stats)
+            out = PostStack().run(ctx, src, stack)
+            results.append((texture_array(out, 4).copy(), stats))
+        return results
 
     scenes.top_camera(scenes.empty_scene(8, 8))
+    stack = make_layers() if make_layers is not None else layers
     return gpu_call(job)
+
+
+def run_layers(gpu_call, image, layers):
+    """``run_stack`` for one frame: (array, FrameStats)."""
+    return run_stack(gpu_call, image, layers)[0]
 
 
 def blur_layer(radius, sigma=0.0, mix=1.0):

@@ -10,33 +10,12 @@ import numpy as np
 import pytest
 
 import scenes
-from test_post import gaussian_reference, run_layers
+from test_post import gaussian_reference, run_layers, run_stack
 
 
 def run_frames(gpu_call, image, layers, frames):
-    """Like ``run_layers``, but runs the stack once per frame number in ``frames`` (one GPU
-    call, fresh context and stack per frame); returns [(array, stats)]."""
-
-    def job(engine, depsgraph):
-        import gpu
-        from penumbra.engine.post import PostContext, PostStack
-        from penumbra.engine.renderer import FrameStats, texture_array
-        from penumbra.shaders.loader import ShaderCache
-
-        h, w = image.shape[:2]
-        buf = gpu.types.Buffer("FLOAT", image.size, image.ravel().tolist())
-        src = gpu.types.GPUTexture((w, h), format="RGBA32F", data=buf)
-        shaders = ShaderCache()
-        results = []
-        for frame in frames:
-            stats = FrameStats()
-            ctx = PostContext(shaders, w, h, frame=frame, stats=stats)
-            out = PostStack().run(ctx, src, layers)
-            results.append((texture_array(out, 4).copy(), stats))
-        return results
-
-    scenes.top_camera(scenes.empty_scene(8, 8))
-    return gpu_call(job)
+    """The stack once per frame number in ``frames``; returns [(array, stats)]."""
+    return run_stack(gpu_call, image, layers, frames=frames)
 
 
 def run_frame(gpu_call, image, layers, frame):

@@ -7,33 +7,15 @@ import numpy as np
 import pytest
 
 import scenes
-from test_post import gaussian_reference, run_layers
+from test_post import gaussian_reference, run_layers, run_stack
 
 
 # --- helpers ------------------------------------------------------------------------------
 
 
 def run_with_images(gpu_call, image, make_layers):
-    """``run_layers`` for layers that reference Blender images: the file is reset first, then
-    ``make_layers()`` builds the layers (creating its images), then the stack runs."""
-
-    def job(engine, depsgraph):
-        import gpu
-        from penumbra.engine.post import PostContext, PostStack
-        from penumbra.engine.renderer import FrameStats, texture_array
-        from penumbra.shaders.loader import ShaderCache
-
-        h, w = image.shape[:2]
-        buf = gpu.types.Buffer("FLOAT", image.size, image.ravel().tolist())
-        src = gpu.types.GPUTexture((w, h), format="RGBA32F", data=buf)
-        stats = FrameStats()
-        ctx = PostContext(ShaderCache(), w, h, stats=stats)
-        out = PostStack().run(ctx, src, layers)
-        return texture_array(out, 4).copy(), stats
-
-    scenes.top_camera(scenes.empty_scene(8, 8))
-    layers = make_layers()
-    return gpu_call(job)
+    """``run_layers`` for layers that reference Blender images (built after the file reset)."""
+    return run_stack(gpu_call, image, make_layers=make_layers)[0]
 
 
 def bpy_image(name, rgba):

@@ -11,7 +11,6 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "tools")]
 
-import bpy  # noqa: E402
 
 import scenes  # noqa: E402
 from devkit import load_penumbra  # noqa: E402

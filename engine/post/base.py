@@ -99,6 +99,17 @@ class PostContext:
     def memory_bytes(self):
         return len(self._pool) * self.width * self.height * 16
 
+    def single_pass(self, program, src, mix, uniforms=None, samplers=None, blocks=None, defines=None):
+        """The common one-pass layer: read ``src``, blend by ``mix``, write a fresh target."""
+        return self.fullscreen(
+            program,
+            self.acquire(src),
+            defines=defines,
+            samplers={"source_tex": src, **(samplers or {})},
+            uniforms={"mix_factor": mix, **(uniforms or {})},
+            blocks=blocks,
+        )
+
     def fullscreen(self, program, target, defines=None, samplers=None, uniforms=None, blocks=None):
         """Draw one full-screen pass of ``program`` into ``target``."""
         import gpu

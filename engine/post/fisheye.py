@@ -54,15 +54,15 @@ class Fisheye(PostEffect):
         return float(params.strength) == 0.0
 
     def execute(self, ctx, src, params, mix):
-        dst = ctx.acquire(src)
-        return ctx.fullscreen(
+        return ctx.single_pass(
             PROGRAM,
-            dst,
-            samplers={"source_tex": src},
+            src,
+            mix,
             uniforms={
-                "mix_factor": mix,
                 "strength": min(max(float(params.strength), -1.0), 1.0),
                 "edge_mode": EDGE_MODES.get(params.edge, 0),
             },
         )
+
+
 EFFECT = Fisheye

@@ -132,13 +132,12 @@ class LensFlare(PostEffect):
         return self._ramp
 
     def execute(self, ctx, src, params, mix):
-        dst = ctx.acquire(src)
-        return ctx.fullscreen(
+        return ctx.single_pass(
             PROGRAM,
-            dst,
-            samplers={"source_tex": src, "lens_tex": self._lens_texture(params.image)},
+            src,
+            mix,
+            samplers={"lens_tex": self._lens_texture(params.image)},
             uniforms={
-                "mix_factor": mix,
                 "flare": (max(float(params.threshold), 0.0), float(params.intensity), float(params.ghost_spacing), 0.0),
                 "halo": (float(params.halo_radius), max(float(params.halo_width), 0.0)),
                 "ghosts": min(max(int(params.ghosts), 0), MAX_GHOSTS),
@@ -146,4 +145,6 @@ class LensFlare(PostEffect):
                 "lens_image": int(params.image is not None),
             },
         )
+
+
 EFFECT = LensFlare

@@ -62,13 +62,11 @@ class Noise(PostEffect):
         return float(params.amount) <= 0.0
 
     def execute(self, ctx, src, params, mix):
-        dst = ctx.acquire(src)
-        return ctx.fullscreen(
+        return ctx.single_pass(
             PROGRAM,
-            dst,
-            samplers={"source_tex": src},
+            src,
+            mix,
             uniforms={
-                "mix_factor": mix,
                 "amount": float(params.amount),
                 "grain_size": max(int(params.size), 1),
                 "frame": int(ctx.frame),
@@ -76,4 +74,6 @@ class Noise(PostEffect):
                 "monochrome": 1 if params.monochrome else 0,
             },
         )
+
+
 EFFECT = Noise

@@ -8,7 +8,6 @@ fraction of its own height covered by dark bands (an exact box filter), otherwis
 its centre is inside one.
 """
 
-import math
 
 from .base import Param, PostEffect, post_program
 
@@ -65,22 +64,22 @@ class Scanlines(PostEffect):
         return float(params.intensity) <= 0.0 or float(params.thickness) <= 0.0
 
     def execute(self, ctx, src, params, mix):
-        dst = ctx.acquire(src)
         scan = (
             max(int(params.count), 1) / ctx.height,
             min(max(float(params.thickness), 0.0), 1.0),
             float(params.intensity),
             scroll_offset(ctx.frame, params.scroll_speed),
         )
-        return ctx.fullscreen(
+        return ctx.single_pass(
             PROGRAM,
-            dst,
-            samplers={"source_tex": src},
+            src,
+            mix,
             uniforms={
-                "mix_factor": mix,
                 "scan": scan,
                 "line_count": max(int(params.count), 1),
                 "antialias": 1 if params.antialias else 0,
             },
         )
+
+
 EFFECT = Scanlines

@@ -34,12 +34,8 @@ class Sepia(PostEffect):
         return float(params.amount) <= 0.0
 
     def execute(self, ctx, src, params, mix):
-        dst = ctx.acquire(src)
         rows = {f"sepia_{ch}": (*row, 0.0) for ch, row in zip("rgb", SEPIA_MATRIX)}
-        return ctx.fullscreen(
-            PROGRAM,
-            dst,
-            samplers={"source_tex": src},
-            uniforms={"mix_factor": mix, "amount": min(float(params.amount), 1.0), **rows},
-        )
+        return ctx.single_pass(PROGRAM, src, mix, uniforms={"amount": min(float(params.amount), 1.0), **rows})
+
+
 EFFECT = Sepia

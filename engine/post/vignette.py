@@ -42,15 +42,15 @@ class Vignette(PostEffect):
     )
 
     def execute(self, ctx, src, params, mix):
-        dst = ctx.acquire(src)
-        return ctx.fullscreen(
+        return ctx.single_pass(
             PROGRAM,
-            dst,
-            samplers={"source_tex": src},
+            src,
+            mix,
             uniforms={
-                "mix_factor": mix,
                 "vignette_color": (*params.color[:3], 1.0),
                 "shape": (params.radius, params.softness, params.roundness, 0.0),
             },
         )
+
+
 EFFECT = Vignette
