@@ -118,5 +118,5 @@ def lit_defines(shadow_filter, pcf_taps, specular_model, depth_format="FLOAT32",
     d.update(enum_defines("SHADOW_MODE", SHADOW_MODES))
     d["JITTER_SIZE"] = JITTER_SIZE
     d["DISK_SAMPLES"] = disk_samples if shadow_filter in ("JITTER", "PCSS") else 8
-    d["EARLY_OUT"] = bool(early_out)
+    d["EARLY_OUT"] = bool(early_out) or shadow_filter not in ("JITTER", "PCSS")  # no variant for others
     return d

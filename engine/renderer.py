@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import kernels
+from .extract import Material
 from .kernels import RING
 from .post import PostContext, PostStack
 from .programs import (
@@ -323,10 +324,7 @@ class Renderer:
                 shader.uniform_float("model", model)
                 for mat_index, batch in parts:
                     mat = inst.materials[mat_index] if 0 <= mat_index < len(inst.materials) else None
-                    if mat is None:
-                        from .extract import Material
-
-                        mat = Material()
+                    mat = mat or DEFAULT_MATERIAL
                     shader.uniform_float("base_color", tuple(mat.base_color))
                     shader.uniform_float("material", (mat.roughness, mat.specular, mat.metallic, 0.0))
                     batch.draw(shader)
@@ -346,6 +344,7 @@ class Renderer:
         return FrameOutput(color, self._depth, self._shadow, stats, width, height)
 
 
+DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
 MAX_FILTER_RADIUS = 32.0  # texels: the widest JITTER/PCSS kernel
 
 
