@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from devkit import load_penumbra  # noqa: E402  (needs the sys.path entries above)
+from devkit import eevee_id, load_penumbra  # noqa: E402  (needs the sys.path entries above)
 from scenes import demo_scene  # noqa: E402
 
 EEVEE_SAMPLES = 16
@@ -46,15 +46,6 @@ CSV_FIELDS = ["engine", "median_s", "min_s", "ratio_to_penumbra", "runs", "width
 
 
 # --- engine set-up ------------------------------------------------------------------------
-
-
-def eevee_id():
-    """EEVEE's engine id on this Blender: 'BLENDER_EEVEE_NEXT' (4.2-4.5) or 'BLENDER_EEVEE' (5.x)."""
-    items = {item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items}
-    for candidate in ("BLENDER_EEVEE_NEXT", "BLENDER_EEVEE"):
-        if candidate in items:
-            return candidate
-    raise RuntimeError(f"no EEVEE engine among {sorted(items)}")
 
 
 def setup_penumbra(scene):

@@ -21,6 +21,17 @@ def load_penumbra():
     return module
 
 
+def eevee_id():
+    """EEVEE's engine id on this Blender: 'BLENDER_EEVEE_NEXT' (4.2-4.5) or 'BLENDER_EEVEE' (5.x)."""
+    import bpy
+
+    items = {item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items}
+    for candidate in ("BLENDER_EEVEE_NEXT", "BLENDER_EEVEE"):
+        if candidate in items:
+            return candidate
+    raise RuntimeError(f"no EEVEE engine among {sorted(items)}")
+
+
 class GpuRunner:
     """Runs ``fn(engine, depsgraph)`` inside a RenderEngine.render() call, where Blender's gpu
     module can draw in background mode. The engine class is built on Penumbra's engine core,

@@ -45,6 +45,7 @@ for _path in (ROOT / "tools", ROOT / "tests"):
 
 import scenes  # noqa: E402
 from analytic import camera_matrices  # noqa: E402
+from devkit import eevee_id  # noqa: E402
 from helpers import render  # noqa: E402
 
 # Part of every cache key: bump it whenever a scene or the measurement changes.
@@ -208,15 +209,6 @@ def scene_light(scene):
 
 
 # --- engines ------------------------------------------------------------------------------
-
-
-def eevee_id():
-    """EEVEE's engine id on this Blender: 'BLENDER_EEVEE_NEXT' (4.2-4.5) or 'BLENDER_EEVEE' (5.x)."""
-    items = {item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items}
-    for candidate in ("BLENDER_EEVEE_NEXT", "BLENDER_EEVEE"):
-        if candidate in items:
-            return candidate
-    raise RuntimeError(f"no EEVEE engine among {sorted(items)}")
 
 
 def configure_cycles(scene, samples=256):

@@ -32,21 +32,6 @@ vec3 bright_sample(vec2 p)
   return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
 }
 
-/* Bilinear read of lens_tex at texel coordinate t (0 = centre of the first texel), clamped. */
-vec3 lens_sample(vec2 t)
-{
-  ivec2 size = textureSize(lens_tex, 0);
-  t = clamp(t, vec2(0.0), vec2(size - 1));
-  ivec2 i0 = ivec2(floor(t));
-  ivec2 i1 = min(i0 + 1, size - 1);
-  vec2 f = t - vec2(i0);
-  vec3 c00 = sanitize(texelFetch(lens_tex, i0, 0)).rgb;
-  vec3 c10 = sanitize(texelFetch(lens_tex, ivec2(i1.x, i0.y), 0)).rgb;
-  vec3 c01 = sanitize(texelFetch(lens_tex, ivec2(i0.x, i1.y), 0)).rgb;
-  vec3 c11 = sanitize(texelFetch(lens_tex, i1, 0)).rgb;
-  return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
-}
-
 void main()
 {
   vec4 c = post_source();
@@ -73,10 +58,10 @@ void main()
 
   vec3 tint;
   if (lens_image != 0) {
-    tint = lens_sample(gl_FragCoord.xy / target_size * vec2(textureSize(lens_tex, 0)) - 0.5);
+    tint = texel_bilinear(lens_tex, gl_FragCoord.xy / target_size * vec2(textureSize(lens_tex, 0)) - 0.5);
   }
   else {
-    tint = lens_sample(vec2(r * float(textureSize(lens_tex, 0).x - 1), 0.0));
+    tint = texel_bilinear(lens_tex, vec2(r * float(textureSize(lens_tex, 0).x - 1), 0.0));
   }
   f *= flare.y * tint;
 
