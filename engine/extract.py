@@ -7,7 +7,7 @@ changed. Matrices, materials, lights and the camera are cheap and read every fra
 
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -31,8 +31,7 @@ class Geometry:
     ranges: list  # (material index, first vertex, vertex count)
     bounds: np.ndarray  # (2, 3) local min/max; NaN when empty
     deps: frozenset = frozenset()
-    serial: int = 0  # distinguishes rebuilt geometry of the same key
-    gpu: dict = field(default_factory=dict)  # GPU batches, filled by the renderer
+    serial: int = 0  # distinguishes rebuilt geometry of the same key (GPU batches key on it)
 
     @property
     def triangle_count(self):

@@ -1,32 +1,38 @@
-"""The scene passes' shader programs and the structs/enums they share with Python.
+"""The scene passes' shader programs and the structs they share with Python.
 
-Sizes, array lengths and enum values are defined here once and reach GLSL as defines and
-generated struct source, so the CPU packing and the shader layout agree by construction.
+Sizes, array lengths and enum values are defined once (here and in ``enums.py``) and reach
+GLSL as defines and generated struct source, so the CPU packing and the shader layout agree
+by construction. Every uniform member is named: no packed vec4 whose meaning lives in a
+comment.
 """
 
 from ..shaders.loader import Program, Struct
+from .enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
 
-LIGHT_TYPES = {"SUN": 0, "POINT": 1, "SPOT": 2, "AREA": 3}
-SHADOW_FILTERS = {"NONE": 0, "HARDWARE": 1, "PCF": 2, "JITTER": 3, "PCSS": 4}
-DEPTH_FORMATS = {"FLOAT32": 0, "FLOAT16": 1, "RGBA8": 2}  # atlas texel encodings
-SHADOW_MODES = {"NONE": -1, "SINGLE": 0, "CUBE": 1}
-SPECULAR_MODELS = {"BLINN": 0, "PHONG": 1}
 MAX_LIGHTS = 64
 MAX_PCF_TAPS = 15 * 15
 MAX_SHADOW_TILES = 48
 JITTER_SIZE = 32  # the jitter texture repeats every 32x32 pixels
 MAX_DISK_SAMPLES = 64
+MAX_FILTER_RADIUS = 32.0  # texels: the widest JITTER/PCSS kernel
 SHADOW_SAMPLER = "shadow_atlas"
 
 LIGHT_STRUCT = Struct(
     "LightData",
     (
-        ("VEC4", "color"),  # rgb: colour * energy * 2^exposure, a: type
-        ("VEC4", "position"),  # xyz, w: radius (soft falloff)
-        ("VEC4", "direction"),  # xyz: where the light points, w: cos(spot_size / 2)
-        ("VEC4", "params"),  # x: spot smooth width, y: shadow mode, z: radius (world), w: tan(sun angle / 2)
-        ("VEC4", "tiles"),  # atlas tile per cube face 0..3 (or x for single maps); -1: no map
-        ("VEC4", "tiles2"),  # tiles of faces 4, 5; z: bias scale
+        ("VEC3", "color"),  # colour * energy * 2^exposure
+        ("INT", "type"),  # LIGHT_*
+        ("VEC3", "position"),
+        ("FLOAT", "radius"),  # soft falloff radius (Blender's shadow_soft_size)
+        ("VEC3", "direction"),  # where the light points
+        ("FLOAT", "spot_cos_half"),  # cos(spot_size / 2); spots only
+        ("FLOAT", "spot_blend_width"),  # (1 - cos(spot_size / 2)) * spot_blend
+        ("INT", "shadow_mode"),  # SHADOW_MODE_*
+        ("FLOAT", "shadow_radius"),  # emitter radius for soft shadows (world units)
+        ("FLOAT", "sun_tan_half_angle"),  # tan(sun angle / 2)
+        ("IVEC4", "tiles"),  # atlas tile of cube faces 0..3 (x: the single map); -1: none
+        ("IVEC2", "tiles_45"),  # atlas tiles of cube faces 4, 5
+        ("FLOAT", "bias_scale"),  # light.penumbra.bias_scale
     ),
 )
 
@@ -37,7 +43,10 @@ TILE_STRUCT = Struct(
     (
         ("MAT4", "view"),
         ("MAT4", "proj_tex"),
-        ("VEC4", "range"),  # x: near, y: far, z: texel world size (ortho), w: texel size per distance
+        ("FLOAT", "near"),
+        ("FLOAT", "far"),
+        ("FLOAT", "texel"),  # world size of a texel (orthographic maps)
+        ("FLOAT", "texel_per_distance"),  # world size of a texel per unit of distance (perspective)
     ),
 )
 
@@ -46,24 +55,33 @@ FRAME_STRUCT = Struct(
     (
         ("MAT4", "view_proj"),
         ("MAT4", "view"),
-        ("VEC4", "camera_position"),  # xyz, w: 1 for orthographic
-        ("VEC4", "camera_forward"),
-        ("VEC4", "world_color"),
-        ("VEC4", "counts"),  # x: light count
-        ("VEC4", "shadow_params"),  # x: constant bias, y: slope bias, z: normal offset, w: spacing
-        ("VEC4", "shadow_size"),  # x: tile size in texels, y: atlas columns, z: disk samples
-        ("VEC4", "filter_params"),  # x: filter radius (texels), y: max penumbra (texels)
+        ("VEC3", "camera_position"),
+        ("INT", "is_ortho"),
+        ("VEC3", "camera_forward"),
+        ("INT", "light_count"),
+        ("VEC3", "world_color"),
+        ("FLOAT", "constant_bias"),  # texels
+        ("FLOAT", "slope_bias"),  # texels per unit of tan(angle)
+        ("FLOAT", "normal_offset"),  # texels
+        ("FLOAT", "pcf_spacing"),  # texels between PCF taps
+        ("FLOAT", "filter_radius"),  # JITTER radius, texels
+        ("FLOAT", "max_filter_radius"),  # widest disk kernel, texels
+        ("INT", "tile_size"),  # texels per side of a shadow tile
+        ("INT", "atlas_columns"),  # tiles per atlas row
     ),
 )
 
-TAP_STRUCT = Struct("PcfTap", (("VEC4", "v"),))  # xy: texel offset, z: weight
+TAP_STRUCT = Struct("PcfTap", (("VEC2", "offset"), ("FLOAT", "weight")))  # offset in texels
 
 MESH_VERTEX_IN = (("VEC3", "pos"), ("VEC3", "nor"))
 
-
-def enum_defines(prefix, mapping):
-    return {f"{prefix}_{k}": v for k, v in mapping.items()}
-
+_ENUM_DEFINES = {
+    **DEPTH_FORMAT.defines(),
+    **LIGHT_TYPE.defines(),
+    **SHADOW_FILTER.defines(),
+    **SPECULAR_MODEL.defines(),
+    **SHADOW_MODE.defines(),
+}
 
 LIT = Program(
     name="lit",
@@ -76,7 +94,7 @@ LIT = Program(
         ("smooth", "VEC3", "v_normal"),
         ("smooth", "FLOAT", "v_view_depth"),
     ),
-    push_constants=(("MAT4", "model"), ("VEC4", "base_color"), ("VEC4", "material")),
+    push_constants=(("MAT4", "model"), ("VEC4", "base_color"), ("FLOAT", "roughness"), ("FLOAT", "specular"), ("FLOAT", "metallic")),
     samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex")),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
@@ -85,6 +103,7 @@ LIT = Program(
         (TILE_STRUCT, "shadow_tiles", MAX_SHADOW_TILES),
     ),
     outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth"), ("FLOAT", "out_shadow")),
+    defines=tuple({**_ENUM_DEFINES, "JITTER_SIZE": JITTER_SIZE}.items()),
 )
 
 SHADOW_DEPTH = Program(
@@ -97,26 +116,23 @@ SHADOW_DEPTH = Program(
     push_constants=(("MAT4", "model"),),
     uniform_blocks=((TILE_STRUCT, "tile", 0),),
     outputs=(("VEC4", "out_depth"),),
+    defines=tuple(DEPTH_FORMAT.defines().items()),
 )
 
 
 def depth_defines(depth_format):
-    d = enum_defines("DEPTH", DEPTH_FORMATS)
-    d["DEPTH_FORMAT"] = f"DEPTH_{depth_format}"
-    return d
+    return {"DEPTH_FORMAT": DEPTH_FORMAT.define(depth_format)}
 
 
 def lit_defines(shadow_filter, pcf_taps, specular_model, depth_format="FLOAT32", disk_samples=16, early_out=True):
-    d = depth_defines(depth_format)
-    d.update(enum_defines("LIGHT", LIGHT_TYPES))
-    d.update(enum_defines("FILTER", SHADOW_FILTERS))
-    d.update(enum_defines("SPECULAR", SPECULAR_MODELS))
-    d["SHADOW_FILTER"] = f"FILTER_{shadow_filter}"
-    d["SPECULAR_MODEL"] = f"SPECULAR_{specular_model}"
-    # Only the PCF variant depends on the tap count; others share one compiled shader.
-    d["PCF_TAPS"] = pcf_taps if shadow_filter == "PCF" else 1
-    d.update(enum_defines("SHADOW_MODE", SHADOW_MODES))
-    d["JITTER_SIZE"] = JITTER_SIZE
-    d["DISK_SAMPLES"] = disk_samples if shadow_filter in ("JITTER", "PCSS") else 8
-    d["EARLY_OUT"] = bool(early_out) or shadow_filter not in ("JITTER", "PCSS")  # no variant for others
-    return d
+    """The lit pass variant's defines. Only what a filter reads varies its variant: the tap
+    count for PCF, the disk size and early-out switch for the disk filters."""
+    filt = SHADOW_FILTER[shadow_filter]
+    return {
+        **depth_defines(depth_format),
+        "SHADOW_FILTER": SHADOW_FILTER.define(shadow_filter),
+        "SPECULAR_MODEL": SPECULAR_MODEL.define(specular_model),
+        "PCF_TAPS": pcf_taps if filt.pcf_taps else 1,
+        "DISK_SAMPLES": disk_samples if filt.disk else 8,
+        "EARLY_OUT": bool(early_out) or not filt.early_out,
+    }

@@ -18,9 +18,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import lightspace
-from .programs import DEPTH_FORMATS, MAX_SHADOW_TILES, SHADOW_DEPTH, TILE_STRUCT, depth_defines
-
-_ATLAS_FORMATS = {"FLOAT32": "R32F", "FLOAT16": "R16F", "RGBA8": "RGBA8"}
+from .enums import DEPTH_FORMAT
+from .programs import MAX_SHADOW_TILES, SHADOW_DEPTH, TILE_STRUCT, depth_defines
 
 
 @dataclass
@@ -33,7 +32,10 @@ class Tile:
         return {
             "view": f.view,
             "proj_tex": lightspace.BIAS_MATRIX @ f.proj,
-            "range": (f.near, f.far, f.texel, f.texel_per_distance),
+            "near": f.near,
+            "far": f.far,
+            "texel": f.texel,
+            "texel_per_distance": f.texel_per_distance,
         }
 
 
@@ -167,7 +169,7 @@ class ShadowAtlas:
         self.size, self.count, self.columns, self.depth_format = size, columns * rows, columns, depth_format
         dims = (columns * size, rows * size)
         # Read with texelFetch only, so the sampler's filter mode never matters.
-        self.texture = gpu.types.GPUTexture(dims, format=_ATLAS_FORMATS[depth_format])
+        self.texture = gpu.types.GPUTexture(dims, format=DEPTH_FORMAT[depth_format].texture)
         self._zbuffer = gpu.types.GPUTexture(dims, format="DEPTH_COMPONENT32F")
         self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self.texture,))
         self._contents = [None] * self.count
@@ -176,8 +178,8 @@ class ShadowAtlas:
     def memory_bytes(self):
         if self.texture is None:
             return 0
-        texel = {"FLOAT32": 4, "FLOAT16": 2, "RGBA8": 4}[self.depth_format]
-        return self.texture.width * self.texture.height * (texel + 4)
+        texel = DEPTH_FORMAT[self.depth_format].bytes
+        return self.texture.width * self.texture.height * (texel + 4)  # + the depth buffer
 
     def free(self):
         self._framebuffer = None
@@ -191,7 +193,7 @@ class ShadowAtlas:
     def _tile_ubo(self, index, data):
         import gpu
 
-        raw = np.ascontiguousarray(data, np.float32).tobytes()
+        raw = data.tobytes()
         while len(self._ubos) <= index:
             self._ubos.append(gpu.types.GPUUniformBuf(raw))
         self._ubos[index].update(raw)
@@ -201,8 +203,6 @@ class ShadowAtlas:
         """Draw every tile of ``plan`` whose content changed. ``draws``: per instance
         (batch, model Matrix, det, identity key); a tile's key is its fit and its casters."""
         import gpu
-
-        from .renderer import pack_struct
 
         shader = shaders.get(SHADOW_DEPTH, depth_defines(self.depth_format))
         with self._framebuffer.bind():
@@ -226,7 +226,7 @@ class ShadowAtlas:
                 gpu.state.depth_test_set("LESS")
                 gpu.state.depth_mask_set(True)
                 shader.bind()
-                shader.uniform_block("tile", self._tile_ubo(index, pack_struct(TILE_STRUCT, [tile.record()])))
+                shader.uniform_block("tile", self._tile_ubo(index, TILE_STRUCT.pack([tile.record()])))
                 for c in tile.casters:
                     batch, model, det, _key = draws[c]
                     if cull_front:
@@ -243,5 +243,3 @@ class ShadowAtlas:
                 stats.passes += 1
                 stats.shadow_maps += 1
 
-
-assert set(_ATLAS_FORMATS) == set(DEPTH_FORMATS)

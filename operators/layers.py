@@ -3,7 +3,8 @@
 import bpy
 from bpy.props import EnumProperty
 
-from ..properties import EFFECT_ITEMS, _redraw
+from ..engine.post import EFFECT_ENUM
+from ..properties import redraw_viewports
 
 
 def _settings(context):
@@ -26,7 +27,7 @@ class _LayerOperator:
     bl_options = {"REGISTER", "UNDO"}
 
     def finish(self, context):
-        _redraw(self, context)
+        redraw_viewports(self, context)
         return {"FINISHED"}
 
     @classmethod
@@ -49,13 +50,13 @@ class PENUMBRA_OT_layer_add(_LayerOperator, bpy.types.Operator):
     bl_idname = "penumbra.layer_add"
     bl_label = "Add Post Layer"
 
-    effect: EnumProperty(name="Effect", items=EFFECT_ITEMS)
+    effect: EnumProperty(name="Effect", items=EFFECT_ENUM.blender_items())
 
     def execute(self, context):
         s = _settings(context)
         layer = s.layers.add()
         layer.effect = self.effect
-        layer.name = layer.bl_rna.properties["effect"].enum_items[self.effect].name
+        layer.name = EFFECT_ENUM[self.effect].label
         new = len(s.layers) - 1
         target = min(s.active_layer_index, new) if len(s.layers) > 1 else 0
         s.layers.move(new, target)

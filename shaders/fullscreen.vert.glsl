@@ -1,6 +1,5 @@
-/* One triangle covering the viewport; uv is 0..1 across the target. */
+/* One triangle covering the viewport; fragment shaders address pixels by gl_FragCoord. */
 void main()
 {
-  uv = pos * 0.5 + 0.5;
   gl_Position = vec4(pos, 0.0, 1.0);
 }

@@ -13,27 +13,25 @@ void main()
   }
   N = (nlen > 1e-30) ? N / nlen : vec3(0.0, 0.0, 1.0);
 
-  vec3 V = (frame.camera_position.w > 0.5) ? -frame.camera_forward.xyz :
-                                             normalize(frame.camera_position.xyz - P);
+  vec3 V = (frame.is_ortho != 0) ? -frame.camera_forward : normalize(frame.camera_position - P);
   if (dot(N, V) < 0.0) {
     N = -N; /* two-sided, as Blender draws meshes */
   }
 
   vec3 base = base_color.rgb;
-  float roughness = clamp(material.x, 0.0, 1.0);
-  float specular = max(material.y, 0.0);
-  float metallic = clamp(material.z, 0.0, 1.0);
-  vec3 albedo = base * (1.0 - metallic);
-  vec3 f0 = mix(vec3(0.08 * specular), base, metallic);
-  float alpha = max(roughness * roughness, 0.02);
+  float rough = clamp(roughness, 0.0, 1.0);
+  float spec_level = max(specular, 0.0);
+  float metal = clamp(metallic, 0.0, 1.0);
+  vec3 albedo = base * (1.0 - metal);
+  vec3 f0 = mix(vec3(0.08 * spec_level), base, metal);
+  float alpha = max(rough * rough, 0.02);
   float shininess = 2.0 / (alpha * alpha) - 2.0;
 
-  vec3 color = albedo * frame.world_color.rgb;
+  vec3 color = albedo * frame.world_color;
   /* Shadow pass: direct light that arrives over direct light that would arrive unshadowed,
    * each light weighted by the luminance of its irradiance here (1 where no light reaches). */
   float arriving = 0.0, unshadowed = 0.0;
-  int light_count = int(frame.counts.x);
-  for (int i = 0; i < light_count; i++) {
+  for (int i = 0; i < frame.light_count; i++) {
     LightData L = lights[i];
     vec3 to_light;
     float irradiance;
@@ -42,7 +40,7 @@ void main()
     if (NdotL <= 0.0 || irradiance <= 0.0) {
       continue;
     }
-    float weight = dot(L.color.rgb, vec3(0.2126, 0.7152, 0.0722)) * irradiance * NdotL;
+    float weight = dot(L.color, vec3(0.2126, 0.7152, 0.0722)) * irradiance * NdotL;
     float visibility = shadow_visibility(L, P, N, NdotL);
     unshadowed += weight;
     arriving += weight * visibility;
@@ -56,7 +54,7 @@ void main()
     vec3 R = reflect(-to_light, N);
     float spec = (shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, V), 0.0), shininess);
 #endif
-    vec3 E = L.color.rgb * (irradiance * NdotL * visibility);
+    vec3 E = L.color * (irradiance * NdotL * visibility);
     color += E * (albedo / M_PI + f0 * spec);
   }
   out_color = vec4(color, 1.0);

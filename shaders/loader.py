@@ -9,34 +9,104 @@ and are compiled the first time a frame needs them, then cached by (program, def
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 SHADER_DIR = Path(__file__).resolve().parent
 
-# Uniform-block structs shared by Python and GLSL. Each is a tuple of (GLSL type, name); only
-# vec4/mat4 members are used so std140 and a packed float32 array agree without padding rules.
-_FLOATS = {"VEC4": 4, "MAT4": 16}
+# Uniform-block member types: (std140 base alignment, size) in bytes, and the numpy kind the
+# packer writes them as.
+_STD140 = {
+    "FLOAT": (4, 4, "f"),
+    "INT": (4, 4, "i"),
+    "VEC2": (8, 8, "f"),
+    "IVEC2": (8, 8, "i"),
+    "VEC3": (16, 12, "f"),
+    "VEC4": (16, 16, "f"),
+    "IVEC4": (16, 16, "i"),
+    "MAT4": (16, 64, "f"),
+}
 
 
 @dataclass(frozen=True)
 class Struct:
+    """A uniform-block struct shared by Python and GLSL: ``fields`` is a tuple of (GLSL type,
+    name). The GLSL declaration and the std140 packing both come from it, so the two agree by
+    construction."""
+
     name: str
     fields: tuple
 
+    def __post_init__(self):
+        for typ, name in self.fields:
+            if typ not in _STD140:
+                raise ValueError(f"{self.name}.{name}: unsupported uniform type {typ}")
+
+    @property
+    def layout(self):
+        """{field: (byte offset, GLSL type)} under std140."""
+        out, off = {}, 0
+        for typ, name in self.fields:
+            align, size, _kind = _STD140[typ]
+            off = (off + align - 1) // align * align
+            out[name] = (off, typ)
+            off += size
+        return out
+
+    @property
+    def stride(self):
+        """Bytes per element in a std140 array (rounded up to 16)."""
+        end = 0
+        for name, (off, typ) in self.layout.items():
+            end = off + _STD140[typ][1]
+        return max(16, (end + 15) // 16 * 16)
+
     @property
     def floats(self):
-        return sum(_FLOATS[t] for t, _ in self.fields)
+        return self.stride // 4
 
     def glsl(self):
         body = "".join(f"  {t.lower()} {n};\n" for t, n in self.fields)
         return f"struct {self.name} {{\n{body}}};\n"
 
-    def offset(self, field):
-        """Float offset of ``field`` inside one packed struct."""
-        off = 0
-        for t, n in self.fields:
-            if n == field:
-                return off
-            off += _FLOATS[t]
-        raise KeyError(field)
+    def pack(self, rows, count=None):
+        """``rows`` (a list of {field: value}) as std140 bytes of ``count`` elements (default:
+        as many as rows, at least one); elements past the rows are zero. Every field of a
+        row must be named in the struct, and every struct field set in every row."""
+        n = max(len(rows), 1) if count is None else count
+        if len(rows) > n:
+            raise ValueError(f"{self.name}: {len(rows)} rows for {n} elements")
+        data = np.zeros((n, self.stride // 4), np.float32)
+        ints = data.view(np.int32)
+        layout = self.layout
+        for i, row in enumerate(rows):
+            missing = set(layout) - set(row)
+            unknown = set(row) - set(layout)
+            if missing or unknown:
+                raise KeyError(f"{self.name}: missing {sorted(missing)}, unknown {sorted(unknown)}")
+            for name, value in row.items():
+                off, typ = layout[name]
+                kind = _STD140[typ][2]
+                v = np.asarray(value, dtype=np.float64)
+                if typ == "MAT4":
+                    v = v.T  # GLSL matrices are column-major
+                v = v.ravel()
+                word = off // 4
+                if kind == "i":
+                    ints[i, word : word + len(v)] = np.rint(v).astype(np.int32)
+                else:
+                    data[i, word : word + len(v)] = v
+        return data
+
+    def unpack(self, data, index, name):
+        """One field of element ``index`` of packed ``data`` (for tests)."""
+        off, typ = self.layout[name]
+        align, size, kind = _STD140[typ]
+        row = np.asarray(data).reshape(-1, self.stride // 4)[index]
+        words = row.view(np.int32) if kind == "i" else row
+        v = words[off // 4 : off // 4 + size // 4].copy()
+        if typ == "MAT4":
+            return v.reshape(4, 4).T
+        return v[0] if len(v) == 1 else v
 
 
 @dataclass(frozen=True)
@@ -54,6 +124,7 @@ class Program:
     samplers: tuple = ()  # (type, name)
     uniform_blocks: tuple = ()  # (Struct, name, array length)
     outputs: tuple = (("VEC4", "out_color"),)
+    defines: tuple = ()  # (name, value) every variant gets: enum values, fixed sizes
 
 
 def _read(rel):
@@ -86,7 +157,7 @@ class ShaderCache:
         return len(self._cache)
 
     def get(self, program, defines=None):
-        defines = tuple(sorted((defines or {}).items()))
+        defines = tuple(sorted({**dict(program.defines), **(defines or {})}.items()))
         key = (program.name, defines)
         shader = self._cache.get(key)
         if shader is None:

@@ -2,6 +2,6 @@
  * selected encoding (float, or the seeds' RGBA8 packing). */
 void main()
 {
-  float d = (v_distance - tile.range.x) / (tile.range.y - tile.range.x);
+  float d = (v_distance - tile.near) / (tile.far - tile.near);
   out_depth = encode_depth(clamp(d, 0.0, 1.0));
 }

@@ -2,6 +2,7 @@
 
 import bpy
 
+from ..engine import settings
 from ..engine.post import EFFECTS
 
 
@@ -13,37 +14,40 @@ class PenumbraPanel:
         return context.scene is not None and context.scene.render.engine in cls.COMPAT_ENGINES
 
 
-class PENUMBRA_PT_shadows(PenumbraPanel, bpy.types.Panel):
-    bl_label = "Shadows"
+def draw_params(layout, group, params, section=None):
+    """One row per declared ``Param`` of ``section`` (all when None), in declaration order,
+    greyed out where the declaration says the current values make it irrelevant."""
+    for p in params:
+        if section is not None and p.section != section:
+            continue
+        row = layout.row()
+        row.active = p.is_active(group, params)
+        row.prop(group, p.name)
+
+
+class _SettingsPanel(PenumbraPanel):
+    """A Render Properties panel drawing one section of the scene settings."""
+
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "render"
+    section = None
 
     def draw(self, context):
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
-        s = context.scene.penumbra
-        layout.prop(s, "shadow_filter")
-        layout.prop(s, "shadow_map_size")
-        layout.prop(s, "shadow_depth_format")
-        layout.prop(s, "shadow_sun_fit")
-        col = layout.column()
-        col.active = s.shadow_filter == "PCF"
-        col.prop(s, "pcf_kernel_size")
-        col.prop(s, "pcf_spacing")
-        col = layout.column()
-        col.active = s.shadow_filter in {"JITTER", "PCSS"}
-        col.prop(s, "shadow_samples")
-        sub = col.column()
-        sub.active = s.shadow_filter == "JITTER"
-        sub.prop(s, "shadow_filter_radius")
-        sub.prop(s, "shadow_early_out")
-        col = layout.column(align=True)
-        col.prop(s, "shadow_bias")
-        col.prop(s, "shadow_slope_bias")
-        col.prop(s, "shadow_normal_offset")
-        layout.prop(s, "shadow_cull_front")
+        draw_params(layout, context.scene.penumbra, settings.SCENE_PARAMS, self.section)
+
+
+class PENUMBRA_PT_shadows(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Shadows"
+    section = settings.SHADOWS
+
+
+class PENUMBRA_PT_lighting(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Lighting"
+    section = settings.LIGHTING
 
 
 class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
@@ -63,20 +67,7 @@ class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
         layout.prop(context.light, "use_shadow")
         col = layout.column()
         col.active = context.light.use_shadow
-        col.prop(context.light.penumbra, "bias_scale")
-
-
-class PENUMBRA_PT_lighting(PenumbraPanel, bpy.types.Panel):
-    bl_label = "Lighting"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
-    bl_context = "render"
-
-    def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
-        layout.prop(context.scene.penumbra, "specular_model")
+        draw_params(col, context.light.penumbra, settings.LIGHT_PARAMS)
 
 
 class PENUMBRA_UL_layers(bpy.types.UIList):
@@ -119,9 +110,7 @@ def draw_layer_stack(layout, context):
         box.use_property_split = True
         box.use_property_decorate = False
         box.prop(layer, "mix", slider=True)
-        params = layer.params()
-        for p in EFFECTS[layer.effect].params:
-            box.prop(params, p.name)
+        draw_params(box, layer.params(), EFFECTS[layer.effect].params)
 
 
 class PENUMBRA_PT_sidebar_layers(PenumbraPanel, bpy.types.Panel):

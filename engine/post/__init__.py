@@ -1,28 +1,42 @@
 """Screen-space post-process layers.
 
-Every effect is one module here (exposing ``EFFECT``, a ``PostEffect`` subclass) plus one GLSL
-file in ``shaders/post/``, with one interface: it declares its parameters as data (``Param``),
-and ``execute(ctx, src, params, mix)`` returns the texture holding its result. The layer
-properties and the sidebar UI are generated from the declarations, so adding an effect is one
-module, one shader and one name in ``MODULES``.
+Every effect is one module here (a ``PostEffect`` subclass declaring its parameters as
+``settings.Param`` rows, its numpy reference beside it) plus one GLSL file in
+``shaders/post/``. Layer properties, the sidebar UI, presets and the contract tests are
+generated from the registry below: adding an effect is one module, one shader and one row.
 """
 
-import importlib
+from ..enums import Enum
+from . import blur, colorizer, fisheye, glow, lens_flare, noise, pixelate, scanlines, sepia, vignette
+from .base import Layer, PostContext, PostEffect, PostStack
 
-from .base import Param, PostContext, PostEffect, PostStack
+# (stored number, effect). The number is what a .blend saves for a layer's effect: never
+# reuse or change one. Order = order of the "add layer" menu.
+REGISTRY = (
+    (0, blur.Blur),
+    (1, glow.Glow),
+    (2, scanlines.Scanlines),
+    (3, vignette.Vignette),
+    (4, colorizer.Colorizer),
+    (5, fisheye.Fisheye),
+    (6, pixelate.Pixelate),
+    (7, sepia.Sepia),
+    (8, noise.Noise),
+    (9, lens_flare.LensFlare),
+)
 
-# Order = order of the "add layer" menu.
-MODULES = ("blur", "glow", "scanlines", "vignette", "colorizer", "fisheye", "pixelate", "sepia", "noise", "lens_flare")
+EFFECTS = {cls.id: cls for _number, cls in REGISTRY}
+
+EFFECT_ENUM = Enum(
+    "post effect",
+    "EFFECT",
+    tuple((cls.id, cls.label, cls.description, number, cls.icon) for number, cls in REGISTRY),
+)
 
 
-def _load():
-    effects = {}
-    for name in MODULES:
-        module = importlib.import_module(f".{name}", __name__)
-        effects[module.EFFECT.id] = module.EFFECT
-    return effects
+def post_stack():
+    """A PostStack over the registered effects."""
+    return PostStack(EFFECTS)
 
 
-EFFECTS = _load()
-
-__all__ = ["EFFECTS", "MODULES", "Param", "PostContext", "PostEffect", "PostStack"]
+__all__ = ["EFFECTS", "EFFECT_ENUM", "REGISTRY", "Layer", "PostContext", "PostEffect", "PostStack", "post_stack"]

@@ -1,56 +1,47 @@
-"""The post stack's shared machinery: parameter declarations, render targets, the stack."""
+"""The post stack's shared machinery: the effect interface, render targets, the stack."""
 
+from collections import namedtuple
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 
-from ...shaders.loader import Program, set_uniforms
+import numpy as np
+
+from ...shaders.loader import Program, Struct, set_uniforms
+from .. import kernels
+from ..settings import values
+
+# One layer of a frame's stack, as the renderer receives it (``params``: a namespace of the
+# effect's parameter values, or None for a disabled layer).
+Layer = namedtuple("Layer", ("effect", "enabled", "mix", "params"))
 
 
-@dataclass(frozen=True)
-class Param:
-    """One effect parameter; properties and UI are generated from these."""
-
-    name: str
-    type: str  # 'FLOAT' | 'INT' | 'BOOL' | 'COLOR' | 'ENUM' | 'IMAGE' (an Image datablock or None)
-    default: object
-    description: str = ""
-    min: float = None
-    max: float = None
-    soft_max: float = None
-    subtype: str = "NONE"
-    items: tuple = ()  # for ENUM: (identifier, label, description)
-
-    @property
-    def label(self):
-        return self.name.replace("_", " ").title()
-
-
-def post_program(name, fragment, push_constants=(), samplers=(), uniform_blocks=()):
-    """A full-screen program; every post fragment shader gets ``source_tex`` and ``mix_factor``."""
+def post_program(name, fragment, push_constants=(), samplers=(), uniform_blocks=(), defines=()):
+    """A full-screen program; every post fragment shader gets ``source_tex``, ``mix_factor``
+    and ``target_size``. ``defines``: constants every variant gets (e.g. an enum's values)."""
     return Program(
         name=name,
         vertex="fullscreen.vert.glsl",
         fragment=fragment,
         libs=("lib/common.glsl", "lib/post_common.glsl"),
         vertex_in=(("VEC2", "pos"),),
-        varyings=(("smooth", "VEC2", "uv"),),
         push_constants=(("FLOAT", "mix_factor"), ("VEC2", "target_size")) + tuple(push_constants),
         samplers=(("FLOAT_2D", "source_tex"),) + tuple(samplers),
         uniform_blocks=tuple(uniform_blocks),
+        defines=tuple(dict(defines).items()),
     )
 
 
 class PostEffect:
-    """Base of every effect. Subclasses set the class attributes and implement ``execute``."""
+    """Base of every effect. Subclasses set the class attributes and implement ``execute``.
+
+    ``execute`` receives parameters already clamped to their declared ranges (``values``), so
+    an effect never repeats a ``Param``'s limits."""
 
     id = ""
     label = ""
     icon = "NONE"
     description = ""
     params = ()
-
-    def resize(self, width, height):
-        """Allocate size-dependent resources (most effects use the context's pool instead)."""
 
     def is_identity(self, params):
         """True when these parameters leave the image unchanged, so the layer costs no pass."""
@@ -62,6 +53,43 @@ class PostEffect:
     @classmethod
     def defaults(cls):
         return SimpleNamespace(**{p.name: p.default for p in cls.params})
+
+    @classmethod
+    def values(cls, source):
+        """The parameters read from ``source`` (a layer's PropertyGroup or a namespace),
+        clamped to their declared ranges, enum ids validated."""
+        return SimpleNamespace(**values(cls.params, source))
+
+
+# Normalised 1-D Gaussian weights as a uniform block, shared by the blurring effects.
+GAUSSIAN_MAX_RADIUS = 256
+GAUSSIAN_WEIGHTS = Struct("GaussianWeights", (("VEC4", "w"),))
+GAUSSIAN_VEC4S = (2 * GAUSSIAN_MAX_RADIUS + 1 + 3) // 4
+
+
+class GaussianWeights:
+    """The uniform buffer of ``kernels.gaussian_1d(radius, sigma)``, re-uploaded only when the
+    kernel changes. Owned by one effect instance."""
+
+    def __init__(self):
+        self._ubo = None
+        self._key = None
+
+    def get(self, radius, sigma=None):
+        import gpu
+
+        radius = min(int(radius), GAUSSIAN_MAX_RADIUS)
+        key = (radius, sigma)
+        if key != self._key:
+            packed = np.zeros(GAUSSIAN_VEC4S * 4, np.float32)
+            w = kernels.gaussian_1d(radius, sigma)
+            packed[: len(w)] = w
+            if self._ubo is None:
+                self._ubo = gpu.types.GPUUniformBuf(packed.tobytes())
+            else:
+                self._ubo.update(packed.tobytes())
+            self._key = key
+        return self._ubo
 
 
 @dataclass
@@ -138,27 +166,30 @@ class PostContext:
 class PostStack:
     """Runs the enabled layers top to bottom; owns one effect instance per layer slot."""
 
-    def __init__(self):
+    def __init__(self, effects=None):
+        if effects is None:
+            from . import EFFECTS as effects
+        self._classes = effects  # id -> PostEffect subclass
         self._effects = {}
 
     def effect(self, slot, effect_id):
-        from . import EFFECTS
-
         key = (slot, effect_id)
         eff = self._effects.get(key)
         if eff is None:
-            eff = EFFECTS[effect_id]()
+            if effect_id not in self._classes:
+                raise ValueError(f"unknown post effect {effect_id!r}; expected one of {', '.join(self._classes)}")
+            eff = self._classes[effect_id]()
             self._effects[key] = eff
         return eff
 
     def run(self, ctx, src, layers):
-        """``layers``: [(effect id, enabled, mix, params namespace)] in stack order."""
+        """``layers``: [Layer] (or equal tuples) in stack order."""
         for slot, (effect_id, enabled, mix, params) in enumerate(layers):
             if not enabled or mix <= 0.0:
                 continue
             eff = self.effect(slot, effect_id)
+            params = eff.values(params)
             if eff.is_identity(params):
                 continue
-            eff.resize(ctx.width, ctx.height)
             src = eff.execute(ctx, src, params, min(float(mix), 1.0))
         return src

@@ -20,8 +20,10 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from .base import Param, PostEffect, post_program
-from .blur import MAX_RADIUS, Blur
+from ..settings import Param
+from .base import PostEffect, post_program
+from .base import GAUSSIAN_MAX_RADIUS
+from .blur import Blur
 
 PROGRAM = post_program(
     "post_colorizer",
@@ -82,7 +84,7 @@ class Colorizer(PostEffect):
     description = "Recolour through a lookup image indexed by blurred luminance and distance to the centre"
     params = (
         Param("image", "IMAGE", None, "Lookup image (x: luminance, y: centre to corners); empty uses a built-in grade"),
-        Param("blur_radius", "INT", 2, "Blur of the luminance before the lookup, in pixels; 0 = none", min=0, max=MAX_RADIUS, soft_max=32),
+        Param("blur_radius", "INT", 2, "Blur of the luminance before the lookup, in pixels; 0 = none", min=0, max=GAUSSIAN_MAX_RADIUS, soft_max=32),
         Param("strength", "FLOAT", 1.0, "Blend between the original colour (0) and the lookup colour (1)", min=0.0, max=1.0, subtype="FACTOR"),
     )
 
@@ -91,7 +93,7 @@ class Colorizer(PostEffect):
         self._default_lut = None
 
     def is_identity(self, params):
-        return float(params.strength) <= 0.0
+        return params.strength <= 0.0
 
     def _lut_texture(self, image):
         import gpu
@@ -106,15 +108,14 @@ class Colorizer(PostEffect):
         return self._default_lut
 
     def execute(self, ctx, src, params, mix):
-        radius = min(max(int(params.blur_radius), 0), MAX_RADIUS)
         luma = src
-        if radius > 0:
-            luma = self._blur.execute(ctx, src, SimpleNamespace(radius=radius, sigma=0.0), 1.0)
+        if params.blur_radius > 0:
+            luma = self._blur.execute(ctx, src, SimpleNamespace(radius=params.blur_radius, sigma=0.0), 1.0)
         dst = ctx.acquire(src, luma)
         return ctx.fullscreen(
             PROGRAM,
             dst,
             samplers={"source_tex": src, "luma_tex": luma, "lut_tex": self._lut_texture(params.image)},
-            uniforms={"mix_factor": mix, "strength": min(max(float(params.strength), 0.0), 1.0)},
+            uniforms={"mix_factor": mix, "strength": params.strength},
         )
 EFFECT = Colorizer

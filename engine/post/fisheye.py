@@ -11,20 +11,26 @@ filtering; ``edge`` says what lies outside the image (only a pinch reads outside
 
 import numpy as np
 
-from .base import Param, PostEffect, post_program
+from ..enums import Enum
+from ..settings import Param
+from .base import PostEffect, post_program
+
+EDGE = Enum(
+    "fisheye edge",
+    "EDGE",
+    (
+        ("CLAMP", "Clamp", "Repeat the border pixels outside the image", 0),
+        ("BLACK", "Black", "Transparent black (all channels 0) outside the image", 1),
+        ("MIRROR", "Mirror", "Mirror the image at its borders", 2),
+    ),
+)
 
 PROGRAM = post_program(
     "post_fisheye",
     "post/fisheye.frag.glsl",
     push_constants=(("FLOAT", "strength"), ("INT", "edge_mode")),
+    defines=EDGE.defines(),
 )
-
-EDGE_ITEMS = (
-    ("CLAMP", "Clamp", "Repeat the border pixels outside the image"),
-    ("BLACK", "Black", "Transparent black (all channels 0) outside the image"),
-    ("MIRROR", "Mirror", "Mirror the image at its borders"),
-)
-EDGE_MODES = {identifier: i for i, (identifier, _, _) in enumerate(EDGE_ITEMS)}
 
 
 def fisheye_source(x, y, width, height, strength):
@@ -47,11 +53,11 @@ class Fisheye(PostEffect):
     description = "Bulge (positive) or pinch (negative) the image about its centre"
     params = (
         Param("strength", "FLOAT", 0.5, "Positive bulges the centre outwards, negative pinches it; 0 = no change", min=-1.0, max=1.0, subtype="FACTOR"),
-        Param("edge", "ENUM", "CLAMP", "What a pinch shows beyond the image borders", items=EDGE_ITEMS),
+        Param("edge", "ENUM", "CLAMP", "What a pinch shows beyond the image borders", enum=EDGE),
     )
 
     def is_identity(self, params):
-        return float(params.strength) == 0.0
+        return params.strength == 0.0
 
     def execute(self, ctx, src, params, mix):
         return ctx.single_pass(
@@ -59,8 +65,8 @@ class Fisheye(PostEffect):
             src,
             mix,
             uniforms={
-                "strength": min(max(float(params.strength), -1.0), 1.0),
-                "edge_mode": EDGE_MODES.get(params.edge, 0),
+                "strength": params.strength,
+                "edge_mode": EDGE.value(params.edge),
             },
         )
 

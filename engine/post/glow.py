@@ -9,17 +9,21 @@ the bright-pass energy times ``intensity``.
 
 import numpy as np
 
-from .. import kernels
-from .base import Param, PostEffect, post_program
-from .blur import MAX_RADIUS, WEIGHT_VEC4S, WEIGHTS
+from ..settings import Param
+from .base import GAUSSIAN_MAX_RADIUS, GAUSSIAN_VEC4S, GAUSSIAN_WEIGHTS, GaussianWeights, PostEffect, post_program
 
 PROGRAM = post_program(
     "post_glow",
     "post/glow.frag.glsl",
-    # glow = (threshold, knee in colour units, intensity, square samples 0/1)
-    push_constants=(("VEC4", "glow"), ("INT", "radius")),
+    push_constants=(
+        ("FLOAT", "threshold"),
+        ("FLOAT", "knee"),  # in colour units
+        ("FLOAT", "intensity"),
+        ("INT", "square_samples"),
+        ("INT", "radius"),
+    ),
     samplers=(("FLOAT_2D", "input_tex"),),
-    uniform_blocks=((WEIGHTS, "weights", WEIGHT_VEC4S),),
+    uniform_blocks=((GAUSSIAN_WEIGHTS, "weights", GAUSSIAN_VEC4S),),
 )
 
 
@@ -49,46 +53,33 @@ class Glow(PostEffect):
         Param("threshold", "FLOAT", 1.0, "Brightness (largest RGB component) above which pixels glow", min=0.0, soft_max=10.0),
         Param("knee", "FLOAT", 0.5, "Softness of the threshold as a fraction of it: 0 is a hard cut, 1 fades in from black", min=0.0, max=1.0, subtype="FACTOR"),
         Param("intensity", "FLOAT", 0.5, "Scale of the glow added to the image; 0 turns the layer off", min=0.0, soft_max=4.0),
-        Param("radius", "INT", 16, "Blur half-width in pixels (clamped to 256); sigma is radius / 2", min=0, max=MAX_RADIUS, soft_max=64),
+        Param("radius", "INT", 16, "Blur half-width in pixels; sigma is radius / 2", min=0, max=GAUSSIAN_MAX_RADIUS, soft_max=64),
         Param("square_samples", "BOOL", False, "Square each bright-pass sample before blurring: favours the strongest highlights"),
     )
 
     def __init__(self):
-        self._ubo = None
-        self._radius = None
+        self._weights = GaussianWeights()
 
     def is_identity(self, params):
-        return float(params.intensity) <= 0.0
-
-    def _weights(self, radius):
-        """Upload the Gaussian weights when the radius changed."""
-        import gpu
-
-        if radius == self._radius:
-            return
-        packed = np.zeros(WEIGHT_VEC4S * 4, np.float32)
-        w = kernels.gaussian_1d(radius)
-        packed[: len(w)] = w
-        if self._ubo is None:
-            self._ubo = gpu.types.GPUUniformBuf(packed.tobytes())
-        else:
-            self._ubo.update(packed.tobytes())
-        self._radius = radius
+        return params.intensity <= 0.0
 
     def execute(self, ctx, src, params, mix):
-        radius = min(max(int(params.radius), 0), MAX_RADIUS)
-        self._weights(radius)
-        threshold = max(float(params.threshold), 0.0)
-        knee = threshold * min(max(float(params.knee), 0.0), 1.0)
-        glow = (threshold, knee, float(params.intensity), 1.0 if params.square_samples else 0.0)
+        ubo = self._weights.get(params.radius)
+        uniforms = {
+            "threshold": params.threshold,
+            "knee": params.threshold * params.knee,  # in colour units
+            "intensity": params.intensity,
+            "square_samples": int(params.square_samples),
+            "radius": params.radius,
+        }
         tmp = ctx.acquire(src)
         ctx.fullscreen(
             PROGRAM,
             tmp,
             defines={"GLOW_COMPOSITE": False},
             samplers={"source_tex": src, "input_tex": src},
-            uniforms={"glow": glow, "radius": radius, "mix_factor": 1.0},
-            blocks={"weights": self._ubo},
+            uniforms={**uniforms, "mix_factor": 1.0},
+            blocks={"weights": ubo},
         )
         dst = ctx.acquire(src, tmp.texture)
         return ctx.fullscreen(
@@ -96,7 +87,9 @@ class Glow(PostEffect):
             dst,
             defines={"GLOW_COMPOSITE": True},
             samplers={"source_tex": src, "input_tex": tmp.texture},
-            uniforms={"glow": glow, "radius": radius, "mix_factor": mix},
-            blocks={"weights": self._ubo},
+            uniforms={**uniforms, "mix_factor": mix},
+            blocks={"weights": ubo},
         )
+
+
 EFFECT = Glow

@@ -38,30 +38,39 @@ layer in every mode; a flare that is empty because nothing exceeds the threshold
 
 import numpy as np
 
-from .base import Param, PostEffect, post_program
+from ..enums import Enum
+from ..settings import Param
+from .base import PostEffect, post_program
+
+MERGE = Enum(
+    "lens flare merge",
+    "MERGE",
+    (
+        ("ADD", "Add", "Input plus flare", 0),
+        ("SCREEN", "Screen", "1 - (1 - input)(1 - flare) on values clamped to >= 0; meant for display-range values", 1),
+        ("AVERAGE", "Average", "(input + flare) / 2", 2),
+        ("DIFFERENCE", "Difference", "|input - flare|", 3),
+    ),
+)
 
 PROGRAM = post_program(
     "post_lens_flare",
     "post/lens_flare.frag.glsl",
     push_constants=(
-        ("VEC4", "flare"),  # (threshold, intensity, ghost_spacing, unused)
-        ("VEC2", "halo"),  # (halo_radius, halo_width)
+        ("FLOAT", "threshold"),
+        ("FLOAT", "intensity"),
+        ("FLOAT", "ghost_spacing"),
+        ("FLOAT", "halo_radius"),
+        ("FLOAT", "halo_width"),
         ("INT", "ghosts"),
         ("INT", "merge_mode"),
         ("INT", "lens_image"),  # 1: lens_tex is the user's image, 0: the built-in ramp
     ),
     samplers=(("FLOAT_2D", "lens_tex"),),
+    defines=MERGE.defines(),
 )
 
 MAX_GHOSTS = 16
-
-MODE_ITEMS = (
-    ("ADD", "Add", "Input plus flare"),
-    ("SCREEN", "Screen", "1 - (1 - input)(1 - flare) on values clamped to >= 0; meant for display-range values"),
-    ("AVERAGE", "Average", "(input + flare) / 2"),
-    ("DIFFERENCE", "Difference", "|input - flare|"),
-)
-MERGE_MODES = {identifier: i for i, (identifier, _, _) in enumerate(MODE_ITEMS)}
 
 # Built-in lens texture: an RGB ramp from the image centre (first entry) to the corners (last),
 # the warm-to-violet tint of coated lens ghosts.
@@ -105,7 +114,7 @@ class LensFlare(PostEffect):
     params = (
         Param("threshold", "FLOAT", 1.0, "Only colour above this value (per channel) flares", min=0.0, soft_max=10.0),
         Param("intensity", "FLOAT", 1.0, "Brightness of the flare; 0 turns the layer off", min=0.0, soft_max=10.0),
-        Param("mode", "ENUM", "ADD", "How the flare is merged into the image", items=MODE_ITEMS),
+        Param("mode", "ENUM", "ADD", "How the flare is merged into the image", enum=MERGE),
         Param("ghosts", "INT", 4, "Number of ghost images along the line through the centre", min=0, max=MAX_GHOSTS),
         Param("ghost_spacing", "FLOAT", 0.4, "Step between ghosts along the line through the centre", min=0.0, soft_max=2.0),
         Param("halo_radius", "FLOAT", 0.6, "Radius of the halo ring (1 = the image corners)", min=0.0, soft_max=1.5),
@@ -117,8 +126,8 @@ class LensFlare(PostEffect):
         self._ramp = None
 
     def is_identity(self, params):
-        no_flare = int(params.ghosts) <= 0 and float(params.halo_width) <= 0.0
-        return float(params.intensity) <= 0.0 or no_flare
+        no_flare = params.ghosts <= 0 and params.halo_width <= 0.0
+        return params.intensity <= 0.0 or no_flare
 
     def _lens_texture(self, image):
         import gpu
@@ -138,10 +147,13 @@ class LensFlare(PostEffect):
             mix,
             samplers={"lens_tex": self._lens_texture(params.image)},
             uniforms={
-                "flare": (max(float(params.threshold), 0.0), float(params.intensity), float(params.ghost_spacing), 0.0),
-                "halo": (float(params.halo_radius), max(float(params.halo_width), 0.0)),
-                "ghosts": min(max(int(params.ghosts), 0), MAX_GHOSTS),
-                "merge_mode": MERGE_MODES.get(params.mode, 0),
+                "threshold": params.threshold,
+                "intensity": params.intensity,
+                "ghost_spacing": params.ghost_spacing,
+                "halo_radius": params.halo_radius,
+                "halo_width": params.halo_width,
+                "ghosts": params.ghosts,
+                "merge_mode": MERGE.value(params.mode),
                 "lens_image": int(params.image is not None),
             },
         )

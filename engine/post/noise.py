@@ -9,7 +9,8 @@ is untouched. The hash is PCG (O'Neill's permuted congruential output function) 
 the inputs; ``grain_reference`` is its numpy twin.
 """
 
-from .base import Param, PostEffect, post_program
+from ..settings import Param
+from .base import PostEffect, post_program
 
 PROGRAM = post_program(
     "post_noise",
@@ -59,7 +60,7 @@ class Noise(PostEffect):
     )
 
     def is_identity(self, params):
-        return float(params.amount) <= 0.0
+        return params.amount <= 0.0
 
     def execute(self, ctx, src, params, mix):
         return ctx.single_pass(
@@ -67,11 +68,11 @@ class Noise(PostEffect):
             src,
             mix,
             uniforms={
-                "amount": float(params.amount),
-                "grain_size": max(int(params.size), 1),
+                "amount": params.amount,
+                "grain_size": params.size,
                 "frame": int(ctx.frame),
-                "seed": int(params.seed),
-                "monochrome": 1 if params.monochrome else 0,
+                "seed": params.seed,
+                "monochrome": int(params.monochrome),
             },
         )
 

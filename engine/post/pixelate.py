@@ -15,21 +15,37 @@ A cell larger than the image is one cell covering it; sizes are clamped to the i
 larger side, which gives the same result.
 """
 
-from .base import Param, PostEffect, post_program
+from ..enums import Enum
+from ..settings import Param
+from .base import PostEffect, post_program
+
+SAMPLING = Enum(
+    "pixelate sampling",
+    "SAMPLING",
+    (
+        ("CENTER", "Center", "Each cell takes the colour of its centre pixel (sharp, cheap)", 0),
+        ("AVERAGE", "Average", "Each cell takes the mean colour of its pixels (smooth, less shimmer)", 1),
+    ),
+)
+
+# The shader's passes, selected by the PIXELATE_PASS define (see pixelate.frag.glsl).
+PASS = Enum(
+    "pixelate pass",
+    "PASS",
+    (
+        ("CENTER", "Center", "Each pixel takes its cell's centre pixel", 0),
+        ("ROWS", "Rows", "Row means of each cell into a compact grid", 1),
+        ("COLUMNS", "Columns", "Column means of the row means", 2),
+        ("EXPAND", "Expand", "Each pixel takes its cell's mean", 3),
+    ),
+)
 
 PROGRAM = post_program(
     "post_pixelate",
     "post/pixelate.frag.glsl",
     push_constants=(("INT", "cell_size"),),
     samplers=(("FLOAT_2D", "input_tex"),),
-)
-
-# PIXELATE_PASS values (see pixelate.frag.glsl).
-PASS_CENTER, PASS_ROWS, PASS_COLUMNS, PASS_EXPAND = 0, 1, 2, 3
-
-SAMPLING_ITEMS = (
-    ("CENTER", "Center", "Each cell takes the colour of its centre pixel (sharp, cheap)"),
-    ("AVERAGE", "Average", "Each cell takes the mean colour of its pixels (smooth, less shimmer)"),
+    defines=PASS.defines(),
 )
 
 
@@ -40,29 +56,29 @@ class Pixelate(PostEffect):
     description = "Mosaic of square cells of one colour"
     params = (
         Param("size", "INT", 8, "Cell width in pixels; 1 leaves the image unchanged", min=1, soft_max=64),
-        Param("sampling", "ENUM", "AVERAGE", "How a cell's colour is chosen", items=SAMPLING_ITEMS),
+        Param("sampling", "ENUM", "AVERAGE", "How a cell's colour is chosen", enum=SAMPLING),
     )
 
     def is_identity(self, params):
-        return int(params.size) <= 1
+        return params.size <= 1
 
     def execute(self, ctx, src, params, mix):
-        size = min(int(params.size), max(ctx.width, ctx.height))
+        size = min(params.size, max(ctx.width, ctx.height))
 
         def run(pass_id, target, input_tex, mix_factor):
             return ctx.fullscreen(
                 PROGRAM,
                 target,
-                defines={"PIXELATE_PASS": pass_id},
+                defines={"PIXELATE_PASS": PASS.define(pass_id)},
                 samplers={"source_tex": src, "input_tex": input_tex},
                 uniforms={"mix_factor": mix_factor, "cell_size": size},
             )
 
         if params.sampling == "CENTER":
-            return run(PASS_CENTER, ctx.acquire(src), src, mix)
+            return run("CENTER", ctx.acquire(src), src, mix)
         rows = ctx.acquire(src)
-        run(PASS_ROWS, rows, src, 1.0)
+        run("ROWS", rows, src, 1.0)
         cells = ctx.acquire(src, rows.texture)
-        run(PASS_COLUMNS, cells, rows.texture, 1.0)
-        return run(PASS_EXPAND, ctx.acquire(src, cells.texture), cells.texture, mix)
+        run("COLUMNS", cells, rows.texture, 1.0)
+        return run("EXPAND", ctx.acquire(src, cells.texture), cells.texture, mix)
 EFFECT = Pixelate

@@ -9,13 +9,21 @@ its centre is inside one.
 """
 
 
-from .base import Param, PostEffect, post_program
+from ..settings import Param
+from .base import PostEffect, post_program
 
 PROGRAM = post_program(
     "post_scanlines",
     "post/scanlines.frag.glsl",
     # scan = (periods per pixel, thickness, intensity, offset in periods in [0, 1))
-    push_constants=(("VEC4", "scan"), ("INT", "line_count"), ("INT", "antialias")),
+    push_constants=(
+        ("FLOAT", "periods_per_pixel"),
+        ("FLOAT", "thickness"),
+        ("FLOAT", "intensity"),
+        ("FLOAT", "scroll"),  # offset in periods
+        ("INT", "line_count"),
+        ("INT", "antialias"),
+    ),
 )
 
 
@@ -61,23 +69,20 @@ class Scanlines(PostEffect):
     )
 
     def is_identity(self, params):
-        return float(params.intensity) <= 0.0 or float(params.thickness) <= 0.0
+        return params.intensity <= 0.0 or params.thickness <= 0.0
 
     def execute(self, ctx, src, params, mix):
-        scan = (
-            max(int(params.count), 1) / ctx.height,
-            min(max(float(params.thickness), 0.0), 1.0),
-            float(params.intensity),
-            scroll_offset(ctx.frame, params.scroll_speed),
-        )
         return ctx.single_pass(
             PROGRAM,
             src,
             mix,
             uniforms={
-                "scan": scan,
-                "line_count": max(int(params.count), 1),
-                "antialias": 1 if params.antialias else 0,
+                "periods_per_pixel": params.count / ctx.height,
+                "thickness": params.thickness,
+                "intensity": params.intensity,
+                "scroll": scroll_offset(ctx.frame, params.scroll_speed),
+                "line_count": params.count,
+                "antialias": int(params.antialias),
             },
         )
 

@@ -5,7 +5,8 @@ any reference share one set of constants. Values are not clamped (the stack is H
 maps to (1.351, 1.203, 0.937).
 """
 
-from .base import Param, PostEffect, post_program
+from ..settings import Param
+from .base import PostEffect, post_program
 
 # Rows give R', G', B' from (R, G, B).
 SEPIA_MATRIX = (
@@ -31,11 +32,11 @@ class Sepia(PostEffect):
     )
 
     def is_identity(self, params):
-        return float(params.amount) <= 0.0
+        return params.amount <= 0.0
 
     def execute(self, ctx, src, params, mix):
         rows = {f"sepia_{ch}": (*row, 0.0) for ch, row in zip("rgb", SEPIA_MATRIX)}
-        return ctx.single_pass(PROGRAM, src, mix, uniforms={"amount": min(float(params.amount), 1.0), **rows})
+        return ctx.single_pass(PROGRAM, src, mix, uniforms={"amount": params.amount, **rows})
 
 
 EFFECT = Sepia

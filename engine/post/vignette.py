@@ -1,11 +1,12 @@
 """VIGNETTE: darkens (or tints) the image towards its edges."""
 
-from .base import Param, PostEffect, post_program
+from ..settings import Param
+from .base import PostEffect, post_program
 
 PROGRAM = post_program(
     "post_vignette",
     "post/vignette.frag.glsl",
-    push_constants=(("VEC4", "vignette_color"), ("VEC4", "shape")),
+    push_constants=(("VEC4", "vignette_color"), ("FLOAT", "radius"), ("FLOAT", "softness"), ("FLOAT", "roundness")),
 )
 
 
@@ -48,7 +49,9 @@ class Vignette(PostEffect):
             mix,
             uniforms={
                 "vignette_color": (*params.color[:3], 1.0),
-                "shape": (params.radius, params.softness, params.roundness, 0.0),
+                "radius": params.radius,
+                "softness": params.softness,
+                "roundness": params.roundness,
             },
         )
 

@@ -6,36 +6,35 @@
  *   point/spot        E = P / (4 pi) * cos / (d^2 + r^2)   (soft falloff)
  *   spot  mask        smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) * blend))
  *   area  (far field) E = P / pi * cos * cos_emitter / d^2
- * Outgoing diffuse radiance is albedo / pi * E; the colour in LightData already holds
+ * Outgoing diffuse radiance is albedo / pi * E; LightData.color already holds
  * colour * energy * 2^exposure. */
 
 /* Direction towards the light and the irradiance it delivers on a surface facing it. */
 void light_incident(LightData L, vec3 P, out vec3 to_light, out float irradiance)
 {
-  int type = int(L.color.a);
-  if (type == LIGHT_SUN) {
-    to_light = -L.direction.xyz;
+  if (L.type == LIGHT_SUN) {
+    to_light = -L.direction;
     irradiance = 1.0;
     return;
   }
-  vec3 d = L.position.xyz - P;
+  vec3 d = L.position - P;
   float dist2 = dot(d, d);
   to_light = d * inversesqrt(max(dist2, 1e-30));
-  float r = L.position.w;
-  if (type == LIGHT_AREA) {
-    float cos_emit = max(dot(-to_light, L.direction.xyz), 0.0);
+  float r = L.radius;
+  if (L.type == LIGHT_AREA) {
+    float cos_emit = max(dot(-to_light, L.direction), 0.0);
     irradiance = cos_emit / (M_PI * max(dist2, 1e-30));
     return;
   }
   irradiance = 1.0 / (4.0 * M_PI * max(dist2 + r * r, 1e-30));
-  if (type == LIGHT_SPOT) {
-    float cos_a = dot(-to_light, L.direction.xyz);
-    float t = cos_a - L.direction.w;
+  if (L.type == LIGHT_SPOT) {
+    float cos_a = dot(-to_light, L.direction);
+    float t = cos_a - L.spot_cos_half;
     if (t <= 0.0) {
       irradiance = 0.0;
     }
-    else if (L.params.x > 0.0) {
-      float s = saturate(t / L.params.x);
+    else if (L.spot_blend_width > 0.0) {
+      float s = saturate(t / L.spot_blend_width);
       irradiance *= s * s * (3.0 - 2.0 * s);
     }
   }

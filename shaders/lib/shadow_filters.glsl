@@ -3,18 +3,18 @@
 
 /* Shadow visibility of world point P for light L (1 = lit, 0 = shadowed).
  *
- * Every map is a square tile of shadow_atlas (frame.shadow_size.x texels wide, shadow_size.y
+ * Every map is a square tile of shadow_atlas (frame.tile_size texels wide, frame.atlas_columns
  * tiles to a row) described by shadow_tiles[i]: its light view, its projection to texture
  * space and its linear depth range. Stored depth is the distance along the light's view axis,
  * normalised to [near, far], so every light type compares and biases the same way.
  *
  * Bias is in texels of the map at the receiver, so one setting holds at every scene scale:
- *   normal offset  moves P along N by shadow_params.z texels * sin(theta)
- *   constant       shadow_params.x texels of depth
- *   slope-scaled   shadow_params.y texels * tan(theta) * max(1, filter radius), tan clamped
+ *   normal offset  moves P along N by frame.normal_offset texels * sin(theta)
+ *   constant       frame.constant_bias texels of depth
+ *   slope-scaled   frame.slope_bias texels * tan(theta) * max(1, filter radius), tan clamped
  *                  to 60 (89 degrees): a filter reading texels r away sees the tilted receiver r times
  *                  deeper, so its slope bias grows with r (receiver-plane reasoning)
- * scaled per light by tiles2.z (light.penumbra.bias_scale). */
+ * scaled per light by LightData.bias_scale (light.penumbra.bias_scale). */
 
 int cube_face(vec3 d)
 {
@@ -32,7 +32,7 @@ int cube_face(vec3 d)
  * the tile are lit: nothing was fitted to cast there. */
 float shadow_tap(ivec2 origin, ivec2 st, float ref)
 {
-  int size = int(frame.shadow_size.x);
+  int size = frame.tile_size;
   if (st.x < 0 || st.y < 0 || st.x >= size || st.y >= size) {
     return 1.0;
   }
@@ -42,7 +42,7 @@ float shadow_tap(ivec2 origin, ivec2 st, float ref)
 
 float shadow_depth_at(ivec2 origin, ivec2 st)
 {
-  int size = int(frame.shadow_size.x);
+  int size = frame.tile_size;
   st = clamp(st, ivec2(0), ivec2(size - 1));
   return decode_depth(texelFetch(shadow_atlas, origin + st, 0));
 }
@@ -88,33 +88,33 @@ float shadow_disk(ivec2 origin, vec2 st, float ref, float r)
 
 float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
 {
-  int mode = int(L.params.y);
+  int mode = L.shadow_mode;
   if (mode == SHADOW_MODE_NONE) {
     return 1.0;
   }
   int tile;
   if (mode == SHADOW_MODE_SINGLE) {
-    tile = int(L.tiles.x);
+    tile = L.tiles.x;
   }
   else {
-    int face = cube_face(P - L.position.xyz);
-    tile = int((face < 4) ? L.tiles[face] : L.tiles2[face - 4]);
+    int face = cube_face(P - L.position);
+    tile = (face < 4) ? L.tiles[face] : L.tiles_45[face - 4];
   }
   if (tile < 0) {
     return 1.0; /* a cube face with no caster in reach was not rendered */
   }
   ShadowTile T = shadow_tiles[tile];
-  float near = T.range.x, far = T.range.y;
+  float near = T.near, far = T.far;
   float depth_scale = 1.0 / (far - near);
-  float bias_scale = L.tiles2.z;
+  float bias_scale = L.bias_scale;
 
   float cos_t = clamp(NdotL, 1e-4, 1.0);
   float sin_t = sqrt(1.0 - cos_t * cos_t);
   float tan_t = min(sin_t / cos_t, 60.0);
   float dist = max(-(T.view * vec4(P, 1.0)).z, 0.0);
-  float texel = T.range.z + T.range.w * dist;
+  float texel = T.texel + T.texel_per_distance * dist;
 
-  vec3 Po = P + N * (frame.shadow_params.z * bias_scale * texel * sin_t);
+  vec3 Po = P + N * (frame.normal_offset * bias_scale * texel * sin_t);
   vec4 vp = T.view * vec4(Po, 1.0);
   vec4 t = T.proj_tex * vp;
   if (t.w <= 0.0) {
@@ -122,15 +122,15 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
   }
   vec2 uv = t.xy / t.w;
   float receiver = -vp.z;
-  float constant_bias = frame.shadow_params.x * bias_scale * texel;
-  float slope_bias = frame.shadow_params.y * bias_scale * texel * tan_t;
+  float constant_bias = frame.constant_bias * bias_scale * texel;
+  float slope_bias = frame.slope_bias * bias_scale * texel * tan_t;
   /* Reference depth for a filter that reads texels up to r away. */
 #define SHADOW_REF(r) ((receiver - constant_bias - slope_bias * max(1.0, (r)) - near) * depth_scale)
   if (SHADOW_REF(0.0) >= 1.0) {
     return 1.0;
   }
-  int size = int(frame.shadow_size.x);
-  int columns = int(frame.shadow_size.y);
+  int size = frame.tile_size;
+  int columns = frame.atlas_columns;
   ivec2 origin = ivec2(tile % columns, tile / columns) * size;
   vec2 st = uv * float(size);
 
@@ -140,25 +140,25 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
   return shadow_bilinear(origin, st, SHADOW_REF(1.0));
 #elif SHADOW_FILTER == FILTER_PCF
   float lit = 0.0;
-  float spacing = frame.shadow_params.w;
+  float spacing = frame.pcf_spacing;
   float ref = SHADOW_REF(floor(sqrt(float(PCF_TAPS)) * 0.5) * spacing);
   for (int i = 0; i < PCF_TAPS; i++) {
-    vec4 tap = pcf_taps[i].v;
-    lit += tap.z * shadow_tap(origin, ivec2(floor(st + tap.xy * spacing)), ref);
+    PcfTap tap = pcf_taps[i];
+    lit += tap.weight * shadow_tap(origin, ivec2(floor(st + tap.offset * spacing)), ref);
   }
   return lit;
 #elif SHADOW_FILTER == FILTER_JITTER
-  float r = frame.filter_params.x;
+  float r = frame.filter_radius;
   return shadow_disk(origin, st, SHADOW_REF(r), r);
 #elif SHADOW_FILTER == FILTER_PCSS
   /* 1. Blocker search: average depth of the texels that occlude P, over the region a light of
    *    this size can shadow P from. 2. Penumbra width from similar triangles: sun
    *    w = (d_r - d_b) * 2 tan(angle / 2); local light w = 2 r (d_r - d_b) / d_b.
    *    3. Disk PCF of that width: hard at contact, soft far from the caster, as in Cycles. */
-  bool sun = int(L.color.a) == LIGHT_SUN;
-  float max_r = frame.filter_params.y;
-  float search_world = sun ? (receiver - near) * 2.0 * L.params.w :
-                             2.0 * L.params.z * (receiver - near) / max(receiver, 1e-30);
+  bool sun = L.type == LIGHT_SUN;
+  float max_r = frame.max_filter_radius;
+  float search_world = sun ? (receiver - near) * 2.0 * L.sun_tan_half_angle :
+                             2.0 * L.shadow_radius * (receiver - near) / max(receiver, 1e-30);
   float search = clamp(0.5 * search_world / texel, 1.0, max_r);
   float ref = SHADOW_REF(search);
   float blockers = 0.0, blocker_sum = 0.0;
@@ -173,8 +173,8 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
     return 1.0;
   }
   float blocker = near + (blocker_sum / blockers) * (far - near);
-  float width = sun ? (receiver - blocker) * 2.0 * L.params.w :
-                      2.0 * L.params.z * (receiver - blocker) / max(blocker, 1e-30);
+  float width = sun ? (receiver - blocker) * 2.0 * L.sun_tan_half_angle :
+                      2.0 * L.shadow_radius * (receiver - blocker) / max(blocker, 1e-30);
   float r = clamp(0.5 * width / texel, 0.5, max_r);
   return shadow_disk(origin, st, SHADOW_REF(r), r);
 #else

@@ -1,9 +1,5 @@
-/* Radial bulge/pinch; the mapping is fisheye.py's fisheye_source. edge_mode: 0 clamp, 1 black,
- * 2 mirror. */
-
-#define EDGE_CLAMP 0
-#define EDGE_BLACK 1
-#define EDGE_MIRROR 2
+/* Radial bulge/pinch; the mapping is fisheye.py's fisheye_source. edge_mode is one of the
+ * EDGE_* values generated from fisheye.py's EDGE enum. */
 
 /* Texel index i of an axis of n texels, folded back into the image (clamp or mirrored repeat). */
 int edge_index(int i, int n)

@@ -1,5 +1,4 @@
 /* GLOW, one of two passes (see glow.py; the bright-pass reference is glow.bright_pass).
- * glow = (threshold, knee, intensity, square samples 0/1).
  * GLOW_COMPOSITE 0: horizontal blur of the bright-passed source -> rgb, alpha 0.
  * GLOW_COMPOSITE 1: vertical blur of that, added to the source's rgb times intensity.
  * Samples outside the image are clamped to the edge, as in blur.frag.glsl. */
@@ -9,10 +8,9 @@ vec3 bright_pass(vec3 c)
 {
   c = max(c, vec3(0.0));
   float b = max(c.r, max(c.g, c.b));
-  float knee = glow.y;
-  float soft = clamp(b - glow.x + knee, 0.0, 2.0 * knee);
+  float soft = clamp(b - threshold + knee, 0.0, 2.0 * knee);
   soft = soft * soft / (4.0 * knee + 1e-5);
-  float contribution = max(soft, b - glow.x) / max(b, 1e-5);
+  float contribution = max(soft, b - threshold) / max(b, 1e-5);
   return c * contribution;
 }
 
@@ -33,7 +31,7 @@ void main()
     vec3 s = sanitize(texelFetch(input_tex, q, 0)).rgb;
 #if !GLOW_COMPOSITE
     s = bright_pass(s);
-    if (glow.w > 0.5) {
+    if (square_samples != 0) {
       s *= s;
     }
 #endif
@@ -41,7 +39,7 @@ void main()
   }
 #if GLOW_COMPOSITE
   vec4 c = post_source();
-  out_color = post_mix(vec4(c.rgb + glow.z * acc, c.a));
+  out_color = post_mix(vec4(c.rgb + intensity * acc, c.a));
 #else
   out_color = vec4(acc, 0.0);
 #endif

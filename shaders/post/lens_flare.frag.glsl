@@ -1,12 +1,7 @@
 /* Ghosts and halo from the bright parts of the input, merged into it; lens_flare.py defines the
  * flare and the merge modes exactly.
- * flare = (threshold, intensity, ghost_spacing, unused); halo = (radius, width), radii in units
- * of the half-diagonal. merge_mode: 0 add, 1 screen, 2 average, 3 difference. */
-
-#define MERGE_ADD 0
-#define MERGE_SCREEN 1
-#define MERGE_AVERAGE 2
-#define MERGE_DIFFERENCE 3
+ * halo_radius and halo_width are in units of the half-diagonal; merge_mode is one of the
+ * MERGE_* values generated from lens_flare.py's MERGE enum. */
 
 /* Bright pass of one input texel; black outside the image. */
 vec3 bright_texel(ivec2 i, ivec2 size)
@@ -14,7 +9,7 @@ vec3 bright_texel(ivec2 i, ivec2 size)
   if (any(lessThan(i, ivec2(0))) || any(greaterThanEqual(i, size))) {
     return vec3(0.0);
   }
-  return max(sanitize(texelFetch(source_tex, i, 0)).rgb - flare.x, vec3(0.0));
+  return max(sanitize(texelFetch(source_tex, i, 0)).rgb - threshold, vec3(0.0));
 }
 
 /* Bilinear read of the bright pass at position p in pixels (texel centres at i + 0.5). */
@@ -43,16 +38,16 @@ void main()
 
   vec3 f = vec3(0.0);
   for (int i = 0; i < ghosts; i++) {
-    vec2 q = centre + u * (flare.z * float(i) - 1.0);
+    vec2 q = centre + u * (ghost_spacing * float(i) - 1.0);
     float a = 1.0 - saturate(length(q - centre) / diag);
     f += (a * a * a) * bright_sample(q);
   }
-  if (halo.y > 0.0) {
-    float t = saturate(1.0 - abs(r - halo.x) / halo.y);
+  if (halo_width > 0.0) {
+    float t = saturate(1.0 - abs(r - halo_radius) / halo_width);
     float ring = t * t * (3.0 - 2.0 * t);
     if (ring > 0.0) {
       vec2 dir = (dist > 0.0) ? u / dist : vec2(0.0);
-      f += ring * bright_sample(centre + dir * (halo.x * diag - dist));
+      f += ring * bright_sample(centre + dir * (halo_radius * diag - dist));
     }
   }
 
@@ -63,7 +58,7 @@ void main()
   else {
     tint = texel_bilinear(lens_tex, vec2(r * float(textureSize(lens_tex, 0).x - 1), 0.0));
   }
-  f *= flare.y * tint;
+  f *= intensity * tint;
 
   vec3 merged;
   if (merge_mode == MERGE_SCREEN) {

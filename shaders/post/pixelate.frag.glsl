@@ -1,20 +1,20 @@
-/* PIXELATE, one pass selected by PIXELATE_PASS (see pixelate.py):
- * 0 CENTER:  each pixel takes its cell's centre pixel of source_tex.
- * 1 ROWS:    pixel (i, y) of a compact grid = mean of cell column i's pixels in row y of
+/* PIXELATE, one pass selected by PIXELATE_PASS, one of pixelate.py's PASS_* values:
+ * CENTER:  each pixel takes its cell's centre pixel of source_tex.
+ * ROWS:    pixel (i, y) of a compact grid = mean of cell column i's pixels in row y of
  *            input_tex (the source); pixels beyond the grid write 0.
- * 2 COLUMNS: pixel (i, j) = mean of rows of cell j in input_tex (the ROWS result).
- * 3 EXPAND:  each pixel takes its cell's value from input_tex (the COLUMNS result).
+ * COLUMNS: pixel (i, j) = mean of rows of cell j in input_tex (the ROWS result).
+ * EXPAND:  each pixel takes its cell's value from input_tex (the COLUMNS result).
  * Cells are anchored at pixel (0, 0); partial edge cells use the pixels that exist. */
 void main()
 {
   ivec2 size = textureSize(source_tex, 0);
   ivec2 p = ivec2(gl_FragCoord.xy);
   ivec2 cells = (size + cell_size - 1) / cell_size;
-#if PIXELATE_PASS == 0
+#if PIXELATE_PASS == PASS_CENTER
   ivec2 origin = (p / cell_size) * cell_size;
   ivec2 n = min(ivec2(cell_size), size - origin);
   out_color = post_mix(sanitize(texelFetch(source_tex, origin + n / 2, 0)));
-#elif PIXELATE_PASS == 1
+#elif PIXELATE_PASS == PASS_ROWS
   if (p.x >= cells.x) {
     out_color = vec4(0.0);
     return;
@@ -26,7 +26,7 @@ void main()
     acc += sanitize(texelFetch(input_tex, ivec2(x, p.y), 0));
   }
   out_color = acc / float(x1 - x0);
-#elif PIXELATE_PASS == 2
+#elif PIXELATE_PASS == PASS_COLUMNS
   if (p.x >= cells.x || p.y >= cells.y) {
     out_color = vec4(0.0);
     return;

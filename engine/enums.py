@@ -1,0 +1,169 @@
+"""Every enum of Penumbra, each with one owner: id, label, description, the number stored in
+.blend files and used in GLSL, and the facts other code asks about ("uses PCF taps").
+
+No bpy, no gpu. Properties, shader defines, panels and tests all read these objects, so an id
+is typed once. Looking up an unknown id raises ``ValueError``: nothing falls back silently.
+
+Numbers are explicit and never reused: Blender stores an EnumProperty as its number, so
+items can be reordered or relabelled without changing what a saved file means.
+"""
+
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+
+@dataclass(frozen=True)
+class Item:
+    id: str
+    label: str
+    description: str
+    value: int  # stored in .blend files and compared in GLSL
+    icon: str = "NONE"
+    facts: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
+
+    def __getattr__(self, name):
+        # Facts read as attributes: SHADOW_FILTER["PCF"].pcf_taps. Unknown facts are errors.
+        facts = object.__getattribute__(self, "facts")
+        if name in facts:
+            return facts[name]
+        raise AttributeError(f"{self.id} has no fact {name!r}")
+
+
+class Enum:
+    """An ordered set of items. ``prefix`` names the GLSL defines (``FILTER_PCF``)."""
+
+    def __init__(self, name, prefix, items, fact_defaults=None):
+        self.name = name
+        self.prefix = prefix
+        defaults = dict(fact_defaults or {})
+        built = []
+        for row in items:
+            ident, label, description, value, *rest = row
+            icon = rest[0] if rest and isinstance(rest[0], str) else "NONE"
+            facts = {**defaults, **(rest[-1] if rest and isinstance(rest[-1], dict) else {})}
+            unknown = set(facts) - set(defaults)
+            if unknown:
+                raise ValueError(f"{name}: {ident} declares undeclared facts {sorted(unknown)}")
+            built.append(Item(ident, label, description, int(value), icon, MappingProxyType(facts)))
+        self.items = tuple(built)
+        self._by_id = {item.id: item for item in self.items}
+        if len(self._by_id) != len(self.items):
+            raise ValueError(f"{name}: duplicate ids")
+        if len({item.value for item in self.items}) != len(self.items):
+            raise ValueError(f"{name}: duplicate numbers")
+
+    def __getitem__(self, ident):
+        try:
+            return self._by_id[ident]
+        except (KeyError, TypeError):
+            raise ValueError(f"unknown {self.name} {ident!r}; expected one of {', '.join(self.ids)}") from None
+
+    def __contains__(self, ident):
+        return ident in self._by_id
+
+    def __iter__(self):
+        return iter(self.items)
+
+    def __len__(self):
+        return len(self.items)
+
+    @property
+    def ids(self):
+        return tuple(item.id for item in self.items)
+
+    def value(self, ident):
+        return self[ident].value
+
+    def with_fact(self, fact):
+        """Ids of the items whose ``fact`` is true."""
+        return frozenset(item.id for item in self.items if item.facts[fact])
+
+    def define(self, ident):
+        """The GLSL name of ``ident`` (``FILTER_PCF``), validated."""
+        return f"{self.prefix}_{self[ident].id}"
+
+    def defines(self):
+        """{``PREFIX_ID``: number} for every item, for shader sources."""
+        return {f"{self.prefix}_{item.id}": item.value for item in self.items}
+
+    def blender_items(self):
+        """EnumProperty items ``(id, label, description, icon, number)``."""
+        return tuple((i.id, i.label, i.description, i.icon, i.value) for i in self.items)
+
+
+SHADOW_FILTER = Enum(
+    "shadow filter",
+    "FILTER",
+    (
+        ("NONE", "None", "One depth comparison per pixel: hard, aliased edges", 0),
+        ("HARDWARE", "Hardware 2x2", "Bilinear-weighted 2x2 comparison, as a filtering compare sampler gives", 1),
+        ("PCF", "PCF", "Percentage-closer filtering with an NxN Gaussian-weighted kernel", 2, {"pcf_taps": True}),
+        (
+            "JITTER",
+            "Jittered Disk",
+            "Disk samples jittered per pixel, with an early out where the outer ring agrees",
+            3,
+            {"disk": True, "fixed_radius": True, "early_out": True},
+        ),
+        (
+            "PCSS",
+            "PCSS",
+            "Contact-hardening soft shadows: penumbra width from the light's size and the blocker distance",
+            4,
+            {"disk": True, "early_out": True},
+        ),
+    ),
+    # pcf_taps: reads the NxN kernel; disk: reads the jittered disk (shadow_samples);
+    # fixed_radius: its width is shadow_filter_radius; early_out: honours shadow_early_out.
+    fact_defaults={"pcf_taps": False, "disk": False, "fixed_radius": False, "early_out": False},
+)
+
+DEPTH_FORMAT = Enum(
+    "depth format",
+    "DEPTH",
+    (
+        ("FLOAT32", "Float 32", "32-bit float depth", 0, {"texture": "R32F", "bytes": 4}),
+        ("FLOAT16", "Float 16", "16-bit float depth: half the memory, less precision", 1, {"texture": "R16F", "bytes": 2}),
+        ("RGBA8", "RGBA8 Packed", "Depth packed into four 8-bit channels (the classic encoding)", 2, {"texture": "RGBA8", "bytes": 4}),
+    ),
+    fact_defaults={"texture": None, "bytes": 0},
+)
+
+SPECULAR_MODEL = Enum(
+    "specular model",
+    "SPECULAR",
+    (
+        ("BLINN", "Blinn-Phong", "Normalised Blinn-Phong highlight (half vector)", 0),
+        ("PHONG", "Phong", "Normalised Phong highlight (reflection vector)", 1),
+    ),
+)
+
+SUN_FIT = Enum(
+    "sun fit",
+    "SUN_FIT",
+    (
+        ("VIEW", "View", "Fit sun maps to what the camera sees: sharpest, redrawn when the view changes the fit", 0),
+        ("SCENE", "Scene", "Fit sun maps to the whole scene: never redrawn for camera moves, coarser in large scenes", 1),
+    ),
+)
+
+LIGHT_TYPE = Enum(
+    "light type",
+    "LIGHT",
+    (
+        ("SUN", "Sun", "Directional light", 0),
+        ("POINT", "Point", "Omnidirectional point light", 1),
+        ("SPOT", "Spot", "Cone light", 2),
+        ("AREA", "Area", "Emitting surface (shaded as a far-field point)", 3),
+    ),
+)
+
+SHADOW_MODE = Enum(
+    "shadow mode",
+    "SHADOW_MODE",
+    (
+        ("NONE", "None", "No shadow map", -1),
+        ("SINGLE", "Single", "One map (sun, spot)", 0),
+        ("CUBE", "Cube", "Up to six cube faces (point, area)", 1),
+    ),
+)

@@ -1,0 +1,106 @@
+"""The lit pass's uniform data for one frame, built in numpy: no bpy, no gpu.
+
+``build_frame_data`` turns the snapshot's lights, the camera, the settings and the shadow plan
+into the packed uniform blocks and shader defines the lit pass binds, so what a frame sends
+to the GPU is unit-tested without one.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import kernels
+from .enums import LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
+from .kernels import RING
+from .programs import (
+    FRAME_STRUCT,
+    LIGHT_STRUCT,
+    MAX_DISK_SAMPLES,
+    MAX_FILTER_RADIUS,
+    MAX_LIGHTS,
+    MAX_PCF_TAPS,
+    MAX_SHADOW_TILES,
+    TAP_STRUCT,
+    TILE_STRUCT,
+    lit_defines,
+)
+
+
+@dataclass
+class FrameData:
+    frame: np.ndarray  # FRAME_STRUCT, packed
+    lights: np.ndarray  # MAX_LIGHTS x LIGHT_STRUCT
+    tiles: np.ndarray  # MAX_SHADOW_TILES x TILE_STRUCT
+    taps: np.ndarray  # MAX_PCF_TAPS x TAP_STRUCT
+    defines: dict  # the lit pass variant
+    disk_samples: int  # jittered-disk samples the variant reads
+
+
+def disk_samples(settings):
+    """``shadow_samples`` rounded down to whole rings, within [RING, MAX_DISK_SAMPLES]."""
+    return int(np.clip(int(settings.shadow_samples) // RING * RING, RING, MAX_DISK_SAMPLES))
+
+
+def light_row(light, shadow=None):
+    """One LIGHT_STRUCT row. ``shadow``: the light's ``shadows.LightShadow`` or None."""
+    half = 0.5 * min(max(light.spot_size, 0.0), math.pi)
+    cos_half = math.cos(half)
+    tiles = (list(shadow.tiles) if shadow else []) + [-1] * 6
+    return {
+        "color": light.color,
+        "type": LIGHT_TYPE.value(light.type),
+        "position": light.position,
+        "radius": light.radius,
+        "direction": light.direction,
+        "spot_cos_half": cos_half if light.type == "SPOT" else -2.0,
+        "spot_blend_width": (1.0 - cos_half) * max(light.spot_blend, 0.0),
+        "shadow_mode": SHADOW_MODE.value(shadow.mode if shadow else "NONE"),
+        "shadow_radius": light.shadow_radius,
+        "sun_tan_half_angle": math.tan(0.5 * min(max(light.angle, 0.0), math.pi * 0.99)),
+        "tiles": tiles[:4],
+        "tiles_45": tiles[4:6],
+        "bias_scale": light.bias_scale,
+    }
+
+
+def frame_row(camera, world_color, light_count, settings, tile_size, atlas_columns):
+    return {
+        "view_proj": camera.projection @ camera.view,
+        "view": camera.view,
+        "camera_position": camera.position,
+        "is_ortho": int(camera.is_ortho),
+        "camera_forward": camera.forward,
+        "light_count": light_count,
+        "world_color": np.asarray(world_color, np.float64)[:3],
+        "constant_bias": settings.shadow_bias,
+        "slope_bias": settings.shadow_slope_bias,
+        "normal_offset": settings.shadow_normal_offset,
+        "pcf_spacing": settings.pcf_spacing,
+        "filter_radius": settings.shadow_filter_radius,
+        "max_filter_radius": MAX_FILTER_RADIUS,
+        "tile_size": tile_size,
+        "atlas_columns": atlas_columns,
+    }
+
+
+def build_frame_data(lights, camera, world_color, settings, plan, tile_size=1, atlas_columns=1, depth_format="FLOAT32"):
+    """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
+    lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
+    the atlas the plan was drawn into (1/1 when no map was drawn)."""
+    if len(lights) > MAX_LIGHTS:
+        raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
+    filt = SHADOW_FILTER[settings.shadow_filter]
+    disk = disk_samples(settings)
+    taps = kernels.pcf_kernel(settings.pcf_kernel_size) if filt.pcf_taps else np.array([[0.0, 0.0, 1.0]])
+    tap_rows = [{"offset": t[:2], "weight": t[2]} for t in taps]
+    return FrameData(
+        frame=FRAME_STRUCT.pack([frame_row(camera, world_color, len(lights), settings, tile_size, atlas_columns)]),
+        lights=LIGHT_STRUCT.pack([light_row(lt, plan.lights.get(i)) for i, lt in enumerate(lights)], MAX_LIGHTS),
+        tiles=TILE_STRUCT.pack([t.record() for t in plan.tiles], MAX_SHADOW_TILES),
+        taps=TAP_STRUCT.pack(tap_rows, MAX_PCF_TAPS),
+        defines=lit_defines(
+            settings.shadow_filter, len(taps), settings.specular_model, depth_format, disk, settings.shadow_early_out
+        ),
+        disk_samples=disk,
+    )

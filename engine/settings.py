@@ -1,0 +1,267 @@
+"""Every Penumbra setting, declared once as data. No bpy.
+
+A ``Param`` row (name, type, default, range, description, where it shows) is the one place a
+setting is written. From these rows come:
+  * the PropertyGroups ``scene.penumbra`` and ``light.penumbra`` (``properties.py``),
+  * the plain ``RenderSettings`` the renderer reads (``render_settings`` below),
+  * the panels (``ui/panels.py`` draws the rows of each section in order),
+  * the post layers' parameters (each effect declares its own rows, ``engine/post``).
+
+Saved files are versioned: ``SCHEMA_VERSION`` is stored with the settings, and ``UPGRADES``
+lists, per version, the steps that bring older stored values forward (a renamed setting keeps
+its value). ``properties.py`` runs them when a file is loaded.
+"""
+
+import dataclasses
+from dataclasses import dataclass
+
+from .enums import DEPTH_FORMAT, SHADOW_FILTER, SPECULAR_MODEL, SUN_FIT
+
+TYPES = ("FLOAT", "INT", "BOOL", "COLOR", "ENUM", "IMAGE")
+
+
+@dataclass(frozen=True)
+class Param:
+    """One setting. ``min``/``max`` are hard limits (the property refuses values outside and
+    ``clamp`` applies them to values from any other source); ``soft_*`` only guide sliders."""
+
+    name: str
+    type: str  # one of TYPES; IMAGE is an Image datablock or None
+    default: object
+    description: str = ""
+    min: float = None
+    max: float = None
+    soft_min: float = None
+    soft_max: float = None
+    step: int = None  # Blender's slider step (for INT: the increment)
+    subtype: str = "NONE"
+    enum: object = None  # ENUM: the owning enums.Enum
+    label: str = None
+    section: str = None  # panel section it is drawn in; None: not drawn by the generic panels
+    active_when: tuple = None  # (other param, fact): greyed out unless enum[other].fact is true
+
+    def __post_init__(self):
+        if self.type not in TYPES:
+            raise ValueError(f"{self.name}: unknown parameter type {self.type!r}")
+        if self.type == "ENUM":
+            if self.enum is None:
+                raise ValueError(f"{self.name}: an ENUM parameter needs its enum")
+            self.enum[self.default]  # noqa: B018  (validates the default id)
+
+    @property
+    def ui_label(self):
+        return self.label or self.name.replace("_", " ").title()
+
+    @property
+    def items(self):
+        """EnumProperty items of an ENUM parameter."""
+        return self.enum.blender_items() if self.enum is not None else ()
+
+    @property
+    def slider_max(self):
+        """The largest value a user is expected to dial in (hard max, else soft max)."""
+        return self.max if self.max is not None else self.soft_max
+
+    def clamp(self, value):
+        """``value`` as the renderer may use it: numbers within [min, max], enum ids
+        validated (an unknown id raises ValueError), colours as tuples."""
+        if self.type == "FLOAT":
+            v = float(value)
+            if self.min is not None:
+                v = max(v, float(self.min))
+            if self.max is not None:
+                v = min(v, float(self.max))
+            return v
+        if self.type == "INT":
+            v = int(value)
+            if self.min is not None:
+                v = max(v, int(self.min))
+            if self.max is not None:
+                v = min(v, int(self.max))
+            return v
+        if self.type == "BOOL":
+            return bool(value)
+        if self.type == "COLOR":
+            return tuple(float(c) for c in value)
+        if self.type == "ENUM":
+            return self.enum[value].id
+        return value  # IMAGE
+
+    def is_active(self, group, params):
+        """Whether a panel shows this row as active, given the values of ``group`` (whose
+        declarations are ``params``)."""
+        if self.active_when is None:
+            return True
+        other, fact = self.active_when
+        enum = next(p.enum for p in params if p.name == other)
+        return bool(getattr(enum[getattr(group, other)], fact))
+
+
+def values(params, source):
+    """{name: clamped value} of ``params`` read from ``source`` (a PropertyGroup or any
+    object with those attributes)."""
+    return {p.name: p.clamp(getattr(source, p.name)) for p in params}
+
+
+# --- scene settings (scene.penumbra) ------------------------------------------------------
+
+SHADOWS = "shadows"
+LIGHTING = "lighting"
+
+SCENE_PARAMS = (
+    Param("shadow_filter", "ENUM", "PCF", "How shadow edges are filtered", enum=SHADOW_FILTER, section=SHADOWS),
+    Param(
+        "shadow_map_size", "INT", 2048, "Texels per side of each shadow map (clamped to the GPU's maximum)",
+        min=1, soft_max=8192, section=SHADOWS,
+    ),
+    Param("shadow_depth_format", "ENUM", "FLOAT32", "How shadow depth is stored", enum=DEPTH_FORMAT, section=SHADOWS),
+    Param("shadow_sun_fit", "ENUM", "VIEW", "What a sun's shadow map covers", enum=SUN_FIT, label="Sun Fit", section=SHADOWS),
+    Param(
+        "pcf_kernel_size", "INT", 5, "Width N of the NxN PCF kernel (made odd)",
+        min=1, max=15, label="PCF Kernel", section=SHADOWS, active_when=("shadow_filter", "pcf_taps"),
+    ),
+    Param(
+        "pcf_spacing", "FLOAT", 1.0, "Distance between PCF taps, in texels",
+        min=0.0, soft_max=8.0, label="PCF Spacing", section=SHADOWS, active_when=("shadow_filter", "pcf_taps"),
+    ),
+    Param(
+        "shadow_samples", "INT", 16, "Samples of the jittered-disk and PCSS filters (rounded down to a multiple of 8)",
+        min=8, max=64, step=8, section=SHADOWS, active_when=("shadow_filter", "disk"),
+    ),
+    Param(
+        "shadow_filter_radius", "FLOAT", 2.0, "Radius of the jittered-disk filter, in shadow-map texels",
+        min=0.0, max=32.0, soft_max=16.0, label="Filter Radius", section=SHADOWS,
+        active_when=("shadow_filter", "fixed_radius"),
+    ),
+    Param(
+        "shadow_early_out", "BOOL", True, "Disk filters: skip the inner samples where the outer ring agrees",
+        label="Early Out", section=SHADOWS, active_when=("shadow_filter", "early_out"),
+    ),
+    Param(
+        "shadow_bias", "FLOAT", 0.5, "Depth bias in shadow-map texels",
+        min=0.0, soft_max=10.0, label="Constant Bias", section=SHADOWS,
+    ),
+    Param(
+        "shadow_slope_bias", "FLOAT", 1.0, "Extra depth bias in texels per unit of tan(angle to the light)",
+        min=0.0, soft_max=10.0, label="Slope Bias", section=SHADOWS,
+    ),
+    Param(
+        "shadow_normal_offset", "FLOAT", 1.0, "Offset of the lookup along the surface normal, in texels",
+        min=0.0, soft_max=10.0, label="Normal Offset", section=SHADOWS,
+    ),
+    Param(
+        "shadow_cull_front", "BOOL", False, "Draw only back faces into shadow maps (less acne on closed meshes)",
+        label="Cull Front Faces", section=SHADOWS,
+    ),
+    Param(
+        "specular_model", "ENUM", "BLINN", "Shape of the specular highlight",
+        enum=SPECULAR_MODEL, label="Specular", section=LIGHTING,
+    ),
+)
+
+# --- light settings (light.penumbra) ------------------------------------------------------
+
+LIGHT_PARAMS = (
+    Param(
+        "bias_scale", "FLOAT", 1.0, "Multiplies the scene's shadow biases for this light",
+        min=0.0, soft_max=10.0, section=SHADOWS,
+    ),
+)
+
+
+# --- what the renderer reads --------------------------------------------------------------
+
+RenderSettings = dataclasses.make_dataclass(
+    "RenderSettings",
+    [(p.name, object, dataclasses.field(default=p.default)) for p in SCENE_PARAMS]
+    + [
+        ("film_transparent", bool, dataclasses.field(default=False)),
+        ("frame", int, dataclasses.field(default=1)),
+        ("layers", list, dataclasses.field(default_factory=list)),  # [post.Layer] in stack order
+    ],
+    namespace={"__doc__": "Everything a frame needs from the scene, as plain validated values."},
+)
+RenderSettings.__module__ = __name__
+
+
+def render_settings(source, **extra):
+    """RenderSettings from ``source`` (``scene.penumbra`` or any object carrying the scene
+    settings), validated and clamped; ``extra`` sets the non-declared fields (frame, layers,
+    film_transparent)."""
+    return RenderSettings(**values(SCENE_PARAMS, source), **extra)
+
+
+# --- versioning of saved settings ---------------------------------------------------------
+
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Rename:
+    """A stored setting renamed from ``old`` to ``new``. ``path`` reaches nested groups
+    (``("layers", "*", "blur")``: the blur group of every layer)."""
+
+    old: str
+    new: str
+    path: tuple = ()
+
+    def apply(self, stored):
+        changed = 0
+        for group in _groups_at(stored, self.path):
+            if self.old in group and self.new not in group:
+                group[self.new] = group[self.old]
+                del group[self.old]
+                changed += 1
+        return changed
+
+
+@dataclass(frozen=True)
+class Renumber:
+    """An enum setting whose stored numbers changed: ``{old number: new number}``."""
+
+    name: str
+    mapping: tuple  # ((old, new), ...)
+    path: tuple = ()
+
+    def apply(self, stored):
+        changed = 0
+        table = dict(self.mapping)
+        for group in _groups_at(stored, self.path):
+            if self.name in group and group[self.name] in table:
+                group[self.name] = table[group[self.name]]
+                changed += 1
+        return changed
+
+
+def _groups_at(stored, path):
+    groups = [stored]
+    for key in path:
+        nxt = []
+        for g in groups:
+            if key == "*":
+                nxt.extend(g)
+            elif key in g:
+                nxt.append(g[key])
+        groups = nxt
+    return groups
+
+
+# Version -> steps that bring version - 1 to it. Version 1 is the first versioned layout.
+SCENE_UPGRADES = {1: ()}
+LIGHT_UPGRADES = {1: ()}
+
+
+def upgrade(stored, upgrades, current=SCHEMA_VERSION, key="schema_version"):
+    """Bring the stored settings ``stored`` (a mapping: a Blender IDPropertyGroup or a dict)
+    from their saved version to ``current``. Settings saved before versioning existed count
+    as version 0. Returns (saved version, changes made); a file from a newer version is left
+    alone (its version is returned, so the caller can warn)."""
+    saved = int(stored.get(key, 0))
+    changes = 0
+    if saved > current:
+        return saved, 0
+    for version in range(saved + 1, current + 1):
+        for step in upgrades.get(version, ()):
+            changes += step.apply(stored)
+    stored[key] = current
+    return saved, changes
