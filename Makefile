@@ -1,9 +1,15 @@
-# Penumbra developer commands. See README.md.
+# Penumbra developer commands. See README.md. Tools run as modules from the repository root
+# (python -m tools.<name>), so the dev library devkit/ is importable.
 LINES ?= 5.2 4.5
 DEMO_LINE ?= 5.2
 PYTEST_ARGS ?=
+# make bench                                   frame times of every engine on the demo scene
+# make bench BENCH=post                        cost of each post layer
+# make bench BENCH=shadows ARGS=--quick        shadow error against time (ARGS: that command's options)
+BENCH ?= frame
+ARGS ?=
 
-.PHONY: demo test setup bench zip clean
+.PHONY: demo test lint setup bench zip clean
 
 setup:
 	@for l in $(LINES); do tools/setup.sh $$l || exit 1; done
@@ -11,24 +17,31 @@ setup:
 # Render the demo scene: out/demo.png (display-referred) and out/demo.exr (scene linear).
 demo:
 	tools/setup.sh $(DEMO_LINE)
-	.venv/blender-$(DEMO_LINE)/bin/python tools/demo.py --out out
+	.venv/blender-$(DEMO_LINE)/bin/python -m tools.demo --out out
 
-# The test suite on every supported Blender line (each in its own venv and process).
-test:
+# Lint and format check (ruff, configured in ruff.toml) over the whole repository.
+lint:
+	tools/setup.sh $(DEMO_LINE)
+	.venv/blender-$(DEMO_LINE)/bin/python -m ruff check .
+	.venv/blender-$(DEMO_LINE)/bin/python -m ruff format --check .
+
+# Lint, then the test suite on every supported Blender line (each in its own venv and process).
+test: lint
 	@status=0; for l in $(LINES); do \
 	  tools/setup.sh $$l || exit 1; \
 	  echo "== Blender $$l =="; \
 	  .venv/blender-$$l/bin/python -m pytest -q tests $(PYTEST_ARGS) || status=1; \
 	done; exit $$status
 
+# Benchmarks: python -m tools.bench {frame,post,shadows} (see tools/bench.py).
 bench:
 	tools/setup.sh $(DEMO_LINE)
-	.venv/blender-$(DEMO_LINE)/bin/python tools/benchmark.py --out out
+	.venv/blender-$(DEMO_LINE)/bin/python -m tools.bench $(BENCH) --out out $(ARGS)
 
 # Build the extension zip with Blender's own tool.
 zip:
 	tools/setup.sh $(DEMO_LINE)
-	.venv/blender-$(DEMO_LINE)/bin/python tools/build_extension.py --out out
+	.venv/blender-$(DEMO_LINE)/bin/python -m tools.build_extension --out out
 
 clean:
 	rm -rf out build .pytest_cache

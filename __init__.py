@@ -1,8 +1,7 @@
 """Penumbra: a real-time GLSL render engine with shadow maps and a post-process stack."""
 
-from . import properties
+from . import operators, properties, ui
 from .engine import render_engine
-from . import operators, ui
 
 modules = (properties, render_engine, operators, ui)
 

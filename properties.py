@@ -100,7 +100,10 @@ PENUMBRA_PG_layer = group_class(
     extra={
         "name": StringProperty(update=redraw_viewports, name="Name", description="Layer name shown in the stack"),
         "effect": EnumProperty(
-            update=redraw_viewports, name="Effect", items=EFFECT_ENUM.blender_items(), description="What this layer does"
+            update=redraw_viewports,
+            name="Effect",
+            items=EFFECT_ENUM.blender_items(),
+            description="What this layer does",
         ),
         "enabled": BoolProperty(update=redraw_viewports, name="Enabled", default=True, description="Run this layer"),
         "solo": BoolProperty(

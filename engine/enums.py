@@ -123,8 +123,20 @@ DEPTH_FORMAT = Enum(
     "DEPTH",
     (
         ("FLOAT32", "Float 32", "32-bit float depth", 0, {"texture": "R32F", "bytes": 4}),
-        ("FLOAT16", "Float 16", "16-bit float depth: half the memory, less precision", 1, {"texture": "R16F", "bytes": 2}),
-        ("RGBA8", "RGBA8 Packed", "Depth packed into four 8-bit channels (the classic encoding)", 2, {"texture": "RGBA8", "bytes": 4}),
+        (
+            "FLOAT16",
+            "Float 16",
+            "16-bit float depth: half the memory, less precision",
+            1,
+            {"texture": "R16F", "bytes": 2},
+        ),
+        (
+            "RGBA8",
+            "RGBA8 Packed",
+            "Depth packed into four 8-bit channels (the classic encoding)",
+            2,
+            {"texture": "RGBA8", "bytes": 4},
+        ),
     ),
     fact_defaults={"texture": None, "bytes": 0},
 )
@@ -143,7 +155,12 @@ SUN_FIT = Enum(
     "SUN_FIT",
     (
         ("VIEW", "View", "Fit sun maps to what the camera sees: sharpest, redrawn when the view changes the fit", 0),
-        ("SCENE", "Scene", "Fit sun maps to the whole scene: never redrawn for camera moves, coarser in large scenes", 1),
+        (
+            "SCENE",
+            "Scene",
+            "Fit sun maps to the whole scene: never redrawn for camera moves, coarser in large scenes",
+            1,
+        ),
     ),
 )
 

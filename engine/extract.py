@@ -224,8 +224,7 @@ def geometry_from_mesh(mesh):
     good = np.all(np.isfinite(pos), axis=(1, 2))
     if not good.all():
         print(
-            f"Penumbra: mesh '{mesh.name}': skipped {int((~good).sum())} triangle(s) with "
-            "non-finite vertices",
+            f"Penumbra: mesh '{mesh.name}': skipped {int((~good).sum())} triangle(s) with non-finite vertices",
             file=sys.stderr,
         )
         pos, nor, mat = pos[good], nor[good], mat[good]

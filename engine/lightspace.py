@@ -199,28 +199,8 @@ def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2
     return _ortho_fit(view, lo, hi, scale, map_size, padding_texels), casters
 
 
-def fit_perspective(position, forward, fov, points, map_size, min_near_ratio=1e-4):
-    """Perspective light view at ``position`` looking along ``forward`` with a square ``fov``
-    (radians), near/far fitted to the ``points`` in front of it. ``None`` when no point lies in
-    front (nothing can cast a shadow into the cone)."""
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    pts = pts[np.all(np.isfinite(pts), axis=1)]
-    view = look_at(position, forward)
-    z = -transform_points(view, pts)[:, 2] if len(pts) else np.zeros(0)
-    z = z[z > 0.0]
-    if len(z) == 0:
-        return None
-    far = float(z.max()) * 1.01
-    near = max(float(z.min()) * 0.99, far * min_near_ratio)
-    fov = float(np.clip(fov, 1e-3, np.pi - 1e-3))
-    proj = perspective(fov, 1.0, near, far)
-    return Fit(view, proj, near, far, texel_per_distance=2.0 * np.tan(fov / 2.0) / max(1, int(map_size)))
-
-
 # Cube-map faces: +X, -X, +Y, -Y, +Z, -Z. The GLSL face selection (cube_face) uses this order.
-CUBE_FORWARDS = np.array(
-    [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64
-)
+CUBE_FORWARDS = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64)
 
 
 def cube_face(direction):

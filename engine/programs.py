@@ -94,7 +94,13 @@ LIT = Program(
         ("smooth", "VEC3", "v_normal"),
         ("smooth", "FLOAT", "v_view_depth"),
     ),
-    push_constants=(("MAT4", "model"), ("VEC4", "base_color"), ("FLOAT", "roughness"), ("FLOAT", "specular"), ("FLOAT", "metallic")),
+    push_constants=(
+        ("MAT4", "model"),
+        ("VEC4", "base_color"),
+        ("FLOAT", "roughness"),
+        ("FLOAT", "specular"),
+        ("FLOAT", "metallic"),
+    ),
     samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex")),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),

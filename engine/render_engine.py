@@ -34,7 +34,9 @@ class PenumbraEngineCore:
             self.renderer = Renderer()
         scene = depsgraph.scene
         snapshot = self.cache.snapshot(depsgraph)
-        settings = scene.penumbra.render_settings(frame=scene.frame_current, film_transparent=scene.render.film_transparent)
+        settings = scene.penumbra.render_settings(
+            frame=scene.frame_current, film_transparent=scene.render.film_transparent
+        )
         out = self.renderer.render(snapshot, camera, settings, width, height)
         self.last_stats = out.stats
         return out

@@ -117,7 +117,9 @@ class Renderer:
         )
         self._lit_pass(draws, data, plan, snapshot.world_color, settings.film_transparent, stats)
         color = self._post_pass(settings, stats)
-        stats.texture_bytes = width * height * (16 + 4 + 4 + 4) + self.shadows.memory_bytes + self._post_ctx.memory_bytes
+        stats.texture_bytes = (
+            width * height * (16 + 4 + 4 + 4) + self.shadows.memory_bytes + self._post_ctx.memory_bytes
+        )
         stats.shaders_compiled = self.shaders.compiled - compiled_before
         return FrameOutput(color, self._depth, self._shadow, stats, width, height)
 
@@ -222,7 +224,9 @@ class Renderer:
         self._depth = gpu.types.GPUTexture((width, height), format="R32F")
         self._shadow = gpu.types.GPUTexture((width, height), format="R32F")
         self._zbuffer = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
-        self._fb = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow))
+        self._fb = gpu.types.GPUFrameBuffer(
+            depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow)
+        )
         self._post_ctx = PostContext(self.shaders, width, height)
         self._size = (width, height)
 

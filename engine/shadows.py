@@ -59,7 +59,7 @@ def _near_bound(position, lo, hi, half_fov):
     return float(d.min()) / math.sqrt(1.0 + 2.0 * math.tan(half_fov) ** 2)
 
 
-def _perspective_tile(position, forward, fov, corners, lo, hi, map_size):
+def perspective_tile(position, forward, fov, corners, lo, hi, map_size):
     """A perspective tile at ``position`` along ``forward``, or None without casters in it."""
     reach = float(np.linalg.norm(corners.reshape(-1, 3) - position, axis=1).max()) * 1.01
     if not np.isfinite(reach) or reach <= 0.0:
@@ -105,12 +105,12 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
             mode = "SINGLE"
         elif light.type == "SPOT":
             fov = min(light.spot_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
-            tile = _perspective_tile(light.position, light.direction, fov, corners, lo, hi, map_size)
+            tile = perspective_tile(light.position, light.direction, fov, corners, lo, hi, map_size)
             tiles = [tile] if tile is not None else []
             mode = "SINGLE"
         else:  # POINT, AREA
             tiles = [
-                _perspective_tile(light.position, fwd, math.pi / 2.0, corners, lo, hi, map_size)
+                perspective_tile(light.position, fwd, math.pi / 2.0, corners, lo, hi, map_size)
                 for fwd in lightspace.CUBE_FORWARDS
             ]
             mode = "CUBE"
@@ -129,7 +129,9 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
                 plan.tiles.append(t)
         plan.lights[i] = entry
     if dropped:
-        print(f"Penumbra: {dropped} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps", file=sys.stderr)
+        print(
+            f"Penumbra: {dropped} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps", file=sys.stderr
+        )
     return plan
 
 
@@ -242,4 +244,3 @@ class ShadowAtlas:
                 self._contents[index] = key
                 stats.passes += 1
                 stats.shadow_maps += 1
-

@@ -1,6 +1,6 @@
 """Contact sheet of every post layer on the demo scene: docs/contact_sheet.png.
 
-    .venv/blender-5.2/bin/python tools/contact_sheet.py --out docs
+    .venv/blender-5.2/bin/python -m tools.contact_sheet --out docs
 
 Each tile is the demo scene rendered by Penumbra with one layer (default parameters, mix 1),
 saved through Blender's colour management (AgX), the first tile without any layer; then one
@@ -8,18 +8,12 @@ tile per shipped preset look. Tiles are laid out with matplotlib.
 """
 
 import argparse
-import os
-import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT / "tools")]
+import bpy
 
-import bpy  # noqa: E402
-
-import scenes  # noqa: E402
-from devkit import load_penumbra  # noqa: E402
+from devkit import imageio, scenes, session
 
 # Parameters that make an effect readable at thumbnail size (others keep their defaults).
 SHOWCASE = {
@@ -29,22 +23,25 @@ SHOWCASE = {
 
 
 def render_png(scene, path):
-    settings = scene.render.image_settings
-    if hasattr(settings, "media_type"):
-        settings.media_type = "IMAGE"
-    settings.file_format = "PNG"
-    settings.color_depth = "8"
+    imageio.set_format(scene.render.image_settings, "PNG", color_depth="8")
     scene.render.filepath = str(path)
     scene.render.use_file_extension = False
     bpy.ops.render.render(write_still=True)
+    return imageio.read_image(path)
 
 
-def main():
+def demo(width, height):
+    scene = scenes.demo_scene(width, height)
+    scene.view_settings.view_transform = "AgX"
+    return scene
+
+
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="docs")
     ap.add_argument("--width", type=int, default=384)
     ap.add_argument("--height", type=int, default=216)
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
 
@@ -52,17 +49,15 @@ def main():
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import OpenImageIO as oiio
 
-    load_penumbra().register()
+    session.load_penumbra().register()
     from penumbra.engine.post import EFFECTS
     from penumbra.operators.presets import SHIPPED_DIR
 
     tiles = []
     with tempfile.TemporaryDirectory() as tmp:
         for eid in [None, *EFFECTS]:
-            scene = scenes.demo_scene(args.width, args.height)
-            scene.view_settings.view_transform = "AgX"
+            scene = demo(args.width, args.height)
             s = scene.penumbra
             s.layers.clear()
             if eid is not None:
@@ -70,16 +65,13 @@ def main():
                 layer.effect = eid
                 for name, value in SHOWCASE.get(eid, {}).items():
                     setattr(layer.params(), name, value)
-            path = Path(tmp) / f"{eid or 'none'}.png"
-            render_png(scene, path)
-            tiles.append((EFFECTS[eid].label if eid else "No layer", oiio.ImageBuf(str(path)).get_pixels(oiio.FLOAT)))
+            pixels = render_png(scene, Path(tmp) / f"{eid or 'none'}.png")
+            tiles.append((EFFECTS[eid].label if eid else "No layer", pixels))
         for preset in sorted(SHIPPED_DIR.glob("*.py")):
-            scene = scenes.demo_scene(args.width, args.height)
-            scene.view_settings.view_transform = "AgX"
+            scene = demo(args.width, args.height)
             bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="PENUMBRA_MT_post_presets")
-            path = Path(tmp) / f"preset_{preset.stem}.png"
-            render_png(scene, path)
-            tiles.append((f"Preset: {bpy.path.display_name(preset.stem)}", oiio.ImageBuf(str(path)).get_pixels(oiio.FLOAT)))
+            pixels = render_png(scene, Path(tmp) / f"preset_{preset.stem}.png")
+            tiles.append((f"Preset: {bpy.path.display_name(preset.stem)}", pixels))
 
     cols = 4
     rows = (len(tiles) + cols - 1) // cols
@@ -95,6 +87,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
-    sys.stdout.flush()
-    os._exit(0)  # bpy 4.5 can hang in its own shutdown after GPU work
+    session.run(main)

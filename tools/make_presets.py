@@ -1,19 +1,10 @@
 """Writes the shipped post-stack looks to presets/post_stack/ with the same writer users'
 presets go through (operators/presets.py), so shipped and saved presets share one format.
 
-    .venv/blender-5.2/bin/python tools/make_presets.py
+    .venv/blender-5.2/bin/python -m tools.make_presets
 """
 
-import os
-import sys
-from pathlib import Path
-
-ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT / "tools")]
-
-
-import scenes  # noqa: E402
-from devkit import load_penumbra  # noqa: E402
+from devkit import scenes, session
 
 # name -> [(effect, layer name, mix, {param: value})], top of the stack first.
 LOOKS = {
@@ -44,8 +35,8 @@ LOOKS = {
 }
 
 
-def main():
-    load_penumbra().register()
+def main(argv=None):
+    session.load_penumbra().register()
     from penumbra.operators.presets import SHIPPED_DIR, preset_source
 
     scene = scenes.empty_scene(8, 8)
@@ -64,6 +55,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
-    sys.stdout.flush()
-    os._exit(0)  # bpy 4.5 can hang in its own shutdown after GPU work
+    session.run(main)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Creates .venv/blender-<line> with bpy, numpy, OpenImageIO, pytest and matplotlib, and makes
-# sure Mesa's EGL (headless OpenGL through llvmpipe) is installed.
+# Creates .venv/blender-<line> with bpy and tools/requirements.txt (numpy, OpenImageIO, pytest,
+# matplotlib, ruff), and makes sure Mesa's EGL (headless OpenGL through llvmpipe) is installed.
 #   tools/setup.sh 5.2        # Blender 5.2 line (Python 3.13)
 #   tools/setup.sh 4.5        # Blender 4.5 LTS (Python 3.11)
 # Re-running is cheap: a venv whose requirements did not change is left alone.

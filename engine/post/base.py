@@ -92,6 +92,32 @@ class GaussianWeights:
         return self._ubo
 
 
+def table_texture(rgb):
+    """An RGBA32F texture of a built-in table: ``rgb`` is (height, width, 3), or (width, 3) for
+    one row; alpha is 1."""
+    import gpu
+
+    rgb = np.asarray(rgb, np.float32)
+    if rgb.ndim == 2:
+        rgb = rgb[None]
+    h, w = rgb.shape[:2]
+    rgba = np.concatenate([rgb, np.ones((h, w, 1), np.float32)], axis=-1)
+    buf = gpu.types.Buffer("FLOAT", rgba.size, rgba.ravel().tolist())
+    return gpu.types.GPUTexture((w, h), format="RGBA32F", data=buf)
+
+
+def image_or_table(image, cache, table):
+    """The texture of a user's Image, or of the built-in ``table`` (created once and kept in
+    ``cache``, a one-item list owned by the effect instance) when there is no image."""
+    import gpu
+
+    if image is not None:
+        return gpu.texture.from_image(image)
+    if not cache:
+        cache.append(table_texture(table))
+    return cache[0]
+
+
 @dataclass
 class Target:
     texture: object

@@ -56,4 +56,23 @@ class Blur(PostEffect):
         )
 
 
-EFFECT = Blur
+def gaussian_reference(img, radius, sigma=None):
+    """Reference of the two BLUR passes, numpy-ready: the separable Gaussian of
+    ``kernels.gaussian_1d(radius, sigma)`` with clamp-to-edge, in float64 (``img``: (h, w, C))."""
+    import numpy as np
+
+    from .. import kernels
+
+    w = kernels.gaussian_1d(radius, sigma)
+    out = np.asarray(img).astype(np.float64)
+    for axis in (1, 0):
+        pad = [(0, 0)] * 3
+        pad[axis] = (radius, radius)
+        p = np.pad(out, pad, mode="edge")
+        acc = np.zeros_like(out)
+        for i, wi in enumerate(w):
+            sl = [slice(None)] * 3
+            sl[axis] = slice(i, i + out.shape[axis])
+            acc += wi * p[tuple(sl)]
+        out = acc
+    return out

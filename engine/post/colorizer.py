@@ -21,8 +21,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from ..settings import Param
-from .base import PostEffect, post_program
-from .base import GAUSSIAN_MAX_RADIUS
+from .base import GAUSSIAN_MAX_RADIUS, PostEffect, image_or_table, post_program
 from .blur import Blur
 
 PROGRAM = post_program(
@@ -84,28 +83,32 @@ class Colorizer(PostEffect):
     description = "Recolour through a lookup image indexed by blurred luminance and distance to the centre"
     params = (
         Param("image", "IMAGE", None, "Lookup image (x: luminance, y: centre to corners); empty uses a built-in grade"),
-        Param("blur_radius", "INT", 2, "Blur of the luminance before the lookup, in pixels; 0 = none", min=0, max=GAUSSIAN_MAX_RADIUS, soft_max=32),
-        Param("strength", "FLOAT", 1.0, "Blend between the original colour (0) and the lookup colour (1)", min=0.0, max=1.0, subtype="FACTOR"),
+        Param(
+            "blur_radius",
+            "INT",
+            2,
+            "Blur of the luminance before the lookup, in pixels; 0 = none",
+            min=0,
+            max=GAUSSIAN_MAX_RADIUS,
+            soft_max=32,
+        ),
+        Param(
+            "strength",
+            "FLOAT",
+            1.0,
+            "Blend between the original colour (0) and the lookup colour (1)",
+            min=0.0,
+            max=1.0,
+            subtype="FACTOR",
+        ),
     )
 
     def __init__(self):
         self._blur = Blur()
-        self._default_lut = None
+        self._default_lut = []
 
     def is_identity(self, params):
         return params.strength <= 0.0
-
-    def _lut_texture(self, image):
-        import gpu
-
-        if image is not None:
-            return gpu.texture.from_image(image)
-        if self._default_lut is None:
-            h, w = DEFAULT_LUT.shape[:2]
-            rgba = np.concatenate([DEFAULT_LUT, np.ones((h, w, 1), np.float32)], axis=-1)
-            buf = gpu.types.Buffer("FLOAT", rgba.size, rgba.ravel().tolist())
-            self._default_lut = gpu.types.GPUTexture((w, h), format="RGBA32F", data=buf)
-        return self._default_lut
 
     def execute(self, ctx, src, params, mix):
         luma = src
@@ -115,7 +118,28 @@ class Colorizer(PostEffect):
         return ctx.fullscreen(
             PROGRAM,
             dst,
-            samplers={"source_tex": src, "luma_tex": luma, "lut_tex": self._lut_texture(params.image)},
+            samplers={
+                "source_tex": src,
+                "luma_tex": luma,
+                "lut_tex": image_or_table(params.image, self._default_lut, DEFAULT_LUT),
+            },
             uniforms={"mix_factor": mix, "strength": params.strength},
         )
-EFFECT = Colorizer
+
+
+def colorizer_reference(img, lut, blur_radius, strength):
+    """Reference of the whole COLORIZER layer, numpy-ready, in float64: ``img`` (h, w, 4) with
+    non-finite components read as 0, its rgb blended towards ``lut_lookup`` of the lookup
+    coordinates by ``strength``; alpha kept. ``lut``: (H, W, C), e.g. ``DEFAULT_LUT``."""
+    import numpy as np
+
+    from .blur import gaussian_reference
+
+    h, w = img.shape[:2]
+    c = np.nan_to_num(np.asarray(img).astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    blurred = gaussian_reference(c, blur_radius) if blur_radius > 0 else c
+    y, x = np.mgrid[0:h, 0:w] + 0.5
+    lx, ly = lookup_coords(blurred[..., :3] @ np.array(LUMA_WEIGHTS), x, y, w, h)
+    out = c.copy()
+    out[..., :3] = c[..., :3] * (1 - strength) + lut_lookup(lut, lx, ly)[..., :3] * strength
+    return out

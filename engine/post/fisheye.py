@@ -52,7 +52,15 @@ class Fisheye(PostEffect):
     icon = "SPHERE"
     description = "Bulge (positive) or pinch (negative) the image about its centre"
     params = (
-        Param("strength", "FLOAT", 0.5, "Positive bulges the centre outwards, negative pinches it; 0 = no change", min=-1.0, max=1.0, subtype="FACTOR"),
+        Param(
+            "strength",
+            "FLOAT",
+            0.5,
+            "Positive bulges the centre outwards, negative pinches it; 0 = no change",
+            min=-1.0,
+            max=1.0,
+            subtype="FACTOR",
+        ),
         Param("edge", "ENUM", "CLAMP", "What a pinch shows beyond the image borders", enum=EDGE),
     )
 
@@ -71,4 +79,43 @@ class Fisheye(PostEffect):
         )
 
 
-EFFECT = Fisheye
+def bilinear_reference(img, px, py, edge="CLAMP"):
+    """Bilinear read of ``img`` (h, w, C) at pixel positions ``px``, ``py`` (texel centres at
+    i + 0.5), numpy-ready, in float64, with the ``edge`` modes: CLAMP repeats the border
+    texels, BLACK reads 0 outside, MIRROR reflects at the borders."""
+    import numpy as np
+
+    img = np.asarray(img, dtype=np.float64)
+    h, w = img.shape[:2]
+    tx, ty = np.asarray(px, np.float64) - 0.5, np.asarray(py, np.float64) - 0.5
+    x0, y0 = np.floor(tx).astype(int), np.floor(ty).astype(int)
+    fx, fy = (tx - x0)[..., None], (ty - y0)[..., None]
+
+    def fold(i, n):
+        if edge == "MIRROR":
+            m = np.mod(i, 2 * n)
+            return np.where(m >= n, 2 * n - 1 - m, m)
+        return np.clip(i, 0, n - 1)
+
+    def tap(ix, iy):
+        v = img[fold(iy, h), fold(ix, w)]
+        if edge == "BLACK":
+            inside = (ix >= 0) & (ix < w) & (iy >= 0) & (iy < h)
+            v = v * inside[..., None]
+        return v
+
+    bottom = tap(x0, y0) * (1 - fx) + tap(x0 + 1, y0) * fx
+    top = tap(x0, y0 + 1) * (1 - fx) + tap(x0 + 1, y0 + 1) * fx
+    return bottom * (1 - fy) + top * fy
+
+
+def fisheye_reference(img, strength, edge):
+    """Reference of the whole FISHEYE layer, numpy-ready, in float64: ``img`` (h, w, C), with
+    non-finite components read as 0, read at ``fisheye_source`` of every pixel centre."""
+    import numpy as np
+
+    h, w = img.shape[:2]
+    y, x = np.mgrid[0:h, 0:w] + 0.5
+    sx, sy = fisheye_source(x, y, w, h, strength)
+    clean = np.nan_to_num(np.asarray(img).astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    return bilinear_reference(clean, sx, sy, edge)

@@ -50,11 +50,46 @@ class Glow(PostEffect):
     icon = "LIGHT_SUN"
     description = "Bloom: blur the highlights above a threshold and add them back"
     params = (
-        Param("threshold", "FLOAT", 1.0, "Brightness (largest RGB component) above which pixels glow", min=0.0, soft_max=10.0),
-        Param("knee", "FLOAT", 0.5, "Softness of the threshold as a fraction of it: 0 is a hard cut, 1 fades in from black", min=0.0, max=1.0, subtype="FACTOR"),
-        Param("intensity", "FLOAT", 0.5, "Scale of the glow added to the image; 0 turns the layer off", min=0.0, soft_max=4.0),
-        Param("radius", "INT", 16, "Blur half-width in pixels; sigma is radius / 2", min=0, max=GAUSSIAN_MAX_RADIUS, soft_max=64),
-        Param("square_samples", "BOOL", False, "Square each bright-pass sample before blurring: favours the strongest highlights"),
+        Param(
+            "threshold",
+            "FLOAT",
+            1.0,
+            "Brightness (largest RGB component) above which pixels glow",
+            min=0.0,
+            soft_max=10.0,
+        ),
+        Param(
+            "knee",
+            "FLOAT",
+            0.5,
+            "Softness of the threshold as a fraction of it: 0 is a hard cut, 1 fades in from black",
+            min=0.0,
+            max=1.0,
+            subtype="FACTOR",
+        ),
+        Param(
+            "intensity",
+            "FLOAT",
+            0.5,
+            "Scale of the glow added to the image; 0 turns the layer off",
+            min=0.0,
+            soft_max=4.0,
+        ),
+        Param(
+            "radius",
+            "INT",
+            16,
+            "Blur half-width in pixels; sigma is radius / 2",
+            min=0,
+            max=GAUSSIAN_MAX_RADIUS,
+            soft_max=64,
+        ),
+        Param(
+            "square_samples",
+            "BOOL",
+            False,
+            "Square each bright-pass sample before blurring: favours the strongest highlights",
+        ),
     )
 
     def __init__(self):
@@ -92,4 +127,19 @@ class Glow(PostEffect):
         )
 
 
-EFFECT = Glow
+def glow_reference(img, threshold, knee, intensity, radius, square_samples=False):
+    """Reference of the whole GLOW layer, numpy-ready: ``img`` (h, w, 4) rgb + intensity *
+    Gaussian(bright-pass), alpha kept, in float64. ``knee`` is the parameter (a fraction of
+    ``threshold``); non-finite input components read as 0."""
+    import numpy as np
+
+    from .blur import gaussian_reference
+
+    clean = np.where(np.isfinite(img), img, 0.0).astype(np.float64)
+    bright = bright_pass(clean[..., :3], threshold, threshold * knee)
+    if square_samples:
+        bright = bright * bright
+    padded = np.concatenate([bright, np.zeros_like(bright[..., :1])], -1)
+    out = clean.copy()
+    out[..., :3] += intensity * gaussian_reference(padded, radius)[..., :3]
+    return out

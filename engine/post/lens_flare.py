@@ -40,7 +40,7 @@ import numpy as np
 
 from ..enums import Enum
 from ..settings import Param
-from .base import PostEffect, post_program
+from .base import PostEffect, image_or_table, post_program
 
 MERGE = Enum(
     "lens flare merge",
@@ -116,36 +116,37 @@ class LensFlare(PostEffect):
         Param("intensity", "FLOAT", 1.0, "Brightness of the flare; 0 turns the layer off", min=0.0, soft_max=10.0),
         Param("mode", "ENUM", "ADD", "How the flare is merged into the image", enum=MERGE),
         Param("ghosts", "INT", 4, "Number of ghost images along the line through the centre", min=0, max=MAX_GHOSTS),
-        Param("ghost_spacing", "FLOAT", 0.4, "Step between ghosts along the line through the centre", min=0.0, soft_max=2.0),
+        Param(
+            "ghost_spacing",
+            "FLOAT",
+            0.4,
+            "Step between ghosts along the line through the centre",
+            min=0.0,
+            soft_max=2.0,
+        ),
         Param("halo_radius", "FLOAT", 0.6, "Radius of the halo ring (1 = the image corners)", min=0.0, soft_max=1.5),
         Param("halo_width", "FLOAT", 0.1, "Half-width of the halo ring; 0 = no halo", min=0.0, soft_max=0.5),
-        Param("image", "IMAGE", None, "Lens dirt / colour texture multiplying the flare; empty uses a built-in radial ramp"),
+        Param(
+            "image",
+            "IMAGE",
+            None,
+            "Lens dirt / colour texture multiplying the flare; empty uses a built-in radial ramp",
+        ),
     )
 
     def __init__(self):
-        self._ramp = None
+        self._ramp = []
 
     def is_identity(self, params):
         no_flare = params.ghosts <= 0 and params.halo_width <= 0.0
         return params.intensity <= 0.0 or no_flare
-
-    def _lens_texture(self, image):
-        import gpu
-
-        if image is not None:
-            return gpu.texture.from_image(image)
-        if self._ramp is None:
-            rgba = np.concatenate([LENS_RAMP, np.ones((len(LENS_RAMP), 1), np.float32)], axis=-1)
-            buf = gpu.types.Buffer("FLOAT", rgba.size, rgba.ravel().tolist())
-            self._ramp = gpu.types.GPUTexture((len(LENS_RAMP), 1), format="RGBA32F", data=buf)
-        return self._ramp
 
     def execute(self, ctx, src, params, mix):
         return ctx.single_pass(
             PROGRAM,
             src,
             mix,
-            samplers={"lens_tex": self._lens_texture(params.image)},
+            samplers={"lens_tex": image_or_table(params.image, self._ramp, LENS_RAMP)},
             uniforms={
                 "threshold": params.threshold,
                 "intensity": params.intensity,
@@ -159,4 +160,42 @@ class LensFlare(PostEffect):
         )
 
 
-EFFECT = LensFlare
+def flare_reference(img, params, lens=None):
+    """The flare ``f`` of this module's definition, numpy-ready, in float64 (h, w, 3), for the
+    input ``img`` (h, w, 4) and a namespace ``params`` holding threshold, intensity, ghosts,
+    ghost_spacing, halo_radius and halo_width (the merge ``mode`` is ``merge``'s business).
+    ``lens``: the lens image's pixels (H, W, C), or None for ``LENS_RAMP``."""
+    import numpy as np
+
+    from .colorizer import lut_lookup
+    from .fisheye import bilinear_reference
+
+    p = params
+    h, w = img.shape[:2]
+    clean = np.nan_to_num(np.asarray(img).astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    bright = np.maximum(clean[..., :3] - p.threshold, 0.0)
+    y, x = np.mgrid[0:h, 0:w] + 0.5
+    cx, cy = w / 2, h / 2
+    diag = np.hypot(cx, cy)
+    ux, uy = x - cx, y - cy
+    dist = np.hypot(ux, uy)
+    r = dist / diag
+    f = np.zeros((h, w, 3))
+    for i in range(p.ghosts):
+        k = p.ghost_spacing * i - 1.0
+        qx, qy = cx + ux * k, cy + uy * k
+        a = 1.0 - np.clip(np.hypot(qx - cx, qy - cy) / diag, 0.0, 1.0)
+        f += (a**3)[..., None] * bilinear_reference(bright, qx, qy, "BLACK")
+    if p.halo_width > 0:
+        t = np.clip(1.0 - np.abs(r - p.halo_radius) / p.halo_width, 0.0, 1.0)
+        ring = t * t * (3.0 - 2.0 * t)
+        safe = np.where(dist > 0, dist, 1.0)
+        dx, dy = np.where(dist > 0, ux / safe, 0.0), np.where(dist > 0, uy / safe, 0.0)
+        along = p.halo_radius * diag - dist
+        f += ring[..., None] * bilinear_reference(bright, cx + dx * along, cy + dy * along, "BLACK")
+    if lens is None:
+        tint = lut_lookup(LENS_RAMP[None], r, np.zeros_like(r))
+    else:
+        lh, lw = lens.shape[:2]
+        tint = bilinear_reference(np.asarray(lens)[..., :3], x / w * lw, y / h * lh, "CLAMP")
+    return p.intensity * f * tint

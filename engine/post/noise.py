@@ -15,7 +15,13 @@ from .base import PostEffect, post_program
 PROGRAM = post_program(
     "post_noise",
     "post/noise.frag.glsl",
-    push_constants=(("FLOAT", "amount"), ("INT", "grain_size"), ("INT", "frame"), ("INT", "seed"), ("INT", "monochrome")),
+    push_constants=(
+        ("FLOAT", "amount"),
+        ("INT", "grain_size"),
+        ("INT", "frame"),
+        ("INT", "seed"),
+        ("INT", "monochrome"),
+    ),
 )
 
 
@@ -75,6 +81,3 @@ class Noise(PostEffect):
                 "monochrome": int(params.monochrome),
             },
         )
-
-
-EFFECT = Noise

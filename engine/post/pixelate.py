@@ -81,4 +81,23 @@ class Pixelate(PostEffect):
         cells = ctx.acquire(src, rows.texture)
         run("COLUMNS", cells, rows.texture, 1.0)
         return run("EXPAND", ctx.acquire(src, cells.texture), cells.texture, mix)
-EFFECT = Pixelate
+
+
+def pixelate_reference(img, size, sampling):
+    """Reference of the PIXELATE layer, numpy-ready, in float64: cells anchored at (0, 0);
+    CENTER: the pixel at origin + n // 2 of the n that exist; AVERAGE: the mean. Non-finite
+    components read as 0."""
+    import numpy as np
+
+    h, w = img.shape[:2]
+    clean = np.where(np.isfinite(img), img, 0.0).astype(np.float64)
+    out = np.empty_like(clean)
+    for y0 in range(0, h, size):
+        for x0 in range(0, w, size):
+            cell = clean[y0 : y0 + size, x0 : x0 + size]
+            if sampling == "CENTER":
+                value = cell[cell.shape[0] // 2, cell.shape[1] // 2]
+            else:
+                value = cell.mean(axis=(0, 1))
+            out[y0 : y0 + size, x0 : x0 + size] = value
+    return out

@@ -8,7 +8,6 @@ fraction of its own height covered by dark bands (an exact box filter), otherwis
 its centre is inside one.
 """
 
-
 from ..settings import Param
 from .base import PostEffect, post_program
 
@@ -62,8 +61,12 @@ class Scanlines(PostEffect):
     description = "Darken horizontal bands like the lines of a CRT screen"
     params = (
         Param("count", "INT", 240, "Number of lines over the image height", min=1, soft_max=1080),
-        Param("thickness", "FLOAT", 0.5, "Fraction of each line period that is dark", min=0.0, max=1.0, subtype="FACTOR"),
-        Param("intensity", "FLOAT", 0.5, "How much the dark bands darken (1 = black)", min=0.0, max=1.0, subtype="FACTOR"),
+        Param(
+            "thickness", "FLOAT", 0.5, "Fraction of each line period that is dark", min=0.0, max=1.0, subtype="FACTOR"
+        ),
+        Param(
+            "intensity", "FLOAT", 0.5, "How much the dark bands darken (1 = black)", min=0.0, max=1.0, subtype="FACTOR"
+        ),
         Param("scroll_speed", "FLOAT", 0.0, "Upward motion in lines per frame (negative scrolls down)", soft_max=2.0),
         Param("antialias", "BOOL", True, "Darken each pixel by the fraction of it the bands cover"),
     )
@@ -87,4 +90,13 @@ class Scanlines(PostEffect):
         )
 
 
-EFFECT = Scanlines
+def scanlines_reference(img, count, thickness, intensity, speed, frame, antialias):
+    """Reference of the whole SCANLINES layer, numpy-ready: returns (``img`` (h, w, 4) with its
+    rgb darkened row by row, in float64; the rows' darkness from ``scanline_darkness``)."""
+    import numpy as np
+
+    h = img.shape[0]
+    dark = scanline_darkness(np.arange(h), h, count, thickness, scroll_offset(frame, speed), antialias)
+    out = np.asarray(img).astype(np.float64)
+    out[..., :3] *= (1.0 - intensity * dark)[:, None, None]
+    return out, dark

@@ -28,7 +28,15 @@ class Sepia(PostEffect):
     icon = "COLOR"
     description = "Old-photograph brown tone (standard sepia matrix)"
     params = (
-        Param("amount", "FLOAT", 1.0, "Blend from the original colour (0) to full sepia (1)", min=0.0, max=1.0, subtype="FACTOR"),
+        Param(
+            "amount",
+            "FLOAT",
+            1.0,
+            "Blend from the original colour (0) to full sepia (1)",
+            min=0.0,
+            max=1.0,
+            subtype="FACTOR",
+        ),
     )
 
     def is_identity(self, params):
@@ -39,4 +47,10 @@ class Sepia(PostEffect):
         return ctx.single_pass(PROGRAM, src, mix, uniforms={"amount": params.amount, **rows})
 
 
-EFFECT = Sepia
+def sepia_reference(rgb, amount):
+    """Reference of the SEPIA layer's colour, numpy-ready (``rgb``: (..., 3)), in float64:
+    ``rgb`` blended towards ``SEPIA_MATRIX @ rgb`` by ``amount``, not clamped."""
+    import numpy as np
+
+    rgb = np.asarray(rgb, dtype=np.float64)
+    return rgb + amount * (rgb @ np.array(SEPIA_MATRIX).T - rgb)

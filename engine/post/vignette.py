@@ -36,9 +36,24 @@ class Vignette(PostEffect):
     icon = "CLIPUV_DEHLT"
     description = "Darken or tint the image towards its edges"
     params = (
-        Param("radius", "FLOAT", 0.8, "Distance from the centre where the falloff starts (1 = half the height)", min=0.0, soft_max=2.0),
+        Param(
+            "radius",
+            "FLOAT",
+            0.8,
+            "Distance from the centre where the falloff starts (1 = half the height)",
+            min=0.0,
+            soft_max=2.0,
+        ),
         Param("softness", "FLOAT", 0.6, "Width of the falloff; 0 is a hard edge", min=0.0, soft_max=2.0),
-        Param("roundness", "FLOAT", 1.0, "1: a circle in pixels; 0: an ellipse following the frame", min=0.0, max=1.0, subtype="FACTOR"),
+        Param(
+            "roundness",
+            "FLOAT",
+            1.0,
+            "1: a circle in pixels; 0: an ellipse following the frame",
+            min=0.0,
+            max=1.0,
+            subtype="FACTOR",
+        ),
         Param("color", "COLOR", (0.0, 0.0, 0.0), "Colour at the edges"),
     )
 
@@ -54,6 +69,3 @@ class Vignette(PostEffect):
                 "roundness": params.roundness,
             },
         )
-
-
-EFFECT = Vignette

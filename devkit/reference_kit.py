@@ -1,0 +1,360 @@
+"""Shadow accuracy kit: reference scenes built in code, per-pixel shadow visibility measured
+the same way in every engine, and converged Cycles references cached on disk::
+
+    scene = reference_kit.build("sun_soft", 160, 90)
+    ref = reference_kit.cycles_reference("sun_soft", samples=512, width=160, height=90)
+    vis = reference_kit.measure_visibility(scene, "PENUMBRA", shadow_filter="PCSS")
+    reference_kit.compare(vis, ref)   # {'iou': ..., 'mae': ..., ...}
+
+Every scene has one light, a black world, a white Lambertian plane (specular 0, roughness 1),
+grey Lambertian casters and a perspective camera looking down at an angle:
+
+=========  ============================================================================
+sun_hard   sun, angle 0.5 deg, over a box, a floating sphere and a floating slab
+sun_soft   the same sun with angle 10 deg
+spot       spot light, radius (shadow_soft_size) 0.25, 70 deg cone, same casters
+point      point light, radius 0.2, same casters
+area       square area light, size 1.0, facing down, same casters
+contact    a tall thin box (0.5 x 0.5 x 3) standing on the plane, sun with angle 8 deg:
+           the shadow is sharp where the box meets the plane and soft far from it
+=========  ============================================================================
+
+Visibility is (render with shadows) / (render with the light's ``use_shadow`` off), in
+luminance, so light units, falloff and cone shapes cancel and only the shadow term remains.
+Engines are set up by ``devkit.engines``; its Cycles renders direct light only, so indirect
+light does not make its shadows brighter than a shadow-mapping engine's.
+"""
+
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from devkit import scenes
+from devkit.analytic import camera_matrices
+from devkit.engines import configure
+from devkit.render import render
+from devkit.session import ROOT
+
+# Part of every cache key: bump it whenever a scene or the measurement changes.
+KIT_VERSION = 1
+DEFAULT_CACHE = ROOT / "out" / "reference_cache"
+DEFAULT_WIDTH, DEFAULT_HEIGHT = 160, 90
+
+PLANE_ALBEDO = 0.8
+CASTER_ALBEDO = 0.6
+LUMA = np.array([0.2126, 0.7152, 0.0722])  # Rec. 709 luminance of scene-linear RGB
+
+# The floating sphere of the five light scenes (the benchmark varies its detail).
+SPHERE_CENTER = (0.9, -0.5, 1.3)
+SPHERE_RADIUS = 0.6
+
+# Contact scene geometry: a pillar PILLAR_WIDTH wide and PILLAR_HEIGHT tall centred on the
+# origin; the sun comes from +Y, CONTACT_ELEVATION above the horizon, so the shadow runs along -Y.
+PILLAR_WIDTH = 0.5
+PILLAR_HEIGHT = 3.0
+CONTACT_ELEVATION = math.radians(50.0)
+CONTACT_SUN_ANGLE = math.radians(8.0)
+
+
+# --- scenes -------------------------------------------------------------------------------
+
+
+def _stage(width, height):
+    """Empty scene, black world, the white plane; returns (scene, caster material)."""
+    scene = scenes.empty_scene(width, height)
+    scenes.plane(scene, "Ground", size=24.0, mat=scenes.white("Plane", PLANE_ALBEDO))
+    return scene, scenes.white("Caster", CASTER_ALBEDO)
+
+
+def _casters_scene(width, height):
+    """The shared set-up of the five light scenes: a box on the ground (contact shadow), a
+    floating sphere (soft shadow far from its caster), a floating slab (thin, long edges)."""
+    scene, grey = _stage(width, height)
+    scenes.box(scene, "Box", center=(-1.3, 0.2, 0.5), size=(1.0, 1.0, 1.0), mat=grey)
+    scenes.uv_sphere(scene, "Sphere", center=SPHERE_CENTER, radius=SPHERE_RADIUS, mat=grey)
+    slab = scenes.box(scene, "Slab", center=(0.5, 1.1, 1.7), size=(1.8, 0.35, 0.08), mat=grey)
+    slab.rotation_euler = (0.0, 0.0, math.radians(-20.0))
+    scenes.look_at(scene, (1.0, -7.0, 5.5), (0.2, -0.2, 0.4), lens=42.0)
+    return scene
+
+
+def _hide_from_camera(light_ob):
+    """Cycles may show an emitter to camera rays; no reference image should contain one."""
+    if hasattr(light_ob, "visible_camera"):
+        light_ob.visible_camera = False
+    return light_ob
+
+
+def _sun(scene, angle_deg):
+    sun = scenes.light(scene, "Sun", "SUN", 3.0, angle=math.radians(angle_deg))
+    # Light travelling towards +X and -Y: the shadows fall towards the camera, to the right.
+    sun.rotation_euler = (math.radians(-45.0), 0.0, math.radians(30.0))
+    return _hide_from_camera(sun)
+
+
+def sun_hard(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    scene = _casters_scene(width, height)
+    _sun(scene, 0.5)
+    return scene
+
+
+def sun_soft(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    scene = _casters_scene(width, height)
+    _sun(scene, 10.0)
+    return scene
+
+
+def spot(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    scene = _casters_scene(width, height)
+    ob = scenes.light(
+        scene,
+        "Spot",
+        "SPOT",
+        1500.0,
+        location=(2.2, -1.8, 5.0),
+        shadow_soft_size=0.25,
+        spot_size=math.radians(70.0),
+        spot_blend=0.15,
+    )
+    scenes.aim(ob, (-0.2, 0.4, 0.0))
+    _hide_from_camera(ob)
+    return scene
+
+
+def point(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    scene = _casters_scene(width, height)
+    ob = scenes.light(scene, "Point", "POINT", 1000.0, location=(1.6, -1.4, 3.6), shadow_soft_size=0.2)
+    _hide_from_camera(ob)
+    return scene
+
+
+def area(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    scene = _casters_scene(width, height)
+    ob = scenes.light(scene, "Area", "AREA", 1500.0, location=(1.4, -1.2, 4.0), shape="SQUARE", size=1.0)
+    _hide_from_camera(ob)
+    return scene
+
+
+def contact(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    scene, grey = _stage(width, height)
+    scenes.box(
+        scene,
+        "Pillar",
+        center=(0.0, 0.0, PILLAR_HEIGHT / 2),
+        size=(PILLAR_WIDTH, PILLAR_WIDTH, PILLAR_HEIGHT),
+        mat=grey,
+    )
+    sun = scenes.light(scene, "Sun", "SUN", 3.0, angle=CONTACT_SUN_ANGLE)
+    # Rotating -Z by -(90 deg - elevation) about X: the light travels towards -Y and down.
+    sun.rotation_euler = (-(math.pi / 2 - CONTACT_ELEVATION), 0.0, 0.0)
+    _hide_from_camera(sun)
+    # From the -Y side, in front of the shadow, which then runs up the image.
+    scenes.look_at(scene, (0.0, -8.0, 5.0), (0.0, -1.2, 0.5), lens=40.0)
+    return scene
+
+
+SCENES = {
+    "sun_hard": sun_hard,
+    "sun_soft": sun_soft,
+    "spot": spot,
+    "point": point,
+    "area": area,
+    "contact": contact,
+}
+SOFT_SCENES = ("sun_soft", "spot", "point", "area", "contact")  # visibly soft shadows in Cycles
+
+
+def build(name, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    """Build reference scene ``name`` (a key of SCENES) as the current scene and return it."""
+    try:
+        builder = SCENES[name]
+    except KeyError:
+        raise ValueError(f"unknown reference scene {name!r}; known: {', '.join(SCENES)}") from None
+    return builder(width, height)
+
+
+def set_sphere_detail(scene, segments):
+    """Rebuild the caster sphere of a light scene with ``segments`` segments and
+    ``segments // 2`` rings: 2 x segments x (rings - 1) triangles (32 -> 960, 100 -> 9,800,
+    318 -> 100,488)."""
+    old = scene.objects["Sphere"]
+    mat = old.data.materials[0] if old.data.materials else None
+    mesh = old.data
+    bpy.data.objects.remove(old)
+    bpy.data.meshes.remove(mesh)
+    return scenes.uv_sphere(
+        scene,
+        "Sphere",
+        center=SPHERE_CENTER,
+        radius=SPHERE_RADIUS,
+        segments=segments,
+        rings=max(segments // 2, 3),
+        mat=mat,
+    )
+
+
+def scene_light(scene):
+    """The one light object of a reference scene."""
+    lights = [ob for ob in scene.objects if ob.type == "LIGHT"]
+    if len(lights) != 1:
+        raise ValueError(f"expected one light in scene '{scene.name}', found {len(lights)}")
+    return lights[0]
+
+
+# --- measurement --------------------------------------------------------------------------
+
+
+def luminance(rgba):
+    return np.asarray(rgba, np.float64)[..., :3] @ LUMA
+
+
+def visibility_from(shadowed, unshadowed, threshold=0.02):
+    """Visibility per pixel from two luminance images: shadowed / unshadowed, clipped to
+    [0, 1]; NaN where the unshadowed image is below ``threshold`` times its 99th percentile
+    (back faces, outside a spot cone, the black background)."""
+    shadowed = np.asarray(shadowed, np.float64)
+    unshadowed = np.asarray(unshadowed, np.float64)
+    lit = unshadowed[np.isfinite(unshadowed)]
+    level = float(np.percentile(lit, 99)) if lit.size else 0.0
+    valid = np.isfinite(unshadowed) & np.isfinite(shadowed) & (unshadowed > threshold * level) & (level > 0)
+    vis = np.full(unshadowed.shape, np.nan)
+    vis[valid] = np.clip(shadowed[valid] / unshadowed[valid], 0.0, 1.0)
+    return vis
+
+
+def render_luminance(scene):
+    """Render ``scene`` with its engine through Blender's output path; luminance (h, w), row 0
+    at the bottom of the image."""
+    return luminance(render(scene)["Combined"])
+
+
+def measure_visibility(scene, engine, threshold=0.02, **engine_settings):
+    """Shadow visibility per pixel (h, w) of ``scene``'s one light in ``engine``: the render
+    with shadows over the render with ``light.data.use_shadow = False``, in luminance.
+    NaN where the light does not reach (see ``visibility_from``); row 0 is the bottom row."""
+    configure(scene, engine, **engine_settings)
+    light = scene_light(scene).data
+    old = light.use_shadow
+    try:
+        light.use_shadow = True
+        shadowed = render_luminance(scene)
+        light.use_shadow = False
+        unshadowed = render_luminance(scene)
+    finally:
+        light.use_shadow = old
+    return visibility_from(shadowed, unshadowed, threshold)
+
+
+def compare(vis, ref, edge=0.5):
+    """Accuracy of visibility ``vis`` against the reference ``ref`` over the pixels valid in
+    both:
+
+    iou           intersection over union of the shadowed regions (visibility < ``edge``)
+    mae           mean absolute visibility error
+    mae_penumbra  the same error over the reference's penumbrae only (0.02 < ref < 0.98),
+                  where filters differ most
+    pixels        valid pixels compared
+    """
+    vis = np.asarray(vis, np.float64)
+    ref = np.asarray(ref, np.float64)
+    if vis.shape != ref.shape:
+        raise ValueError(f"shape mismatch: {vis.shape} vs {ref.shape}")
+    valid = np.isfinite(vis) & np.isfinite(ref)
+    a, b = vis[valid] < edge, ref[valid] < edge
+    union = int((a | b).sum())
+    err = np.abs(vis[valid] - ref[valid])
+    soft = (ref[valid] > 0.02) & (ref[valid] < 0.98)
+    return {
+        "iou": float((a & b).sum() / union) if union else 1.0,
+        "mae": float(err.mean()) if err.size else float("nan"),
+        "mae_penumbra": float(err[soft].mean()) if soft.any() else float("nan"),
+        "pixels": int(valid.sum()),
+    }
+
+
+# --- Cycles references ----------------------------------------------------------------------
+
+
+def cache_path(name, samples, width, height, cache_dir=DEFAULT_CACHE):
+    """Where the Cycles reference of ``name`` is cached: scene, samples, resolution, Blender
+    major.minor (references may differ between Blender lines) and the kit version."""
+    major, minor = bpy.app.version[:2]
+    key = f"{name}-{samples}spp-{width}x{height}-blender{major}.{minor}-v{KIT_VERSION}.npy"
+    return Path(cache_dir) / key
+
+
+def cycles_reference(name, samples=512, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT, cache_dir=DEFAULT_CACHE):
+    """Cycles visibility of reference scene ``name`` at ``samples`` spp, from the cache when
+    present; otherwise rendered (this rebuilds the current scene) and cached."""
+    path = cache_path(name, samples, width, height, cache_dir)
+    if path.exists():
+        return np.load(path)
+    vis = measure_visibility(build(name, width, height), "CYCLES", samples=samples)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    # Write then rename, so a concurrent reader never sees half a file.
+    fd, tmp = tempfile.mkstemp(suffix=".npy", dir=path.parent)
+    with os.fdopen(fd, "wb") as f:
+        np.save(f, vis)
+    os.chmod(tmp, 0o644)  # mkstemp creates files readable by their owner only
+    os.replace(tmp, path)
+    return vis
+
+
+# --- contact hardening ----------------------------------------------------------------------
+
+
+def _sample_bilinear(image, px, py):
+    """Bilinear samples of ``image`` (h, w) at pixel coordinates (0 = first pixel centre);
+    NaN outside the image or next to an invalid pixel."""
+    h, w = image.shape
+    x0, y0 = np.floor(px).astype(int), np.floor(py).astype(int)
+    fx, fy = px - x0, py - y0
+    inside = (x0 >= 0) & (y0 >= 0) & (x0 + 1 < w) & (y0 + 1 < h)
+    x0c, y0c = np.clip(x0, 0, w - 2), np.clip(y0, 0, h - 2)
+    a, b = image[y0c, x0c], image[y0c, x0c + 1]
+    c, d = image[y0c + 1, x0c], image[y0c + 1, x0c + 1]
+    value = (a * (1 - fx) + b * fx) * (1 - fy) + (c * (1 - fx) + d * fx) * fy
+    return np.where(inside, value, np.nan)
+
+
+def _crossing(x, v, level):
+    """First x where the profile v(x) reaches ``level`` (linear interpolation), or NaN."""
+    above = np.nonzero(v >= level)[0]
+    if len(above) == 0 or above[0] == 0:
+        return float("nan")
+    i = above[0]
+    return float(x[i - 1] + (level - v[i - 1]) / (v[i] - v[i - 1]) * (x[i] - x[i - 1]))
+
+
+def penumbra_width(scene, vis, distance, low=0.1, high=0.9, band=0.06):
+    """Width on the plane (scene units) of the ``low``-``high`` visibility transition across
+    the contact scene's pillar shadow, ``distance`` units from the pillar along the shadow.
+
+    The visibility image is sampled along lines across the shadow (averaged over a ``band``
+    along it, against noise), from the shadow's centre line outwards on both sides; the
+    width is the mean of the two sides. NaN when the profile never drops below ``low``."""
+    view, proj, w, h = camera_matrices(scene)
+    y = -(PILLAR_WIDTH / 2 + distance) + np.linspace(-band / 2, band / 2, 7)
+    x = np.linspace(0.0, 1.5, 601)
+    X, Y = np.meshgrid(x, y)
+    widths = []
+    for side in (1.0, -1.0):
+        world = np.stack([side * X, Y, np.zeros_like(X), np.ones_like(X)], axis=-1) @ (proj @ view).T
+        ndc = world[..., :2] / world[..., 3:4]
+        px = (ndc[..., 0] + 1) / 2 * w - 0.5
+        py = (ndc[..., 1] + 1) / 2 * h - 0.5
+        profile = np.nanmean(_sample_bilinear(np.asarray(vis, np.float64), px, py), axis=0)
+        if not np.nanmin(profile) < low:
+            return float("nan")
+        widths.append(_crossing(x, profile, high) - _crossing(x, profile, low))
+    return float(np.mean(widths))
+
+
+def contact_widths(scene, vis, near=0.3, far=1.8):
+    """(near width, far width) of the contact scene's penumbra, ``near`` and ``far`` units
+    from the pillar along its shadow."""
+    return penumbra_width(scene, vis, near), penumbra_width(scene, vis, far)

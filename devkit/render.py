@@ -1,0 +1,41 @@
+"""Rendering to numpy arrays: through Blender's own output path (what a batch render writes),
+or one frame of Penumbra's engine core inside a GPU context."""
+
+import os
+import tempfile
+
+import bpy
+
+from devkit.imageio import read_exr, set_format
+
+
+def render(scene=None, passes=("Combined",)):
+    """Render ``scene`` with its engine through Blender's own output path (the same file a
+    batch render writes); return {pass: array (h, w, c)} flipped so row 0 is the bottom of the
+    image (the orientation of GPU textures and Blender's pixel buffers)."""
+    scene = scene or bpy.context.scene
+    scene.view_layers[0].use_pass_z = "Depth" in passes
+    set_format(scene.render.image_settings, "OPEN_EXR_MULTILAYER", color_depth="32", exr_codec="ZIP")
+    old = scene.render.filepath
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "frame.exr")
+        scene.render.filepath = path
+        scene.render.use_file_extension = False
+        try:
+            bpy.ops.render.render(write_still=True)
+            data = read_exr(path)
+        finally:
+            scene.render.filepath = old
+    return {k: v[::-1] for k, v in data.items()}
+
+
+def engine_frame(runner, scene, width, height):
+    """One frame of ``scene``'s camera through the engine core (``devkit.session.GpuRunner``
+    ``runner``): (FrameStats, scene-linear RGBA array (height, width, 4), row 0 at the bottom)."""
+    from penumbra.engine.extract import camera_from_scene
+
+    def job(engine, depsgraph):
+        out = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, width, height), width, height)
+        return out.stats, out.color_array().copy()
+
+    return runner(job)

@@ -1,0 +1,178 @@
+"""The process a tool or a test runs in: throw-away user folders, the repository loaded as the
+``penumbra`` package, code run inside a GPU context, and a safe way out.
+
+Nothing here imports ``bpy`` at import time: ``isolate()`` must run before Blender starts.
+"""
+
+import contextlib
+import importlib.util
+import os
+import sys
+import tempfile
+import traceback
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# Environment variables that could point Blender at a real user's configuration.
+_XDG = ("XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_CACHE_HOME")
+
+
+def isolated_env(home, base=None):
+    """A copy of ``base`` (default: this process's environment) whose HOME and Blender user
+    folders all lie inside ``home``: for child processes."""
+    base = os.environ if base is None else base
+    env = {k: v for k, v in base.items() if not k.startswith("BLENDER_USER_") and k not in _XDG}
+    env["HOME"] = str(home)
+    env["BLENDER_USER_RESOURCES"] = str(Path(home) / "blender")
+    return env
+
+
+def isolate(home=None):
+    """Point this process's HOME and Blender user folders at ``home`` (default: a new temporary
+    folder) so presets and preferences never touch a real user's config. Call it before ``bpy``
+    is imported; returns the HOME path."""
+    if "bpy" in sys.modules:
+        raise RuntimeError("isolate() must run before bpy is imported")
+    home = Path(home) if home is not None else Path(tempfile.mkdtemp(prefix="penumbra-home-"))
+    env = isolated_env(home)
+    for key in [k for k in os.environ if k not in env]:
+        del os.environ[key]
+    os.environ.update(env)
+    return home
+
+
+def child_env(base=None):
+    """A copy of ``base`` (default: this process's environment) with the repository root first
+    on PYTHONPATH, so a child Python started in any folder can ``import devkit``."""
+    env = dict(os.environ if base is None else base)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH")) if p)
+    return env
+
+
+def load_penumbra():
+    """Import the repository root as the package ``penumbra`` (its folder name may differ)."""
+    if "penumbra" in sys.modules:
+        return sys.modules["penumbra"]
+    spec = importlib.util.spec_from_file_location(
+        "penumbra", ROOT / "__init__.py", submodule_search_locations=[str(ROOT)]
+    )
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["penumbra"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+class GpuRunner:
+    """Runs ``fn(engine, depsgraph)`` inside a RenderEngine.render() call, where Blender's gpu
+    module can draw in background mode. The engine class is built on Penumbra's engine core,
+    so ``engine.render_frame`` and ``engine.draw_display`` are the production code paths.
+
+    Use as ``runner = GpuRunner(); runner.register(); runner(fn); runner.unregister()``. The
+    current scene needs a camera (Blender refuses to render without one)."""
+
+    def __init__(self):
+        import bpy
+
+        load_penumbra()
+        from penumbra.engine.render_engine import PenumbraEngineCore
+
+        runner = self
+
+        class PENUMBRA_GPU_RUNNER(PenumbraEngineCore, bpy.types.RenderEngine):
+            bl_idname = "PENUMBRA_GPU_RUNNER"
+            bl_label = "Penumbra GPU runner"
+            bl_use_gpu_context = True
+
+            def render(self, depsgraph):
+                try:
+                    runner._result = runner._job(self, depsgraph)
+                except Exception as exc:  # handed back to the caller
+                    runner._error = exc
+                finally:
+                    self.free_gpu()  # while the GPU context is active
+
+            def update_render_passes(self, scene=None, renderlayer=None):
+                self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+
+        self.engine_class = PENUMBRA_GPU_RUNNER
+        self._job = self._result = self._error = None
+
+    def register(self):
+        import bpy
+
+        bpy.utils.register_class(self.engine_class)
+
+    def unregister(self):
+        import bpy
+
+        bpy.utils.unregister_class(self.engine_class)
+
+    def __call__(self, fn):
+        import bpy
+
+        scene = bpy.context.scene
+        old = scene.render.engine
+        scene.render.engine = self.engine_class.bl_idname
+        self._job, self._result, self._error = fn, None, None
+        try:
+            bpy.ops.render.render(write_still=False)
+        finally:
+            scene.render.engine = old
+        if self._error is not None:
+            raise self._error
+        return self._result
+
+
+def gpu_renderer():
+    """The GPU renderer string, or None: the gpu module only answers once a GPU context exists
+    (after a GPU engine has rendered), and not at all on some Blender versions in background mode."""
+    try:
+        import gpu
+
+        return gpu.platform.renderer_get()
+    except Exception:
+        return None
+
+
+@contextlib.contextmanager
+def stdout_to_stderr():
+    """Send file descriptor 1 to stderr for the duration: Blender's render progress and reports
+    ("Fra:1 Mem:..." lines) are printed by C code straight to it, and stdout is kept for results."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def hard_exit(status=0):
+    """Flush stdout and stderr, then leave the process with ``status`` without running the
+    interpreter's and bpy's exit handlers: with Blender 4.5 as a module, a static destructor can
+    wait forever on a GPU or file worker thread at exit. Every tool ends here, and so does the
+    pytest session on Blender 4.5, once everything has been reported."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(status)
+
+
+def run(main, argv=None):
+    """Run a tool's ``main(argv)`` and leave through ``hard_exit``: with its return value (None
+    is 0), 1 after an uncaught exception (traceback on stderr), or the code of a SystemExit."""
+    try:
+        status = main(argv)
+    except SystemExit as exc:
+        if exc.code is None or isinstance(exc.code, int):
+            status = exc.code
+        else:
+            print(exc.code, file=sys.stderr)
+            status = 1
+    except BaseException:
+        traceback.print_exc()
+        status = 1
+    hard_exit(status or 0)

@@ -1,0 +1,148 @@
+"""What a frame sends to the GPU, built without one: std140 packing against hand-derived
+offsets, the lit pass's uniform data from a shadow plan, and the shaders' use of the structs."""
+
+import math
+import re
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from devkit.session import ROOT, load_penumbra
+
+load_penumbra()
+from penumbra.engine import lightspace, programs, settings, shadows  # noqa: E402
+from penumbra.engine.extract import Camera, Light  # noqa: E402
+from penumbra.engine.frame_data import build_frame_data  # noqa: E402
+from penumbra.shaders.loader import Struct  # noqa: E402
+
+
+def test_std140_offsets_match_hand_derived_layout():
+    s = Struct("T", (("FLOAT", "a"), ("VEC3", "b"), ("VEC2", "c"), ("INT", "d"), ("MAT4", "e"), ("IVEC2", "f")))
+    # a at 0; vec3 aligns to 16 and takes 12 (16..28); vec2 aligns to 8 (32..40); int at 40;
+    # mat4 aligns to 16 (48..112); ivec2 aligns to 8 (112..120); stride rounds up to 128.
+    assert {k: v[0] for k, v in s.layout.items()} == {"a": 0, "b": 16, "c": 32, "d": 40, "e": 48, "f": 112}
+    assert s.stride == 128
+    assert "  vec3 b;\n" in s.glsl() and "  ivec2 f;\n" in s.glsl()
+
+
+def test_pack_round_trips_floats_ints_and_column_major_matrices():
+    s = Struct("T", (("VEC3", "v"), ("INT", "i"), ("MAT4", "m"), ("IVEC4", "t")))
+    m = np.arange(16, dtype=np.float64).reshape(4, 4)
+    data = s.pack([{"v": (1.5, -2, 3), "i": -1, "m": m, "t": (4, -1, 7, 48)}], count=3)
+    assert data.shape == (3, s.stride // 4) and data.dtype == np.float32
+    np.testing.assert_array_equal(s.unpack(data, 0, "v"), [1.5, -2, 3])
+    assert s.unpack(data, 0, "i") == -1  # an int bit pattern, not the float -1.0
+    assert data.view(np.int32)[0, 3] == -1
+    np.testing.assert_array_equal(s.unpack(data, 0, "m"), m)
+    np.testing.assert_array_equal(data[0, 4:8], m[:, 0])  # first column first
+    np.testing.assert_array_equal(s.unpack(data, 0, "t"), [4, -1, 7, 48])
+    assert not data[1:].any()  # elements past the rows are zero
+    with pytest.raises(KeyError, match="missing"):
+        s.pack([{"v": (0, 0, 0)}])
+    with pytest.raises(KeyError, match="unknown"):
+        s.pack([{"v": (0, 0, 0), "i": 0, "m": m, "t": (0, 0, 0, 0), "extra": 1}])
+
+
+def _settings(**overrides):
+    source = SimpleNamespace(**{p.name: p.default for p in settings.SCENE_PARAMS})
+    vars(source).update(overrides)
+    return settings.render_settings(source)
+
+
+def _camera():
+    view = lightspace.look_at((0.0, -6.0, 3.0), (0.0, 1.0, -0.5))
+    return Camera(view=view, projection=lightspace.perspective(math.radians(50), 16 / 9, 0.1, 100.0))
+
+
+def _light(kind, position=(0.0, 0.0, 4.0), **kw):
+    matrix = np.eye(4)
+    matrix[:3, 3] = position
+    return Light(type=kind, color=np.array([2.0, 1.0, 0.5]), matrix=matrix, radius=0.25, **kw)
+
+
+def _plan(lights):
+    """A real plan over a ground box and a caster box above it."""
+    ground = lightspace.box_corners(np.array([-5.0, -5.0, -0.1]), np.array([5.0, 5.0, 0.0]))
+    caster = lightspace.box_corners(np.array([-0.5, -0.5, 0.5]), np.array([0.5, 0.5, 1.5]))
+    return shadows.plan_shadows(lights, np.stack([ground, caster]), 256)
+
+
+def test_frame_data_carries_every_light_its_tiles_and_the_settings():
+    lights = [
+        _light("SUN", angle=math.radians(10)),
+        _light("POINT"),
+        _light("SPOT", spot_size=math.radians(60), spot_blend=0.5),
+        _light("SPOT", use_shadow=False),
+    ]
+    plan = _plan(lights)
+    st = _settings(shadow_bias=0.25, pcf_spacing=1.5)
+    data = build_frame_data(lights, _camera(), (0.1, 0.2, 0.3), st, plan, tile_size=256, atlas_columns=3)
+    F, L = programs.FRAME_STRUCT, programs.LIGHT_STRUCT
+    assert F.unpack(data.frame, 0, "light_count") == 4
+    assert F.unpack(data.frame, 0, "tile_size") == 256 and F.unpack(data.frame, 0, "atlas_columns") == 3
+    assert F.unpack(data.frame, 0, "constant_bias") == pytest.approx(0.25)
+    assert F.unpack(data.frame, 0, "pcf_spacing") == pytest.approx(1.5)
+    np.testing.assert_allclose(F.unpack(data.frame, 0, "world_color"), (0.1, 0.2, 0.3), rtol=1e-6)
+    np.testing.assert_allclose(F.unpack(data.frame, 0, "view_proj"), _camera().projection @ _camera().view, rtol=1e-6)
+
+    modes = [L.unpack(data.lights, i, "shadow_mode") for i in range(4)]
+    assert modes == [0, 1, 0, -1]  # SINGLE, CUBE, SINGLE, NONE
+    cube = plan.lights[1].tiles
+    np.testing.assert_array_equal(L.unpack(data.lights, 1, "tiles"), cube[:4])
+    np.testing.assert_array_equal(L.unpack(data.lights, 1, "tiles_45"), cube[4:6])
+    np.testing.assert_array_equal(L.unpack(data.lights, 3, "tiles"), [-1, -1, -1, -1])
+    assert L.unpack(data.lights, 0, "sun_tan_half_angle") == pytest.approx(math.tan(math.radians(5)))
+    assert L.unpack(data.lights, 2, "spot_cos_half") == pytest.approx(math.cos(math.radians(30)))
+    assert L.unpack(data.lights, 0, "spot_cos_half") == pytest.approx(-2.0)  # not a spot: no cone
+    # Every planned tile is packed with its own fit; the rest of the block is zero.
+    T = programs.TILE_STRUCT
+    for i, tile in enumerate(plan.tiles):
+        assert T.unpack(data.tiles, i, "near") == pytest.approx(tile.fit.near, rel=1e-6)
+        assert T.unpack(data.tiles, i, "far") == pytest.approx(tile.fit.far, rel=1e-6)
+    assert not data.tiles[len(plan.tiles) :].any()
+
+
+@pytest.mark.parametrize("kernel", [1, 3, 5, 15])
+def test_pcf_taps_are_the_normalised_kernel_and_size_the_variant(kernel):
+    data = build_frame_data([], _camera(), (0, 0, 0), _settings(pcf_kernel_size=kernel), shadows.ShadowPlan())
+    assert data.defines["PCF_TAPS"] == kernel * kernel
+    weights = data.taps[: kernel * kernel, 2]
+    assert weights.sum() == pytest.approx(1.0, abs=1e-6)
+    assert not data.taps[kernel * kernel :].any()
+
+
+def test_only_what_a_filter_reads_varies_its_shader_variant():
+    def defines(**kw):
+        return build_frame_data([], _camera(), (0, 0, 0), _settings(**kw), shadows.ShadowPlan()).defines
+
+    assert defines(shadow_filter="NONE", pcf_kernel_size=3) == defines(shadow_filter="NONE", pcf_kernel_size=9)
+    assert defines(shadow_filter="NONE", shadow_samples=64) == defines(shadow_filter="NONE", shadow_samples=8)
+    assert defines(shadow_filter="PCF", shadow_early_out=False) == defines(shadow_filter="PCF")
+    assert defines(shadow_filter="JITTER", shadow_samples=20)["DISK_SAMPLES"] == 16  # whole rings of 8
+    assert defines(shadow_filter="PCSS", shadow_early_out=False)["EARLY_OUT"] is False
+    assert defines(shadow_filter="PCSS")["SHADOW_FILTER"] == "FILTER_PCSS"
+
+
+def test_more_lights_than_the_block_holds_is_an_error_not_a_silent_drop():
+    lights = [_light("POINT", use_shadow=False)] * (programs.MAX_LIGHTS + 1)
+    with pytest.raises(ValueError, match="at most"):
+        build_frame_data(lights, _camera(), (0, 0, 0), _settings(), shadows.ShadowPlan())
+
+
+# Which struct each GLSL variable name holds in the scene shaders.
+_VARIABLES = {"frame": programs.FRAME_STRUCT, "L": programs.LIGHT_STRUCT, "T": programs.TILE_STRUCT,
+              "tile": programs.TILE_STRUCT, "tap": programs.TAP_STRUCT}  # fmt: skip
+
+
+def test_scene_shaders_read_only_fields_their_structs_declare():
+    sources = [ROOT / "shaders" / p for p in ("lit.frag.glsl", "mesh.vert.glsl", "shadow_depth.vert.glsl",
+                                              "shadow_depth.frag.glsl")]  # fmt: skip
+    sources += sorted((ROOT / "shaders" / "lib").glob("*.glsl"))
+    used = 0
+    for path in sources:
+        text = re.sub(r"/\*.*?\*/", "", path.read_text(), flags=re.S)
+        for var, field in re.findall(r"\b(frame|L|T|tile|tap)\.([A-Za-z_]\w*)", text):
+            assert field in _VARIABLES[var].layout, f"{path.name}: {var}.{field} is not a {_VARIABLES[var].name} field"
+            used += 1
+    assert used > 30

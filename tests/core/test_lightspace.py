@@ -1,0 +1,161 @@
+"""Light-space maths: plain numpy, checked against hand-derived values."""
+
+import numpy as np
+import pytest
+
+from devkit.session import load_penumbra
+
+load_penumbra()
+from penumbra.engine import lightspace  # noqa: E402
+
+
+@pytest.mark.parametrize(
+    "forward",
+    [(0, 0, -1), (0, 0, 1), (0, 1, 0), (0, -1, 0), (1, 0, 0), (0.3, -0.2, -0.9), (1e-12, 0, -1)],
+)
+def test_look_at_is_orthonormal_for_every_direction(forward):
+    v = lightspace.look_at((1.0, 2.0, 3.0), forward)
+    r = v[:3, :3]
+    np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(r) == pytest.approx(1.0)
+    f = np.asarray(forward, float) / np.linalg.norm(forward)
+    np.testing.assert_allclose(r @ f, (0, 0, -1), atol=1e-12)  # forward maps to -Z
+    np.testing.assert_allclose(v @ (1, 2, 3, 1), (0, 0, 0, 1), atol=1e-12)  # eye maps to origin
+
+
+def test_look_at_zero_direction_falls_back():
+    v = lightspace.look_at((0, 0, 0), (0, 0, 0))
+    assert np.all(np.isfinite(v))
+
+
+def test_orthographic_maps_box_to_ndc_cube():
+    p = lightspace.orthographic(-2, 4, -1, 3, 0.5, 10.5)
+    corners = np.array([[-2, -1, -0.5], [4, 3, -10.5]])
+    ndc = lightspace.transform_points(p, corners)
+    np.testing.assert_allclose(ndc, [[-1, -1, -1], [1, 1, 1]], atol=1e-12)
+
+
+def test_perspective_matches_definition():
+    p = lightspace.perspective(np.radians(90), 2.0, 1.0, 100.0)
+    # A point on the near plane at the top edge maps to y = 1, z = -1.
+    ndc = lightspace.transform_points(p, [[0, 1, -1], [0, 0, -100]])
+    np.testing.assert_allclose(ndc[0], [0, 1, -1], atol=1e-12)
+    np.testing.assert_allclose(ndc[1][2], 1.0, atol=1e-12)
+
+
+def test_bias_matrix_maps_ndc_to_unit_cube():
+    np.testing.assert_allclose(lightspace.BIAS_MATRIX @ (-1, -1, -1, 1), (0, 0, 0, 1))
+    np.testing.assert_allclose(lightspace.BIAS_MATRIX @ (1, 1, 1, 1), (1, 1, 1, 1))
+
+
+@pytest.mark.parametrize(
+    "m",
+    [
+        np.diag([2.0, 3.0, 0.5, 1.0]),
+        np.diag([-1.0, 1.0, 1.0, 1.0]),
+        np.array([[1, 0.5, 0, 0], [0, 1, 0.2, 0], [0.1, 0, 2, 0], [0, 0, 0, 1.0]]),
+    ],
+)
+def test_normal_matrix_is_inverse_transpose_up_to_positive_scale(m):
+    n = lightspace.normal_matrix(m)
+    ref = np.linalg.inv(m[:3, :3]).T
+    c = n @ np.linalg.inv(ref)  # must be c * identity with c > 0
+    assert c[0, 0] > 0
+    np.testing.assert_allclose(c, c[0, 0] * np.eye(3), atol=1e-9 * abs(c[0, 0]))
+
+
+def test_normal_matrix_is_finite_for_zero_scale():
+    n = lightspace.normal_matrix(np.diag([0.0, 1.0, 1.0, 1.0]))
+    assert np.all(np.isfinite(n))
+    # The x-axis normal of a surface flattened in x survives; others collapse to zero.
+    np.testing.assert_allclose(n @ (1, 0, 0), (1, 0, 0))
+
+
+def test_sun_fit_contains_points_and_is_texel_snapped():
+    rng = np.random.default_rng(1)
+    pts = rng.uniform(-5, 5, (200, 3))
+    d = np.array([0.3, -0.4, -0.8])
+    fit = lightspace.fit_sun_ortho(d, pts, 1024)
+    view, proj, texel = fit.view, fit.proj, fit.texel
+    ndc = lightspace.transform_points(proj @ view, pts)
+    assert np.all(np.abs(ndc) <= 1.0)
+    # Frustum edges lie on whole texels of light space: moving the points by less than a
+    # texel keeps the projection's offset on the same grid.
+    left = (-1 - proj[0, 3]) / proj[0, 0]
+    assert abs(left / texel - round(left / texel)) < 1e-6
+    width = 2 / proj[0, 0]
+    assert width / texel == pytest.approx(1024)
+
+
+def test_sun_fit_scale_invariant():
+    """The same scene at 1e-3 and 1e4 scale gets the same fit, scaled (no fixed epsilons)."""
+    pts = np.array([[-1, -1, 0], [1, 1, 0], [0.2, 0.1, 2.0]])
+    d = (0.2, 0.1, -1.0)
+    a = lightspace.fit_sun_ortho(d, pts, 512)
+    for s in (1e-3, 1e4):
+        b = lightspace.fit_sun_ortho(d, pts * s, 512)
+        assert b.texel == pytest.approx(a.texel * s, rel=0.2)
+        ndc_a = lightspace.transform_points(a.view_proj, pts)
+        ndc_b = lightspace.transform_points(b.view_proj, pts * s)
+        assert np.all(np.abs(ndc_b) <= 1.0)
+        np.testing.assert_allclose(ndc_b[:, 2], ndc_a[:, 2], atol=0.05)
+
+
+def test_sun_fit_empty_and_nonfinite():
+    assert lightspace.fit_sun_ortho((0, 0, -1), np.zeros((0, 3)), 512) is None
+    assert lightspace.fit_sun_ortho((0, 0, -1), [[np.nan, 0, 0]], 512) is None
+    one = lightspace.fit_sun_ortho((0, 0, -1), [[1, 2, 3]], 1)
+    assert one is not None and np.all(np.isfinite(one.view_proj)) and one.far > one.near
+
+
+def test_perspective_tile_covers_the_casters_in_front_only():
+    """The fit spot and cube-face maps use: near/far bracket every caster in the cone, all their
+    corners project inside the map, and a light with every caster behind it gets no tile."""
+    from penumbra.engine.shadows import perspective_tile
+
+    boxes = [((-0.5, -0.5, -2.5), (0.5, 0.5, -2.0)), ((0.0, 0.0, -6.5), (1.0, 1.0, -6.0)), ((0, 0, 4), (1, 1, 5))]
+    corners = np.stack([lightspace.box_corners(np.array(lo, float), np.array(hi, float)) for lo, hi in boxes])
+    lo, hi = corners.min(axis=1), corners.max(axis=1)
+    tile = perspective_tile(np.zeros(3), np.array([0, 0, -1.0]), np.radians(90), corners, lo, hi, 256)
+    assert list(tile.casters) == [0, 1]  # the box behind the light casts nothing into the cone
+    assert tile.fit.near <= 2.0 and tile.fit.far >= 6.5
+    ndc = lightspace.transform_points(tile.fit.view_proj, corners[:2].reshape(-1, 3))
+    assert np.all(np.abs(ndc) <= 1.0 + 1e-9)
+    assert tile.fit.texel_per_distance == pytest.approx(2.0 / 256)
+    behind = perspective_tile(np.zeros(3), np.array([0, 0, 1.0]), 0.5, corners[:2], lo[:2], hi[:2], 256)
+    assert behind is None
+
+
+@pytest.mark.parametrize("face", range(6))
+def test_cube_faces_cover_their_axis(face):
+    fwd = lightspace.CUBE_FORWARDS[face]
+    assert lightspace.cube_face(fwd * 3 + 0.1) == face
+    view = lightspace.look_at((1, 2, 3), fwd)
+    ndc = lightspace.transform_points(lightspace.perspective(np.pi / 2, 1, 0.1, 10) @ view, [(1, 2, 3) + fwd * 2])
+    np.testing.assert_allclose(ndc[0, :2], 0, atol=1e-12)
+
+
+def test_boxes_in_frustum_is_conservative():
+    vp = lightspace.orthographic(-1, 1, -1, 1, 0.1, 10)
+    inside = lightspace.box_corners((-0.5, -0.5, -2), (0.5, 0.5, -1))
+    straddle = lightspace.box_corners((0.9, -0.1, -2), (3, 0.1, -1))
+    outside = lightspace.box_corners((2, 2, -2), (3, 3, -1))
+    behind = lightspace.box_corners((-0.5, -0.5, 1), (0.5, 0.5, 2))
+    got = lightspace.boxes_in_frustum(vp, np.stack([inside, straddle, outside, behind]))
+    assert got.tolist() == [True, True, False, False]
+
+
+def test_sun_fit_to_view_covers_visible_receivers_and_their_casters():
+    ground = lightspace.box_corners((-1000, -1000, -0.1), (1000, 1000, 0.0))
+    caster = lightspace.box_corners((-0.5, -0.5, 1.0), (0.5, 0.5, 2.0))
+    far_away = lightspace.box_corners((500, 500, 0), (501, 501, 1))
+    view = lightspace.look_at((0, -10, 10), (0, 1, -1))
+    cam = lightspace.orthographic(-4, 4, -4, 4, 0.1, 40) @ view
+    fit, casters = lightspace.fit_sun_to_view(
+        (0.2, 0.1, -1.0), np.stack([ground, caster, far_away]), lightspace.frustum_corners(cam), 1024
+    )
+    assert sorted(casters.tolist()) == [0, 1]  # the far box cannot shadow what the camera sees
+    whole = lightspace.fit_sun_ortho((0.2, 0.1, -1.0), np.concatenate([ground, caster, far_away]), 1024)
+    assert fit.texel < whole.texel / 50  # the view-fitted map is far sharper
+    ndc = lightspace.transform_points(fit.view_proj, caster)
+    assert np.all(np.abs(ndc) <= 1.0)

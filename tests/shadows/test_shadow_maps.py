@@ -1,0 +1,90 @@
+"""Which shadow maps a frame draws, reuses or skips, and the depth encodings they hold."""
+
+import math
+
+import numpy as np
+import pytest
+
+from devkit import scenes
+from devkit.analytic import iou
+from devkit.render import engine_frame
+
+
+def test_light_without_shadow_gets_no_shadow_map(penumbra, gpu_call):
+    scene = scenes.demo_scene(64, 36)
+    stats, _ = engine_frame(gpu_call, scene, 64, 36)
+    assert stats.shadow_maps == 2  # the sun and the spot
+    scene.objects["Sun"].data.use_shadow = False
+    stats, _ = engine_frame(gpu_call, scene, 64, 36)
+    assert stats.shadow_maps == 1
+    scene.objects["Spot"].data.use_shadow = False
+    stats, _ = engine_frame(gpu_call, scene, 64, 36)
+    assert stats.shadow_maps == 0 and stats.passes == 1 + stats.post_passes
+
+
+def test_point_light_skips_cube_faces_without_casters(shadow_scene, gpu_call):
+    scene = shadow_scene("POINT", "PCF")
+    stats, _ = engine_frame(gpu_call, scene, 64, 36)
+    assert stats.shadow_maps == 5  # the +Z face sees nothing
+    scene.objects["L"].location = (0.0, 0.0, 100.0)  # far above a 30 m plane: side faces see nothing either
+    stats, _ = engine_frame(gpu_call, scene, 64, 36)
+    assert stats.shadow_maps == 1
+
+
+def test_no_caster_no_shadow_map(penumbra, gpu_call):
+    scene = scenes.empty_scene(32, 32)
+    scenes.top_camera(scene)
+    for kind in ("SUN", "SPOT", "POINT", "AREA"):
+        scenes.light(scene, kind, kind, 10.0, location=(0, 0, 3))
+    stats, img = engine_frame(gpu_call, scene, 64, 36)
+    assert stats.shadow_maps == 0 and np.all(np.isfinite(img))
+    # A spot pointing away from every mesh also gets no map.
+    scenes.plane(scene, size=4.0)
+    for name in ("SUN", "POINT", "AREA"):
+        scene.objects[name].data.use_shadow = False
+    scene.objects["SPOT"].rotation_euler = (math.pi, 0, 0)  # points up, the plane is below
+    stats, _ = engine_frame(gpu_call, scene, 64, 36)
+    assert stats.shadow_maps == 0
+
+
+def _two_frames(gpu_call, scene, move):
+    from penumbra.engine.extract import camera_from_scene
+
+    def job(engine, depsgraph):
+        first = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 64, 64), 64, 64).stats
+        move()
+        depsgraph.update()
+        second = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 64, 64), 64, 64).stats
+        return first, second
+
+    return gpu_call(job)
+
+
+def test_camera_moves_redraw_sun_maps_only_when_the_fit_changes(shadow_scene, gpu_call):
+    scene = shadow_scene("SUN", "PCF", size=64)
+    scene.camera.data.ortho_scale = 60.0  # the camera sees the whole 30 m plane
+
+    def nudge():
+        scene.camera.location.x += 0.5
+
+    first, second = _two_frames(gpu_call, scene, nudge)
+    assert (first.shadow_maps, first.shadow_maps_reused) == (1, 0)
+    assert (second.shadow_maps, second.shadow_maps_reused) == (0, 1)  # same receivers, same fit
+    scene.camera.data.ortho_scale = 8.0  # now the view crops the plane: the fit follows it
+    first, second = _two_frames(gpu_call, scene, nudge)
+    assert second.shadow_maps == 1
+    scene.penumbra.shadow_sun_fit = "SCENE"  # camera-independent: never redrawn for moves
+    first, second = _two_frames(gpu_call, scene, nudge)
+    assert (second.shadow_maps, second.shadow_maps_reused) == (0, 1)
+
+
+@pytest.mark.parametrize("fmt", ["FLOAT32", "FLOAT16", "RGBA8"])
+def test_depth_encodings_cast_the_same_shadow(shadow_scene, analytic_shadow, fmt):
+    scene = shadow_scene("SPOT", "NONE")
+    scene.penumbra.shadow_depth_format = fmt
+    _lum, visibility, on_plane, shadowed = analytic_shadow(scene, scene.objects["L"])
+    lit = on_plane & ~shadowed
+    measured = visibility < 0.5
+    score = iou(measured[on_plane], shadowed[on_plane])
+    acne = (lit & measured).sum() / lit.sum()
+    assert score > 0.95 and acne < 0.01, f"{fmt}: IoU {score:.3f}, acne {acne:.2%}"

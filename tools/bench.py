@@ -1,0 +1,41 @@
+"""Benchmarks, one command each (modules in tools/benchmarks/):
+
+    frame     render time of Penumbra, EEVEE, Workbench and Cycles on the demo scene
+              -> <out>/benchmark.csv
+    post      cost of each post layer; separable against direct 2-D blur -> <out>/post_costs.csv
+    shadows   shadow error against frame time, scaling, per-frame work, JITTER early out
+              -> <out>/shadow_tradeoff.csv, shadow_pareto.png, scaling.csv, scaling.png
+
+Run from the repository root, e.g.::
+
+    .venv/blender-5.2/bin/python -m tools.bench frame --out out --runs 5
+    .venv/blender-5.2/bin/python -m tools.bench shadows --quick
+
+Markdown tables for the README go to stdout, progress and Blender's own output to stderr.
+``python -m tools.bench <command> --help`` lists each command's options.
+"""
+
+import argparse
+
+from devkit import session
+from tools.benchmarks import frame, post, shadows
+
+COMMANDS = {"frame": frame, "post": post, "shadows": shadows}
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        prog="python -m tools.bench", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="{" + ",".join(COMMANDS) + "}")
+    for name, module in COMMANDS.items():
+        command = sub.add_parser(
+            name, help=module.HELP, description=module.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+        )
+        module.add_arguments(command)
+    args = parser.parse_args(argv)
+    return COMMANDS[args.command].run(args)
+
+
+if __name__ == "__main__":
+    session.run(main)
