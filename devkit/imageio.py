@@ -68,3 +68,32 @@ def save_render(scene, path, file_format, color_depth):
 
     set_format(scene.render.image_settings, file_format, color_depth)
     bpy.data.images["Render Result"].save_render(str(path), scene=scene)
+
+
+def read_exr_layers(path):
+    """{(view layer, view): {pass: float32 array (h, w, channels)}} of a multilayer EXR, top row
+    first; view is "" for a mono render. Blender 5.x writes one part per pass and view (the
+    view in the part's "view" attribute); 4.5 one part with channels "layer.pass[.view].C"."""
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise RuntimeError(oiio.geterror())
+    out = {}
+    sub = 0
+    try:
+        while inp.seek_subimage(sub, 0):
+            spec = inp.spec()
+            part_view = spec.getattribute("view") or ""
+            pixels = np.asarray(inp.read_image(sub, 0, 0, spec.nchannels, oiio.FLOAT), np.float32)
+            groups = {}
+            for i, name in enumerate(spec.channelnames):
+                parts = name.split(".")
+                layer, pass_name = parts[0], parts[1]
+                view = parts[2] if len(parts) == 4 else part_view
+                groups.setdefault((layer, view, pass_name), []).append(i)
+            for (layer, view, pass_name), idx in groups.items():
+                idx.sort(key=lambda i: _CHANNEL_ORDER.find(spec.channelnames[i].split(".")[-1]))
+                out.setdefault((layer, view), {})[pass_name] = pixels[:, :, idx]
+            sub += 1
+    finally:
+        inp.close()
+    return out

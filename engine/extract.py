@@ -107,18 +107,32 @@ def matrix_np(m):
     return np.array(m, dtype=np.float64).reshape(4, 4)
 
 
-def camera_from_scene(depsgraph, scene, width, height):
-    """The active scene camera's matrices for a final render of ``width`` x ``height``."""
+def camera_from_scene(depsgraph, scene, width, height, matrix_world=None, shift_x=None):
+    """The active scene camera's matrices for a final render of ``width`` x ``height``.
+    ``matrix_world`` and ``shift_x`` override the camera's own for one view of a multiview
+    render (Blender's ``RenderEngine.camera_model_matrix`` / ``camera_shift_x``)."""
     cam_ob = scene.camera.evaluated_get(depsgraph)
-    proj = cam_ob.calc_matrix_camera(
-        depsgraph,
-        x=width,
-        y=height,
-        scale_x=scene.render.pixel_aspect_x,
-        scale_y=scene.render.pixel_aspect_y,
-    )
-    view = matrix_np(cam_ob.matrix_world.inverted_safe())
-    return Camera(view=view, projection=matrix_np(proj), is_ortho=cam_ob.data.type == "ORTHO")
+    aspect_x, aspect_y = scene.render.pixel_aspect_x, scene.render.pixel_aspect_y
+    proj = matrix_np(cam_ob.calc_matrix_camera(depsgraph, x=width, y=height, scale_x=aspect_x, scale_y=aspect_y))
+    ortho = cam_ob.data.type == "ORTHO"
+    if shift_x is not None and shift_x != cam_ob.data.shift_x:
+        delta = (shift_x - cam_ob.data.shift_x) * shift_scale(
+            cam_ob.data.sensor_fit, width * aspect_x, height * aspect_y
+        )
+        if ortho:
+            proj[0, 3] -= delta
+        else:
+            proj[0, 2] += delta
+    world = cam_ob.matrix_world if matrix_world is None else matrix_world
+    view = matrix_np(world.inverted_safe())
+    return Camera(view=view, projection=proj, is_ortho=ortho)
+
+
+def shift_scale(sensor_fit, width, height):
+    """How far (in NDC x) a camera shift of 1 moves the frame: Blender measures shift in units
+    of the fitted sensor side (the larger image side for AUTO)."""
+    side = {"HORIZONTAL": width, "VERTICAL": height}.get(sensor_fit, max(width, height))
+    return 2.0 * side / width
 
 
 def camera_from_view(view_matrix, window_matrix):

@@ -42,6 +42,26 @@ def disk_samples(settings):
     return int(np.clip(int(settings.shadow_samples) // RING * RING, RING, MAX_DISK_SAMPLES))
 
 
+def select_lights(lights, camera_position, limit):
+    """At most ``limit`` lights, the ones whose light reaches the camera's surroundings most
+    (sun: its strength; others: power over the squared distance to the camera), in their
+    original order. Ties keep the earlier light, so the choice is stable across frames."""
+    if len(lights) <= limit:
+        return list(lights)
+    cam = np.asarray(camera_position, np.float64)
+
+    def strength(light):
+        power = float(np.dot(light.color, (0.2126, 0.7152, 0.0722)))
+        if light.type == "SUN":
+            return power
+        d2 = float(np.sum((light.position - cam) ** 2)) + light.radius**2
+        return power / (4.0 * math.pi * max(d2, 1e-12))
+
+    order = sorted(range(len(lights)), key=lambda i: (-strength(lights[i]), i))
+    keep = sorted(order[:limit])
+    return [lights[i] for i in keep]
+
+
 def light_row(light, shadow=None):
     """One LIGHT_STRUCT row. ``shadow``: the light's ``shadows.LightShadow`` or None."""
     half = 0.5 * min(max(light.spot_size, 0.0), math.pi)

@@ -4,8 +4,10 @@ import sys
 import traceback
 
 import bpy
+import numpy as np
 
 from .extract import SceneCache, camera_from_scene, camera_from_view
+from .output import render_views, render_window
 
 
 class PenumbraEngineCore:
@@ -59,6 +61,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
     bl_label = "Penumbra"
     bl_use_preview = False
     bl_use_gpu_context = True
+    bl_use_eevee_viewport = True  # Material Preview shading falls back to EEVEE, as for Cycles
     bl_use_shading_nodes_custom = False
 
     # --- final render ---------------------------------------------------------------------
@@ -70,35 +73,81 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         self.register_pass(scene, renderlayer, "Shadow", 1, "X", "VALUE")
 
     def render(self, depsgraph):
+        """Render the pixels Blender asks for: the render region of the frame at Blender's
+        integer resolution, into this view layer's own result, once per view of a multiview
+        render. Each result is written whole or cancelled, never left half-written."""
         scene = depsgraph.scene
-        scale = scene.render.resolution_percentage / 100.0
-        width = max(1, int(scene.render.resolution_x * scale))
-        height = max(1, int(scene.render.resolution_y * scale))
+        layer = depsgraph.view_layer.name
         if scene.camera is None:
             self.report({"ERROR"}, f"Penumbra: scene '{scene.name}' has no active camera; set one in Scene Properties")
             return
+        r = scene.render
+        width, height = self.resolution_x, self.resolution_y
+        window = render_window(
+            width, height, r.use_border, (r.border_min_x, r.border_min_y, r.border_max_x, r.border_max_y)
+        )
+        if window.width <= 0 or window.height <= 0:
+            self.report({"ERROR"}, "Penumbra: the render region is empty; widen it in the Output properties")
+            return
+        views = render_views(r)
+        reported = set()
         try:
-            camera = camera_from_scene(depsgraph, scene, width, height)
-            out = self.render_frame(depsgraph, camera, width, height)
-            color = out.color_array()
-            depth = out.depth_array()
-            shadow = out.shadow_array()
+            limit = _gpu_texture_limit()
+            if max(width, height) > limit:
+                self.report(
+                    {"ERROR"},
+                    f"Penumbra: {width}x{height} is larger than this GPU's largest texture ({limit} pixels a "
+                    "side); lower the resolution or its %",
+                )
+                return
+            for index, view in enumerate(views):
+                if self.test_break():
+                    return
+                self.update_stats("", f"Penumbra | {layer}{' | ' + view if view else ''} | rendering")
+                if view:
+                    self.active_view_set(view)
+                    camera = camera_from_scene(
+                        depsgraph,
+                        scene,
+                        width,
+                        height,
+                        matrix_world=self.camera_model_matrix(scene.camera),
+                        shift_x=self.camera_shift_x(scene.camera),
+                    )
+                else:
+                    camera = camera_from_scene(depsgraph, scene, width, height)
+                out = self.render_frame(depsgraph, camera, width, height)
+                for message in out.stats.messages:
+                    if message not in reported:
+                        reported.add(message)
+                        self.report({"WARNING"}, message)
+                passes = {
+                    "Combined": window.cut(out.color_array()),
+                    "Depth": window.cut(out.depth_array()),
+                    "Shadow": window.cut(out.shadow_array()),
+                }
+                self._write_result(window, layer, view, passes)
+                self.update_progress((index + 1) / len(views))
         except Exception as exc:  # a render must end with a message, never a crash
             traceback.print_exc(file=sys.stderr)
             self.report({"ERROR"}, f"Penumbra: render failed: {exc}")
-            return
         finally:
             # A final-render engine instance renders one frame; free while the context lives.
             self.free_gpu()
-        result = self.begin_result(0, 0, width, height)
-        layer = result.layers[0]
-        layer.passes["Combined"].rect.foreach_set(color.ravel())
-        depth_pass = layer.passes.get("Depth")
-        if depth_pass is not None:
-            depth_pass.rect.foreach_set(depth.ravel())
-        shadow_pass = layer.passes.get("Shadow")
-        if shadow_pass is not None:
-            shadow_pass.rect.foreach_set(shadow.ravel())
+
+    def _write_result(self, window, layer, view, passes):
+        """Fill one result (``window``-sized, of ``layer`` and ``view``) with every pass the
+        view layer has; on any error the result is cancelled, not left half-written."""
+        result = self.begin_result(0, 0, window.width, window.height, layer=layer, view=view)
+        try:
+            render_layer = result.layers[0]
+            for name, data in passes.items():
+                render_pass = render_layer.passes.find_by_name(name, view)
+                if render_pass is not None:
+                    render_pass.rect.foreach_set(np.ascontiguousarray(data, np.float32).ravel())
+        except BaseException:
+            self.end_result(result, cancel=True)
+            raise
         self.end_result(result)
 
     # --- viewport -------------------------------------------------------------------------
@@ -121,6 +170,12 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             return
         self._reported = None
         self.draw_display(depsgraph.scene, out.color, width, height)
+
+
+def _gpu_texture_limit():
+    import gpu
+
+    return gpu.capabilities.max_texture_size_get()
 
 
 def _compat_panels():

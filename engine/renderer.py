@@ -3,17 +3,16 @@ The same code serves the viewport and final renders; only where the camera comes
 where the result goes differ.
 """
 
-import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import kernels
 from .extract import Material
-from .frame_data import build_frame_data
+from .frame_data import build_frame_data, select_lights
 from .post import post_stack
 from .post.base import PostContext
-from .programs import JITTER_SIZE, LIT, MAX_LIGHTS, SHADOW_SAMPLER
+from .programs import JITTER_SIZE, LIT, MAX_LIGHTS, MAX_SHADOW_TILES, SHADOW_SAMPLER
 from .shadows import ShadowAtlas, plan_shadows
 
 DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
@@ -31,6 +30,7 @@ class FrameStats:
     triangles: int = 0
     texture_bytes: int = 0
     shaders_compiled: int = 0
+    messages: list = field(default_factory=list)  # what the user must be told about this frame
 
 
 @dataclass
@@ -103,7 +103,12 @@ class Renderer:
         compiled_before = self.shaders.compiled
         self._ensure_targets(width, height)
         draws = self._draw_list(snapshot, stats)
-        lights = snapshot.lights[:MAX_LIGHTS]
+        lights = select_lights(snapshot.lights, camera.position, MAX_LIGHTS)
+        if len(lights) < len(snapshot.lights):
+            stats.messages.append(
+                f"Penumbra: {len(snapshot.lights)} lights; only the {MAX_LIGHTS} that contribute most to the view "
+                "are lit"
+            )
         plan = self._shadow_pass(draws, lights, camera, settings, stats)
         data = build_frame_data(
             lights,
@@ -157,10 +162,18 @@ class Renderer:
         if not plan.tiles:
             return plan
         columns, _rows = self.shadows.grid(len(plan.tiles))
-        clamped = _clamp_map_size(map_size, columns)
+        clamped = min(map_size, _gpu_texture_limit() // columns)
         if clamped != map_size:
+            stats.messages.append(
+                f"Penumbra: shadow map size {map_size} clamped to {clamped}: {len(plan.tiles)} maps share this "
+                "GPU's largest texture"
+            )
             map_size = clamped
             plan = plan_shadows(lights, corners, map_size, view_corners)
+        if plan.unshadowed:
+            stats.messages.append(
+                f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
+            )
         self.shadows.ensure(map_size, len(plan.tiles), settings.shadow_depth_format)
         shadow_draws = [(d.whole, d.model, d.det, d.identity) for d in draws]
         self.shadows.render(plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats)
@@ -171,9 +184,9 @@ class Renderer:
 
         shader = self.shaders.get(LIT, data.defines)
         shadow_tex = self.shadows.texture if plan.tiles else self._shadow_dummy()
-        bg = world_color
-        alpha = 0.0 if film_transparent else 1.0
-        self._color.clear(format="FLOAT", value=(float(bg[0]), float(bg[1]), float(bg[2]), alpha))
+        # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
+        bg = (0.0, 0.0, 0.0, 0.0) if film_transparent else (*map(float, world_color[:3]), 1.0)
+        self._color.clear(format="FLOAT", value=bg)
         # The second attachment holds view distance; the background is "infinitely" far, as in
         # Blender's own Depth pass.
         self._depth.clear(format="FLOAT", value=(1e10,))
@@ -300,11 +313,7 @@ def _view_corners(camera):
     return c if np.all(np.isfinite(c)) else None
 
 
-def _clamp_map_size(size, columns=1):
+def _gpu_texture_limit():
     import gpu
 
-    limit = gpu.capabilities.max_texture_size_get() // max(1, columns)
-    clamped = int(min(max(int(size), 1), limit))
-    if clamped != int(size):
-        print(f"Penumbra: shadow map size {size} clamped to {clamped} (GPU limit)", file=sys.stderr)
-    return clamped
+    return gpu.capabilities.max_texture_size_get()

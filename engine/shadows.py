@@ -12,7 +12,6 @@ Tiles whose fit and casters did not change since the last frame are not redrawn.
 """
 
 import math
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,6 +48,7 @@ class LightShadow:
 class ShadowPlan:
     tiles: list = field(default_factory=list)
     lights: dict = field(default_factory=dict)  # light index -> LightShadow
+    unshadowed: int = 0  # lights that cast shadows but found no room in the atlas
 
 
 def _near_bound(position, lo, hi, half_fov):
@@ -83,7 +83,7 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
     what the camera sees (all geometry when None). Returns a ShadowPlan; tiles beyond
-    MAX_SHADOW_TILES are dropped with a message (those lights render unshadowed)."""
+    MAX_SHADOW_TILES are not planned (``plan.unshadowed`` counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
     corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(corners) == 0:
@@ -128,10 +128,7 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
                 entry.tiles.append(len(plan.tiles))
                 plan.tiles.append(t)
         plan.lights[i] = entry
-    if dropped:
-        print(
-            f"Penumbra: {dropped} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps", file=sys.stderr
-        )
+    plan.unshadowed = dropped
     return plan
 
 

@@ -1,0 +1,56 @@
+"""Which pixels and views a final render writes, by Blender's own rules. No bpy, no gpu."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Window:
+    """The pixels of the full frame a render result holds: columns [x0, x1), rows [y0, y1),
+    row 0 at the bottom (Blender's and the GPU's orientation)."""
+
+    x0: int
+    y0: int
+    x1: int
+    y1: int
+
+    @property
+    def width(self):
+        return self.x1 - self.x0
+
+    @property
+    def height(self):
+        return self.y1 - self.y0
+
+    def cut(self, image):
+        """The window of a full-frame array (height, width, ...)."""
+        return image[self.y0 : self.y1, self.x0 : self.x1]
+
+
+def render_window(width, height, use_border=False, border=(0.0, 0.0, 1.0, 1.0)):
+    """The window Blender asks an engine to fill for a ``width`` x ``height`` frame (already
+    scaled by the resolution %). With a render region, ``border`` = (min x, min y, max x,
+    max y) as fractions; Blender truncates each edge's float32 position to whole pixels."""
+    if not use_border:
+        return Window(0, 0, width, height)
+    f = np.float32
+    xmin, ymin, xmax, ymax = border
+    x0, x1 = int(f(xmin) * f(width)), int(f(xmax) * f(width))
+    y0, y1 = int(f(ymin) * f(height)), int(f(ymax) * f(height))
+    return Window(x0, y0, x1, y1)
+
+
+def scaled_size(resolution_x, resolution_y, percentage):
+    """Blender's integer resolution rule: ``resolution * percentage / 100``, truncated."""
+    return max(1, resolution_x * percentage // 100), max(1, resolution_y * percentage // 100)
+
+
+def render_views(render):
+    """The view names a render writes: ``[""]`` for a mono render; with multiview, the left and
+    right eye (Stereo 3D) or every view switched on (Multi-View), as Blender renders them."""
+    if not render.use_multiview:
+        return [""]
+    if render.views_format == "STEREO_3D":
+        return [v.name for v in render.views if v.name in ("left", "right")]
+    return [v.name for v in render.views if v.use]

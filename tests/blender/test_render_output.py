@@ -1,0 +1,234 @@
+"""Final renders write exactly the pixels Blender asks for: the render region (cropped or
+not), Blender's integer resolution rule, every view layer into its own layer, every eye of a
+stereo render, a transparent film. Every render runs in a child process, so a crash (a render
+region with crop once segfaulted Blender) fails the test instead of the run."""
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from devkit.session import ROOT
+
+PRELUDE = """
+import json, os, tempfile
+import numpy as np
+import bpy
+from devkit import imageio, scenes, session
+session.load_penumbra().register()
+TMP = tempfile.mkdtemp()
+
+def render_layers(scene, name="frame"):
+    '''Render through Blender's output path; {(layer, view): {pass: array}}, row 0 at the bottom.'''
+    imageio.set_format(scene.render.image_settings, "OPEN_EXR_MULTILAYER", color_depth="32", exr_codec="ZIP")
+    if scene.render.use_multiview:
+        scene.render.image_settings.views_format = "MULTIVIEW"
+    path = os.path.join(TMP, name + ".exr")
+    scene.render.filepath = path
+    scene.render.use_file_extension = False
+    bpy.ops.render.render(write_still=True)
+    return {k: {p: a[::-1] for p, a in v.items()} for k, v in imageio.read_exr_layers(path).items()}
+
+def combined(scene, name="frame"):
+    (only,) = render_layers(scene, name).values()
+    return only["Combined"]
+
+def demo(width, height):
+    scene = scenes.demo_scene(width, height)
+    scene.view_layers[0].name = "ViewLayer"
+    return scene
+
+def report(**values):
+    print("RESULT " + json.dumps(values))
+    session.hard_exit(0)
+"""
+
+
+def run_child(body):
+    script = textwrap.dedent(PRELUDE) + textwrap.dedent(body)
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300, cwd=ROOT)
+    log = proc.stderr[-3000:]
+    assert proc.returncode == 0, log
+    assert "Traceback" not in proc.stderr, log
+    line = next((ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")), None)
+    assert line is not None, proc.stdout[-2000:] + log
+    return json.loads(line[len("RESULT ") :]), proc.stdout + proc.stderr
+
+
+@pytest.mark.parametrize("crop", [False, True])
+def test_render_region_equals_the_same_window_of_a_full_render(crop):
+    result, _ = run_child(
+        f"""
+        scene = demo(96, 64)
+        full = combined(scene, "full")
+        r = scene.render
+        r.use_border, r.use_crop_to_border = True, {crop!r}
+        r.border_min_x, r.border_max_x, r.border_min_y, r.border_max_y = 0.21, 0.68, 0.13, 0.77
+        part = combined(scene, "part")
+        # Blender's window: each edge's float32 position truncated to whole pixels.
+        f = np.float32
+        x0, x1 = int(f(0.21) * f(96)), int(f(0.68) * f(96))
+        y0, y1 = int(f(0.13) * f(64)), int(f(0.77) * f(64))
+        if {crop!r}:
+            window, outside = part, np.zeros(0)
+        else:
+            window = part[y0:y1, x0:x1]
+            mask = np.ones(part.shape[:2], bool)
+            mask[y0:y1, x0:x1] = False
+            outside = part[mask]
+        report(
+            shape=list(part.shape), window=[x0, y0, x1, y1],
+            max_diff=float(np.abs(window - full[y0:y1, x0:x1]).max()),
+            outside_max=float(np.abs(outside).max()) if outside.size else 0.0,
+            window_mean=float(window[..., :3].mean()),
+        )
+        """
+    )
+    x0, y0, x1, y1 = result["window"]
+    expected_shape = [y1 - y0, x1 - x0, 4] if crop else [64, 96, 4]
+    assert result["shape"] == expected_shape
+    assert result["max_diff"] == 0.0  # bit for bit, post layers included
+    assert result["outside_max"] == 0.0  # uncropped: Blender leaves the rest of the frame empty
+    assert result["window_mean"] > 0.01
+
+
+@pytest.mark.parametrize("size,percent", [((200, 100), 29), ((1280, 720), 70), ((100, 100), 29)])
+def test_resolution_percentage_follows_blenders_integer_rule(size, percent):
+    w, h = size
+    result, _ = run_child(
+        f"""
+        scene = demo({w}, {h})
+        scene.penumbra.layers.clear()  # post sizes in pixels would differ between the two sizes
+        scene.render.resolution_percentage = {percent}
+        scaled = combined(scene, "scaled")
+        scene.render.resolution_x, scene.render.resolution_y = {w * percent // 100}, {h * percent // 100}
+        scene.render.resolution_percentage = 100
+        direct = combined(scene, "direct")
+        report(shape=list(scaled.shape), max_diff=float(np.abs(scaled - direct).max()),
+               empty_rows=int((np.abs(scaled).sum(axis=(1, 2)) == 0).sum()),
+               empty_cols=int((np.abs(scaled).sum(axis=(0, 2)) == 0).sum()))
+        """
+    )
+    assert result["shape"] == [h * percent // 100, w * percent // 100, 4]
+    assert result["max_diff"] == 0.0
+    assert result["empty_rows"] == 0 and result["empty_cols"] == 0
+
+
+def test_every_view_layer_gets_its_own_image():
+    result, _ = run_child(
+        """
+        scene = demo(64, 40)
+        crate = bpy.data.objects["Crate"]
+        props = bpy.data.collections.new("Props")
+        scene.collection.children.link(props)
+        for c in list(crate.users_collection):
+            c.objects.unlink(crate)
+        props.objects.link(crate)
+        second = scene.view_layers.new("NoProps")
+        second.layer_collection.children["Props"].exclude = True
+        both = render_layers(scene, "both")
+        scene.view_layers["NoProps"].use = False
+        first_alone = combined(scene, "first")
+        scene.view_layers["NoProps"].use = True
+        scene.view_layers["ViewLayer"].use = False
+        second_alone = combined(scene, "second")
+        a, b = both[("ViewLayer", "")]["Combined"], both[("NoProps", "")]["Combined"]
+        report(layers=sorted(k[0] for k in both),
+               first=float(np.abs(a - first_alone).max()), second=float(np.abs(b - second_alone).max()),
+               differ=float(np.abs(a - b).max()))
+        """
+    )
+    assert result["layers"] == ["NoProps", "ViewLayer"]
+    assert result["first"] == 0.0 and result["second"] == 0.0
+    assert result["differ"] > 0.05  # the crate is in one layer only
+
+
+def test_stereo_eyes_differ_and_each_equals_a_mono_render_from_that_eye():
+    result, _ = run_child(
+        """
+        scene = demo(80, 48)
+        scene.render.use_multiview = True
+        scene.render.views_format = "STEREO_3D"
+        cam = scene.camera
+        cam.data.stereo.convergence_mode = "OFFAXIS"
+        cam.data.stereo.interocular_distance = 0.3
+        eyes = {}
+
+        class Probe(bpy.types.RenderEngine):
+            '''Blender's own eye matrices and shifts, as a render engine receives them.'''
+            bl_idname = "EYE_PROBE"
+            bl_label = "Eye probe"
+
+            def render(self, depsgraph):
+                for view in ("left", "right"):
+                    self.active_view_set(view)
+                    c = depsgraph.scene.camera
+                    eyes[view] = ([list(r) for r in self.camera_model_matrix(c)], self.camera_shift_x(c))
+
+        bpy.utils.register_class(Probe)
+        scene.render.engine = "EYE_PROBE"
+        bpy.ops.render.render()
+        scene.render.engine = "PENUMBRA"
+        stereo = render_layers(scene, "stereo")
+        scene.render.use_multiview = False
+        from mathutils import Matrix
+        diffs = {}
+        for view in ("left", "right"):
+            matrix, shift = eyes[view]
+            cam.matrix_world = Matrix(matrix)
+            cam.data.shift_x = shift
+            mono = combined(scene, "mono_" + view)
+            diffs[view] = float(np.abs(stereo[("ViewLayer", view)]["Combined"] - mono).max())
+        left, right = stereo[("ViewLayer", "left")]["Combined"], stereo[("ViewLayer", "right")]["Combined"]
+        report(views=sorted(k[1] for k in stereo), diffs=diffs, eyes_differ=float(np.abs(left - right).max()),
+               shifts=[eyes["left"][1], eyes["right"][1]])
+        """
+    )
+    assert result["views"] == ["left", "right"]
+    assert result["shifts"][0] != result["shifts"][1]  # off-axis: the eyes' frames are shifted
+    assert result["eyes_differ"] > 0.05
+    # Same pixels up to float rounding of the eye's matrix (the mono camera is set through
+    # Blender's float32 object transform).
+    assert result["diffs"]["left"] < 1e-3 and result["diffs"]["right"] < 1e-3
+
+
+def test_transparent_film_leaves_the_background_exactly_zero():
+    result, _ = run_child(
+        """
+        scene = scenes.empty_scene(64, 48)
+        scenes.set_world(scene, (0.3, 0.4, 0.5))
+        scenes.light(scene, "Sun", "SUN", 3.0)
+        scenes.box(scene, center=(0, 0, 0), size=(3, 3, 3))
+        scenes.top_camera(scene)
+        scene.render.film_transparent = True
+        c = combined(scene)
+        alpha = c[..., 3]
+        background = alpha == 0
+        report(bg_fraction=float(background.mean()), bg_max=float(np.abs(c[background]).max()),
+               object_alpha=float(alpha[~background].min()))
+        """
+    )
+    assert 0.2 < result["bg_fraction"] < 0.95
+    assert result["bg_max"] == 0.0  # RGBA all zero: no world haze when composited
+    assert result["object_alpha"] == 1.0
+
+
+def test_a_frame_larger_than_the_gpu_allows_is_refused_with_a_message():
+    result, _ = run_child(
+        """
+        scene = scenes.empty_scene(64, 48)
+        scenes.light(scene, "Sun", "SUN", 3.0)
+        scenes.box(scene)
+        scenes.top_camera(scene)
+        scene.render.resolution_x = 40000  # above every GPU's largest texture (16384 on llvmpipe)
+        scene.render.resolution_y = 4
+        try:
+            bpy.ops.render.render()
+            report(error="")
+        except RuntimeError as exc:  # the operator's error is the engine's report
+            report(error=str(exc))
+        """
+    )
+    assert "Penumbra: 40000x4 is larger than this GPU's largest texture" in result["error"]
