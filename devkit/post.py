@@ -12,7 +12,8 @@ import numpy as np
 # A parameter value standing for "as large as a user can type" where a ``Param`` declares no
 # upper bound at all (neither ``max`` nor ``soft_max``), and its negative where it declares no
 # ``min``. INT properties are 32-bit in Blender.
-LARGE_FLOAT = 1.0e6
+LARGE_FLOAT = 3.4028234663852886e38  # float32 max: the largest value a FloatProperty takes
+HDR_PIXEL = 1.0e6  # a very bright but real HDR pixel (images the user picks for a layer)
 LARGE_INT = 2**31 - 1
 
 

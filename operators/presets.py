@@ -5,12 +5,15 @@ Shipped looks live in the extension's ``presets/post_stack/``; user presets in B
 scripts folder under ``presets/penumbra/post_stack/``.
 """
 
+import json
 from pathlib import Path
 
 import bpy
 from bpy.props import BoolProperty, StringProperty
 
 from ..engine.post import EFFECTS
+from ..engine.post.stack_data import stack_data, validate
+from ..properties import redraw_viewports
 
 PRESET_SUBDIR = "penumbra/post_stack"
 SHIPPED_DIR = Path(__file__).resolve().parent.parent / "presets" / "post_stack"
@@ -21,35 +24,66 @@ def user_preset_dir(create=False):
     return Path(path) if path else None
 
 
-def _literal(param, value):
-    if param.type == "IMAGE":
-        return f"bpy.data.images.get({value.name!r})" if value is not None else "None"
-    if param.type == "COLOR":
-        return repr(tuple(round(float(v), 6) for v in value))
-    if param.type == "FLOAT":
-        return repr(round(float(value), 6))
-    return repr(value)
-
-
 def preset_source(settings):
-    """Python source that rebuilds ``settings.layers`` exactly (order, switches, parameters)."""
-    lines = [
-        "import bpy",
-        "s = bpy.context.scene.penumbra",
-        "s.layers.clear()",
-    ]
-    for layer in settings.layers:
-        lines.append("layer = s.layers.add()")
-        lines.append(f"layer.effect = {layer.effect!r}")
-        lines.append(f"layer.name = {layer.name!r}")
-        lines.append(f"layer.enabled = {bool(layer.enabled)!r}")
-        lines.append(f"layer.mix = {round(float(layer.mix), 6)!r}")
+    """Python source of a preset that rebuilds ``settings.layers`` exactly (order, switches,
+    solo, parameters). The stack travels as data through ``penumbra.post_stack_apply``, which
+    validates all of it before it changes anything."""
+    # JSON escapes every quote inside its strings, so it never holds three quotes in a row.
+    data = json.dumps(stack_data(settings.layers, EFFECTS), indent=1)
+    return f'import bpy\n\nSTACK = r"""\n{data}\n"""\n\nbpy.ops.penumbra.post_stack_apply(stack=STACK)\n'
+
+
+def apply_stack(settings, layers, images):
+    """Replace ``settings.layers`` by validated ``layers`` (``stack_data.validate``)."""
+    settings.layers.clear()
+    for entry in layers:
+        layer = settings.layers.add()
+        layer.effect = entry["effect"]
+        for key in ("name", "enabled", "solo", "mix"):
+            if key in entry:
+                setattr(layer, key, entry[key])
         group = layer.params()
-        for param in EFFECTS[layer.effect].params:
-            value = _literal(param, getattr(group, param.name))
-            lines.append(f"layer.{layer.effect.lower()}.{param.name} = {value}")
-    lines.append("s.active_layer_index = 0")
-    return "\n".join(lines) + "\n"
+        kinds = {p.name: p.type for p in EFFECTS[entry["effect"]].params}
+        for name, value in entry["params"].items():
+            if kinds[name] == "IMAGE":
+                value = images.get(value) if value is not None else None
+            setattr(group, name, value)
+    settings.active_layer_index = 0
+
+
+class PENUMBRA_OT_post_stack_apply(bpy.types.Operator):
+    """Replace the post-layer stack by a preset's layers (validated first: on any error the
+    stack is left as it was)"""
+
+    bl_idname = "penumbra.post_stack_apply"
+    bl_label = "Apply Post Stack"
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
+
+    stack: StringProperty(name="Stack", description="The stack as JSON (see engine/post/stack_data.py)")
+
+    def execute(self, context):
+        try:
+            data = json.loads(self.stack)
+        except ValueError as exc:
+            self.report({"ERROR"}, f"Penumbra: the preset is not readable: {exc}")
+            return {"CANCELLED"}
+        layers, errors, warnings = validate(data, EFFECTS)
+        images = {}
+        for entry in layers:
+            kinds = {p.name: p.type for p in EFFECTS[entry["effect"]].params}
+            for name, value in entry["params"].items():
+                if kinds[name] == "IMAGE" and value is not None:
+                    images[value] = bpy.data.images.get(value)
+                    if images[value] is None:
+                        warnings.append(f"{entry['effect']}: image {value!r} is not in this file; left empty")
+        if errors:
+            self.report({"ERROR"}, "Penumbra: preset not applied, the stack is unchanged: " + "; ".join(errors))
+            return {"CANCELLED"}
+        apply_stack(context.scene.penumbra, layers, images)
+        for message in warnings:
+            self.report({"WARNING"}, f"Penumbra: preset: {message}")
+        redraw_viewports(self, context)
+        return {"FINISHED"}
 
 
 class PENUMBRA_MT_post_presets(bpy.types.Menu):
@@ -107,5 +141,5 @@ class PENUMBRA_OT_post_preset_add(bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (PENUMBRA_MT_post_presets, PENUMBRA_OT_post_preset_add)
+classes = (PENUMBRA_OT_post_stack_apply, PENUMBRA_MT_post_presets, PENUMBRA_OT_post_preset_add)
 register, unregister = bpy.utils.register_classes_factory(classes)

@@ -73,6 +73,7 @@ class Glow(PostEffect):
             0.5,
             "Scale of the glow added to the image; 0 turns the layer off",
             min=0.0,
+            max=1000.0,
             soft_max=4.0,
         ),
         Param(

@@ -113,7 +113,15 @@ class LensFlare(PostEffect):
     description = "Ghosts and a halo from the bright parts of the image"
     params = (
         Param("threshold", "FLOAT", 1.0, "Only colour above this value (per channel) flares", min=0.0, soft_max=10.0),
-        Param("intensity", "FLOAT", 1.0, "Brightness of the flare; 0 turns the layer off", min=0.0, soft_max=10.0),
+        Param(
+            "intensity",
+            "FLOAT",
+            1.0,
+            "Brightness of the flare; 0 turns the layer off",
+            min=0.0,
+            max=1000.0,
+            soft_max=10.0,
+        ),
         Param("mode", "ENUM", "ADD", "How the flare is merged into the image", enum=MERGE),
         Param("ghosts", "INT", 4, "Number of ghost images along the line through the centre", min=0, max=MAX_GHOSTS),
         Param(
@@ -122,10 +130,19 @@ class LensFlare(PostEffect):
             0.4,
             "Step between ghosts along the line through the centre",
             min=0.0,
+            max=16.0,
             soft_max=2.0,
         ),
-        Param("halo_radius", "FLOAT", 0.6, "Radius of the halo ring (1 = the image corners)", min=0.0, soft_max=1.5),
-        Param("halo_width", "FLOAT", 0.1, "Half-width of the halo ring; 0 = no halo", min=0.0, soft_max=0.5),
+        Param(
+            "halo_radius",
+            "FLOAT",
+            0.6,
+            "Radius of the halo ring (1 = the image corners)",
+            min=0.0,
+            max=16.0,
+            soft_max=1.5,
+        ),
+        Param("halo_width", "FLOAT", 0.1, "Half-width of the halo ring; 0 = no halo", min=0.0, max=16.0, soft_max=0.5),
         Param(
             "image",
             "IMAGE",

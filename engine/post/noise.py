@@ -59,7 +59,15 @@ class Noise(PostEffect):
     icon = "MOD_NOISE"
     description = "Animated film grain (the same frame always gives the same grain)"
     params = (
-        Param("amount", "FLOAT", 0.05, "Grain strength: each channel moves by up to this much", min=0.0, soft_max=1.0),
+        Param(
+            "amount",
+            "FLOAT",
+            0.05,
+            "Grain strength: each channel moves by up to this much",
+            min=0.0,
+            max=1000.0,
+            soft_max=1.0,
+        ),
         Param("size", "INT", 1, "Grain size in pixels", min=1, soft_max=16),
         Param("monochrome", "BOOL", True, "Same grain in R, G and B (luminance grain) instead of per channel"),
         Param("seed", "INT", 0, "Pattern variant, so stacked noise layers differ"),

@@ -1,46 +1,77 @@
 import bpy
-s = bpy.context.scene.penumbra
-s.layers.clear()
-layer = s.layers.add()
-layer.effect = 'FISHEYE'
-layer.name = 'Tube bulge'
-layer.enabled = True
-layer.mix = 1.0
-layer.fisheye.strength = 0.25
-layer.fisheye.edge = 'BLACK'
-layer = s.layers.add()
-layer.effect = 'BLUR'
-layer.name = 'Phosphor'
-layer.enabled = True
-layer.mix = 0.35
-layer.blur.radius = 1
-layer.blur.sigma = 0.0
-layer = s.layers.add()
-layer.effect = 'SCANLINES'
-layer.name = 'Scanlines'
-layer.enabled = True
-layer.mix = 1.0
-layer.scanlines.count = 220
-layer.scanlines.thickness = 0.45
-layer.scanlines.intensity = 0.6
-layer.scanlines.scroll_speed = 0.05
-layer.scanlines.antialias = True
-layer = s.layers.add()
-layer.effect = 'NOISE'
-layer.name = 'Signal noise'
-layer.enabled = True
-layer.mix = 1.0
-layer.noise.amount = 0.04
-layer.noise.size = 1
-layer.noise.monochrome = True
-layer.noise.seed = 0
-layer = s.layers.add()
-layer.effect = 'VIGNETTE'
-layer.name = 'Tube edge'
-layer.enabled = True
-layer.mix = 1.0
-layer.vignette.radius = 0.9
-layer.vignette.softness = 0.5
-layer.vignette.roundness = 0.6
-layer.vignette.color = (0.0, 0.0, 0.0)
-s.active_layer_index = 0
+
+STACK = r"""
+{
+ "format": 1,
+ "layers": [
+  {
+   "effect": "FISHEYE",
+   "name": "Tube bulge",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "strength": 0.25,
+    "edge": "BLACK"
+   }
+  },
+  {
+   "effect": "BLUR",
+   "name": "Phosphor",
+   "enabled": true,
+   "solo": false,
+   "mix": 0.35,
+   "params": {
+    "radius": 1,
+    "sigma": 0.0
+   }
+  },
+  {
+   "effect": "SCANLINES",
+   "name": "Scanlines",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "count": 220,
+    "thickness": 0.45,
+    "intensity": 0.6,
+    "scroll_speed": 0.05,
+    "antialias": true
+   }
+  },
+  {
+   "effect": "NOISE",
+   "name": "Signal noise",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "amount": 0.04,
+    "size": 1,
+    "monochrome": true,
+    "seed": 0
+   }
+  },
+  {
+   "effect": "VIGNETTE",
+   "name": "Tube edge",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "radius": 0.9,
+    "softness": 0.5,
+    "roundness": 0.6,
+    "color": [
+     0.0,
+     0.0,
+     0.0
+    ]
+   }
+  }
+ ]
+}
+"""
+
+bpy.ops.penumbra.post_stack_apply(stack=STACK)

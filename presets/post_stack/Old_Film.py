@@ -1,38 +1,65 @@
 import bpy
-s = bpy.context.scene.penumbra
-s.layers.clear()
-layer = s.layers.add()
-layer.effect = 'SEPIA'
-layer.name = 'Sepia'
-layer.enabled = True
-layer.mix = 1.0
-layer.sepia.amount = 0.85
-layer = s.layers.add()
-layer.effect = 'NOISE'
-layer.name = 'Grain'
-layer.enabled = True
-layer.mix = 1.0
-layer.noise.amount = 0.08
-layer.noise.size = 2
-layer.noise.monochrome = True
-layer.noise.seed = 0
-layer = s.layers.add()
-layer.effect = 'SCANLINES'
-layer.name = 'Gate flicker'
-layer.enabled = True
-layer.mix = 0.5
-layer.scanlines.count = 3
-layer.scanlines.thickness = 0.1
-layer.scanlines.intensity = 0.15
-layer.scanlines.scroll_speed = 0.37
-layer.scanlines.antialias = True
-layer = s.layers.add()
-layer.effect = 'VIGNETTE'
-layer.name = 'Burn'
-layer.enabled = True
-layer.mix = 1.0
-layer.vignette.radius = 0.6
-layer.vignette.softness = 0.9
-layer.vignette.roundness = 1.0
-layer.vignette.color = (0.0, 0.0, 0.0)
-s.active_layer_index = 0
+
+STACK = r"""
+{
+ "format": 1,
+ "layers": [
+  {
+   "effect": "SEPIA",
+   "name": "Sepia",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "amount": 0.85
+   }
+  },
+  {
+   "effect": "NOISE",
+   "name": "Grain",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "amount": 0.08,
+    "size": 2,
+    "monochrome": true,
+    "seed": 0
+   }
+  },
+  {
+   "effect": "SCANLINES",
+   "name": "Gate flicker",
+   "enabled": true,
+   "solo": false,
+   "mix": 0.5,
+   "params": {
+    "count": 3,
+    "thickness": 0.1,
+    "intensity": 0.15,
+    "scroll_speed": 0.37,
+    "antialias": true
+   }
+  },
+  {
+   "effect": "VIGNETTE",
+   "name": "Burn",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "radius": 0.6,
+    "softness": 0.9,
+    "roundness": 1.0,
+    "color": [
+     0.0,
+     0.0,
+     0.0
+    ]
+   }
+  }
+ ]
+}
+"""
+
+bpy.ops.penumbra.post_stack_apply(stack=STACK)

@@ -1,30 +1,53 @@
 import bpy
-s = bpy.context.scene.penumbra
-s.layers.clear()
-layer = s.layers.add()
-layer.effect = 'GLOW'
-layer.name = 'Glow'
-layer.enabled = True
-layer.mix = 1.0
-layer.glow.threshold = 0.6
-layer.glow.knee = 0.5
-layer.glow.intensity = 0.8
-layer.glow.radius = 12
-layer.glow.square_samples = False
-layer = s.layers.add()
-layer.effect = 'BLUR'
-layer.name = 'Diffusion'
-layer.enabled = True
-layer.mix = 0.2
-layer.blur.radius = 4
-layer.blur.sigma = 0.0
-layer = s.layers.add()
-layer.effect = 'VIGNETTE'
-layer.name = 'Vignette'
-layer.enabled = True
-layer.mix = 0.6
-layer.vignette.radius = 1.0
-layer.vignette.softness = 0.8
-layer.vignette.roundness = 1.0
-layer.vignette.color = (0.0, 0.0, 0.0)
-s.active_layer_index = 0
+
+STACK = r"""
+{
+ "format": 1,
+ "layers": [
+  {
+   "effect": "GLOW",
+   "name": "Glow",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "threshold": 0.6,
+    "knee": 0.5,
+    "intensity": 0.8,
+    "radius": 12,
+    "square_samples": false
+   }
+  },
+  {
+   "effect": "BLUR",
+   "name": "Diffusion",
+   "enabled": true,
+   "solo": false,
+   "mix": 0.2,
+   "params": {
+    "radius": 4,
+    "sigma": 0.0
+   }
+  },
+  {
+   "effect": "VIGNETTE",
+   "name": "Vignette",
+   "enabled": true,
+   "solo": false,
+   "mix": 0.6,
+   "params": {
+    "radius": 1.0,
+    "softness": 0.8,
+    "roundness": 1.0,
+    "color": [
+     0.0,
+     0.0,
+     0.0
+    ]
+   }
+  }
+ ]
+}
+"""
+
+bpy.ops.penumbra.post_stack_apply(stack=STACK)

@@ -1,41 +1,68 @@
 import bpy
-s = bpy.context.scene.penumbra
-s.layers.clear()
-layer = s.layers.add()
-layer.effect = 'LENS_FLARE'
-layer.name = 'Flare'
-layer.enabled = True
-layer.mix = 1.0
-layer.lens_flare.threshold = 0.8
-layer.lens_flare.intensity = 0.6
-layer.lens_flare.mode = 'SCREEN'
-layer.lens_flare.ghosts = 5
-layer.lens_flare.ghost_spacing = 0.4
-layer.lens_flare.halo_radius = 0.6
-layer.lens_flare.halo_width = 0.1
-layer.lens_flare.image = None
-layer = s.layers.add()
-layer.effect = 'COLORIZER'
-layer.name = 'Warm grade'
-layer.enabled = True
-layer.mix = 0.5
-layer.colorizer.image = None
-layer.colorizer.blur_radius = 2
-layer.colorizer.strength = 0.6
-layer = s.layers.add()
-layer.effect = 'FISHEYE'
-layer.name = 'Barrel'
-layer.enabled = True
-layer.mix = 1.0
-layer.fisheye.strength = 0.12
-layer.fisheye.edge = 'CLAMP'
-layer = s.layers.add()
-layer.effect = 'VIGNETTE'
-layer.name = 'Vignette'
-layer.enabled = True
-layer.mix = 1.0
-layer.vignette.radius = 0.75
-layer.vignette.softness = 0.7
-layer.vignette.roundness = 1.0
-layer.vignette.color = (0.05, 0.03, 0.02)
-s.active_layer_index = 0
+
+STACK = r"""
+{
+ "format": 1,
+ "layers": [
+  {
+   "effect": "LENS_FLARE",
+   "name": "Flare",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "threshold": 0.8,
+    "intensity": 0.6,
+    "mode": "SCREEN",
+    "ghosts": 5,
+    "ghost_spacing": 0.4,
+    "halo_radius": 0.6,
+    "halo_width": 0.1,
+    "image": null
+   }
+  },
+  {
+   "effect": "COLORIZER",
+   "name": "Warm grade",
+   "enabled": true,
+   "solo": false,
+   "mix": 0.5,
+   "params": {
+    "image": null,
+    "blur_radius": 2,
+    "strength": 0.6
+   }
+  },
+  {
+   "effect": "FISHEYE",
+   "name": "Barrel",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "strength": 0.12,
+    "edge": "CLAMP"
+   }
+  },
+  {
+   "effect": "VIGNETTE",
+   "name": "Vignette",
+   "enabled": true,
+   "solo": false,
+   "mix": 1.0,
+   "params": {
+    "radius": 0.75,
+    "softness": 0.7,
+    "roundness": 1.0,
+    "color": [
+     0.05,
+     0.03,
+     0.02
+    ]
+   }
+  }
+ ]
+}
+"""
+
+bpy.ops.penumbra.post_stack_apply(stack=STACK)

@@ -26,7 +26,7 @@ def stack(settings):
             elif p.type == "IMAGE":
                 v = v.name if v is not None else None
             values.append((p.name, v))
-        out.append((layer.effect, layer.name, layer.enabled, round(layer.mix, 5), tuple(values)))
+        out.append((layer.effect, layer.name, layer.enabled, layer.solo, round(layer.mix, 5), tuple(values)))
     return out
 
 
@@ -41,6 +41,7 @@ def test_save_and_load_round_trip(penumbra, user_home):
     s = scene.penumbra
     s.layers[0].blur.radius, s.layers[0].mix, s.layers[1].enabled = 9, 0.4, False
     s.layers[1].vignette.color = (0.2, 0.1, 0.05)
+    s.layers[1].solo = True
     before = stack(s)
     assert bpy.ops.penumbra.post_preset_add(name="My Look") == {"FINISHED"}
     path = user_preset_dir() / "My_Look.py"
@@ -75,3 +76,44 @@ def test_shipped_presets_load_and_change_the_image(penumbra, path):
     styled = render(scene)["Combined"]
     assert np.all(np.isfinite(styled))
     assert np.abs(styled - plain).mean() > 0.01
+
+
+def _write_preset(tmp_path, layers):
+    import json
+
+    path = tmp_path / "preset.py"
+    data = json.dumps({"format": 1, "layers": layers})
+    path.write_text(f"import bpy\nbpy.ops.penumbra.post_stack_apply(stack={data!r})\n", encoding="utf-8")
+    return path
+
+
+def test_a_preset_with_an_unknown_effect_changes_nothing(penumbra, tmp_path):
+    scene = scenes.demo_scene(32, 32)
+    before = stack(scene.penumbra)
+    path = _write_preset(tmp_path, [{"effect": "BLUR", "params": {"radius": 2}}, {"effect": "BLOOM_X"}])
+    with pytest.raises(RuntimeError, match="unknown effect 'BLOOM_X'.*stack is unchanged|stack is unchanged.*BLOOM_X"):
+        load(path)
+    assert stack(scene.penumbra) == before
+
+
+def test_a_preset_with_a_malformed_value_changes_nothing(penumbra, tmp_path):
+    scene = scenes.demo_scene(32, 32)
+    before = stack(scene.penumbra)
+    path = _write_preset(
+        tmp_path, [{"effect": "GLOW", "mix": "half"}, {"effect": "FISHEYE", "params": {"edge": "WRAP"}}]
+    )
+    with pytest.raises(RuntimeError) as info:
+        load(path)
+    assert "mix must be a number" in str(info.value) and "unknown fisheye edge 'WRAP'" in str(info.value)
+    assert stack(scene.penumbra) == before
+
+
+def test_unknown_fields_are_reported_and_the_rest_applied(penumbra, tmp_path, capfd):
+    scene = scenes.demo_scene(32, 32)
+    layers = [{"effect": "BLUR", "name": "Soft", "mix": 0.5, "glare": 1, "params": {"radius": 7, "shape": "star"}}]
+    load(_write_preset(tmp_path, layers))
+    captured = capfd.readouterr()
+    messages = captured.out + captured.err
+    assert "unknown field 'glare' skipped" in messages and "unknown parameter 'shape' skipped" in messages
+    (layer,) = scene.penumbra.layers
+    assert (layer.effect, layer.name, layer.mix, layer.blur.radius) == ("BLUR", "Soft", 0.5, 7)

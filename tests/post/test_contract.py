@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from devkit.post import (
-    LARGE_FLOAT,
+    HDR_PIXEL,
     blender_image,
     effects,
     hdr_image,
@@ -63,7 +63,7 @@ def param(effect_id, name):
 def image_extremes(name):
     """IMAGE parameter values: none (the effect's built-in behaviour), a huge-valued image and
     one holding NaN/Inf and negative texels. Built inside the GPU call's fresh file."""
-    hot = np.full((1, 1, 4), LARGE_FLOAT, np.float32)
+    hot = np.full((1, 1, 4), HDR_PIXEL, np.float32)
     bad = np.array(
         [
             [[np.nan, 1.0, -np.inf, 1.0], [np.inf, -5.0, 0.5, np.nan]],
