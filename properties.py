@@ -47,11 +47,21 @@ def _limits(param, cast):
     return kw
 
 
-def property_for(param):
+def update_passes(self, context):
+    """Property update of a pass switch: Blender re-asks the engine which passes exist."""
+    view_layer = getattr(context, "view_layer", None)
+    if view_layer is not None:
+        view_layer.update_render_passes()
+
+
+def property_for(param, update=redraw_viewports):
     """The bpy property of one ``settings.Param``."""
-    kw = {"name": param.ui_label, "description": param.description, "update": redraw_viewports}
+    kw = {"name": param.ui_label, "description": param.description, "update": update}
+    if param.unit == "PIXELS":
+        kw["subtype"] = "PIXEL"
     if param.type == "FLOAT":
-        return FloatProperty(default=param.default, subtype=param.subtype, **_limits(param, float), **kw)
+        kw.setdefault("subtype", param.subtype)
+        return FloatProperty(default=param.default, **_limits(param, float), **kw)
     if param.type == "INT":
         return IntProperty(default=param.default, **_limits(param, int), **kw)
     if param.type == "BOOL":
@@ -67,9 +77,9 @@ def property_for(param):
     raise ValueError(f"unknown parameter type {param.type!r}")
 
 
-def group_class(name, params, doc, extra=None, methods=None):
+def group_class(name, params, doc, extra=None, methods=None, update=redraw_viewports):
     """A PropertyGroup class with one property per ``Param`` (plus ``extra`` annotations)."""
-    annotations = {p.name: property_for(p) for p in params}
+    annotations = {p.name: property_for(p, update) for p in params}
     annotations.update(extra or {})
     return type(name, (bpy.types.PropertyGroup,), {"__annotations__": annotations, "__doc__": doc, **(methods or {})})
 
@@ -127,7 +137,7 @@ PENUMBRA_PG_layer = group_class(
 )
 
 
-def _render_settings(self, frame, film_transparent=False):
+def _render_settings(self, frame, film_transparent=False, pixel_scale=1.0):
     """The plain settings a frame needs (the renderer never reads Blender properties)."""
     soloing = any(layer.solo for layer in self.layers)
     layers = []
@@ -136,7 +146,9 @@ def _render_settings(self, frame, film_transparent=False):
         effect = EFFECTS[layer.effect]
         params = effect.values(layer.params()) if enabled else None
         layers.append(Layer(layer.effect, enabled, layer.mix, params))
-    return settings.render_settings(self, frame=frame, film_transparent=film_transparent, layers=layers)
+    return settings.render_settings(
+        self, frame=frame, film_transparent=film_transparent, pixel_scale=pixel_scale, layers=layers
+    )
 
 
 PENUMBRA_PG_scene = group_class(
@@ -156,6 +168,14 @@ PENUMBRA_PG_light = group_class(
     settings.LIGHT_PARAMS,
     "Per-light Penumbra settings (``light.penumbra``).",
     extra={"schema_version": _schema_version()},
+)
+
+
+PENUMBRA_PG_view_layer = group_class(
+    "PENUMBRA_PG_view_layer",
+    settings.VIEW_LAYER_PARAMS,
+    "Per-view-layer Penumbra settings (``view_layer.penumbra``): its optional passes.",
+    update=update_passes,
 )
 
 
@@ -209,7 +229,7 @@ def _on_save_pre(*_args):
             owner.penumbra.schema_version = settings.SCHEMA_VERSION
 
 
-classes = (*EFFECT_GROUPS.values(), PENUMBRA_PG_layer, PENUMBRA_PG_scene, PENUMBRA_PG_light)
+classes = (*EFFECT_GROUPS.values(), PENUMBRA_PG_layer, PENUMBRA_PG_scene, PENUMBRA_PG_light, PENUMBRA_PG_view_layer)
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(classes)
 
 
@@ -217,6 +237,7 @@ def register():
     _register_classes()
     bpy.types.Scene.penumbra = PointerProperty(type=PENUMBRA_PG_scene, name="Penumbra")
     bpy.types.Light.penumbra = PointerProperty(type=PENUMBRA_PG_light, name="Penumbra")
+    bpy.types.ViewLayer.penumbra = PointerProperty(type=PENUMBRA_PG_view_layer, name="Penumbra")
     bpy.app.handlers.load_post.append(_on_load_post)
     bpy.app.handlers.save_pre.append(_on_save_pre)
 
@@ -225,6 +246,7 @@ def unregister():
     for handlers, fn in ((bpy.app.handlers.load_post, _on_load_post), (bpy.app.handlers.save_pre, _on_save_pre)):
         if fn in handlers:
             handlers.remove(fn)
+    del bpy.types.ViewLayer.penumbra
     del bpy.types.Light.penumbra
     del bpy.types.Scene.penumbra
     _unregister_classes()

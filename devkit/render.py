@@ -15,6 +15,8 @@ def render(scene=None, passes=("Combined",)):
     image (the orientation of GPU textures and Blender's pixel buffers)."""
     scene = scene or bpy.context.scene
     scene.view_layers[0].use_pass_z = "Depth" in passes
+    if hasattr(scene.view_layers[0], "penumbra"):
+        scene.view_layers[0].penumbra.use_pass_shadow = "Shadow" in passes
     set_format(scene.render.image_settings, "OPEN_EXR_MULTILAYER", color_depth="32", exr_codec="ZIP")
     old = scene.render.filepath
     with tempfile.TemporaryDirectory() as tmp:

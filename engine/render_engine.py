@@ -28,8 +28,9 @@ class PenumbraEngineCore:
         self.renderer = None
         self.cache.clear()
 
-    def render_frame(self, depsgraph, camera, width, height):
-        """Extract, then render one frame; returns the renderer's FrameOutput."""
+    def render_frame(self, depsgraph, camera, width, height, pixel_scale=1.0):
+        """Extract, then render one frame; returns the renderer's FrameOutput. ``pixel_scale``
+        scales the post layers' sizes in pixels (a final render's resolution %)."""
         from .renderer import Renderer
 
         if self.renderer is None:
@@ -37,7 +38,7 @@ class PenumbraEngineCore:
         scene = depsgraph.scene
         snapshot = self.cache.snapshot(depsgraph)
         settings = scene.penumbra.render_settings(
-            frame=scene.frame_current, film_transparent=scene.render.film_transparent
+            frame=scene.frame_current, film_transparent=scene.render.film_transparent, pixel_scale=pixel_scale
         )
         out = self.renderer.render(snapshot, camera, settings, width, height)
         self.last_stats = out.stats
@@ -70,7 +71,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
         if renderlayer.use_pass_z:
             self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
-        self.register_pass(scene, renderlayer, "Shadow", 1, "X", "VALUE")
+        if renderlayer.penumbra.use_pass_shadow:
+            self.register_pass(scene, renderlayer, "Shadow", 1, "X", "VALUE")
 
     def render(self, depsgraph):
         """Render the pixels Blender asks for: the render region of the frame at Blender's
@@ -116,7 +118,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     )
                 else:
                     camera = camera_from_scene(depsgraph, scene, width, height)
-                out = self.render_frame(depsgraph, camera, width, height)
+                out = self.render_frame(depsgraph, camera, width, height, r.resolution_percentage / 100.0)
                 for message in out.stats.messages:
                     if message not in reported:
                         reported.add(message)
@@ -178,45 +180,9 @@ def _gpu_texture_limit():
     return gpu.capabilities.max_texture_size_get()
 
 
-def _compat_panels():
-    """Blender's own panels that work for Penumbra too (light, camera, output, colour...)."""
-    wanted = {
-        "RENDER_PT_color_management",
-        "RENDER_PT_color_management_curves",
-        "RENDER_PT_color_management_display_settings",
-        "RENDER_PT_color_management_white_balance",
-        "RENDER_PT_format",
-        "RENDER_PT_frame_range",
-        "RENDER_PT_output",
-        "RENDER_PT_film",
-        "DATA_PT_light",
-        "DATA_PT_EEVEE_light",
-        "DATA_PT_spot",
-        "DATA_PT_context_light",
-        "DATA_PT_lens",
-        "DATA_PT_camera",
-        "DATA_PT_camera_dof",
-        "DATA_PT_context_camera",
-        "MATERIAL_PT_preview",
-        "EEVEE_MATERIAL_PT_surface",
-        "EEVEE_MATERIAL_PT_context_material",
-        "MATERIAL_PT_viewport",
-        "WORLD_PT_context_world",
-        "EEVEE_WORLD_PT_surface",
-        "WORLD_PT_viewport_display",
-    }
-    for panel in bpy.types.Panel.__subclasses__():
-        if panel.__name__ in wanted and hasattr(panel, "COMPAT_ENGINES"):
-            yield panel
-
-
 def register():
     bpy.utils.register_class(PenumbraRenderEngine)
-    for panel in _compat_panels():
-        panel.COMPAT_ENGINES.add(PenumbraRenderEngine.bl_idname)
 
 
 def unregister():
-    for panel in _compat_panels():
-        panel.COMPAT_ENGINES.discard(PenumbraRenderEngine.bl_idname)
     bpy.utils.unregister_class(PenumbraRenderEngine)

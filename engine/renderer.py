@@ -223,6 +223,7 @@ class Renderer:
     def _post_pass(self, settings, stats):
         ctx = self._post_ctx
         ctx.frame = settings.frame
+        ctx.pixel_scale = settings.pixel_scale
         ctx.stats = stats
         return self.post.run(ctx, self._color, settings.layers)
 

@@ -39,6 +39,7 @@ class Param:
     label: str = None
     section: str = None  # panel section it is drawn in; None: not drawn by the generic panels
     active_when: tuple = None  # (other param, fact): greyed out unless enum[other].fact is true
+    unit: str = None  # "PIXELS": a size in output pixels, scaled with the resolution %
 
     def __post_init__(self):
         if self.type not in TYPES:
@@ -95,6 +96,19 @@ class Param:
         other, fact = self.active_when
         enum = next(p.enum for p in params if p.name == other)
         return bool(getattr(enum[getattr(group, other)], fact))
+
+
+def scale_pixels(params, namespace, scale):
+    """Sizes in pixels (``unit="PIXELS"``) of a values namespace scaled by ``scale`` (the
+    resolution %), so a preview at 25 % looks like the full frame; whole-pixel sizes are
+    rounded and kept within their limits."""
+    if scale == 1.0:
+        return namespace
+    for p in params:
+        if p.unit == "PIXELS":
+            v = getattr(namespace, p.name) * scale
+            setattr(namespace, p.name, p.clamp(round(v) if p.type == "INT" else v))
+    return namespace
 
 
 def values(params, source):
@@ -247,6 +261,21 @@ LIGHT_PARAMS = (
 )
 
 
+# --- view layer settings (view_layer.penumbra) -----------------------------------------------
+
+PASSES = "passes"
+
+VIEW_LAYER_PARAMS = (
+    Param(
+        "use_pass_shadow",
+        "BOOL",
+        False,
+        "Shadow pass: the fraction of direct light that arrives (1 = unshadowed, luminance-weighted over lights)",
+        label="Shadow",
+        section=PASSES,
+    ),
+)
+
 # --- what the renderer reads --------------------------------------------------------------
 
 RenderSettings = dataclasses.make_dataclass(
@@ -254,6 +283,7 @@ RenderSettings = dataclasses.make_dataclass(
     [(p.name, object, dataclasses.field(default=p.default)) for p in SCENE_PARAMS]
     + [
         ("film_transparent", bool, dataclasses.field(default=False)),
+        ("pixel_scale", float, dataclasses.field(default=1.0)),  # resolution % / 100 of a final render
         ("frame", int, dataclasses.field(default=1)),
         ("layers", list, dataclasses.field(default_factory=list)),  # [post.Layer] in stack order
     ],

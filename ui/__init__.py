@@ -1,6 +1,6 @@
-from . import panels
+from . import compat, panels
 
-modules = (panels,)
+modules = (panels, compat)
 
 
 def register():

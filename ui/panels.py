@@ -50,6 +50,37 @@ class PENUMBRA_PT_lighting(_SettingsPanel, bpy.types.Panel):
     section = settings.LIGHTING
 
 
+class PENUMBRA_PT_film(PenumbraPanel, bpy.types.Panel):
+    bl_label = "Film"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(context.scene.render, "film_transparent")
+
+
+class PENUMBRA_PT_passes(PenumbraPanel, bpy.types.Panel):
+    """The passes Penumbra writes (Combined always)."""
+
+    bl_label = "Passes"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "view_layer"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        view_layer = context.view_layer
+        col = layout.column(heading="Include", align=True)
+        col.prop(view_layer, "use_pass_z")
+        draw_params(col, view_layer.penumbra, settings.VIEW_LAYER_PARAMS)
+
+
 class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
     bl_label = "Penumbra"
     bl_space_type = "PROPERTIES"
@@ -135,6 +166,8 @@ class PENUMBRA_PT_render_layers(PenumbraPanel, bpy.types.Panel):
 
 
 classes = (
+    PENUMBRA_PT_film,
+    PENUMBRA_PT_passes,
     PENUMBRA_PT_shadows,
     PENUMBRA_PT_light,
     PENUMBRA_PT_lighting,

@@ -8,7 +8,7 @@ import numpy as np
 
 from ...shaders.loader import Program, Struct, set_uniforms
 from .. import kernels
-from ..settings import values
+from ..settings import scale_pixels, values
 
 # One layer of a frame's stack, as the renderer receives it (``params``: a namespace of the
 # effect's parameter values, or None for a disabled layer).
@@ -133,6 +133,7 @@ class PostContext:
     height: int
     frame: int = 0
     stats: object = None
+    pixel_scale: float = 1.0  # sizes in pixels are scaled by this (the resolution %)
     _pool: list = field(default_factory=list)
     _batch: object = None
 
@@ -214,7 +215,7 @@ class PostStack:
             if not enabled or mix <= 0.0:
                 continue
             eff = self.effect(slot, effect_id)
-            params = eff.values(params)
+            params = scale_pixels(eff.params, eff.values(params), ctx.pixel_scale)
             if eff.is_identity(params):
                 continue
             src = eff.execute(ctx, src, params, min(float(mix), 1.0))

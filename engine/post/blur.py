@@ -19,8 +19,26 @@ class Blur(PostEffect):
     icon = "MATFLUID"
     description = "Separable Gaussian blur"
     params = (
-        Param("radius", "INT", 4, "Kernel half-width in pixels", min=0, max=GAUSSIAN_MAX_RADIUS, soft_max=64),
-        Param("sigma", "FLOAT", 0.0, "Gaussian sigma in pixels; 0 uses radius / 2", min=0.0, max=1000.0, soft_max=64.0),
+        Param(
+            "radius",
+            "INT",
+            4,
+            "Kernel half-width in pixels",
+            min=0,
+            max=GAUSSIAN_MAX_RADIUS,
+            soft_max=64,
+            unit="PIXELS",
+        ),
+        Param(
+            "sigma",
+            "FLOAT",
+            0.0,
+            "Gaussian sigma in pixels; 0 uses radius / 2",
+            min=0.0,
+            max=1000.0,
+            soft_max=64.0,
+            unit="PIXELS",
+        ),
     )
 
     def __init__(self):

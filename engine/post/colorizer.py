@@ -91,6 +91,7 @@ class Colorizer(PostEffect):
             min=0,
             max=GAUSSIAN_MAX_RADIUS,
             soft_max=32,
+            unit="PIXELS",
         ),
         Param(
             "strength",

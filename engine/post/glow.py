@@ -84,6 +84,7 @@ class Glow(PostEffect):
             min=0,
             max=GAUSSIAN_MAX_RADIUS,
             soft_max=64,
+            unit="PIXELS",
         ),
         Param(
             "square_samples",

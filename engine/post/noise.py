@@ -68,7 +68,7 @@ class Noise(PostEffect):
             max=1000.0,
             soft_max=1.0,
         ),
-        Param("size", "INT", 1, "Grain size in pixels", min=1, soft_max=16),
+        Param("size", "INT", 1, "Grain size in pixels", min=1, soft_max=16, unit="PIXELS"),
         Param("monochrome", "BOOL", True, "Same grain in R, G and B (luminance grain) instead of per channel"),
         Param("seed", "INT", 0, "Pattern variant, so stacked noise layers differ"),
     )

@@ -55,7 +55,9 @@ class Pixelate(PostEffect):
     icon = "MESH_GRID"
     description = "Mosaic of square cells of one colour"
     params = (
-        Param("size", "INT", 8, "Cell width in pixels; 1 leaves the image unchanged", min=1, soft_max=64),
+        Param(
+            "size", "INT", 8, "Cell width in pixels; 1 leaves the image unchanged", min=1, soft_max=64, unit="PIXELS"
+        ),
         Param("sampling", "ENUM", "AVERAGE", "How a cell's colour is chosen", enum=SAMPLING),
     )
 

@@ -232,3 +232,29 @@ def test_a_frame_larger_than_the_gpu_allows_is_refused_with_a_message():
         """
     )
     assert "Penumbra: 40000x4 is larger than this GPU's largest texture" in result["error"]
+
+
+def test_post_sizes_in_pixels_follow_the_resolution_percentage():
+    """A 50 % preview of a stack with a radius-8 blur and 6-pixel cells is the full-size look
+    at half the pixels: the same as a half-size frame with a radius-4 blur and 3-pixel cells."""
+    result, _ = run_child(
+        """
+        scene = demo(200, 120)
+        s = scene.penumbra
+        s.layers.clear()
+        for effect in ("BLUR", "PIXELATE"):
+            layer = s.layers.add()
+            layer.effect = effect
+        s.layers[0].blur.radius, s.layers[1].pixelate.size = 8, 6
+        scene.render.resolution_percentage = 50
+        preview = combined(scene, "preview")
+        scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 100, 60, 100
+        s.layers[0].blur.radius, s.layers[1].pixelate.size = 4, 3
+        half = combined(scene, "half")
+        s.layers[0].blur.radius, s.layers[1].pixelate.size = 8, 6
+        unscaled = combined(scene, "unscaled")
+        report(same=float(np.abs(preview - half).max()), unscaled=float(np.abs(preview - unscaled).max()))
+        """
+    )
+    assert result["same"] == 0.0
+    assert result["unscaled"] > 0.01  # the sizes really matter in this scene

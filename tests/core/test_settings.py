@@ -13,6 +13,7 @@ from penumbra.engine.post import EFFECT_ENUM, EFFECTS, REGISTRY  # noqa: E402
 
 ALL_ENUMS = [getattr(enums, n) for n in dir(enums) if isinstance(getattr(enums, n), enums.Enum)] + [EFFECT_ENUM]
 ALL_PARAMS = [("scene", p) for p in settings.SCENE_PARAMS] + [("light", p) for p in settings.LIGHT_PARAMS]
+ALL_PARAMS += [("view_layer", p) for p in settings.VIEW_LAYER_PARAMS]
 ALL_PARAMS += [(eid, p) for eid, cls in EFFECTS.items() for p in cls.params]
 
 
@@ -76,7 +77,7 @@ def test_render_settings_come_from_the_declarations_and_reject_unknown_ids():
     source.pcf_kernel_size = 99  # above its max of 15
     rs = settings.render_settings(source, frame=7)
     assert rs.pcf_kernel_size == 15 and rs.frame == 7
-    fields = [f for f in vars(rs) if f not in {"frame", "layers", "film_transparent"}]
+    fields = [f for f in vars(rs) if f not in {"frame", "layers", "film_transparent", "pixel_scale"}]
     assert fields == [p.name for p in settings.SCENE_PARAMS]
     source.shadow_filter = "SOFT"
     with pytest.raises(ValueError, match="unknown shadow filter"):
@@ -97,11 +98,13 @@ def test_active_when_follows_the_filter_facts():
 def test_every_scene_setting_is_drawn_by_a_panel_section():
     assert {p.section for p in settings.SCENE_PARAMS} <= {settings.SHADOWS, settings.LIGHTING}
     assert all(p.section is not None for p in settings.SCENE_PARAMS + settings.LIGHT_PARAMS)
+    assert {p.section for p in settings.VIEW_LAYER_PARAMS} == {settings.PASSES}
 
 
 def test_generated_properties_mirror_the_declarations(penumbra):
     props = penumbra.properties
     groups = [(props.PENUMBRA_PG_scene, settings.SCENE_PARAMS), (props.PENUMBRA_PG_light, settings.LIGHT_PARAMS)]
+    groups += [(props.PENUMBRA_PG_view_layer, settings.VIEW_LAYER_PARAMS)]
     groups += [(props.EFFECT_GROUPS[eid], cls.params) for eid, cls in EFFECTS.items()]
     for group, params in groups:
         rna = group.bl_rna.properties

@@ -76,7 +76,7 @@ def test_every_light_and_filter_casts_the_analytic_shadow(shadow_scene, analytic
 def test_shadow_pass_is_the_visibility_of_direct_light(shadow_scene, analytic_shadow):
     """The Shadow render pass equals (render with shadows) / (render without) for one light."""
     scene = shadow_scene("SPOT", "PCF")
-    shadow = render(scene, passes=("Combined", "Depth"))["Shadow"][..., 0]
+    shadow = render(scene, passes=("Combined", "Depth", "Shadow"))["Shadow"][..., 0]
     _lum, visibility, on_plane, shadowed = analytic_shadow(scene, scene.objects["L"])
     np.testing.assert_allclose(shadow[on_plane], visibility[on_plane], atol=1e-5)
     assert iou((shadow < 0.5)[on_plane], shadowed[on_plane]) > 0.95

@@ -1,0 +1,64 @@
+"""The Properties editor shows what works: Blender's generic panels minus the features
+Penumbra ignores, the EEVEE panels that edit what it reads, and its own Film and Passes;
+optional passes exist only when switched on."""
+
+import bpy
+import pytest
+
+from devkit import scenes
+from devkit.render import render
+
+SHOWN = [
+    "RENDER_PT_format", "RENDER_PT_output", "RENDER_PT_color_management", "RENDER_PT_stereoscopy",
+    "DATA_PT_EEVEE_light", "DATA_PT_camera", "DATA_PT_lens", "DATA_PT_context_mesh", "DATA_PT_vertex_colors",
+    "EEVEE_MATERIAL_PT_surface", "EEVEE_WORLD_PT_surface", "OBJECT_PT_visibility", "OBJECT_PT_custom_props",
+    "PHYSICS_PT_add", "PARTICLE_PT_context_particles", "PENUMBRA_PT_film", "PENUMBRA_PT_passes",
+]  # fmt: skip
+HIDDEN = [
+    "DATA_PT_light",  # would repeat the light type switch
+    "DATA_PT_camera_dof",  # depth of field is not rendered
+    "RENDER_PT_freestyle", "DATA_PT_lightprobe", "RENDER_PT_eevee_motion_blur", "VIEWLAYER_PT_layer_passes",
+]  # fmt: skip
+
+
+def _panel(name):
+    return next((p for p in bpy.types.Panel.__subclasses__() if p.__name__ == name), None)
+
+
+@pytest.mark.parametrize("name", SHOWN)
+def test_panels_that_work_are_shown(penumbra, name):
+    panel = _panel(name)
+    assert panel is not None, f"{name} does not exist in Blender {bpy.app.version_string}"
+    assert "PENUMBRA" in panel.COMPAT_ENGINES
+
+
+@pytest.mark.parametrize("name", HIDDEN)
+def test_panels_of_ignored_features_are_hidden(penumbra, name):
+    panel = _panel(name) or _panel(name.replace("eevee_", "eevee_next_"))
+    if panel is None:
+        pytest.skip(f"{name} does not exist in Blender {bpy.app.version_string}")
+    assert "PENUMBRA" not in getattr(panel, "COMPAT_ENGINES", set())
+
+
+def test_every_shown_panel_is_generic_or_chosen(penumbra):
+    from penumbra.ui import compat
+
+    # Some panels share one COMPAT_ENGINES set with the panel they derive from.
+    chosen = [
+        getattr(p, "COMPAT_ENGINES", None) for p in bpy.types.Panel.__subclasses__() if p.__name__ in compat.INCLUDE
+    ]
+    for panel in bpy.types.Panel.__subclasses__():
+        engines = getattr(panel, "COMPAT_ENGINES", set())
+        if "PENUMBRA" in engines and not panel.__name__.startswith("PENUMBRA_"):
+            assert "BLENDER_RENDER" in engines or any(engines is c for c in chosen), panel.__name__
+
+
+def test_shadow_pass_exists_only_when_switched_on(penumbra):
+    scene = scenes.empty_scene(24, 16)
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(0.6, 0.3, 0.0))
+    scenes.box_over_plane(scene)
+    scenes.top_camera(scene)
+    assert "Shadow" not in render(scene, passes=("Combined",))
+    with_pass = render(scene, passes=("Combined", "Shadow"))
+    assert with_pass["Shadow"].shape == (16, 24, 1)
+    assert 0.0 <= with_pass["Shadow"].min() < 0.5 < with_pass["Shadow"].max() <= 1.0  # the box's shadow
