@@ -54,3 +54,40 @@ def render_views(render):
     if render.views_format == "STEREO_3D":
         return [v.name for v in render.views if v.name in ("left", "right")]
     return [v.name for v in render.views if v.use]
+
+
+# Blender settings a scene can switch on that Penumbra does not render: (where, attribute,
+# what the user is told). Checked on every final render; each one in use is named once in
+# the render report.
+_UNSUPPORTED = (
+    ("camera", "dof.use_dof", "camera depth of field is not rendered"),
+    ("render", "use_motion_blur", "motion blur is not rendered"),
+    ("render", "use_freestyle", "Freestyle lines are not rendered"),
+    ("view_layer", "use_pass_normal", "the Normal pass is not written"),
+    ("view_layer", "use_pass_mist", "the Mist pass is not written"),
+    ("view_layer", "use_pass_emit", "the Emission pass is not written"),
+    ("view_layer", "use_pass_diffuse_color", "the Diffuse Color pass is not written"),
+    ("view_layer", "use_pass_ambient_occlusion", "the Ambient Occlusion pass is not written"),
+    ("view_layer", "use_pass_cryptomatte_object", "Cryptomatte passes are not written"),
+    ("view_layer", "use_pass_cryptomatte_material", "Cryptomatte passes are not written"),
+)
+
+
+def _lookup(owner, path):
+    for part in path.split("."):
+        owner = getattr(owner, part, None)
+        if owner is None:
+            return None
+    return owner
+
+
+def unsupported_in_use(camera_data, render, view_layer):
+    """Messages for the settings of ``_UNSUPPORTED`` that are switched on, each once."""
+    owners = {"camera": camera_data, "render": render, "view_layer": view_layer}
+    out = []
+    for where, path, message in _UNSUPPORTED:
+        if _lookup(owners[where], path) is True:
+            text = f"Penumbra: {message}"
+            if text not in out:
+                out.append(text)
+    return out

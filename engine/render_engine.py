@@ -7,7 +7,7 @@ import bpy
 import numpy as np
 
 from .extract import SceneCache, camera_from_scene, camera_from_view
-from .output import render_views, render_window
+from .output import render_views, render_window, unsupported_in_use
 
 
 class PenumbraEngineCore:
@@ -93,6 +93,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             return
         views = render_views(r)
         reported = set()
+        for message in unsupported_in_use(scene.camera.data, r, depsgraph.view_layer):
+            self.report({"WARNING"}, message)
         try:
             limit = _gpu_texture_limit()
             if max(width, height) > limit:

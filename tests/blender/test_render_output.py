@@ -258,3 +258,20 @@ def test_post_sizes_in_pixels_follow_the_resolution_percentage():
     )
     assert result["same"] == 0.0
     assert result["unscaled"] > 0.01  # the sizes really matter in this scene
+
+
+def test_features_penumbra_does_not_render_are_named_in_the_report():
+    result, output = run_child(
+        """
+        scene = demo(32, 24)
+        scene.camera.data.dof.use_dof = True
+        scene.render.use_motion_blur = True
+        scene.view_layers[0].use_pass_mist = True
+        bpy.ops.render.render()
+        report(done=True)
+        """
+    )
+    assert result["done"]
+    for message in ("camera depth of field is not rendered", "motion blur is not rendered",
+                    "the Mist pass is not written"):  # fmt: skip
+        assert output.count(f"Penumbra: {message}") == 1, message
