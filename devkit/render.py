@@ -17,6 +17,7 @@ def render(scene=None, passes=("Combined",)):
     scene.view_layers[0].use_pass_z = "Depth" in passes
     if hasattr(scene.view_layers[0], "penumbra"):
         scene.view_layers[0].penumbra.use_pass_shadow = "Shadow" in passes
+        scene.view_layers[0].penumbra.use_pass_lit = "Lit" in passes
     set_format(scene.render.image_settings, "OPEN_EXR_MULTILAYER", color_depth="32", exr_codec="ZIP")
     old = scene.render.filepath
     with tempfile.TemporaryDirectory() as tmp:

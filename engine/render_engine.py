@@ -73,6 +73,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
         if renderlayer.penumbra.use_pass_shadow:
             self.register_pass(scene, renderlayer, "Shadow", 1, "X", "VALUE")
+        if renderlayer.penumbra.use_pass_lit:
+            self.register_pass(scene, renderlayer, "Lit", 4, "RGBA", "COLOR")
 
     def render(self, depsgraph):
         """Render the pixels Blender asks for: the render region of the frame at Blender's
@@ -125,11 +127,14 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     if message not in reported:
                         reported.add(message)
                         self.report({"WARNING"}, message)
-                passes = {
-                    "Combined": window.cut(out.color_array()),
-                    "Depth": window.cut(out.depth_array()),
-                    "Shadow": window.cut(out.shadow_array()),
-                }
+                passes = {"Combined": window.cut(out.color_array())}
+                options = depsgraph.view_layer.penumbra
+                if depsgraph.view_layer.use_pass_z:
+                    passes["Depth"] = window.cut(out.depth_array())
+                if options.use_pass_shadow:
+                    passes["Shadow"] = window.cut(out.shadow_array())
+                if options.use_pass_lit:
+                    passes["Lit"] = window.cut(out.lit_array())
                 self._write_result(window, layer, view, passes)
                 self.update_progress((index + 1) / len(views))
         except Exception as exc:  # a render must end with a message, never a crash

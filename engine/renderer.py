@@ -41,6 +41,10 @@ class FrameOutput:
     stats: FrameStats
     width: int
     height: int
+    lit: object = None  # GPUTexture, the lit pass before the post stack
+
+    def lit_array(self):
+        return texture_array(self.lit, 4)
 
     def color_array(self):
         return texture_array(self.color, 4)
@@ -126,7 +130,7 @@ class Renderer:
             width * height * (16 + 4 + 4 + 4) + self.shadows.memory_bytes + self._post_ctx.memory_bytes
         )
         stats.shaders_compiled = self.shaders.compiled - compiled_before
-        return FrameOutput(color, self._depth, self._shadow, stats, width, height)
+        return FrameOutput(color, self._depth, self._shadow, stats, width, height, lit=self._color)
 
     # --- stages ---------------------------------------------------------------------------
 

@@ -274,6 +274,14 @@ VIEW_LAYER_PARAMS = (
         label="Shadow",
         section=PASSES,
     ),
+    Param(
+        "use_pass_lit",
+        "BOOL",
+        False,
+        "Lit pass: Combined before the post stack, so it lines up with Depth and Shadow whatever the layers do",
+        label="Lit (Before Post)",
+        section=PASSES,
+    ),
 )
 
 # --- what the renderer reads --------------------------------------------------------------

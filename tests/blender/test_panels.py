@@ -3,6 +3,7 @@ Penumbra ignores, the EEVEE panels that edit what it reads, and its own Film and
 optional passes exist only when switched on."""
 
 import bpy
+import numpy as np
 import pytest
 
 from devkit import scenes
@@ -62,3 +63,19 @@ def test_shadow_pass_exists_only_when_switched_on(penumbra):
     with_pass = render(scene, passes=("Combined", "Shadow"))
     assert with_pass["Shadow"].shape == (16, 24, 1)
     assert 0.0 <= with_pass["Shadow"].min() < 0.5 < with_pass["Shadow"].max() <= 1.0  # the box's shadow
+
+
+def test_lit_pass_is_the_image_before_the_post_stack_and_lines_up_with_depth(penumbra):
+    """With a FISHEYE layer, Combined is warped but Lit is the unwarped lit image: equal to a
+    render without post layers, so it lines up with Depth."""
+    scene = scenes.demo_scene(48, 32)
+    scene.penumbra.layers.clear()
+    plain = render(scene, passes=("Combined", "Depth"))
+    layer = scene.penumbra.layers.add()
+    layer.effect = "FISHEYE"
+    layer.fisheye.strength = 0.8
+    warped = render(scene, passes=("Combined", "Depth", "Lit"))
+    assert "Lit" not in plain
+    np.testing.assert_array_equal(warped["Lit"], plain["Combined"])
+    np.testing.assert_array_equal(warped["Depth"], plain["Depth"])
+    assert np.abs(warped["Combined"] - plain["Combined"]).max() > 0.05
