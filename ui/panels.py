@@ -8,10 +8,19 @@ from ..engine.post import EFFECTS
 
 class PenumbraPanel:
     COMPAT_ENGINES = {"PENUMBRA"}
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
 
     @classmethod
     def poll(cls, context):
         return context.scene is not None and context.scene.render.engine in cls.COMPAT_ENGINES
+
+    def split_layout(self):
+        """The panel's layout in Blender's property-split style (labels left, no decorators)."""
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        return layout
 
 
 def draw_params(layout, group, params, section=None):
@@ -28,15 +37,11 @@ def draw_params(layout, group, params, section=None):
 class _SettingsPanel(PenumbraPanel):
     """A Render Properties panel drawing one section of the scene settings."""
 
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
     bl_context = "render"
     section = None
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = self.split_layout()
         draw_params(layout, context.scene.penumbra, settings.SCENE_PARAMS, self.section)
 
 
@@ -52,14 +57,10 @@ class PENUMBRA_PT_lighting(_SettingsPanel, bpy.types.Panel):
 
 class PENUMBRA_PT_film(PenumbraPanel, bpy.types.Panel):
     bl_label = "Film"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
     bl_context = "render"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = self.split_layout()
         layout.prop(context.scene.render, "film_transparent")
 
 
@@ -67,14 +68,10 @@ class PENUMBRA_PT_passes(PenumbraPanel, bpy.types.Panel):
     """The passes Penumbra writes (Combined always)."""
 
     bl_label = "Passes"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
     bl_context = "view_layer"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = self.split_layout()
         view_layer = context.view_layer
         col = layout.column(heading="Include", align=True)
         col.prop(view_layer, "use_pass_z")
@@ -83,8 +80,6 @@ class PENUMBRA_PT_passes(PenumbraPanel, bpy.types.Panel):
 
 class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
     bl_label = "Penumbra"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
     bl_context = "data"
 
     @classmethod
@@ -92,9 +87,7 @@ class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
         return super().poll(context) and context.light is not None
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = self.split_layout()
         layout.prop(context.light, "use_shadow")
         col = layout.column()
         col.active = context.light.use_shadow
@@ -156,8 +149,6 @@ class PENUMBRA_PT_sidebar_layers(PenumbraPanel, bpy.types.Panel):
 
 class PENUMBRA_PT_render_layers(PenumbraPanel, bpy.types.Panel):
     bl_label = "Post Layers"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
     bl_context = "render"
     bl_options = {"DEFAULT_CLOSED"}
 
