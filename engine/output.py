@@ -64,7 +64,6 @@ _UNSUPPORTED = (
     ("render", "use_motion_blur", "motion blur is not rendered"),
     ("render", "use_freestyle", "Freestyle lines are not rendered"),
     ("view_layer", "use_pass_normal", "the Normal pass is not written"),
-    ("view_layer", "use_pass_mist", "the Mist pass is not written"),
     ("view_layer", "use_pass_emit", "the Emission pass is not written"),
     ("view_layer", "use_pass_diffuse_color", "the Diffuse Color pass is not written"),
     ("view_layer", "use_pass_ambient_occlusion", "the Ambient Occlusion pass is not written"),
@@ -91,3 +90,33 @@ def unsupported_in_use(camera_data, render, view_layer):
             if text not in out:
                 out.append(text)
     return out
+
+
+def view_distance_scale(projection, is_ortho, width, height):
+    """Per pixel (height, width), distance from the camera over distance along its axis: 1
+    everywhere for an orthographic camera, ``|ray| / |ray.z|`` through each pixel centre for
+    a perspective one (``projection``: the 4x4 camera projection)."""
+    if is_ortho:
+        return np.ones((height, width))
+    xs = (np.arange(width) + 0.5) / width * 2.0 - 1.0
+    ys = (np.arange(height) + 0.5) / height * 2.0 - 1.0
+    ndc = np.stack(np.broadcast_arrays(xs[None, :], ys[:, None], np.full((height, width), 1.0), 1.0), -1)
+    view = ndc @ np.linalg.inv(np.asarray(projection, np.float64)).T
+    d = view[..., :3] / view[..., 3:4]
+    return np.linalg.norm(d, axis=-1) / np.abs(d[..., 2])
+
+
+MIST_FALLOFF = {
+    "LINEAR": lambda m: m,
+    "QUADRATIC": lambda m: m * m,
+    "INVERSE_QUADRATIC": np.sqrt,
+}
+
+
+def mist_pass(axial_depth, distance_scale, start, depth, falloff):
+    """Blender's Mist pass: 0 at ``start`` metres from the camera, 1 at ``start + depth`` and
+    beyond (the background too), shaped by the world's mist ``falloff``."""
+    distance = np.asarray(axial_depth, np.float64) * distance_scale
+    m = np.clip((distance - start) / max(depth, 1e-12), 0.0, 1.0)
+    m = np.where(np.isfinite(distance), m, 1.0)
+    return MIST_FALLOFF[falloff](m).astype(np.float32)

@@ -7,7 +7,7 @@ import bpy
 import numpy as np
 
 from .extract import SceneCache, camera_from_scene, camera_from_view
-from .output import render_views, render_window, unsupported_in_use
+from .output import mist_pass, render_views, render_window, unsupported_in_use, view_distance_scale
 
 
 class PenumbraEngineCore:
@@ -73,6 +73,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
         if renderlayer.penumbra.use_pass_shadow:
             self.register_pass(scene, renderlayer, "Shadow", 1, "X", "VALUE")
+        if renderlayer.use_pass_mist:
+            self.register_pass(scene, renderlayer, "Mist", 1, "Z", "VALUE")
         if renderlayer.penumbra.use_pass_lit:
             self.register_pass(scene, renderlayer, "Lit", 4, "RGBA", "COLOR")
 
@@ -135,6 +137,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     passes["Shadow"] = window.cut(out.shadow_array())
                 if options.use_pass_lit:
                     passes["Lit"] = window.cut(out.lit_array())
+                if depsgraph.view_layer.use_pass_mist:
+                    passes["Mist"] = window.cut(self._mist(scene, camera, out, width, height))
                 self._write_result(window, layer, view, passes)
                 self.update_progress((index + 1) / len(views))
         except Exception as exc:  # a render must end with a message, never a crash
@@ -143,6 +147,17 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         finally:
             # A final-render engine instance renders one frame; free while the context lives.
             self.free_gpu()
+
+    @staticmethod
+    def _mist(scene, camera, out, width, height):
+        """The Mist pass from the Depth target and the world's mist settings."""
+        scale = view_distance_scale(camera.projection, camera.is_ortho, width, height)
+        depth = out.depth_array().astype(np.float64)
+        depth[depth >= 1e9] = np.inf  # the background is beyond any mist
+        mist = scene.world.mist_settings if scene.world is not None else None
+        if mist is None:
+            return np.where(np.isfinite(depth), 0.0, 1.0).astype(np.float32)
+        return mist_pass(depth, scale, mist.start, mist.depth, mist.falloff)
 
     def _write_result(self, window, layer, view, passes):
         """Fill one result (``window``-sized, of ``layer`` and ``view``) with every pass the

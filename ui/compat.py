@@ -31,6 +31,7 @@ INCLUDE = {
     "EEVEE_MATERIAL_PT_context_material",
     "EEVEE_MATERIAL_PT_surface",  # the Principled BSDF Penumbra reads
     "EEVEE_WORLD_PT_surface",  # the world colour (ambient)
+    "EEVEE_WORLD_PT_mist",  # the Mist pass's start, depth and falloff
     "MATERIAL_PT_viewport",  # viewport display colour: the fallback material
     "WORLD_PT_viewport_display",
 }

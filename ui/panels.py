@@ -75,6 +75,7 @@ class PENUMBRA_PT_passes(PenumbraPanel, bpy.types.Panel):
         view_layer = context.view_layer
         col = layout.column(heading="Include", align=True)
         col.prop(view_layer, "use_pass_z")
+        col.prop(view_layer, "use_pass_mist")
         draw_params(col, view_layer.penumbra, settings.VIEW_LAYER_PARAMS)
 
 

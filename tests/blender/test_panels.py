@@ -79,3 +79,36 @@ def test_lit_pass_is_the_image_before_the_post_stack_and_lines_up_with_depth(pen
     np.testing.assert_array_equal(warped["Lit"], plain["Combined"])
     np.testing.assert_array_equal(warped["Depth"], plain["Depth"])
     assert np.abs(warped["Combined"] - plain["Combined"]).max() > 0.05
+
+
+@pytest.mark.parametrize("falloff", ["QUADRATIC", "LINEAR", "INVERSE_QUADRATIC"])
+def test_mist_pass_matches_cycles(penumbra, falloff):
+    """Blender's Mist pass (distance from the camera, the world's start, depth and falloff)
+    against Cycles' on the same scene, away from silhouettes; the background is 1."""
+    from devkit import engines
+
+    scene = scenes.empty_scene(64, 40)
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(0.5, 0.2, 0.0))
+    scenes.box_over_plane(scene, plane_size=8.0)
+    scenes.look_at(scene, (5.0, -7.0, 3.0), (0.0, 0.0, 0.5))
+    scene.world.mist_settings.start, scene.world.mist_settings.depth = 4.0, 9.0
+    scene.world.mist_settings.falloff = falloff
+    scene.view_layers[0].use_pass_mist = True
+    ours = render(scene)["Mist"][..., 0]
+    engines.configure(scene, "CYCLES", samples=1)
+    scene.view_layers[0].use_pass_mist = True
+    ref = render(scene)["Mist"][..., 0]
+    scene.render.engine = "PENUMBRA"
+    edges = np.zeros_like(ref, bool)
+    for axis in (0, 1):
+        jump = np.abs(np.diff(ref, axis=axis)) > 0.06  # a silhouette, not the smooth ramp
+        pad = [(0, 0), (0, 0)]
+        pad[axis] = (0, 1)
+        edges |= np.pad(jump, pad)
+        pad[axis] = (1, 0)
+        edges |= np.pad(jump, pad)
+    background = ref >= 1.0 - 1e-6
+    inside = ~edges & ~background
+    assert inside.mean() > 0.25 and 0.05 < ref[inside].mean() < 0.95  # the ramp is in view
+    np.testing.assert_allclose(ours[inside], ref[inside], atol=2e-3)
+    assert np.all(ours[background & ~edges] == 1.0)
