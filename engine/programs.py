@@ -108,7 +108,7 @@ LIT = Program(
         (TAP_STRUCT, "pcf_taps", MAX_PCF_TAPS),
         (TILE_STRUCT, "shadow_tiles", MAX_SHADOW_TILES),
     ),
-    outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth"), ("FLOAT", "out_shadow")),
+    outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth"), ("FLOAT", "out_shadow"), ("VEC4", "out_normal")),
     defines=tuple({**_ENUM_DEFINES, "JITTER_SIZE": JITTER_SIZE}.items()),
 )
 

@@ -73,6 +73,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
         if renderlayer.penumbra.use_pass_shadow:
             self.register_pass(scene, renderlayer, "Shadow", 1, "X", "VALUE")
+        if renderlayer.use_pass_normal:
+            self.register_pass(scene, renderlayer, "Normal", 3, "XYZ", "VECTOR")
         if renderlayer.use_pass_mist:
             self.register_pass(scene, renderlayer, "Mist", 1, "Z", "VALUE")
         if renderlayer.penumbra.use_pass_lit:
@@ -137,6 +139,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     passes["Shadow"] = window.cut(out.shadow_array())
                 if options.use_pass_lit:
                     passes["Lit"] = window.cut(out.lit_array())
+                if depsgraph.view_layer.use_pass_normal:
+                    passes["Normal"] = window.cut(out.normal_array())
                 if depsgraph.view_layer.use_pass_mist:
                     passes["Mist"] = window.cut(self._mist(scene, camera, out, width, height))
                 self._write_result(window, layer, view, passes)

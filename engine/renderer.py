@@ -42,6 +42,10 @@ class FrameOutput:
     width: int
     height: int
     lit: object = None  # GPUTexture, the lit pass before the post stack
+    normal: object = None  # GPUTexture, world-space shading normal (0 for the background)
+
+    def normal_array(self):
+        return texture_array(self.normal, 4)[..., :3]
 
     def lit_array(self):
         return texture_array(self.lit, 4)
@@ -95,7 +99,7 @@ class Renderer:
         self._batches = {}  # (geometry key, serial) -> (whole, parts)
         self._jitter_tex = None
         self._size = None
-        self._color = self._depth = self._shadow = self._zbuffer = self._fb = None
+        self._color = self._depth = self._shadow = self._normal = self._zbuffer = self._fb = None
         self._post_ctx = None
         self._ubos = {}
         self._dummy_shadow = None
@@ -127,10 +131,10 @@ class Renderer:
         self._lit_pass(draws, data, plan, snapshot.world_color, settings.film_transparent, stats)
         color = self._post_pass(settings, stats)
         stats.texture_bytes = (
-            width * height * (16 + 4 + 4 + 4) + self.shadows.memory_bytes + self._post_ctx.memory_bytes
+            width * height * (16 + 4 + 4 + 8 + 4) + self.shadows.memory_bytes + self._post_ctx.memory_bytes
         )
         stats.shaders_compiled = self.shaders.compiled - compiled_before
-        return FrameOutput(color, self._depth, self._shadow, stats, width, height, lit=self._color)
+        return FrameOutput(color, self._depth, self._shadow, stats, width, height, lit=self._color, normal=self._normal)
 
     # --- stages ---------------------------------------------------------------------------
 
@@ -195,6 +199,7 @@ class Renderer:
         # Blender's own Depth pass.
         self._depth.clear(format="FLOAT", value=(1e10,))
         self._shadow.clear(format="FLOAT", value=(1.0,))
+        self._normal.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
         width, height = self._size
         with self._fb.bind():
             gpu.state.viewport_set(0, 0, width, height)
@@ -241,9 +246,10 @@ class Renderer:
         self._color = gpu.types.GPUTexture((width, height), format="RGBA32F")
         self._depth = gpu.types.GPUTexture((width, height), format="R32F")
         self._shadow = gpu.types.GPUTexture((width, height), format="R32F")
+        self._normal = gpu.types.GPUTexture((width, height), format="RGBA16F")
         self._zbuffer = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
         self._fb = gpu.types.GPUFrameBuffer(
-            depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow)
+            depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow, self._normal)
         )
         self._post_ctx = PostContext(self.shaders, width, height)
         self._size = (width, height)

@@ -60,4 +60,5 @@ void main()
   out_color = vec4(color, 1.0);
   out_depth = v_view_depth;
   out_shadow = (unshadowed > 0.0) ? arriving / unshadowed : 1.0;
+  out_normal = vec4(N, 0.0); /* world-space shading normal, facing the camera (Normal pass) */
 }

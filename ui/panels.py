@@ -76,6 +76,7 @@ class PENUMBRA_PT_passes(PenumbraPanel, bpy.types.Panel):
         col = layout.column(heading="Include", align=True)
         col.prop(view_layer, "use_pass_z")
         col.prop(view_layer, "use_pass_mist")
+        col.prop(view_layer, "use_pass_normal")
         draw_params(col, view_layer.penumbra, settings.VIEW_LAYER_PARAMS)
 
 

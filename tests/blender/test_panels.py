@@ -112,3 +112,35 @@ def test_mist_pass_matches_cycles(penumbra, falloff):
     assert inside.mean() > 0.25 and 0.05 < ref[inside].mean() < 0.95  # the ramp is in view
     np.testing.assert_allclose(ours[inside], ref[inside], atol=2e-3)
     assert np.all(ours[background & ~edges] == 1.0)
+
+
+def test_normal_pass_matches_cycles(penumbra):
+    """World-space shading normals (facing the camera) against Cycles' Normal pass, away from
+    silhouettes: a plane, a box and a smooth sphere; the background is 0."""
+    from devkit import engines
+
+    scene = scenes.empty_scene(64, 40)
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(0.5, 0.2, 0.0))
+    scenes.box_over_plane(scene, plane_size=6.0, box_center=(-1.0, 0.0, 0.5))
+    sphere = scenes.uv_sphere(scene, center=(1.2, 0.3, 0.8), radius=0.8, segments=48, rings=24)
+    for poly in sphere.data.polygons:
+        poly.use_smooth = True
+    scenes.look_at(scene, (5.0, -7.0, 4.0), (0.0, 0.0, 0.3))
+    scene.view_layers[0].use_pass_normal = True
+    ours = render(scene)["Normal"]
+    engines.configure(scene, "CYCLES", samples=1)
+    scene.view_layers[0].use_pass_normal = True
+    ref = render(scene)["Normal"]
+    scene.render.engine = "PENUMBRA"
+    diff = np.abs(np.diff(ref, axis=0)).max(-1)
+    edges = np.zeros(ref.shape[:2], bool)
+    edges[1:] |= diff > 0.1
+    edges[:-1] |= diff > 0.1
+    diff = np.abs(np.diff(ref, axis=1)).max(-1)
+    edges[:, 1:] |= diff > 0.1
+    edges[:, :-1] |= diff > 0.1
+    background = np.abs(ref).max(-1) == 0.0
+    inside = ~edges & ~background
+    assert inside.mean() > 0.15  # ground, box faces and sphere in view
+    np.testing.assert_allclose(ours[inside], ref[inside], atol=5e-3)
+    assert np.all(ours[background & ~edges] == 0.0)
