@@ -195,8 +195,12 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             if message != self._reported:  # once per distinct error, not every redraw
                 traceback.print_exc(file=sys.stderr)
                 self._reported = message
+            self.update_stats("", message)  # shown in the viewport's text overlay
             return
         self._reported = None
+        # What the final render would put in its report (lights left out, clamped maps) shows
+        # in the viewport's text overlay, as Blender's engines show their status there.
+        self.update_stats("", " | ".join(out.stats.messages))
         self.draw_display(depsgraph.scene, out.color, width, height)
 
 
