@@ -10,6 +10,7 @@ Saved files carry ``schema_version``; loading a file runs the upgrade steps of
 """
 
 import sys
+from types import SimpleNamespace
 
 import bpy
 from bpy.app.handlers import persistent
@@ -143,8 +144,11 @@ def _render_settings(self, frame, film_transparent=False, pixel_scale=1.0):
     layers = []
     for layer in self.layers:
         enabled = layer.solo if soloing else layer.enabled
-        effect = EFFECTS[layer.effect]
-        params = effect.values(layer.params()) if enabled else None
+        # Raw values: the post stack clamps them to their declared ranges once, per frame.
+        params = None
+        if enabled:
+            group = layer.params()
+            params = SimpleNamespace(**{p.name: getattr(group, p.name) for p in EFFECTS[layer.effect].params})
         layers.append(Layer(layer.effect, enabled, layer.mix, params))
     return settings.render_settings(
         self, frame=frame, film_transparent=film_transparent, pixel_scale=pixel_scale, layers=layers

@@ -7,6 +7,7 @@ and are compiled the first time a frame needs them, then cached by (program, def
 """
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -41,7 +42,7 @@ class Struct:
             if typ not in _STD140:
                 raise ValueError(f"{self.name}.{name}: unsupported uniform type {typ}")
 
-    @property
+    @cached_property
     def layout(self):
         """{field: (byte offset, GLSL type)} under std140."""
         out, off = {}, 0
@@ -52,7 +53,7 @@ class Struct:
             off += size
         return out
 
-    @property
+    @cached_property
     def stride(self):
         """Bytes per element in a std140 array (rounded up to 16)."""
         end = 0
