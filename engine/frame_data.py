@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import kernels
-from .enums import LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
+from .enums import LIGHT_TYPE, SHADOW_MODE
 from .kernels import RING
 from .programs import (
     FRAME_STRUCT,
@@ -19,9 +19,7 @@ from .programs import (
     MAX_DISK_SAMPLES,
     MAX_FILTER_RADIUS,
     MAX_LIGHTS,
-    MAX_PCF_TAPS,
     MAX_SHADOW_TILES,
-    TAP_STRUCT,
     TILE_STRUCT,
     lit_defines,
 )
@@ -32,9 +30,9 @@ class FrameData:
     frame: np.ndarray  # FRAME_STRUCT, packed
     lights: np.ndarray  # MAX_LIGHTS x LIGHT_STRUCT
     tiles: np.ndarray  # MAX_SHADOW_TILES x TILE_STRUCT
-    taps: np.ndarray  # MAX_PCF_TAPS x TAP_STRUCT
     defines: dict  # the lit pass variant
     disk_samples: int  # jittered-disk samples the variant reads
+    order: list  # the light index of each row of ``lights`` (shadowed lights first)
 
 
 def disk_samples(settings):
@@ -92,6 +90,7 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "is_ortho": int(camera.is_ortho),
         "camera_forward": camera.forward,
         "light_count": light_count,
+        "shadowed_count": 0,
         "world_color": np.asarray(world_color, np.float64)[:3],
         "constant_bias": settings.shadow_bias,
         "slope_bias": settings.shadow_slope_bias,
@@ -104,23 +103,49 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
     }
 
 
-def build_frame_data(lights, camera, world_color, settings, plan, tile_size=1, atlas_columns=1, depth_format="FLOAT32"):
+def shading_order(lights, plan):
+    """Light indices as the lit pass loops over them: lights with a shadow map first (in their
+    own order), then the rest. The lit pass runs the shadow filter only in its first loop, so
+    a light without a map never pays for it. Returns (order, number with maps)."""
+    shadowed = [i for i in range(len(lights)) if i in plan.lights]
+    others = [i for i in range(len(lights)) if i not in plan.lights]
+    return shadowed + others, len(shadowed)
+
+
+def build_frame_data(
+    lights,
+    camera,
+    world_color,
+    settings,
+    plan,
+    tile_size=1,
+    atlas_columns=1,
+    depth_format="FLOAT32",
+    aux_outputs=True,
+):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
-    the atlas the plan was drawn into (1/1 when no map was drawn)."""
+    the atlas the plan was drawn into (1/1 when no map was drawn); ``aux_outputs``: whether
+    the variant writes the depth, shadow and normal targets as well as colour."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
-    filt = SHADOW_FILTER[settings.shadow_filter]
     disk = disk_samples(settings)
-    taps = kernels.pcf_kernel(settings.pcf_kernel_size) if filt.pcf_taps else np.array([[0.0, 0.0, 1.0]])
-    tap_rows = [{"offset": t[:2], "weight": t[2]} for t in taps]
+    order, shadowed = shading_order(lights, plan)
+    frame = frame_row(camera, world_color, len(lights), settings, tile_size, atlas_columns)
+    frame["shadowed_count"] = shadowed
     return FrameData(
-        frame=FRAME_STRUCT.pack([frame_row(camera, world_color, len(lights), settings, tile_size, atlas_columns)]),
-        lights=LIGHT_STRUCT.pack([light_row(lt, plan.lights.get(i)) for i, lt in enumerate(lights)], MAX_LIGHTS),
+        frame=FRAME_STRUCT.pack([frame]),
+        lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i)) for i in order], MAX_LIGHTS),
         tiles=TILE_STRUCT.pack([t.record() for t in plan.tiles], MAX_SHADOW_TILES),
-        taps=TAP_STRUCT.pack(tap_rows, MAX_PCF_TAPS),
         defines=lit_defines(
-            settings.shadow_filter, len(taps), settings.specular_model, depth_format, disk, settings.shadow_early_out
+            settings.shadow_filter if shadowed else "NONE",  # no map: no filter code at all
+            kernels.pcf_weights(settings.pcf_kernel_size),
+            settings.specular_model,
+            depth_format,
+            disk,
+            settings.shadow_early_out,
+            aux_outputs,
         ),
         disk_samples=disk,
+        order=order,
     )

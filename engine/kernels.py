@@ -32,17 +32,24 @@ def pcf_kernel(size, sigma=None):
     odd; ``sigma`` defaults to ``size / 5``, which for 5x5 reproduces seed 000's table
     (centre 0.1621, (1, 0) 0.0983, (2, 1) 0.0133) to four decimals.
     """
+    w1 = pcf_weights(size, sigma)
+    r = len(w1) // 2
+    w2 = np.outer(w1, w1)
+    w2 /= w2.sum()
+    dy, dx = np.mgrid[-r : r + 1, -r : r + 1]
+    return np.stack([dx.ravel(), dy.ravel(), w2.ravel()], axis=1)
+
+
+def pcf_weights(size, sigma=None):
+    """The 1-D factor of ``pcf_kernel``: ``size`` (made odd) normalised Gaussian weights whose
+    outer product is the NxN kernel. The lit pass compiles these in as constants."""
     size = max(1, int(size))
     if size % 2 == 0:
         size += 1
     r = size // 2
     if sigma is None:
         sigma = max(size / 5.0, 1e-6)
-    w1 = gaussian_1d(r, sigma) if r > 0 else np.ones(1)
-    w2 = np.outer(w1, w1)
-    w2 /= w2.sum()
-    dy, dx = np.mgrid[-r : r + 1, -r : r + 1]
-    return np.stack([dx.ravel(), dy.ravel(), w2.ravel()], axis=1)
+    return gaussian_1d(r, sigma) if r > 0 else np.ones(1)
 
 
 RING = 8  # samples per ring of the jittered disk; the outer ring is evaluated first

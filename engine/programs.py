@@ -6,11 +6,12 @@ by construction. Every uniform member is named: no packed vec4 whose meaning liv
 comment.
 """
 
+from dataclasses import replace
+
 from ..shaders.loader import Program, Struct
 from .enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
 
 MAX_LIGHTS = 64
-MAX_PCF_TAPS = 15 * 15
 MAX_SHADOW_TILES = 48
 JITTER_SIZE = 32  # the jitter texture repeats every 32x32 pixels
 MAX_DISK_SAMPLES = 64
@@ -59,6 +60,7 @@ FRAME_STRUCT = Struct(
         ("INT", "is_ortho"),
         ("VEC3", "camera_forward"),
         ("INT", "light_count"),
+        ("INT", "shadowed_count"),  # lights [0, shadowed_count) have maps and come first
         ("VEC3", "world_color"),
         ("FLOAT", "constant_bias"),  # texels
         ("FLOAT", "slope_bias"),  # texels per unit of tan(angle)
@@ -70,8 +72,6 @@ FRAME_STRUCT = Struct(
         ("INT", "atlas_columns"),  # tiles per atlas row
     ),
 )
-
-TAP_STRUCT = Struct("PcfTap", (("VEC2", "offset"), ("FLOAT", "weight")))  # offset in texels
 
 MESH_VERTEX_IN = (("VEC3", "pos"), ("VEC3", "nor"))
 
@@ -105,12 +105,14 @@ LIT = Program(
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
         (LIGHT_STRUCT, "lights", MAX_LIGHTS),
-        (TAP_STRUCT, "pcf_taps", MAX_PCF_TAPS),
         (TILE_STRUCT, "shadow_tiles", MAX_SHADOW_TILES),
     ),
     outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth"), ("FLOAT", "out_shadow"), ("VEC4", "out_normal")),
     defines=tuple({**_ENUM_DEFINES, "JITTER_SIZE": JITTER_SIZE}.items()),
 )
+
+# The viewport's lit pass: colour only, no auxiliary targets to clear or write.
+LIT_COLOR = replace(LIT, name="lit_color", outputs=LIT.outputs[:1])
 
 SHADOW_DEPTH = Program(
     name="shadow_depth",
@@ -130,15 +132,28 @@ def depth_defines(depth_format):
     return {"DEPTH_FORMAT": DEPTH_FORMAT.define(depth_format)}
 
 
-def lit_defines(shadow_filter, pcf_taps, specular_model, depth_format="FLOAT32", disk_samples=16, early_out=True):
-    """The lit pass variant's defines. Only what a filter reads varies its variant: the tap
-    count for PCF, the disk size and early-out switch for the disk filters."""
+def lit_defines(
+    shadow_filter,
+    pcf_weights,
+    specular_model,
+    depth_format="FLOAT32",
+    disk_samples=16,
+    early_out=True,
+    aux_outputs=True,
+):
+    """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
+    kernel (compiled in as constants, so its loops unroll), the disk size and early-out
+    switch for the disk filters. ``aux_outputs``: the variant also writes depth, shadow and
+    normal (a final render's passes); without them it writes colour only (the viewport)."""
     filt = SHADOW_FILTER[shadow_filter]
+    weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
     return {
         **depth_defines(depth_format),
         "SHADOW_FILTER": SHADOW_FILTER.define(shadow_filter),
         "SPECULAR_MODEL": SPECULAR_MODEL.define(specular_model),
-        "PCF_TAPS": pcf_taps if filt.pcf_taps else 1,
+        "PCF_RADIUS": len(weights) // 2,
+        "PCF_WEIGHTS": "float[](" + ", ".join(f"{w:.9g}" for w in weights) + ")",
         "DISK_SAMPLES": disk_samples if filt.disk else 8,
         "EARLY_OUT": bool(early_out) or not filt.early_out,
+        "AUX_OUTPUTS": bool(aux_outputs),
     }

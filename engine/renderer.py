@@ -12,7 +12,7 @@ from .extract import Material
 from .frame_data import build_frame_data, select_lights
 from .post import post_stack
 from .post.base import PostContext
-from .programs import JITTER_SIZE, LIT, MAX_LIGHTS, MAX_SHADOW_TILES, SHADOW_SAMPLER
+from .programs import JITTER_SIZE, LIT, LIT_COLOR, MAX_LIGHTS, MAX_SHADOW_TILES, SHADOW_SAMPLER
 from .shadows import ShadowAtlas, plan_shadows
 
 DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
@@ -99,17 +99,20 @@ class Renderer:
         self._batches = {}  # (geometry key, serial) -> (whole, parts)
         self._jitter_tex = None
         self._size = None
-        self._color = self._depth = self._shadow = self._normal = self._zbuffer = self._fb = None
+        self._color = self._depth = self._shadow = self._normal = self._zbuffer = None
+        self._fb = self._fb_color = None
         self._post_ctx = None
         self._ubos = {}
         self._dummy_shadow = None
 
     # --- the frame ------------------------------------------------------------------------
 
-    def render(self, snapshot, camera, settings, width, height):
+    def render(self, snapshot, camera, settings, width, height, aux=True):
+        """One frame. ``aux``: also write the depth, shadow and normal targets (a final
+        render's passes); the viewport needs colour only and skips them."""
         stats = FrameStats()
         compiled_before = self.shaders.compiled
-        self._ensure_targets(width, height)
+        self._ensure_targets(width, height, aux)
         draws = self._draw_list(snapshot, stats)
         lights = select_lights(snapshot.lights, camera.position, MAX_LIGHTS)
         if len(lights) < len(snapshot.lights):
@@ -127,13 +130,15 @@ class Renderer:
             tile_size=self.shadows.size if plan.tiles else 1,
             atlas_columns=self.shadows.columns if plan.tiles else 1,
             depth_format=self.shadows.depth_format if plan.tiles else "FLOAT32",
+            aux_outputs=aux,
         )
-        self._lit_pass(draws, data, plan, snapshot.world_color, settings.film_transparent, stats)
+        self._lit_pass(_front_to_back(draws, camera), data, plan, snapshot.world_color, settings, aux, stats)
         color = self._post_pass(settings, stats)
-        stats.texture_bytes = (
-            width * height * (16 + 4 + 4 + 8 + 4) + self.shadows.memory_bytes + self._post_ctx.memory_bytes
-        )
+        target_bytes = 16 + 4 + (4 + 4 + 8 if aux else 0)  # colour, z-buffer, depth, shadow, normal
+        stats.texture_bytes = width * height * target_bytes + self.shadows.memory_bytes + self._post_ctx.memory_bytes
         stats.shaders_compiled = self.shaders.compiled - compiled_before
+        if not aux:
+            return FrameOutput(color, None, None, stats, width, height, lit=self._color)
         return FrameOutput(color, self._depth, self._shadow, stats, width, height, lit=self._color, normal=self._normal)
 
     # --- stages ---------------------------------------------------------------------------
@@ -187,29 +192,30 @@ class Renderer:
         self.shadows.render(plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats)
         return plan
 
-    def _lit_pass(self, draws, data, plan, world_color, film_transparent, stats):
+    def _lit_pass(self, draws, data, plan, world_color, settings, aux, stats):
         import gpu
 
-        shader = self.shaders.get(LIT, data.defines)
+        shader = self.shaders.get(LIT if aux else LIT_COLOR, data.defines)
         shadow_tex = self.shadows.texture if plan.tiles else self._shadow_dummy()
         # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
-        bg = (0.0, 0.0, 0.0, 0.0) if film_transparent else (*map(float, world_color[:3]), 1.0)
+        bg = (0.0, 0.0, 0.0, 0.0) if settings.film_transparent else (*map(float, world_color[:3]), 1.0)
         self._color.clear(format="FLOAT", value=bg)
-        # The second attachment holds view distance; the background is "infinitely" far, as in
-        # Blender's own Depth pass.
-        self._depth.clear(format="FLOAT", value=(1e10,))
-        self._shadow.clear(format="FLOAT", value=(1.0,))
-        self._normal.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+        if aux:
+            # The second attachment holds view distance; the background is "infinitely" far, as
+            # in Blender's own Depth pass.
+            self._depth.clear(format="FLOAT", value=(1e10,))
+            self._shadow.clear(format="FLOAT", value=(1.0,))
+            self._normal.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
         width, height = self._size
-        with self._fb.bind():
+        fb = self._fb if aux else self._fb_color
+        with fb.bind():
             gpu.state.viewport_set(0, 0, width, height)
-            self._fb.clear(depth=1.0)
+            fb.clear(depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
             gpu.state.depth_mask_set(True)
             shader.bind()
             shader.uniform_block("frame", self._ubo("frame", data.frame))
             shader.uniform_block("lights", self._ubo("lights", data.lights))
-            shader.uniform_block("pcf_taps", self._ubo("taps", data.taps))
             shader.uniform_block("shadow_tiles", self._ubo("tiles", data.tiles))
             shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
             shader.uniform_sampler("jitter_tex", self._jitter(data.disk_samples))
@@ -238,21 +244,25 @@ class Renderer:
 
     # --- resources ------------------------------------------------------------------------
 
-    def _ensure_targets(self, width, height):
+    def _ensure_targets(self, width, height, aux):
+        """The lit pass's targets at this size; the auxiliary ones (depth, shadow, normal) only
+        once a frame asks for them."""
         import gpu
 
-        if self._size == (width, height):
-            return
-        self._color = gpu.types.GPUTexture((width, height), format="RGBA32F")
-        self._depth = gpu.types.GPUTexture((width, height), format="R32F")
-        self._shadow = gpu.types.GPUTexture((width, height), format="R32F")
-        self._normal = gpu.types.GPUTexture((width, height), format="RGBA16F")
-        self._zbuffer = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
-        self._fb = gpu.types.GPUFrameBuffer(
-            depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow, self._normal)
-        )
-        self._post_ctx = PostContext(self.shaders, width, height)
-        self._size = (width, height)
+        if self._size != (width, height):
+            self._color = gpu.types.GPUTexture((width, height), format="RGBA32F")
+            self._zbuffer = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
+            self._fb_color = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self._color,))
+            self._depth = self._shadow = self._normal = self._fb = None
+            self._post_ctx = PostContext(self.shaders, width, height)
+            self._size = (width, height)
+        if aux and self._fb is None:
+            self._depth = gpu.types.GPUTexture((width, height), format="R32F")
+            self._shadow = gpu.types.GPUTexture((width, height), format="R32F")
+            self._normal = gpu.types.GPUTexture((width, height), format="RGBA16F")
+            self._fb = gpu.types.GPUFrameBuffer(
+                depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow, self._normal)
+            )
 
     def _ubo(self, name, data):
         import gpu
@@ -311,6 +321,22 @@ class Renderer:
             self._dummy_shadow = gpu.types.GPUTexture((1, 1), format="R32F")
             self._dummy_shadow.clear(format="FLOAT", value=(1.0,))
         return self._dummy_shadow
+
+
+def _front_to_back(draws, camera):
+    """The draws nearest the camera first (by the nearest point of their bounds), so the
+    depth test rejects hidden pixels before they are shaded."""
+    if len(draws) < 2:
+        return draws
+    corners = np.stack([d.corners for d in draws])
+    lo, hi = corners.min(axis=1), corners.max(axis=1)
+    if camera.is_ortho:
+        key = np.min(corners @ camera.forward, axis=1)
+    else:
+        position = camera.position
+        key = np.linalg.norm(np.maximum(0.0, np.maximum(lo - position, position - hi)), axis=1)
+    key = np.where(np.isfinite(key), key, np.inf)
+    return [draws[i] for i in np.argsort(key, kind="stable")]
 
 
 def _view_corners(camera):

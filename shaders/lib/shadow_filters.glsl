@@ -139,12 +139,17 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
 #elif SHADOW_FILTER == FILTER_HARDWARE
   return shadow_bilinear(origin, st, SHADOW_REF(1.0));
 #elif SHADOW_FILTER == FILTER_PCF
-  float lit = 0.0;
+  /* Separable Gaussian weights compiled in as constants, so both loops unroll. */
+  const float w[2 * PCF_RADIUS + 1] = PCF_WEIGHTS;
   float spacing = frame.pcf_spacing;
-  float ref = SHADOW_REF(floor(sqrt(float(PCF_TAPS)) * 0.5) * spacing);
-  for (int i = 0; i < PCF_TAPS; i++) {
-    PcfTap tap = pcf_taps[i];
-    lit += tap.weight * shadow_tap(origin, ivec2(floor(st + tap.offset * spacing)), ref);
+  float ref = SHADOW_REF(float(PCF_RADIUS) * spacing);
+  float lit = 0.0;
+  for (int y = -PCF_RADIUS; y <= PCF_RADIUS; y++) {
+    float row = 0.0;
+    for (int x = -PCF_RADIUS; x <= PCF_RADIUS; x++) {
+      row += w[x + PCF_RADIUS] * shadow_tap(origin, ivec2(floor(st + vec2(x, y) * spacing)), ref);
+    }
+    lit += w[y + PCF_RADIUS] * row;
   }
   return lit;
 #elif SHADOW_FILTER == FILTER_JITTER

@@ -11,7 +11,8 @@ import pytest
 from devkit.session import ROOT, load_penumbra
 
 load_penumbra()
-from penumbra.engine import lightspace, programs, settings, shadows  # noqa: E402
+from penumbra.engine import kernels, lightspace, programs, settings, shadows  # noqa: E402
+from penumbra.engine.enums import LIGHT_TYPE, SHADOW_MODE  # noqa: E402
 from penumbra.engine.extract import Camera, Light  # noqa: E402
 from penumbra.engine.frame_data import build_frame_data  # noqa: E402
 from penumbra.shaders.loader import Struct  # noqa: E402
@@ -104,17 +105,37 @@ def test_frame_data_carries_every_light_its_tiles_and_the_settings():
 
 
 @pytest.mark.parametrize("kernel", [1, 3, 5, 15])
-def test_pcf_taps_are_the_normalised_kernel_and_size_the_variant(kernel):
-    data = build_frame_data([], _camera(), (0, 0, 0), _settings(pcf_kernel_size=kernel), shadows.ShadowPlan())
-    assert data.defines["PCF_TAPS"] == kernel * kernel
-    weights = data.taps[: kernel * kernel, 2]
-    assert weights.sum() == pytest.approx(1.0, abs=1e-6)
-    assert not data.taps[kernel * kernel :].any()
+def test_pcf_weights_compile_in_as_the_separable_factor_of_the_normalised_kernel(kernel):
+    lights = [_light("SUN")]
+    data = build_frame_data(lights, _camera(), (0, 0, 0), _settings(pcf_kernel_size=kernel), _plan(lights))
+    radius = data.defines["PCF_RADIUS"]
+    assert radius == kernel // 2
+    weights = np.array([float(w) for w in re.findall(r"[-+0-9.e]+", data.defines["PCF_WEIGHTS"].split("(", 1)[1])])
+    assert len(weights) == 2 * radius + 1
+    full = kernels.pcf_kernel(kernel)
+    np.testing.assert_allclose(np.outer(weights, weights).ravel(), full[:, 2], rtol=1e-7)
+    assert np.outer(weights, weights).sum() == pytest.approx(1.0, abs=1e-6)
+
+
+def test_lights_with_maps_come_first_and_only_they_run_the_filter_loop():
+    sun, lamp, spot = _light("SUN"), _light("POINT", use_shadow=False), _light("SPOT")
+    lights = [lamp, sun, spot]
+    plan = shadows.ShadowPlan()
+    plan.lights = {1: shadows.LightShadow("SINGLE", [0]), 2: shadows.LightShadow("SINGLE", [1])}
+    data = build_frame_data(lights, _camera(), (0, 0, 0), _settings(), plan)
+    assert data.order == [1, 2, 0]
+    F, L = programs.FRAME_STRUCT, programs.LIGHT_STRUCT
+    assert F.unpack(data.frame, 0, "shadowed_count") == 2 and F.unpack(data.frame, 0, "light_count") == 3
+    modes = [L.unpack(data.lights, i, "shadow_mode") for i in range(3)]
+    assert modes == [SHADOW_MODE.value("SINGLE")] * 2 + [SHADOW_MODE.value("NONE")]
+    assert L.unpack(data.lights, 0, "type") == LIGHT_TYPE.value("SUN")
+    assert L.unpack(data.lights, 2, "type") == LIGHT_TYPE.value("POINT")
 
 
 def test_only_what_a_filter_reads_varies_its_shader_variant():
     def defines(**kw):
-        return build_frame_data([], _camera(), (0, 0, 0), _settings(**kw), shadows.ShadowPlan()).defines
+        lights = [_light("SUN")]
+        return build_frame_data(lights, _camera(), (0, 0, 0), _settings(**kw), _plan(lights)).defines
 
     assert defines(shadow_filter="NONE", pcf_kernel_size=3) == defines(shadow_filter="NONE", pcf_kernel_size=9)
     assert defines(shadow_filter="NONE", shadow_samples=64) == defines(shadow_filter="NONE", shadow_samples=8)
@@ -132,7 +153,7 @@ def test_more_lights_than_the_block_holds_is_an_error_not_a_silent_drop():
 
 # Which struct each GLSL variable name holds in the scene shaders.
 _VARIABLES = {"frame": programs.FRAME_STRUCT, "L": programs.LIGHT_STRUCT, "T": programs.TILE_STRUCT,
-              "tile": programs.TILE_STRUCT, "tap": programs.TAP_STRUCT}  # fmt: skip
+              "tile": programs.TILE_STRUCT}  # fmt: skip
 
 
 def test_scene_shaders_read_only_fields_their_structs_declare():
@@ -142,7 +163,29 @@ def test_scene_shaders_read_only_fields_their_structs_declare():
     used = 0
     for path in sources:
         text = re.sub(r"/\*.*?\*/", "", path.read_text(), flags=re.S)
-        for var, field in re.findall(r"\b(frame|L|T|tile|tap)\.([A-Za-z_]\w*)", text):
+        for var, field in re.findall(r"\b(frame|L|T|tile)\.([A-Za-z_]\w*)", text):
             assert field in _VARIABLES[var].layout, f"{path.name}: {var}.{field} is not a {_VARIABLES[var].name} field"
             used += 1
     assert used > 30
+
+
+def test_a_frame_without_maps_compiles_no_shadow_filter():
+    """Lights without maps cost nothing extra: every filter setting gives the one variant with
+    no filter code when no light has a map (and so one compile, not one per filter)."""
+    lights = [_light("POINT", use_shadow=False), _light("SUN", use_shadow=False)]
+    variants = {
+        tuple(
+            sorted(
+                build_frame_data(
+                    lights, _camera(), (0, 0, 0), _settings(shadow_filter=f), _plan(lights)
+                ).defines.items()
+            )
+        )
+        for f in ("NONE", "HARDWARE", "PCF", "JITTER", "PCSS")
+    }
+    assert len(variants) == 1
+    assert dict(next(iter(variants)))["SHADOW_FILTER"] == "FILTER_NONE"
+    shadowed = [_light("SUN")]
+    assert build_frame_data(shadowed, _camera(), (0, 0, 0), _settings(), _plan(shadowed)).defines["SHADOW_FILTER"] == (
+        "FILTER_PCF"
+    )
