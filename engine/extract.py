@@ -259,17 +259,23 @@ def geometry_from_mesh(mesh):
     )
 
 
-def _geometry_key(inst, ob):
-    """Cache key and the datablock names whose geometry updates invalidate it."""
-    orig = ob.original
+def _geometry_key(inst, ob, own_data):
+    """Cache key and the datablock names whose geometry updates invalidate it.
+
+    ``own_data(orig)`` is the pointer of the evaluated geometry of object ``orig`` itself. An
+    instance that draws exactly that geometry (a collection instance, dupli-verts, a particle
+    instance) shares the object's key, so its geometry is extracted once whatever the number
+    of instances; an instance with other geometry (made by a geometry-nodes modifier) is keyed
+    by that geometry."""
+    orig = ob.original if ob.original is not None else ob
     data = ob.data
     data_name = data.original.name_full if data is not None and data.original is not None else ""
-    if inst.is_instance and orig is not None and orig.data is not None and orig.data.original != data.original:
-        # Geometry-nodes instance of bare mesh data: depends on the instancer too.
-        parent = inst.parent.original.name_full if inst.parent is not None else ""
-        return ("GN", parent, data_name), frozenset({parent, data_name})
-    name = orig.name_full if orig is not None else ob.name_full
-    if ob.type == "MESH" and orig is not None and len(orig.modifiers) == 0 and not _has_shape_keys(orig):
+    name = orig.name_full
+    if inst.is_instance and data is not None and data.as_pointer() != own_data(orig):
+        # Geometry made by the object's modifiers for its instances: shared by every instance
+        # of that same geometry, rebuilt when the object's geometry changes.
+        return ("GN", name, data_name, data.as_pointer()), frozenset({name, data_name})
+    if ob.type == "MESH" and len(orig.modifiers) == 0 and not _has_shape_keys(orig):
         return ("ME", data_name), frozenset({data_name, name})
     return ("OB", name), frozenset({name, data_name})
 
@@ -328,6 +334,16 @@ class SceneCache:
         instances = []
         lights = []
         used = set()
+        own = {}
+
+        def own_data(orig):
+            """Pointer of ``orig``'s own evaluated geometry (cached for this snapshot)."""
+            key = orig.name_full
+            if key not in own:
+                data = orig.evaluated_get(depsgraph).data
+                own[key] = data.as_pointer() if data is not None else 0
+            return own[key]
+
         for inst in depsgraph.object_instances:
             ob = inst.object
             if ob.type == "LIGHT":
@@ -341,7 +357,7 @@ class SceneCache:
             if not np.all(np.isfinite(matrix)):
                 print(f"Penumbra: object '{ob.name}' has a non-finite matrix; skipped", file=sys.stderr)
                 continue
-            key, deps = _geometry_key(inst, ob)
+            key, deps = _geometry_key(inst, ob, own_data)
             geo = self._geometry_for(inst, ob, key, deps)
             if geo is None or geo.triangle_count == 0:
                 continue

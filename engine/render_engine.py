@@ -21,16 +21,19 @@ class PenumbraEngineCore:
         self.renderer = None
         self.last_stats = None
         self._reported = None
+        self._shown = None  # (view key, FrameOutput) of the frame the viewport shows
 
     def free_gpu(self):
         """Release this instance's GPU resources. Call it while the GPU context is active:
         freeing GPU objects later, from a destructor without a context, aborts Blender 4.5."""
         self.renderer = None
+        self._shown = None
         self.cache.clear()
 
-    def render_frame(self, depsgraph, camera, width, height, pixel_scale=1.0):
+    def render_frame(self, depsgraph, camera, width, height, pixel_scale=1.0, aux=True):
         """Extract, then render one frame; returns the renderer's FrameOutput. ``pixel_scale``
-        scales the post layers' sizes in pixels (a final render's resolution %)."""
+        scales the post layers' sizes in pixels (a final render's resolution %); ``aux``: also
+        produce the depth, shadow and normal targets (passes), not only colour."""
         from .renderer import Renderer
 
         if self.renderer is None:
@@ -40,9 +43,26 @@ class PenumbraEngineCore:
         settings = scene.penumbra.render_settings(
             frame=scene.frame_current, film_transparent=scene.render.film_transparent, pixel_scale=pixel_scale
         )
-        out = self.renderer.render(snapshot, camera, settings, width, height)
+        out = self.renderer.render(snapshot, camera, settings, width, height, aux=aux)
         self.last_stats = out.stats
         return out
+
+    def viewport_frame(self, depsgraph, view_matrix, window_matrix, width, height):
+        """The frame a viewport redraw shows: re-rendered only when the view, the region size
+        or the scene changed since the last one (``view_update`` calls ``scene_changed``);
+        otherwise the last frame is shown again. Returns (FrameOutput, whether it rendered)."""
+        key = (width, height, tuple(map(tuple, view_matrix)), tuple(map(tuple, window_matrix)))
+        if self._shown is not None and self._shown[0] == key:
+            return self._shown[1], False
+        camera = camera_from_view(view_matrix, window_matrix)
+        self._shown = None
+        out = self.render_frame(depsgraph, camera, width, height, aux=False)
+        self._shown = (key, out)
+        return out, True
+
+    def scene_changed(self):
+        """Something in the scene changed: the next viewport redraw renders afresh."""
+        self._shown = None
 
     def draw_display(self, scene, texture, width, height):
         """Draw a scene-linear texture through Blender's colour management (view transform,
@@ -98,6 +118,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.report({"ERROR"}, "Penumbra: the render region is empty; widen it in the Output properties")
             return
         views = render_views(r)
+        vl = depsgraph.view_layer
+        aux = vl.use_pass_z or vl.use_pass_mist or vl.use_pass_normal or vl.penumbra.use_pass_shadow
         reported = set()
         for message in unsupported_in_use(scene.camera.data, r, depsgraph.view_layer):
             self.report({"WARNING"}, message)
@@ -126,7 +148,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     )
                 else:
                     camera = camera_from_scene(depsgraph, scene, width, height)
-                out = self.render_frame(depsgraph, camera, width, height, r.resolution_percentage / 100.0)
+                out = self.render_frame(depsgraph, camera, width, height, r.resolution_percentage / 100.0, aux)
                 for message in out.stats.messages:
                     if message not in reported:
                         reported.add(message)
@@ -182,14 +204,14 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
 
     def view_update(self, context, depsgraph):
         self.cache.apply_updates(depsgraph)
+        self.scene_changed()
 
     def view_draw(self, context, depsgraph):
         region = context.region
         rv3d = context.region_data
         width, height = region.width, region.height
         try:
-            camera = camera_from_view(rv3d.view_matrix, rv3d.window_matrix)
-            out = self.render_frame(depsgraph, camera, width, height)
+            out, _rendered = self.viewport_frame(depsgraph, rv3d.view_matrix, rv3d.window_matrix, width, height)
         except Exception as exc:
             message = f"Penumbra: viewport draw failed: {exc}"
             if message != self._reported:  # once per distinct error, not every redraw

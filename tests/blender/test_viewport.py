@@ -19,15 +19,13 @@ def _viewport_frame(gpu_call, scene):
         import gpu
         from mathutils import Matrix
 
-        from penumbra.engine.extract import camera_from_view
-
         r = scene.render
         w, h = r.resolution_x, r.resolution_y
         cam = scene.camera.evaluated_get(depsgraph)
         # What a RegionView3D reports in camera view when the camera frame fills the region.
         view_matrix = cam.matrix_world.inverted()
         window_matrix = cam.calc_matrix_camera(depsgraph, x=w, y=h, scale_x=1.0, scale_y=1.0)
-        out = engine.render_frame(depsgraph, camera_from_view(view_matrix, window_matrix), w, h)
+        out, _rendered = engine.viewport_frame(depsgraph, view_matrix, window_matrix, w, h)  # what view_draw runs
         linear = out.color_array().copy()
         offscreen = gpu.types.GPUOffScreen(w, h, format="RGBA32F")
         with offscreen.bind():

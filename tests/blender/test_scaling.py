@@ -1,0 +1,128 @@
+"""A frame costs what the scene needs: what must not happen, counted rather than timed
+(instances extracted once, no re-render for a redraw with nothing changed, a variant without
+shadow code when no light has a map)."""
+
+import math
+
+import bpy
+import numpy as np
+
+from devkit import scenes
+
+
+def _instanced_scene(count):
+    """``count`` collection instances of one bunny-sized mesh (a UV sphere) over a ground, lit
+    by a sun."""
+    scene = scenes.empty_scene(96, 54)
+    mat = scenes.white()
+    scenes.plane(scene, "Ground", size=20.0, mat=mat)
+    source = bpy.data.collections.new("Source")
+    scene.collection.children.link(source)
+    ball = scenes.uv_sphere(scene, "Ball", radius=0.4, mat=mat)
+    scene.collection.objects.unlink(ball)
+    source.objects.link(ball)
+    scene.view_layers[0].layer_collection.children["Source"].exclude = True  # drawn only as instances
+    for i in range(count):
+        empty = bpy.data.objects.new(f"Instance{i}", None)
+        empty.instance_type = "COLLECTION"
+        empty.instance_collection = source
+        empty.location = ((i % 4) * 1.5 - 2.25, (i // 4) * 1.5 - 2.25, 0.6)
+        scene.collection.objects.link(empty)
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(30), 0, math.radians(20)))
+    scenes.look_at(scene, (0, -9, 7), (0, 0, 0))
+    return scene
+
+
+def test_collection_instances_share_one_extracted_geometry(penumbra, gpu_call):
+    scene = _instanced_scene(16)
+
+    def job(engine, depsgraph):
+        from penumbra.engine.extract import camera_from_scene
+
+        out = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 96, 54), 96, 54)
+        keys = {inst.key for inst in engine.cache.snapshot(depsgraph).instances}
+        return engine.cache.built, len(keys), out.stats.draws, out.color_array().copy()
+
+    built, keys, draws, image = gpu_call(job)
+    assert keys == 2 and built == 2  # the ground and the one sphere mesh, for 17 drawn instances
+    assert draws >= 17
+    # Every instance is drawn where it stands: 16 distinct sphere silhouettes, not one.
+    assert (image[..., :3].sum(axis=-1) > 0).mean() > 0.3
+
+
+def test_instances_of_a_modified_object_share_its_evaluated_geometry(penumbra, gpu_call):
+    scene = _instanced_scene(4)
+    ball = bpy.data.objects["Ball"]
+    ball.modifiers.new("Bevel", "BEVEL")  # an evaluated mesh of its own, shared by the instances
+
+    def job(engine, depsgraph):
+        from penumbra.engine.extract import camera_from_scene
+
+        engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 96, 54), 96, 54)
+        return engine.cache.built
+
+    assert gpu_call(job) == 2
+
+
+def test_geometry_nodes_instances_of_different_meshes_stay_distinct(penumbra, gpu_call):
+    """Two instance sources on one points object: each keeps its own geometry (a shared key
+    would draw one shape at every point)."""
+    scene = scenes.empty_scene(96, 54)
+    scenes.look_at(scene, (0, -8, 0.01), (0, 0, 0))
+    scenes.set_world(scene, (1.0, 1.0, 1.0))
+    points = bpy.data.objects.new("Points", bpy.data.meshes.new("Points"))
+    points.data.from_pydata([(-2, 0, 0), (2, 0, 0)], [], [])
+    scene.collection.objects.link(points)
+    tree = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
+    tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    nodes, links = tree.nodes, tree.links
+    group_in, group_out = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    join = nodes.new("GeometryNodeJoinGeometry")
+    cube, sphere = nodes.new("GeometryNodeMeshCube"), nodes.new("GeometryNodeMeshUVSphere")
+    for shape, z in ((cube, 1.5), (sphere, -1.5)):
+        place = nodes.new("GeometryNodeInstanceOnPoints")
+        move = nodes.new("GeometryNodeTranslateInstances")
+        move.inputs["Translation"].default_value = (0, 0, z)
+        links.new(group_in.outputs[0], place.inputs["Points"])
+        links.new(shape.outputs["Mesh"], place.inputs["Instance"])
+        links.new(place.outputs[0], move.inputs["Instances"])
+        links.new(move.outputs[0], join.inputs[0])
+    links.new(join.outputs[0], group_out.inputs[0])
+    points.modifiers.new("Scatter", "NODES").node_group = tree
+
+    def job(engine, depsgraph):
+
+        snap = engine.cache.snapshot(depsgraph)
+        return sorted(snap.geometry[i.key].triangle_count for i in snap.instances)
+
+    counts = gpu_call(job)
+    cube_tris = 12
+    assert counts[:2] == [cube_tris, cube_tris] and counts[2] == counts[3] > cube_tris
+
+
+def test_viewport_redraw_with_nothing_changed_shows_the_last_frame(penumbra, gpu_call):
+    scene = scenes.demo_scene(64, 36)
+
+    def job(engine, depsgraph):
+        cam = scene.camera.evaluated_get(depsgraph)
+        view = cam.matrix_world.inverted()
+        window = cam.calc_matrix_camera(depsgraph, x=64, y=36, scale_x=1.0, scale_y=1.0)
+        rendered = []
+        first, r = engine.viewport_frame(depsgraph, view, window, 64, 36)
+        rendered.append(r)
+        image = first.color_array().copy()
+        again, r = engine.viewport_frame(depsgraph, view, window, 64, 36)
+        rendered.append(r)
+        same = again is first and np.array_equal(again.color_array(), image)
+        engine.scene_changed()  # what view_update does on any depsgraph update
+        rendered.append(engine.viewport_frame(depsgraph, view, window, 64, 36)[1])
+        moved = view.copy()
+        moved.translation.x += 0.1
+        rendered.append(engine.viewport_frame(depsgraph, moved, window, 64, 36)[1])
+        rendered.append(engine.viewport_frame(depsgraph, moved, window, 64, 40)[1])  # region resized
+        return rendered, same
+
+    rendered, same = gpu_call(job)
+    assert rendered == [True, False, True, True, True]
+    assert same
