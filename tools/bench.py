@@ -2,6 +2,8 @@
 
     frame     render time of Penumbra, EEVEE, Workbench and Cycles on the demo scene
               -> <out>/benchmark.csv
+    perf      frame cost and scaling as ratios to Workbench: resolution, viewport redraw,
+              lights, objects, instances, triangles, extraction -> <out>/perf.csv
     post      cost of each post layer; separable against direct 2-D blur -> <out>/post_costs.csv
     shadows   shadow error against frame time, scaling, per-frame work, JITTER early out
               -> <out>/shadow_tradeoff.csv, shadow_pareto.png, scaling.csv, scaling.png
@@ -18,9 +20,9 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import frame, post, shadows
+from tools.benchmarks import frame, perf, post, shadows
 
-COMMANDS = {"frame": frame, "post": post, "shadows": shadows}
+COMMANDS = {"frame": frame, "perf": perf, "post": post, "shadows": shadows}
 
 
 def main(argv=None):

@@ -1,0 +1,449 @@
+"""What a frame costs and how it scales, as ratios to Workbench measured in the same run.
+
+The baseline is Blender's Workbench with anti-aliasing off and shadows on (one sample of flat
+shading with a shadow, the nearest thing Blender ships to one Penumbra sample). For every
+case both engines render the same scene, interleaved (Penumbra, Workbench, Penumbra, ...)
+after one untimed render each, ``--runs`` times; a row quotes the medians and their ratio.
+Final renders (F12) go through ``bpy.ops.render.render``: a new engine instance per render,
+so every Penumbra row pays for extraction, shadow maps and allocation, as a batch render does.
+
+Sections (``--sections``, all by default):
+  resolution  demo scene without post layers at 480x270, 960x540 and 1920x1080
+  viewport    the viewport path at 960x540 (demo scene with its post layers), one engine
+              instance: display only, redraw with nothing changed, camera moving, scene edited
+  lights      N shadowed spot lights over a field of boxes (N = 1, 8, 32, 64): F12, and the
+              viewport path with every map reused
+  objects     N separate objects (each its own mesh) and N instances of one mesh
+  instances   1 and 16 collection instances of the Stanford bunny (69k triangles): F12
+  triangles   one grid mesh of 70k ... 2M triangles: F12, and extraction against a bare copy
+              of the same data with ``foreach_get`` (the limit for reading a mesh from Python)
+
+Writes ``<out>/perf.csv``; Markdown tables for the README go to stdout, progress and
+Blender's own output to stderr. ``--quick``: fewer sizes and counts, 3 runs.
+"""
+
+import math
+import statistics
+import sys
+import time
+
+import bpy
+import numpy as np
+
+from devkit import assets, engines, report, scenes, session
+
+HELP = "frame cost and scaling as ratios to Workbench (AA off, shadows on)"
+SECTIONS = ("resolution", "viewport", "lights", "objects", "instances", "triangles")
+CSV_FIELDS = ["section", "case", "penumbra_ms", "workbench_ms", "ratio", "note", "runs", "blender"]
+
+
+def add_arguments(parser):
+    from pathlib import Path
+
+    from devkit import timing
+
+    parser.add_argument("--out", type=Path, default=Path("out"), help="output folder for perf.csv (default out)")
+    timing.add_runs_argument(parser, None, "timed renders per engine and case (default 5; 3 with --quick)")
+    parser.add_argument("--quick", action="store_true", help="fewer sizes and counts")
+    parser.add_argument(
+        "--sections", default=",".join(SECTIONS), help="comma-separated subset of: " + ", ".join(SECTIONS)
+    )
+
+
+# --- engines -------------------------------------------------------------------------------
+
+
+def _workbench(scene):
+    engines.configure(scene, "WORKBENCH")
+    scene.display.render_aa = "OFF"
+    scene.display.shading.show_shadows = True
+
+
+def _penumbra(scene):
+    engines.configure(scene, "PENUMBRA")
+
+
+def _render():
+    with session.stdout_to_stderr():
+        bpy.ops.render.render(write_still=False)
+
+
+def paired(scene, runs):
+    """Median seconds of interleaved F12 renders: {'PENUMBRA': s, 'WORKBENCH': s}."""
+    setups = {"PENUMBRA": _penumbra, "WORKBENCH": _workbench}
+    times = {k: [] for k in setups}
+    for setup in setups.values():  # warm-up: shader compilation, first allocations
+        setup(scene)
+        _render()
+    for _ in range(runs):
+        for key, setup in setups.items():
+            setup(scene)
+            start = time.perf_counter()
+            _render()
+            times[key].append(time.perf_counter() - start)
+    _penumbra(scene)
+    return {k: statistics.median(v) for k, v in times.items()}
+
+
+def _row(section, case, t, note="", runs=0):
+    p, w = t.get("PENUMBRA"), t.get("WORKBENCH")
+    return {
+        "section": section,
+        "case": case,
+        "penumbra_ms": None if p is None else p * 1e3,
+        "workbench_ms": None if w is None else w * 1e3,
+        "ratio": p / w if p and w else None,
+        "note": note,
+        "runs": runs,
+        "blender": bpy.app.version_string,
+    }
+
+
+# --- scenes ----------------------------------------------------------------------------------
+
+
+def demo(width, height, post=False):
+    scene = scenes.demo_scene(width, height)
+    if not post:
+        scene.penumbra.layers.clear()
+    return scene
+
+
+def spot_field(count, width=960, height=540):
+    """A 24 m ground with a 6x6 field of boxes, lit by ``count`` shadowed spots on a grid 4 m
+    above it, each pointing down; total power fixed, so the image stays exposed alike."""
+    scene = scenes.empty_scene(width, height)
+    scenes.set_world(scene, (0.02, 0.02, 0.03))
+    mat = scenes.white()
+    scenes.plane(scene, "Ground", size=24.0, mat=mat)
+    for i in range(36):
+        x, y = (i % 6) * 3.6 - 9.0, (i // 6) * 3.6 - 9.0
+        scenes.box(scene, f"Box{i}", center=(x, y, 0.5), size=(0.8, 0.8, 1.0), mat=mat)
+    side = math.ceil(math.sqrt(count))
+    for i in range(count):
+        x = ((i % side) + 0.5) / side * 20.0 - 10.0
+        y = ((i // side) + 0.5) / side * 20.0 - 10.0
+        scenes.light(
+            scene, f"Spot{i}", "SPOT", 4000.0 / count, location=(x, y, 4.0), spot_size=math.radians(50), spot_blend=0.2
+        )
+    scenes.look_at(scene, (0.0, -17.0, 15.0), (0.0, -1.0, 0.0))
+    return scene
+
+
+def object_field(count, instanced):
+    """``count`` cubes on a square grid over a ground, as separate objects with their own mesh
+    or as collection instances of one cube; one sun."""
+    scene = scenes.empty_scene(960, 540)
+    mat = scenes.white()
+    scenes.plane(scene, "Ground", size=40.0, mat=mat)
+    side = math.ceil(math.sqrt(count))
+    spacing = 36.0 / side
+    if instanced:
+        source = bpy.data.collections.new("Source")
+        scene.collection.children.link(source)
+        cube = scenes.box(scene, "Cube", size=(spacing * 0.5,) * 3, mat=mat)
+        scene.collection.objects.unlink(cube)
+        source.objects.link(cube)
+        scene.view_layers[0].layer_collection.children["Source"].exclude = True
+    for i in range(count):
+        x = ((i % side) + 0.5) * spacing - 18.0
+        y = ((i // side) + 0.5) * spacing - 18.0
+        if instanced:
+            ob = bpy.data.objects.new(f"Instance{i}", None)
+            ob.instance_type, ob.instance_collection = "COLLECTION", source
+            ob.location = (x, y, spacing * 0.25)
+            scene.collection.objects.link(ob)
+        else:
+            scenes.box(scene, f"Cube{i}", center=(x, y, spacing * 0.25), size=(spacing * 0.5,) * 3, mat=mat)
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(35), 0, math.radians(25)))
+    scenes.look_at(scene, (0.0, -34.0, 30.0), (0.0, -2.0, 0.0))
+    return scene
+
+
+def bunny_field(count):
+    """``count`` collection instances of the Stanford bunny on a ground, one sun."""
+    scene = scenes.empty_scene(960, 540)
+    mat = scenes.white()
+    scenes.plane(scene, "Ground", size=20.0, mat=mat)
+    source = bpy.data.collections.new("Bunny")
+    scene.collection.children.link(source)
+    bunny = assets.import_mesh(scene, assets.BUNNY, height=1.0, name="Bunny")
+    bunny.data.materials.append(mat)
+    scene.collection.objects.unlink(bunny)
+    source.objects.link(bunny)
+    scene.view_layers[0].layer_collection.children["Bunny"].exclude = True
+    for i in range(count):
+        ob = bpy.data.objects.new(f"Bunny{i}", None)
+        ob.instance_type, ob.instance_collection = "COLLECTION", source
+        ob.location = ((i % 4) * 1.6 - 2.4, (i // 4) * 1.6 - 2.4, 0.0)
+        scene.collection.objects.link(ob)
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(35), 0, math.radians(25)))
+    scenes.look_at(scene, (0.0, -9.0, 6.0), (0.0, 0.0, 0.5))
+    return scene
+
+
+def grid_mesh(scene, n, name="Grid"):
+    """An n x n quad grid (2 n^2 triangles) of gentle waves, 8 m wide, built with foreach_set."""
+    k = n + 1
+    u, v = np.meshgrid(np.linspace(-4, 4, k), np.linspace(-4, 4, k))
+    co = np.stack([u, v, 0.3 * np.sin(u * 2.0) * np.cos(v * 2.0) + 0.4], axis=-1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(n), np.arange(n))
+    a = (j * k + i).ravel()
+    quads = np.stack([a, a + 1, a + k + 1, a + k], axis=1)
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(co, [], quads)
+    me.shade_smooth()
+    ob = bpy.data.objects.new(name, me)
+    scene.collection.objects.link(ob)
+    return ob
+
+
+def bare_copy(mesh):
+    """Seconds to copy a mesh's triangle data out with plain ``foreach_get`` (positions,
+    triangle corners, corner normals): what any extraction from Python must at least do."""
+    start = time.perf_counter()
+    mesh.calc_loop_triangles()
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    tri = np.empty(len(mesh.loop_triangles) * 3, np.int32)
+    mesh.loop_triangles.foreach_get("loops", tri)
+    nor = np.empty(len(mesh.loops) * 3, np.float32)
+    mesh.corner_normals.foreach_get("vector", nor)
+    return time.perf_counter() - start
+
+
+# --- sections ------------------------------------------------------------------------------
+
+
+def section_resolution(plan):
+    rows = []
+    for w, h in plan["resolutions"]:
+        scene = demo(w, h)
+        rows.append(_row("resolution", f"{w}x{h}", paired(scene, plan["runs"]), runs=plan["runs"]))
+    return rows
+
+
+def section_viewport(plan):
+    """The engine core's viewport path at 960x540 (``viewport_frame`` + ``draw_display``)."""
+    import gpu
+
+    w, h = 960, 540
+    scene = demo(w, h, post=True)
+    runner = session.GpuRunner()
+    runner.register()
+    runs = max(plan["runs"], 5)
+
+    def job(engine, depsgraph):
+        cam = scene.camera.evaluated_get(depsgraph)
+        view = cam.matrix_world.inverted()
+        window = cam.calc_matrix_camera(depsgraph, x=w, y=h, scale_x=1.0, scale_y=1.0)
+        offscreen = gpu.types.GPUOffScreen(w, h, format="RGBA16F")
+
+        def show(out):
+            with offscreen.bind():
+                fb = gpu.state.active_framebuffer_get()
+                with gpu.matrix.push_pop(), gpu.matrix.push_pop_projection():
+                    gpu.matrix.load_identity()
+                    gpu.matrix.load_projection_matrix(_pixel_projection(w, h))
+                    engine.draw_display(scene, out.color, w, h)
+                fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")  # waits for the GPU
+
+        moved = [0]
+
+        def move():
+            moved[0] += 1
+            v = view.copy()
+            v.translation.x += 0.01 * moved[0]
+            return v
+
+        cases = {
+            "display only": lambda: show(engine.viewport_frame(depsgraph, view, window, w, h)[0]),
+            "redraw, nothing changed": lambda: show(engine.viewport_frame(depsgraph, view, window, w, h)[0]),
+            "camera moving": lambda: show(engine.viewport_frame(depsgraph, move(), window, w, h)[0]),
+            "scene edited (view still)": lambda: (
+                engine.scene_changed(),
+                show(engine.viewport_frame(depsgraph, view, window, w, h)[0]),
+            ),
+        }
+        out = engine.viewport_frame(depsgraph, view, window, w, h)[0]
+        times = {}
+        for name, fn in cases.items():
+            fn()
+            samples = []
+            for _ in range(runs):
+                if name == "display only":
+                    start = time.perf_counter()
+                    show(out)
+                else:
+                    start = time.perf_counter()
+                    fn()
+                samples.append(time.perf_counter() - start)
+            times[name] = statistics.median(samples)
+        offscreen.free()
+        return times
+
+    try:
+        times = runner(job)
+    finally:
+        runner.unregister()
+    base = times["display only"]
+    return [
+        {
+            "section": "viewport",
+            "case": name,
+            "penumbra_ms": t * 1e3,
+            "workbench_ms": None,
+            "ratio": t / base,
+            "note": "ratio to display only",
+            "runs": runs,
+            "blender": bpy.app.version_string,
+        }
+        for name, t in times.items()
+    ]
+
+
+def _pixel_projection(w, h):
+    from mathutils import Matrix
+
+    return Matrix(((2 / w, 0, 0, -1), (0, 2 / h, 0, -1), (0, 0, -1, 0), (0, 0, 0, 1)))
+
+
+def _viewport_reused(scene, runs):
+    """Median seconds of the engine core's frame with every shadow map reused (one engine
+    instance, colour only, as the viewport renders after an edit elsewhere)."""
+    from penumbra.engine.extract import camera_from_scene
+
+    runner = session.GpuRunner()
+    runner.register()
+    r = scene.render
+
+    def job(engine, depsgraph):
+        cam = camera_from_scene(depsgraph, scene, r.resolution_x, r.resolution_y)
+
+        def frame():
+            engine.render_frame(depsgraph, cam, r.resolution_x, r.resolution_y, aux=False).color.read()
+
+        frame()
+        samples = []
+        for _ in range(runs):
+            start = time.perf_counter()
+            frame()
+            samples.append(time.perf_counter() - start)
+        return statistics.median(samples)
+
+    try:
+        return runner(job)
+    finally:
+        runner.unregister()
+
+
+def section_lights(plan):
+    rows = []
+    first = None
+    for n in plan["lights"]:
+        scene = spot_field(n)
+        t = paired(scene, plan["runs"])
+        reused = _viewport_reused(scene, plan["runs"])
+        first = first or t["PENUMBRA"]
+        note = f"{t['PENUMBRA'] / first:.2f}x one light; maps reused {reused * 1e3:.0f} ms"
+        rows.append(_row("lights", f"{n} shadowed spots", t, note, plan["runs"]))
+    return rows
+
+
+def section_objects(plan):
+    rows = []
+    for instanced in (False, True):
+        for n in plan["objects"]:
+            scene = object_field(n, instanced)
+            case = f"{n} {'instances' if instanced else 'objects'}"
+            rows.append(_row("objects", case, paired(scene, plan["runs"]), runs=plan["runs"]))
+    return rows
+
+
+def section_instances(plan):
+    rows = []
+    first = None
+    for n in (1, 16):
+        scene = bunny_field(n)
+        t = paired(scene, plan["runs"])
+        first = first or t["PENUMBRA"]
+        rows.append(_row("instances", f"{n} bunny instances", t, f"{t['PENUMBRA'] / first:.2f}x one", plan["runs"]))
+    return rows
+
+
+def section_triangles(plan):
+    from penumbra.engine.extract import geometry_from_mesh
+
+    rows = []
+    for n in plan["grids"]:
+        scene = scenes.empty_scene(960, 540)
+        grid = grid_mesh(scene, n)
+        grid.data.materials.append(scenes.white())
+        scenes.plane(scene, "Ground", size=12.0, mat=grid.data.materials[0])
+        scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(35), 0, math.radians(25)))
+        scenes.look_at(scene, (0.0, -9.0, 7.0), (0.0, 0.0, 0.0))
+        t = paired(scene, plan["runs"])
+        copies = [bare_copy(grid.data) for _ in range(3)]
+        extracts = []
+        for _ in range(3):
+            start = time.perf_counter()
+            geometry_from_mesh(grid.data)
+            extracts.append(time.perf_counter() - start)
+        copy, extract = statistics.median(copies), statistics.median(extracts)
+        note = f"extraction {extract * 1e3:.0f} ms = {extract / copy:.2f}x the bare copy ({copy * 1e3:.0f} ms)"
+        rows.append(_row("triangles", f"{2 * n * n:,} triangles", t, note, plan["runs"]))
+    return rows
+
+
+PLANS = {
+    "full": {
+        "resolutions": ((480, 270), (960, 540), (1920, 1080)),
+        "lights": (1, 8, 32, 64),
+        "objects": (10, 100, 1000, 10000),
+        "grids": (187, 500, 1000),  # 70k, 500k, 2M triangles
+        "runs": 5,
+    },
+    "quick": {
+        "resolutions": ((960, 540),),
+        "lights": (1, 32),
+        "objects": (10, 1000),
+        "grids": (187, 500),
+        "runs": 3,
+    },
+}
+
+
+def run(args):
+    session.load_penumbra().register()
+    plan = dict(PLANS["quick" if args.quick else "full"])
+    if args.runs:
+        plan["runs"] = args.runs
+    chosen = [s.strip() for s in args.sections.split(",") if s.strip()]
+    unknown = sorted(set(chosen) - set(SECTIONS))
+    if unknown:
+        print(f"bench perf: unknown section(s): {', '.join(unknown)}", file=sys.stderr)
+        return 2
+    rows = []
+    for name in chosen:
+        print(f"bench perf: {name}", file=sys.stderr, flush=True)
+        rows += globals()[f"section_{name}"](plan)
+    args.out.mkdir(parents=True, exist_ok=True)
+    report.write_csv(args.out / "perf.csv", rows, CSV_FIELDS)
+    cells = [
+        [
+            r["section"],
+            r["case"],
+            report.cell(r["penumbra_ms"], 4),
+            report.cell(r["workbench_ms"], 4),
+            f"{r['ratio']:.2f}x" if r["ratio"] else "",
+            r["note"],
+        ]
+        for r in rows
+    ]
+    print(report.markdown_table(["Section", "Case", "Penumbra (ms)", "Workbench (ms)", "Ratio", "Note"], cells))
+    print()
+    print(
+        f"Blender {bpy.app.version_string}; GPU: {session.gpu_renderer() or 'n/a'}; medians of {plan['runs']} "
+        "interleaved renders after one warm-up each. Workbench: anti-aliasing off, shadows on."
+    )
+    return 0
