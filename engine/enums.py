@@ -122,7 +122,13 @@ DEPTH_FORMAT = Enum(
     "depth format",
     "DEPTH",
     (
-        ("FLOAT32", "Float 32", "32-bit float depth", 0, {"texture": "R32F", "bytes": 4}),
+        (
+            "FLOAT32",
+            "Float 32",
+            "32-bit float depth",
+            0,
+            {"texture": "DEPTH_COMPONENT32F", "bytes": 4, "depth_only": True},
+        ),
         (
             "FLOAT16",
             "Float 16",
@@ -138,7 +144,8 @@ DEPTH_FORMAT = Enum(
             {"texture": "RGBA8", "bytes": 4},
         ),
     ),
-    fact_defaults={"texture": None, "bytes": 0},
+    # depth_only: the map is the depth buffer itself (no colour target, no copy).
+    fact_defaults={"texture": None, "bytes": 0, "depth_only": False},
 )
 
 SPECULAR_MODEL = Enum(

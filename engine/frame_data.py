@@ -10,12 +10,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernels
+from . import kernels, light_bins
 from .enums import LIGHT_TYPE, SHADOW_MODE
 from .kernels import RING
 from .programs import (
     FRAME_STRUCT,
     LIGHT_STRUCT,
+    LIGHT_WORDS,
     MAX_DISK_SAMPLES,
     MAX_FILTER_RADIUS,
     MAX_LIGHTS,
@@ -33,6 +34,7 @@ class FrameData:
     defines: dict  # the lit pass variant
     disk_samples: int  # jittered-disk samples the variant reads
     order: list  # the light index of each row of ``lights`` (shadowed lights first)
+    bins: np.ndarray = None  # (rows, columns, LIGHT_WORDS) light masks of the screen bins, or None
 
 
 def disk_samples(settings):
@@ -91,6 +93,7 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "camera_forward": camera.forward,
         "light_count": light_count,
         "shadowed_count": 0,
+        "shadowed_mask": (0, 0, 0, 0),
         "world_color": np.asarray(world_color, np.float64)[:3],
         "constant_bias": settings.shadow_bias,
         "slope_bias": settings.shadow_slope_bias,
@@ -122,17 +125,25 @@ def build_frame_data(
     atlas_columns=1,
     depth_format="FLOAT32",
     aux_outputs=True,
+    rects=None,
+    size=None,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
     the atlas the plan was drawn into (1/1 when no map was drawn); ``aux_outputs``: whether
-    the variant writes the depth, shadow and normal targets as well as colour."""
+    the variant writes the depth, shadow and normal targets as well as colour; ``rects``: per
+    light, the screen rectangle it can light (``light_bins.screen_rects``) on a frame of
+    ``size`` (width, height) pixels, which bins the lights when several are local."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings)
     order, shadowed = shading_order(lights, plan)
     frame = frame_row(camera, world_color, len(lights), settings, tile_size, atlas_columns)
     frame["shadowed_count"] = shadowed
+    frame["shadowed_mask"] = light_bins.word_masks(0, shadowed, LIGHT_WORDS)
+    bins = None
+    if rects is not None and should_bin(lights):
+        bins = light_bins.bin_masks([rects[i] for i in order], size[0], size[1], LIGHT_WORDS)
     return FrameData(
         frame=FRAME_STRUCT.pack([frame]),
         lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i)) for i in order], MAX_LIGHTS),
@@ -145,7 +156,18 @@ def build_frame_data(
             disk,
             settings.shadow_early_out,
             aux_outputs,
+            bins is not None,
         ),
         disk_samples=disk,
         order=order,
+        bins=bins,
     )
+
+
+BIN_MIN_LOCAL_LIGHTS = 2
+
+
+def should_bin(lights):
+    """Bin the lights when at least BIN_MIN_LOCAL_LIGHTS of them light only part of space
+    (spots, area lights): below that, the per-pixel bin lookup costs more than it saves."""
+    return sum(light.type in ("SPOT", "AREA") for light in lights) >= BIN_MIN_LOCAL_LIGHTS

@@ -9,9 +9,11 @@ comment.
 from dataclasses import replace
 
 from ..shaders.loader import Program, Struct
+from . import light_bins
 from .enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
 
 MAX_LIGHTS = 64
+LIGHT_WORDS = MAX_LIGHTS // light_bins.WORD_BITS  # channels of a light-bin texel
 MAX_SHADOW_TILES = 48
 JITTER_SIZE = 32  # the jitter texture repeats every 32x32 pixels
 MAX_DISK_SAMPLES = 64
@@ -61,6 +63,7 @@ FRAME_STRUCT = Struct(
         ("VEC3", "camera_forward"),
         ("INT", "light_count"),
         ("INT", "shadowed_count"),  # lights [0, shadowed_count) have maps and come first
+        ("IVEC4", "shadowed_mask"),  # the same lights as bits of the light-bin words
         ("VEC3", "world_color"),
         ("FLOAT", "constant_bias"),  # texels
         ("FLOAT", "slope_bias"),  # texels per unit of tan(angle)
@@ -101,14 +104,22 @@ LIT = Program(
         ("FLOAT", "specular"),
         ("FLOAT", "metallic"),
     ),
-    samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex")),
+    samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex"), ("FLOAT_2D", "light_bins")),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
         (LIGHT_STRUCT, "lights", MAX_LIGHTS),
         (TILE_STRUCT, "shadow_tiles", MAX_SHADOW_TILES),
     ),
     outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth"), ("FLOAT", "out_shadow"), ("VEC4", "out_normal")),
-    defines=tuple({**_ENUM_DEFINES, "JITTER_SIZE": JITTER_SIZE}.items()),
+    defines=tuple(
+        {
+            **_ENUM_DEFINES,
+            "JITTER_SIZE": JITTER_SIZE,
+            "LIGHT_BIN_SIZE": light_bins.BIN_SIZE,
+            "LIGHT_WORD_BITS": light_bins.WORD_BITS,
+            "LIGHT_WORDS": LIGHT_WORDS,
+        }.items()
+    ),
 )
 
 # The viewport's lit pass: colour only, no auxiliary targets to clear or write.
@@ -128,6 +139,27 @@ SHADOW_DEPTH = Program(
 )
 
 
+# FLOAT32 maps are the depth buffer itself: the linear depth goes to gl_FragDepth, so a tile
+# needs no colour target and no second buffer.
+SHADOW_DEPTH_ONLY = replace(SHADOW_DEPTH, name="shadow_depth_only", outputs=(), depth_write="ANY")
+
+# Copies a tile rendered in the scratch target into its place in the atlas (FLOAT16, RGBA8).
+TILE_COPY = Program(
+    name="tile_copy",
+    vertex="fullscreen.vert.glsl",
+    fragment="tile_copy.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("IVEC2", "origin"),),
+    samplers=(("FLOAT_2D", "tile_color"),),
+    outputs=(("VEC4", "out_color"),),
+)
+
+
+def shadow_program(depth_format):
+    """The depth pass of a map stored as ``depth_format``."""
+    return SHADOW_DEPTH_ONLY if DEPTH_FORMAT[depth_format].depth_only else SHADOW_DEPTH
+
+
 def depth_defines(depth_format):
     return {"DEPTH_FORMAT": DEPTH_FORMAT.define(depth_format)}
 
@@ -140,11 +172,13 @@ def lit_defines(
     disk_samples=16,
     early_out=True,
     aux_outputs=True,
+    binned=False,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
     switch for the disk filters. ``aux_outputs``: the variant also writes depth, shadow and
-    normal (a final render's passes); without them it writes colour only (the viewport)."""
+    normal (a final render's passes); without them it writes colour only (the viewport).
+    ``binned``: each pixel loops over the lights its screen bin lists (``light_bins``)."""
     filt = SHADOW_FILTER[shadow_filter]
     weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
     return {
@@ -156,4 +190,5 @@ def lit_defines(
         "DISK_SAMPLES": disk_samples if filt.disk else 8,
         "EARLY_OUT": bool(early_out) or not filt.early_out,
         "AUX_OUTPUTS": bool(aux_outputs),
+        "LIGHT_BINS": bool(binned),
     }

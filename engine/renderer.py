@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels
+from . import kernels, light_bins
 from .extract import Material
 from .frame_data import build_frame_data, select_lights
 from .post import post_stack
@@ -29,7 +29,10 @@ class FrameStats:
     draws: int = 0
     triangles: int = 0
     texture_bytes: int = 0
+    shadow_bytes: int = 0  # the shadow atlas (and its one-tile scratch target, if any)
     shaders_compiled: int = 0
+    lights_out_of_view: int = 0  # lights that reach no visible surface: no map, no shading
+    binned: bool = False  # the lit pass looped over each screen bin's lights only
     messages: list = field(default_factory=list)  # what the user must be told about this frame
 
 
@@ -104,6 +107,7 @@ class Renderer:
         self._post_ctx = None
         self._ubos = {}
         self._dummy_shadow = None
+        self._bins_tex = None
 
     # --- the frame ------------------------------------------------------------------------
 
@@ -120,6 +124,7 @@ class Renderer:
                 f"Penumbra: {len(snapshot.lights)} lights; only the {MAX_LIGHTS} that contribute most to the view "
                 "are lit"
             )
+        lights, rects = self._lights_in_view(lights, draws, camera, width, height, stats)
         plan = self._shadow_pass(draws, lights, camera, settings, stats)
         data = build_frame_data(
             lights,
@@ -131,11 +136,15 @@ class Renderer:
             atlas_columns=self.shadows.columns if plan.tiles else 1,
             depth_format=self.shadows.depth_format if plan.tiles else "FLOAT32",
             aux_outputs=aux,
+            rects=rects,
+            size=(width, height),
         )
+        stats.binned = data.bins is not None
         self._lit_pass(_front_to_back(draws, camera), data, plan, snapshot.world_color, settings, aux, stats)
         color = self._post_pass(settings, stats)
         target_bytes = 16 + 4 + (4 + 4 + 8 if aux else 0)  # colour, z-buffer, depth, shadow, normal
-        stats.texture_bytes = width * height * target_bytes + self.shadows.memory_bytes + self._post_ctx.memory_bytes
+        stats.shadow_bytes = self.shadows.memory_bytes if plan.tiles else 0
+        stats.texture_bytes = width * height * target_bytes + stats.shadow_bytes + self._post_ctx.memory_bytes
         stats.shaders_compiled = self.shaders.compiled - compiled_before
         if not aux:
             return FrameOutput(color, None, None, stats, width, height, lit=self._color)
@@ -165,6 +174,19 @@ class Renderer:
         for stale in [k for k in self._batches if k not in live]:
             del self._batches[stale]
         return draws
+
+    def _lights_in_view(self, lights, draws, camera, width, height, stats):
+        """The lights that can light a visible surface, with the screen rectangle each can
+        reach (``light_bins.screen_rects``); a light that reaches nothing the camera sees gets
+        no shadow map and no shading."""
+        if not draws or not lights:
+            return lights, None
+        corners = np.concatenate([d.corners for d in draws])
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        rects = light_bins.screen_rects(lights, camera.projection @ camera.view, lo, hi, width, height)
+        keep = [i for i, r in enumerate(rects) if r is not None]
+        stats.lights_out_of_view = len(lights) - len(keep)
+        return [lights[i] for i in keep], [rects[i] for i in keep]
 
     def _shadow_pass(self, draws, lights, camera, settings, stats):
         """Plan the maps this frame needs (numpy) and draw the ones whose content changed."""
@@ -219,6 +241,7 @@ class Renderer:
             shader.uniform_block("shadow_tiles", self._ubo("tiles", data.tiles))
             shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
             shader.uniform_sampler("jitter_tex", self._jitter(data.disk_samples))
+            shader.uniform_sampler("light_bins", self._bins_texture(data.bins))
             for d in draws:
                 shader.uniform_float("model", d.model)
                 materials = d.instance.materials
@@ -313,6 +336,18 @@ class Renderer:
             tex = gpu.types.GPUTexture((JITTER_SIZE, JITTER_SIZE, samples // 2), format="RGBA32F", data=buf)
             self._jitter_tex = (samples, tex)
         return self._jitter_tex[1]
+
+    def _bins_texture(self, bins):
+        """The light-bin masks as an RGBA32F texture (a 1x1 zero texture when not binned)."""
+        import gpu
+
+        if bins is None:
+            bins = np.zeros((1, 1, 4), np.float32)
+        rows, cols = bins.shape[:2]
+        buf = gpu.types.Buffer("FLOAT", bins.size, np.ascontiguousarray(bins, np.float32).ravel())
+        # Kept until the next frame: the draw that samples it runs after this call returns.
+        self._bins_tex = gpu.types.GPUTexture((cols, rows), format="RGBA32F", data=buf)
+        return self._bins_tex
 
     def _shadow_dummy(self):
         import gpu

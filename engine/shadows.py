@@ -18,7 +18,7 @@ import numpy as np
 
 from . import lightspace
 from .enums import DEPTH_FORMAT
-from .programs import MAX_SHADOW_TILES, SHADOW_DEPTH, TILE_STRUCT, depth_defines
+from .programs import MAX_SHADOW_TILES, TILE_COPY, TILE_STRUCT, depth_defines, shadow_program
 
 
 @dataclass
@@ -133,8 +133,13 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
 
 
 class ShadowAtlas:
-    """The atlas of one engine instance: square tiles in a grid ``columns`` wide, one depth
-    buffer, one framebuffer. Tiles remember what they hold so unchanged maps are reused."""
+    """The atlas of one engine instance: square tiles in a grid ``columns`` wide. Tiles
+    remember what they hold so unchanged maps are reused.
+
+    Memory is what the maps hold and one tile more at most: a FLOAT32 atlas is a depth texture
+    the depth pass writes directly (4 bytes a texel, nothing else); FLOAT16 and RGBA8 maps are
+    drawn in one tile-sized scratch target (colour and depth) and copied into a colour atlas
+    of their own format (2 or 4 bytes a texel)."""
 
     def __init__(self):
         self.size = 0
@@ -142,8 +147,9 @@ class ShadowAtlas:
         self.columns = 1
         self.depth_format = "FLOAT32"
         self.texture = None
-        self._zbuffer = None
         self._framebuffer = None
+        self._scratch = None  # (colour, depth, framebuffer) of one tile, non-FLOAT32 formats
+        self._copy_batch = None
         self._ubos = []
         self._contents = []
 
@@ -167,10 +173,16 @@ class ShadowAtlas:
         self.free()
         self.size, self.count, self.columns, self.depth_format = size, columns * rows, columns, depth_format
         dims = (columns * size, rows * size)
+        fmt = DEPTH_FORMAT[depth_format]
         # Read with texelFetch only, so the sampler's filter mode never matters.
-        self.texture = gpu.types.GPUTexture(dims, format=DEPTH_FORMAT[depth_format].texture)
-        self._zbuffer = gpu.types.GPUTexture(dims, format="DEPTH_COMPONENT32F")
-        self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self.texture,))
+        self.texture = gpu.types.GPUTexture(dims, format=fmt.texture)
+        if fmt.depth_only:
+            self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.texture)
+        else:
+            self._framebuffer = gpu.types.GPUFrameBuffer(color_slots=(self.texture,))
+            color = gpu.types.GPUTexture((size, size), format=fmt.texture)
+            depth = gpu.types.GPUTexture((size, size), format="DEPTH_COMPONENT32F")
+            self._scratch = (color, depth, gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=(color,)))
         self._contents = [None] * self.count
 
     @property
@@ -178,12 +190,14 @@ class ShadowAtlas:
         if self.texture is None:
             return 0
         texel = DEPTH_FORMAT[self.depth_format].bytes
-        return self.texture.width * self.texture.height * (texel + 4)  # + the depth buffer
+        scratch = 0 if self._scratch is None else self.size * self.size * (texel + 4)
+        return self.texture.width * self.texture.height * texel + scratch
 
     def free(self):
         self._framebuffer = None
+        self._scratch = None
+        self._copy_batch = None
         self.texture = None
-        self._zbuffer = None
         self._ubos = []
         self._contents = []
         self.size = self.count = 0
@@ -203,25 +217,31 @@ class ShadowAtlas:
         (batch, model Matrix, det, identity key); a tile's key is its fit and its casters."""
         import gpu
 
-        shader = shaders.get(SHADOW_DEPTH, depth_defines(self.depth_format))
-        with self._framebuffer.bind():
-            for index, tile in enumerate(plan.tiles):
-                key = (
-                    tile.fit.view_proj.tobytes(),
-                    tile.fit.near,
-                    tile.fit.far,
-                    cull_front,
-                    tuple(draws[c][3] for c in tile.casters),
-                )
-                if self._contents[index] == key:
-                    stats.shadow_maps_reused += 1
-                    continue
-                x0, y0 = (index % self.columns) * self.size, (index // self.columns) * self.size
-                gpu.state.viewport_set(x0, y0, self.size, self.size)
-                gpu.state.scissor_set(x0, y0, self.size, self.size)
-                gpu.state.scissor_test_set(True)
-                self._framebuffer.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
-                gpu.state.scissor_test_set(False)
+        depth_only = DEPTH_FORMAT[self.depth_format].depth_only
+        shader = shaders.get(shadow_program(self.depth_format), depth_defines(self.depth_format))
+        for index, tile in enumerate(plan.tiles):
+            key = (
+                tile.fit.view_proj.tobytes(),
+                tile.fit.near,
+                tile.fit.far,
+                cull_front,
+                tuple(draws[c][3] for c in tile.casters),
+            )
+            if self._contents[index] == key:
+                stats.shadow_maps_reused += 1
+                continue
+            x0, y0 = (index % self.columns) * self.size, (index // self.columns) * self.size
+            target = self._framebuffer if depth_only else self._scratch[2]
+            with target.bind():
+                if depth_only:
+                    gpu.state.viewport_set(x0, y0, self.size, self.size)
+                    gpu.state.scissor_set(x0, y0, self.size, self.size)
+                    gpu.state.scissor_test_set(True)
+                    target.clear(depth=1.0)
+                    gpu.state.scissor_test_set(False)
+                else:
+                    gpu.state.viewport_set(0, 0, self.size, self.size)
+                    target.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
                 gpu.state.depth_test_set("LESS")
                 gpu.state.depth_mask_set(True)
                 shader.bind()
@@ -238,6 +258,23 @@ class ShadowAtlas:
                 gpu.state.front_facing_set(False)
                 gpu.state.depth_test_set("NONE")
                 gpu.state.depth_mask_set(False)
-                self._contents[index] = key
+            if not depth_only:
+                self._copy_scratch(x0, y0, shaders)
                 stats.passes += 1
-                stats.shadow_maps += 1
+            self._contents[index] = key
+            stats.passes += 1
+            stats.shadow_maps += 1
+
+    def _copy_scratch(self, x0, y0, shaders):
+        import gpu
+        from gpu_extras.batch import batch_for_shader
+
+        shader = shaders.get(TILE_COPY)
+        if self._copy_batch is None:
+            self._copy_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
+        with self._framebuffer.bind():
+            gpu.state.viewport_set(x0, y0, self.size, self.size)
+            shader.bind()
+            shader.uniform_int("origin", (x0, y0))
+            shader.uniform_sampler("tile_color", self._scratch[0])
+            self._copy_batch.draw(shader)

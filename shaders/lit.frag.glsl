@@ -4,7 +4,8 @@
  *
  * The lit pass pays only for what it uses: lights with a shadow map come first
  * (frame.shadowed_count of them) and only their loop contains the shadow filter; lights
- * without a map take the second loop; a scene without lights runs neither. */
+ * without a map take the second loop; a scene without lights runs neither. With several
+ * local lights, each pixel loops only over the lights its screen bin lists. */
 
 struct Surface {
   vec3 P, N, V;
@@ -72,12 +73,34 @@ void main()
 
   vec3 color = s.albedo * frame.world_color;
   float arriving = 0.0, unshadowed = 0.0;
+#if LIGHT_BINS
+  /* Only the lights this pixel's screen bin lists (engine/light_bins.py): word w of the bin
+   * holds lights w * LIGHT_WORD_BITS + bit, as exact small integers in a float channel. */
+  vec4 words = texelFetch(light_bins, ivec2(gl_FragCoord.xy) / LIGHT_BIN_SIZE, 0);
+  for (int w = 0; w < LIGHT_WORDS; w++) {
+    uint bits = uint(words[w]) & uint(frame.shadowed_mask[w]);
+    while (bits != 0u) {
+      int b = findLSB(bits);
+      bits &= bits - 1u;
+      add_light(w * LIGHT_WORD_BITS + b, true, s, color, arriving, unshadowed);
+    }
+  }
+  for (int w = 0; w < LIGHT_WORDS; w++) {
+    uint bits = uint(words[w]) & ~uint(frame.shadowed_mask[w]);
+    while (bits != 0u) {
+      int b = findLSB(bits);
+      bits &= bits - 1u;
+      add_light(w * LIGHT_WORD_BITS + b, false, s, color, arriving, unshadowed);
+    }
+  }
+#else
   for (int i = 0; i < frame.shadowed_count; i++) {
     add_light(i, true, s, color, arriving, unshadowed);
   }
   for (int i = frame.shadowed_count; i < frame.light_count; i++) {
     add_light(i, false, s, color, arriving, unshadowed);
   }
+#endif
   out_color = vec4(color, 1.0);
 #if AUX_OUTPUTS
   out_depth = v_view_depth;

@@ -126,6 +126,7 @@ class Program:
     uniform_blocks: tuple = ()  # (Struct, name, array length)
     outputs: tuple = (("VEC4", "out_color"),)
     defines: tuple = ()  # (name, value) every variant gets: enum values, fixed sizes
+    depth_write: str = ""  # 'ANY' etc. when the fragment stage writes gl_FragDepth
 
 
 def _read(rel):
@@ -195,6 +196,8 @@ class ShaderCache:
             info.uniform_buf(slot, struct.name, f"{name}[{count}]" if count else name)
         for slot, (typ, name) in enumerate(program.outputs):
             info.fragment_out(slot, typ, name)
+        if program.depth_write:
+            info.depth_write(program.depth_write)
         vert, frag = program_sources(program)
         info.vertex_source(vert)
         info.fragment_source(frag)

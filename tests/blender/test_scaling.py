@@ -8,6 +8,7 @@ import bpy
 import numpy as np
 
 from devkit import scenes
+from devkit.render import engine_frame
 
 
 def _instanced_scene(count):
@@ -126,3 +127,52 @@ def test_viewport_redraw_with_nothing_changed_shows_the_last_frame(penumbra, gpu
     rendered, same = gpu_call(job)
     assert rendered == [True, False, True, True, True]
     assert same
+
+
+def test_shadow_atlas_memory_is_what_the_maps_hold(penumbra, gpu_call):
+    """FLOAT32 maps are the depth buffer itself (4 bytes a texel, nothing else); FLOAT16 and
+    RGBA8 maps add one tile-sized scratch target, not a second atlas-sized buffer."""
+    scene = scenes.demo_scene(64, 36)  # a sun and a spot: two tiles in a 2x1 atlas
+    scene.penumbra.shadow_map_size = 256
+    tile = 256 * 256
+    expected = {"FLOAT32": 2 * tile * 4, "FLOAT16": 2 * tile * 2 + tile * (2 + 4), "RGBA8": 2 * tile * 4 + tile * 8}
+    for fmt, bytes_ in expected.items():
+        scene.penumbra.shadow_depth_format = fmt
+        stats, _image = engine_frame(gpu_call, scene, 64, 36)
+        assert stats.shadow_maps == 2
+        assert stats.shadow_bytes == bytes_, fmt
+
+
+def _spot_scene():
+    """A ground with boxes, a sun and six spots (one of them pointing at the sky)."""
+    scene = scenes.empty_scene(160, 90)
+    mat = scenes.white()
+    scenes.plane(scene, "Ground", size=16.0, mat=mat)
+    for i in range(4):
+        scenes.box(scene, f"Box{i}", center=(i * 3.0 - 4.5, 0.0, 0.5), mat=mat)
+    for i in range(5):
+        scenes.light(scene, f"Spot{i}", "SPOT", 300.0, location=(i * 3.0 - 6.0, -1.0, 4.0), spot_size=0.9)
+    scenes.light(scene, "SkySpot", "SPOT", 300.0, location=(0.0, 0.0, 4.0), rotation=(math.pi, 0, 0))
+    scenes.light(scene, "Sun", "SUN", 1.0, rotation=(math.radians(40), 0, math.radians(30)))
+    scenes.look_at(scene, (0.0, -12.0, 9.0), (0.0, 0.0, 0.0))
+    return scene
+
+
+def test_binned_lighting_gives_the_image_of_every_light_on_every_pixel(penumbra, gpu_call, monkeypatch):
+    from penumbra.engine import frame_data
+
+    scene = _spot_scene()
+    binned_stats, binned = engine_frame(gpu_call, scene, 160, 90)
+    assert binned_stats.binned
+    monkeypatch.setattr(frame_data, "BIN_MIN_LOCAL_LIGHTS", 10**6)  # every light on every pixel
+    stats, full = engine_frame(gpu_call, scene, 160, 90)
+    assert not stats.binned
+    np.testing.assert_allclose(binned, full, rtol=1e-5, atol=1e-6)
+    assert binned[..., :3].max() > 0.2  # the spots do light the ground
+
+
+def test_a_light_that_reaches_nothing_visible_gets_no_map(penumbra, gpu_call):
+    scene = _spot_scene()
+    stats, _image = engine_frame(gpu_call, scene, 160, 90)
+    assert stats.lights_out_of_view == 1  # the spot pointing at the sky
+    assert stats.shadow_maps == 6  # five spots and the sun

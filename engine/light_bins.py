@@ -1,0 +1,154 @@
+"""Which lights can reach which part of the screen: plain numpy, no bpy and no gpu.
+
+The screen is cut into square bins of ``BIN_SIZE`` pixels; each bin lists, as a bit mask, the
+lights that can light a visible surface inside it, and the lit pass loops over those lights
+only. A pixel outside a spot's cone or behind an area light then costs nothing for that light,
+so a frame with many local lights costs what their overlap costs, not their number.
+
+A light's reach is a convex polytope: its influence (a spot's cone, bounded by the square
+pyramid around it; the half-space in front of an area light; all space for suns and points)
+intersected with the box around everything drawn and with the camera's view frustum. Its
+vertices, found by intersecting every three of its planes, project to a screen rectangle; the
+bins that rectangle touches get the light's bit. Every step is conservative: a light may be
+listed in a bin it does not reach, never left out of one it does.
+"""
+
+import itertools
+import math
+
+import numpy as np
+
+BIN_SIZE = 16  # pixels per side of a bin
+WORD_BITS = 16  # lights per float channel: sums of distinct powers of two below 2^16 are exact in float32
+WIDE_SPOT = math.radians(80.0)  # half-angles above this are bounded by their half-space only
+
+
+def _unit_planes(planes):
+    """Rows (nx, ny, nz, d) meaning n . x <= d, scaled to unit normals (zero rows stay zero)."""
+    planes = np.asarray(planes, np.float64).reshape(-1, 4)
+    n = np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
+    return np.where(n > 0, planes / np.where(n > 0, n, 1.0), 0.0)
+
+
+def frustum_planes(view_proj):
+    """The six planes of a camera's view volume (OpenGL clip space: -w <= x, y, z <= w)."""
+    m = np.asarray(view_proj, np.float64)
+    rows = []
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            # sign * clip[axis] <= clip.w  ->  (sign * row_axis - row_w) . (x, 1) <= 0
+            r = sign * m[axis] - m[3]
+            rows.append((*r[:3], -r[3]))
+    return _unit_planes(rows)
+
+
+def box_planes(lo, hi):
+    """The six planes of the axis-aligned box [lo, hi]."""
+    rows = []
+    for axis in range(3):
+        n = np.zeros(3)
+        n[axis] = 1.0
+        rows.append((*n, hi[axis]))
+        rows.append((*(-n), -lo[axis]))
+    return _unit_planes(rows)
+
+
+def influence_planes(light):
+    """Half-spaces bounding where ``light`` can deliver light (empty: everywhere)."""
+    kind = light.type
+    if kind not in ("SPOT", "AREA"):
+        return np.zeros((0, 4))
+    p, a = light.position, light.direction
+    if kind == "AREA":
+        return _unit_planes([(*(-a), -(a @ p))])  # emits forward only: (x - p) . a >= 0
+    half = 0.5 * min(max(light.spot_size, 0.0), math.pi)
+    if half > WIDE_SPOT:
+        return _unit_planes([(*(-a), -(a @ p))])
+    helper = np.eye(3)[int(np.argmin(np.abs(a)))]
+    u = np.cross(a, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(a, u)
+    c, s = math.cos(half), math.sin(half)
+    rows = [(-a[0], -a[1], -a[2], -(a @ p))]  # in front of the apex
+    for side in (u, -u, v, -v):
+        n = side * c - a * s  # the side of the square pyramid circumscribing the cone
+        rows.append((*n, n @ p))
+    return _unit_planes(rows)
+
+
+def _polytope_vertices(planes, tolerance):
+    """Vertices of {x : n . x <= d for every row}: every triple of planes intersected, the
+    points inside all of them kept. (k, 3); empty when the polytope is empty."""
+    triples = np.array(list(itertools.combinations(range(len(planes)), 3)))
+    if len(triples) == 0:
+        return np.zeros((0, 3))
+    a = planes[triples, :3]  # (t, 3, 3)
+    b = planes[triples, 3]  # (t, 3)
+    det = np.linalg.det(a)
+    ok = np.abs(det) > 1e-9
+    if not ok.any():
+        return np.zeros((0, 3))
+    x = np.linalg.solve(a[ok], b[ok][..., None])[..., 0]
+    inside = np.all(x @ planes[:, :3].T - planes[:, 3] <= tolerance, axis=1)
+    return x[inside]
+
+
+def screen_rects(lights, view_proj, lo, hi, width, height):
+    """Per light, the pixel rectangle (x0, y0, x1, y1) (end exclusive) it can light, or None
+    when it reaches no visible surface. ``lo``/``hi``: the box around everything drawn."""
+    vp = np.asarray(view_proj, np.float64)
+    frustum = frustum_planes(vp)
+    scene = box_planes(lo, hi)
+    scale = float(np.max(np.abs(np.concatenate([lo, hi])))) if np.all(np.isfinite([lo, hi])) else 0.0
+    full = (0, 0, width, height)
+    rects = []
+    for light in lights:
+        influence = influence_planes(light)
+        planes = np.concatenate([influence, scene, frustum])
+        if not np.all(np.isfinite(planes)):
+            rects.append(full)
+            continue
+        tolerance = 1e-6 * (1.0 + scale + np.abs(planes[:, 3]).max())
+        verts = _polytope_vertices(planes, tolerance)
+        if len(verts) == 0:
+            rects.append(None)
+            continue
+        clip = np.c_[verts, np.ones(len(verts))] @ vp.T
+        w = clip[:, 3]
+        if np.any(w <= 0) or not np.all(np.isfinite(clip)):
+            rects.append(full)  # numerically at the camera: keep it everywhere
+            continue
+        px = (clip[:, 0] / w * 0.5 + 0.5) * width
+        py = (clip[:, 1] / w * 0.5 + 0.5) * height
+        x0 = int(np.clip(math.floor(px.min()) - 1, 0, width))
+        x1 = int(np.clip(math.ceil(px.max()) + 1, 0, width))
+        y0 = int(np.clip(math.floor(py.min()) - 1, 0, height))
+        y1 = int(np.clip(math.ceil(py.max()) + 1, 0, height))
+        rects.append((x0, y0, x1, y1) if x1 > x0 and y1 > y0 else None)
+    return rects
+
+
+def bin_masks(rects, width, height, words=4):
+    """The bins' light masks: (rows, columns, words) float32; bit b of word w set means light
+    ``w * WORD_BITS + b`` can reach the bin. ``rects``: per light, from ``screen_rects``."""
+    cols, rows = -(-width // BIN_SIZE), -(-height // BIN_SIZE)
+    masks = np.zeros((rows, cols, words), np.float64)
+    for index, rect in enumerate(rects):
+        if rect is None:
+            continue
+        x0, y0, x1, y1 = rect
+        word, bit = divmod(index, WORD_BITS)
+        masks[y0 // BIN_SIZE : -(-y1 // BIN_SIZE), x0 // BIN_SIZE : -(-x1 // BIN_SIZE), word] += float(1 << bit)
+    return masks.astype(np.float32)
+
+
+def word_masks(first, count, words=4):
+    """Per word, the bits of lights ``first .. first + count - 1``."""
+    out = []
+    for w in range(words):
+        bits = 0
+        for b in range(WORD_BITS):
+            if first <= w * WORD_BITS + b < first + count:
+                bits |= 1 << b
+        out.append(bits)
+    return out
