@@ -127,25 +127,26 @@ DEPTH_FORMAT = Enum(
             "Float 32",
             "32-bit float depth",
             0,
-            {"texture": "DEPTH_COMPONENT32F", "bytes": 4, "depth_only": True},
+            {"texture": "DEPTH_COMPONENT32F", "bytes": 4, "depth_only": True, "channels": 1},
         ),
         (
             "FLOAT16",
             "Float 16",
             "16-bit float depth: half the memory, less precision",
             1,
-            {"texture": "R16F", "bytes": 2},
+            {"texture": "R16F", "bytes": 2, "channels": 1},
         ),
         (
             "RGBA8",
             "RGBA8 Packed",
             "Depth packed into four 8-bit channels (the classic encoding)",
             2,
-            {"texture": "RGBA8", "bytes": 4},
+            {"texture": "RGBA8", "bytes": 4, "channels": 4},
         ),
     ),
     # depth_only: the map is the depth buffer itself (no colour target, no copy).
-    fact_defaults={"texture": None, "bytes": 0, "depth_only": False},
+    # channels: texture channels one depth value spans.
+    fact_defaults={"texture": None, "bytes": 0, "depth_only": False, "channels": 1},
 )
 
 SPECULAR_MODEL = Enum(

@@ -157,6 +157,7 @@ def build_frame_data(
             settings.shadow_early_out,
             aux_outputs,
             bins is not None,
+            settings.pcf_spacing,
         ),
         disk_samples=disk,
         order=order,

@@ -173,22 +173,26 @@ def lit_defines(
     early_out=True,
     aux_outputs=True,
     binned=False,
+    pcf_spacing=1.0,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
     switch for the disk filters. ``aux_outputs``: the variant also writes depth, shadow and
     normal (a final render's passes); without them it writes colour only (the viewport).
-    ``binned``: each pixel loops over the lights its screen bin lists (``light_bins``)."""
+    ``binned``: each pixel loops over the lights its screen bin lists (``light_bins``).
+    PCF with taps one texel apart on a one-channel map reads 2x2 texels per fetch (gather)."""
     filt = SHADOW_FILTER[shadow_filter]
+    gather = bool(filt.pcf_taps and pcf_spacing == 1.0 and DEPTH_FORMAT[depth_format].channels == 1)
     weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
     return {
         **depth_defines(depth_format),
         "SHADOW_FILTER": SHADOW_FILTER.define(shadow_filter),
         "SPECULAR_MODEL": SPECULAR_MODEL.define(specular_model),
         "PCF_RADIUS": len(weights) // 2,
-        "PCF_WEIGHTS": "float[](" + ", ".join(f"{w:.9g}" for w in weights) + ")",
+        "PCF_WEIGHTS_LIST": ", ".join(f"{w:.9g}" for w in weights),
         "DISK_SAMPLES": disk_samples if filt.disk else 8,
         "EARLY_OUT": bool(early_out) or not filt.early_out,
         "AUX_OUTPUTS": bool(aux_outputs),
         "LIGHT_BINS": bool(binned),
+        "PCF_GATHER": gather,
     }

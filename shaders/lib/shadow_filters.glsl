@@ -140,10 +140,32 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
   return shadow_bilinear(origin, st, SHADOW_REF(1.0));
 #elif SHADOW_FILTER == FILTER_PCF
   /* Separable Gaussian weights compiled in as constants, so both loops unroll. */
-  const float w[2 * PCF_RADIUS + 1] = PCF_WEIGHTS;
+  const float w[2 * PCF_RADIUS + 2] = float[](PCF_WEIGHTS_LIST, 0.0); /* one zero past the end */
   float spacing = frame.pcf_spacing;
   float ref = SHADOW_REF(float(PCF_RADIUS) * spacing);
   float lit = 0.0;
+#  if PCF_GATHER
+  /* Taps one texel apart: each textureGather reads a 2x2 block, so an NxN kernel takes
+   * ceil(N/2)^2 fetches. Gather order: (x0, y1), (x1, y1), (x1, y0), (x0, y0). The block past
+   * the kernel's last row/column gets the zero weight. */
+  ivec2 c = ivec2(floor(st));
+  vec2 inv_atlas = 1.0 / vec2(textureSize(shadow_atlas, 0));
+  for (int by = -PCF_RADIUS; by <= PCF_RADIUS; by += 2) {
+    for (int bx = -PCF_RADIUS; bx <= PCF_RADIUS; bx += 2) {
+      ivec2 b = c + ivec2(bx, by);
+      vec4 d = textureGather(shadow_atlas, (vec2(origin + b) + 1.0) * inv_atlas);
+      /* Texels outside the tile are lit (negative coordinates wrap to huge unsigned ones). */
+      bvec4 in_x = lessThan(uvec4(ivec4(b.x, b.x + 1, b.x + 1, b.x)), uvec4(size));
+      bvec4 in_y = lessThan(uvec4(ivec4(b.y + 1, b.y + 1, b.y, b.y)), uvec4(size));
+      vec4 inside = vec4(in_x) * vec4(in_y);
+      vec4 tap = mix(vec4(1.0), vec4(lessThanEqual(vec4(ref), d)), inside);
+      vec4 wx = vec4(w[bx + PCF_RADIUS], w[bx + PCF_RADIUS + 1], w[bx + PCF_RADIUS + 1], w[bx + PCF_RADIUS]);
+      vec4 wy = vec4(w[by + PCF_RADIUS + 1], w[by + PCF_RADIUS + 1], w[by + PCF_RADIUS], w[by + PCF_RADIUS]);
+      lit += dot(tap, wx * wy);
+    }
+  }
+  return lit;
+#  endif
   for (int y = -PCF_RADIUS; y <= PCF_RADIUS; y++) {
     float row = 0.0;
     for (int x = -PCF_RADIUS; x <= PCF_RADIUS; x++) {

@@ -7,7 +7,7 @@ import pytest
 
 from devkit import scenes
 from devkit.analytic import iou
-from devkit.render import engine_frame
+from devkit.render import engine_frame, render
 
 
 def test_light_without_shadow_gets_no_shadow_map(penumbra, gpu_call):
@@ -88,3 +88,23 @@ def test_depth_encodings_cast_the_same_shadow(shadow_scene, analytic_shadow, fmt
     score = iou(measured[on_plane], shadowed[on_plane])
     acne = (lit & measured).sum() / lit.sum()
     assert score > 0.95 and acne < 0.01, f"{fmt}: IoU {score:.3f}, acne {acne:.2%}"
+
+
+@pytest.mark.parametrize("kind", ["SUN", "POINT"])
+@pytest.mark.parametrize("kernel", [3, 5, 9])
+def test_gathered_pcf_equals_the_tap_by_tap_kernel(shadow_scene, kind, kernel):
+    """PCF with taps one texel apart reads 2x2 texels per fetch (textureGather); any other
+    spacing reads tap by tap. A spacing a hair above 1 takes the tap path over the same texels,
+    so both must give the same visibility (up to the few pixels whose tap lands exactly on a
+    texel edge). Point lights cover cube-face tiles with neighbours in the atlas."""
+    scene = shadow_scene(kind, "PCF")
+    scene.penumbra.pcf_kernel_size = kernel
+    scene.penumbra.shadow_map_size = 256  # coarse texels: the kernel spans a visible penumbra
+    gathered = render(scene, passes=("Combined", "Shadow"))["Shadow"][..., 0]
+    scene.penumbra.pcf_spacing = 1.0 + 1e-6
+    tapped = render(scene, passes=("Combined", "Shadow"))["Shadow"][..., 0]
+    penumbra = (tapped > 0.02) & (tapped < 0.98)
+    assert penumbra.sum() > 100  # the comparison covers soft edges, not only flat regions
+    differs = np.abs(gathered - tapped) > 1e-4
+    assert differs.mean() < 0.002, f"{differs.sum()} pixels differ"
+    np.testing.assert_allclose(np.median(np.abs(gathered - tapped)[penumbra]), 0.0, atol=1e-5)
