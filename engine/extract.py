@@ -24,18 +24,23 @@ class Material:
 
 @dataclass
 class Geometry:
-    """Triangles of one mesh, de-indexed and sorted by material slot."""
+    """Triangles of one mesh as an indexed vertex buffer, the triangles sorted by material slot.
 
-    positions: np.ndarray  # (3 * tris, 3) float32
-    normals: np.ndarray  # (3 * tris, 3) float32
-    ranges: list  # (material index, first vertex, vertex count)
-    bounds: np.ndarray  # (2, 3) local min/max; NaN when empty
+    A vertex is a mesh vertex when the mesh is smooth throughout (normals on points), else a
+    face corner (flat or mixed shading: normals on faces or corners), as Blender's own draw
+    code does; triangles index those vertices."""
+
+    positions: np.ndarray  # (vertices, 3) float32
+    normals: np.ndarray  # (vertices, 3) float32
+    indices: np.ndarray  # (triangles, 3) int32 into positions
+    ranges: list  # (material index, first triangle, triangle count)
+    bounds: np.ndarray  # (2, 3) local min/max of the drawn vertices; NaN when empty
     deps: frozenset = frozenset()
     serial: int = 0  # distinguishes rebuilt geometry of the same key (GPU batches key on it)
 
     @property
     def triangle_count(self):
-        return len(self.positions) // 3
+        return len(self.indices)
 
 
 @dataclass
@@ -212,48 +217,60 @@ def world_color(scene):
 # --- geometry ----------------------------------------------------------------------------
 
 
+def _read(collection, attr, count, dtype, width=1):
+    out = np.empty(count * width, dtype)
+    collection.foreach_get(attr, out)
+    return out.reshape(-1, width) if width > 1 else out
+
+
 def geometry_from_mesh(mesh):
-    """De-index a Blender mesh into flat triangle arrays, sorted by material slot.
+    """A Blender mesh as an indexed triangle buffer (``Geometry``), read with ``foreach_get``
+    from Blender's own arrays: positions, triangle corners, and normals on points (smooth
+    meshes) or corners (``Mesh.normals_domain``).
 
     Triangles with a non-finite vertex are dropped (NaN/Inf positions must not reach the GPU).
     """
     mesh.calc_loop_triangles()
-    tris = mesh.loop_triangles
-    n = len(tris)
+    n = len(mesh.loop_triangles)
     if n == 0:
         empty = np.zeros((0, 3), np.float32)
-        return Geometry(empty, empty, [], np.full((2, 3), np.nan))
-    co = np.empty(len(mesh.vertices) * 3, np.float32)
-    mesh.vertices.foreach_get("co", co)
-    co = co.reshape(-1, 3)
-    vidx = np.empty(n * 3, np.int32)
-    tris.foreach_get("vertices", vidx)
-    nor = np.empty(n * 9, np.float32)
-    tris.foreach_get("split_normals", nor)
-    mat = np.empty(n, np.int32)
-    tris.foreach_get("material_index", mat)
-
-    pos = co[vidx].reshape(n, 3, 3)
-    nor = nor.reshape(n, 3, 3)
-    good = np.all(np.isfinite(pos), axis=(1, 2))
+        return Geometry(empty, empty, np.zeros((0, 3), np.int32), [], np.full((2, 3), np.nan))
+    co = _read(mesh.vertices, "co", len(mesh.vertices), np.float32, 3)
+    corners = _read(mesh.loop_triangles, "loops", n, np.int32, 3)
+    mat = _read(mesh.loop_triangles, "material_index", n, np.int32)
+    corner_vert = _read(mesh.loops, "vertex_index", len(mesh.loops), np.int32)
+    if mesh.normals_domain == "POINT":  # smooth throughout: one vertex per mesh vertex
+        positions = co
+        normals = _read(mesh.vertex_normals, "vector", len(co), np.float32, 3)
+        tris = corner_vert[corners]
+    else:  # flat or mixed: one vertex per face corner
+        positions = co[corner_vert]
+        normals = _read(mesh.corner_normals, "vector", len(corner_vert), np.float32, 3)
+        tris = corners
+    vertex_ok = np.all(np.isfinite(positions), axis=1)
+    good = np.all(vertex_ok[tris], axis=1)
     if not good.all():
         print(
             f"Penumbra: mesh '{mesh.name}': skipped {int((~good).sum())} triangle(s) with non-finite vertices",
             file=sys.stderr,
         )
-        pos, nor, mat = pos[good], nor[good], mat[good]
-    nor = np.where(np.isfinite(nor), nor, 0.0).astype(np.float32)
+        tris, mat = tris[good], mat[good]
+        positions = np.where(vertex_ok[:, None], positions, 0.0).astype(np.float32)
+    normals = np.where(np.isfinite(normals), normals, 0.0).astype(np.float32, copy=False)
     order = np.argsort(mat, kind="stable")
-    pos, nor, mat = pos[order], nor[order], mat[order]
+    tris, mat = tris[order], mat[order]
     ranges = []
     if len(mat):
         slots, starts, counts = np.unique(mat, return_index=True, return_counts=True)
-        ranges = [(int(s), int(a) * 3, int(c) * 3) for s, a, c in zip(slots, starts, counts)]
-    flat = pos.reshape(-1, 3)
-    bounds = np.stack([flat.min(axis=0), flat.max(axis=0)]) if len(flat) else np.full((2, 3), np.nan)
+        ranges = [(int(s), int(a), int(c)) for s, a, c in zip(slots, starts, counts)]
+    used = np.zeros(len(positions), bool)
+    used[tris.ravel()] = True
+    drawn = positions[used]
+    bounds = np.stack([drawn.min(axis=0), drawn.max(axis=0)]) if len(drawn) else np.full((2, 3), np.nan)
     return Geometry(
-        np.ascontiguousarray(flat, np.float32),
-        np.ascontiguousarray(nor.reshape(-1, 3), np.float32),
+        np.ascontiguousarray(positions, np.float32),
+        np.ascontiguousarray(normals, np.float32),
+        np.ascontiguousarray(tris, np.int32),
         ranges,
         bounds.astype(np.float64),
     )

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import kernels, light_bins
-from .enums import LIGHT_TYPE, SHADOW_MODE
+from .enums import LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
 from .kernels import RING
 from .programs import (
     FRAME_STRUCT,
@@ -32,7 +32,7 @@ class FrameData:
     lights: np.ndarray  # MAX_LIGHTS x LIGHT_STRUCT
     tiles: np.ndarray  # MAX_SHADOW_TILES x TILE_STRUCT
     defines: dict  # the lit pass variant
-    disk_samples: int  # jittered-disk samples the variant reads
+    disk_samples: int  # jittered-disk samples the variant reads (0: it reads none)
     order: list  # the light index of each row of ``lights`` (shadowed lights first)
     bins: np.ndarray = None  # (rows, columns, LIGHT_WORDS) light masks of the screen bins, or None
 
@@ -159,7 +159,7 @@ def build_frame_data(
             bins is not None,
             settings.pcf_spacing,
         ),
-        disk_samples=disk,
+        disk_samples=disk if shadowed and SHADOW_FILTER[settings.shadow_filter].disk else 0,
         order=order,
         bins=bins,
     )

@@ -101,6 +101,7 @@ class Renderer:
         self.post = post_stack()
         self._batches = {}  # (geometry key, serial) -> (whole, parts)
         self._jitter_tex = None
+        self._jitter_dummy = None
         self._size = None
         self._color = self._depth = self._shadow = self._normal = self._zbuffer = None
         self._fb = self._fb_color = None
@@ -312,22 +313,28 @@ class Renderer:
         vbo = gpu.types.GPUVertBuf(fmt, len(geo.positions))
         vbo.attr_fill("pos", geo.positions)
         vbo.attr_fill("nor", geo.normals)
-        whole = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+        whole = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices))
         parts = []
         for mat_index, first, count in geo.ranges:
-            if first == 0 and count == len(geo.positions):
+            if first == 0 and count == len(geo.indices):
                 parts.append((mat_index, whole))
                 continue
-            ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=np.arange(first, first + count, dtype=np.int32).reshape(-1, 3))
+            ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices[first : first + count])
             parts.append((mat_index, gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)))
         self._batches[cache_key] = (whole, parts)
         return self._batches[cache_key]
 
     def _jitter(self, samples):
         """The jittered-disk texture: (JITTER_SIZE, JITTER_SIZE, samples / 2) RGBA, two 2-D
-        offsets per texel, outer ring first (kernels.jitter_disk)."""
+        offsets per texel, outer ring first (kernels.jitter_disk); a 1x1x1 texture when the
+        variant reads no disk (``samples`` 0)."""
         import gpu
 
+        if samples == 0:
+            if self._jitter_dummy is None:
+                buf = gpu.types.Buffer("FLOAT", 4, [0.0] * 4)
+                self._jitter_dummy = gpu.types.GPUTexture((1, 1, 1), format="RGBA32F", data=buf)
+            return self._jitter_dummy
         if self._jitter_tex is None or self._jitter_tex[0] != samples:
             disk = kernels.jitter_disk(JITTER_SIZE, samples).astype(np.float32)
             # (y, x, sample, 2) -> 3-D texture (x, y, sample pair) of RGBA: z slowest in memory.
