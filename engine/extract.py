@@ -266,8 +266,9 @@ def geometry_from_mesh(mesh):
         positions = co[corner_vert]
         normals = _read(mesh.corner_normals, "vector", nc, np.float32, 3)
         tris = corners
-    vertex_ok = np.isfinite(positions).all(axis=1)
-    if not vertex_ok.all():
+    dropped = False
+    if not np.isfinite(positions).all():
+        vertex_ok = np.isfinite(positions).all(axis=1)
         good = vertex_ok[tris].all(axis=1)
         print(
             f"Penumbra: mesh '{mesh.name}': skipped {int((~good).sum())} triangle(s) with non-finite vertices",
@@ -275,11 +276,12 @@ def geometry_from_mesh(mesh):
         )
         tris, mat = tris[good], mat[good]
         positions = np.where(vertex_ok[:, None], positions, 0.0).astype(np.float32)
+        dropped = True
     if not np.isfinite(normals).all():
         normals = np.where(np.isfinite(normals), normals, 0.0).astype(np.float32)
     ranges = []
     if len(mat):
-        lo_mat, hi_mat = int(mat.min()), int(mat.max())
+        lo_mat, hi_mat = (0, 0) if face_material is None else (int(mat.min()), int(mat.max()))
         if lo_mat == hi_mat:  # one material: already in order
             ranges = [(lo_mat, 0, len(mat))]
         else:
@@ -288,10 +290,12 @@ def geometry_from_mesh(mesh):
             counts = np.bincount(mat - lo_mat)
             starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
             ranges = [(lo_mat + i, int(starts[i]), int(c)) for i, c in enumerate(counts) if c]
-    used = np.zeros(len(positions), bool)
-    used[tris.ravel()] = True
-    drawn = positions if used.all() else positions[used]
-    bounds = np.stack([drawn.min(axis=0), drawn.max(axis=0)]) if len(drawn) else np.full((2, 3), np.nan)
+    drawn = positions
+    if dropped or len(positions) == nv:  # mesh vertices may be loose (in no triangle)
+        used = np.zeros(len(positions), bool)
+        used[tris.ravel()] = True
+        drawn = positions[used]
+    bounds = np.array([drawn.min(axis=0), drawn.max(axis=0)]) if len(drawn) else np.full((2, 3), np.nan)
     return Geometry(
         np.ascontiguousarray(positions, np.float32),
         np.ascontiguousarray(normals, np.float32),
@@ -333,16 +337,38 @@ class SceneCache:
     def __init__(self):
         self.geometry = {}
         self.built = 0  # geometries extracted since creation (tests and stats read it)
+        self.materials = {}  # material name -> Material, until an update changes it
+        self.materials_read = 0
 
     def apply_updates(self, depsgraph):
-        """Drop the geometry of every datablock whose geometry the depsgraph says changed."""
+        """Drop the geometry of every datablock whose geometry the depsgraph says changed, and
+        the material read of every material (or, for a node group, every material) that
+        changed."""
         changed = set()
         for update in depsgraph.updates:
+            id_orig = update.id.original if update.id.original is not None else update.id
+            kind = getattr(id_orig, "id_type", "")
+            if kind == "MATERIAL":
+                self.materials.pop(id_orig.name_full, None)
+            elif kind == "NODETREE" and not getattr(id_orig, "is_embedded_data", False):
+                self.materials.clear()  # a node group may feed any material (a material's own
+                # tree is embedded data: its material is updated too)
             if update.is_updated_geometry:
-                id_orig = update.id.original if update.id.original is not None else update.id
                 changed.add(id_orig.name_full)
         if changed:
             self.invalidate(changed)
+
+    def _material(self, mat):
+        """A material's shading values, read once per material datablock (not per object)
+        until a depsgraph update says it changed."""
+        if mat is None:
+            return None
+        key = mat.original.name_full if mat.original is not None else mat.name_full
+        cached = self.materials.get(key)
+        if cached is None:
+            cached = self.materials[key] = material_from_blender(mat)
+            self.materials_read += 1
+        return cached
 
     def invalidate(self, names):
         for key in [k for k, g in self.geometry.items() if g.deps & names]:
@@ -350,6 +376,7 @@ class SceneCache:
 
     def clear(self):
         self.geometry.clear()
+        self.materials.clear()
 
     def _geometry_for(self, inst, ob, key, deps):
         geo = self.geometry.get(key)
@@ -404,7 +431,7 @@ class SceneCache:
             if geo is None or geo.triangle_count == 0:
                 continue
             used.add(key)
-            materials = [material_from_blender(slot.material) for slot in ob.material_slots]
+            materials = [self._material(slot.material) for slot in ob.material_slots]
             instances.append(MeshInstance(key=key, matrix=matrix, materials=materials))
         # Forget geometry no longer in the scene so its GPU buffers are freed.
         for key in [k for k in self.geometry if k not in used]:

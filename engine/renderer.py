@@ -16,6 +16,7 @@ from .programs import JITTER_SIZE, LIT, LIT_COLOR, MAX_LIGHTS, MAX_SHADOW_TILES,
 from .shadows import ShadowAtlas, plan_shadows
 
 DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
+_CORNER_BITS = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=bool)  # box corners
 
 
 @dataclass
@@ -155,22 +156,24 @@ class Renderer:
 
     def _draw_list(self, snapshot, stats):
         """The frame's instances with their batches; batches of geometry no longer in the
-        snapshot are released."""
+        snapshot are released. Per-instance numbers (sign of the matrix, world bounds) are
+        computed for all instances at once."""
         from mathutils import Matrix
 
-        from .lightspace import box_corners
-
+        kept = [(inst, snapshot.geometry[inst.key]) for inst in snapshot.instances if inst.key in snapshot.geometry]
         draws = []
-        for inst in snapshot.instances:
-            geo = snapshot.geometry.get(inst.key)
-            if geo is None:
-                continue
-            whole, parts = self._batches_for(inst.key, geo)
-            det = float(np.linalg.det(inst.matrix[:3, :3]))
-            identity = (inst.key, inst.matrix.tobytes(), geo.serial)
-            corners = box_corners(geo.bounds[0], geo.bounds[1]) @ inst.matrix[:3, :3].T + inst.matrix[:3, 3]
-            draws.append(Draw(inst, whole, parts, Matrix(inst.matrix.tolist()), det, identity, corners))
-            stats.triangles += geo.triangle_count
+        if kept:
+            matrices = np.stack([inst.matrix for inst, _geo in kept])
+            bounds = np.stack([geo.bounds for _inst, geo in kept])
+            dets = np.linalg.det(matrices[:, :3, :3])
+            local = np.where(_CORNER_BITS[None], bounds[:, None, 1], bounds[:, None, 0])  # (n, 8, 3)
+            corners = np.einsum("nij,nkj->nki", matrices[:, :3, :3], local) + matrices[:, None, :3, 3]
+            for i, (inst, geo) in enumerate(kept):
+                whole, parts = self._batches_for(inst.key, geo)
+                identity = (inst.key, inst.matrix.tobytes(), geo.serial)
+                model = Matrix(inst.matrix.tolist())
+                draws.append(Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i]))
+                stats.triangles += geo.triangle_count
         live = {(key, geo.serial) for key, geo in snapshot.geometry.items()}
         for stale in [k for k in self._batches if k not in live]:
             del self._batches[stale]

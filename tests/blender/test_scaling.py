@@ -176,3 +176,34 @@ def test_a_light_that_reaches_nothing_visible_gets_no_map(penumbra, gpu_call):
     stats, _image = engine_frame(gpu_call, scene, 160, 90)
     assert stats.lights_out_of_view == 1  # the spot pointing at the sky
     assert stats.shadow_maps == 6  # five spots and the sun
+
+
+def test_materials_are_read_once_and_again_only_after_they_change(penumbra):
+    """Fifty objects share two materials: two reads, not fifty. Editing one material's node
+    value re-reads that material only (the depsgraph update invalidates it), and the next
+    snapshot carries the new value."""
+    from penumbra.engine.extract import SceneCache
+
+    scene = scenes.empty_scene(32, 32)
+    red, blue = scenes.material("Red", (0.8, 0.1, 0.1)), scenes.material("Blue", (0.1, 0.1, 0.8))
+    for i in range(50):
+        scenes.box(scene, f"Box{i}", center=(i, 0, 0), mat=red if i % 2 else blue)
+    cache = SceneCache()
+
+    def on_update(_scene, depsgraph):
+        cache.apply_updates(depsgraph)
+
+    cache.snapshot(bpy.context.evaluated_depsgraph_get())
+    assert cache.materials_read == 2
+    cache.snapshot(bpy.context.evaluated_depsgraph_get())
+    assert cache.materials_read == 2  # nothing changed: nothing re-read
+    bpy.app.handlers.depsgraph_update_post.append(on_update)
+    try:
+        bsdf = next(n for n in red.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+        bsdf.inputs["Base Color"].default_value = (0.2, 0.9, 0.3, 1.0)
+        snap = cache.snapshot(bpy.context.evaluated_depsgraph_get())
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(on_update)
+    assert cache.materials_read == 3
+    colours = {tuple(round(c, 3) for c in inst.materials[0].base_color[:3]) for inst in snap.instances}
+    assert colours == {(0.2, 0.9, 0.3), (0.1, 0.1, 0.8)}
