@@ -48,15 +48,22 @@ class PenumbraEngineCore:
         return out
 
     def viewport_frame(self, depsgraph, view_matrix, window_matrix, width, height):
-        """The frame a viewport redraw shows: re-rendered only when the view, the region size
-        or the scene changed since the last one (``view_update`` calls ``scene_changed``);
-        otherwise the last frame is shown again. Returns (FrameOutput, whether it rendered)."""
+        """The frame a viewport redraw shows. Nothing changed since the last full-resolution
+        frame (``view_update`` calls ``scene_changed``): the last frame again, nothing rendered.
+        The view moved since the last frame: a frame at ``navigation_scale`` of the region's
+        resolution (post sizes scaled alike). The view stopped after moving: the full-resolution
+        frame. Returns (FrameOutput, whether it rendered); ``out.width < width`` means the
+        frame is a navigation preview and a redraw should follow to refine it."""
         key = (width, height, tuple(map(tuple, view_matrix)), tuple(map(tuple, window_matrix)))
-        if self._shown is not None and self._shown[0] == key:
-            return self._shown[1], False
+        shown = self._shown
+        if shown is not None and shown[0] == key and shown[1].width == width:
+            return shown[1], False
+        scale = float(depsgraph.scene.penumbra.navigation_scale)
+        moving = shown is not None and shown[0][:2] == (width, height) and shown[0] != key and scale < 1.0
+        w, h = (max(1, round(width * scale)), max(1, round(height * scale))) if moving else (width, height)
         camera = camera_from_view(view_matrix, window_matrix)
         self._shown = None
-        out = self.render_frame(depsgraph, camera, width, height, aux=False)
+        out = self.render_frame(depsgraph, camera, w, h, pixel_scale=w / width, aux=False)
         self._shown = (key, out)
         return out, True
 
@@ -224,6 +231,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         # in the viewport's text overlay, as Blender's engines show their status there.
         self.update_stats("", " | ".join(out.stats.messages))
         self.draw_display(depsgraph.scene, out.color, width, height)
+        if out.width < width:
+            self.tag_redraw()  # a navigation preview: the next redraw refines it if the view stopped
 
 
 def _gpu_texture_limit():

@@ -121,6 +121,7 @@ def values(params, source):
 
 SHADOWS = "shadows"
 LIGHTING = "lighting"
+VIEWPORT = "viewport"
 
 SCENE_PARAMS = (
     Param("shadow_filter", "ENUM", "PCF", "How shadow edges are filtered", enum=SHADOW_FILTER, section=SHADOWS),
@@ -243,6 +244,18 @@ SCENE_PARAMS = (
         enum=SPECULAR_MODEL,
         label="Specular",
         section=LIGHTING,
+    ),
+    Param(
+        "navigation_scale",
+        "FLOAT",
+        0.5,
+        "Resolution scale of the viewport while the view moves; once it stops, the viewport renders "
+        "at full resolution (1: always full resolution)",
+        min=0.1,
+        max=1.0,
+        label="Navigation Scale",
+        section=VIEWPORT,
+        subtype="FACTOR",
     ),
 )
 

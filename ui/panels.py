@@ -55,6 +55,12 @@ class PENUMBRA_PT_lighting(_SettingsPanel, bpy.types.Panel):
     section = settings.LIGHTING
 
 
+class PENUMBRA_PT_viewport(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Viewport"
+    section = settings.VIEWPORT
+    bl_options = {"DEFAULT_CLOSED"}
+
+
 class PENUMBRA_PT_film(PenumbraPanel, bpy.types.Panel):
     bl_label = "Film"
     bl_context = "render"
@@ -164,6 +170,7 @@ classes = (
     PENUMBRA_PT_shadows,
     PENUMBRA_PT_light,
     PENUMBRA_PT_lighting,
+    PENUMBRA_PT_viewport,
     PENUMBRA_UL_layers,
     PENUMBRA_MT_layer_add,
     PENUMBRA_PT_sidebar_layers,

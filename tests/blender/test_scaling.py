@@ -103,29 +103,46 @@ def test_geometry_nodes_instances_of_different_meshes_stay_distinct(penumbra, gp
 
 
 def test_viewport_redraw_with_nothing_changed_shows_the_last_frame(penumbra, gpu_call):
+    """Nothing changed: the last frame, no render. View moving: a frame at navigation_scale;
+    view stopped: the full-resolution frame, then nothing again until something changes."""
     scene = scenes.demo_scene(64, 36)
+    scene.penumbra.navigation_scale = 0.5
 
     def job(engine, depsgraph):
         cam = scene.camera.evaluated_get(depsgraph)
         view = cam.matrix_world.inverted()
         window = cam.calc_matrix_camera(depsgraph, x=64, y=36, scale_x=1.0, scale_y=1.0)
-        rendered = []
-        first, r = engine.viewport_frame(depsgraph, view, window, 64, 36)
-        rendered.append(r)
-        image = first.color_array().copy()
-        again, r = engine.viewport_frame(depsgraph, view, window, 64, 36)
-        rendered.append(r)
-        same = again is first and np.array_equal(again.color_array(), image)
-        engine.scene_changed()  # what view_update does on any depsgraph update
-        rendered.append(engine.viewport_frame(depsgraph, view, window, 64, 36)[1])
         moved = view.copy()
         moved.translation.x += 0.1
-        rendered.append(engine.viewport_frame(depsgraph, moved, window, 64, 36)[1])
-        rendered.append(engine.viewport_frame(depsgraph, moved, window, 64, 40)[1])  # region resized
-        return rendered, same
+        steps = []
 
-    rendered, same = gpu_call(job)
-    assert rendered == [True, False, True, True, True]
+        def redraw(v, width=64, height=36):
+            out, rendered = engine.viewport_frame(depsgraph, v, window, width, height)
+            steps.append((rendered, out.width, out.height))
+            return out
+
+        first = redraw(view)
+        image = first.color_array().copy()
+        again = redraw(view)
+        same = again is first and np.array_equal(again.color_array(), image)
+        engine.scene_changed()  # what view_update does on any depsgraph update
+        redraw(view)
+        redraw(moved)  # navigating: reduced resolution
+        redraw(moved)  # the view stopped: refined at full resolution
+        redraw(moved)  # nothing changed
+        redraw(moved, 64, 40)  # region resized: full resolution at once
+        return steps, same
+
+    steps, same = gpu_call(job)
+    assert steps == [
+        (True, 64, 36),
+        (False, 64, 36),
+        (True, 64, 36),
+        (True, 32, 18),
+        (True, 64, 36),
+        (False, 64, 36),
+        (True, 64, 40),
+    ]
     assert same
 
 
