@@ -5,7 +5,7 @@ import bpy
 import numpy as np
 from mathutils import Matrix, Vector
 
-from devkit.session import ROOT
+from devkit.session import ROOT, stdout_to_stderr
 
 ASSETS = ROOT.parent / "shared" / "assets"
 BUNNY = ASSETS / "stanford-bunny.obj"  # 69,451 triangles
@@ -18,7 +18,8 @@ def import_mesh(scene, path, height=1.0, name=None):
     if not path.exists():
         raise FileNotFoundError(f"{path}: the shared assets folder is missing")
     before = set(bpy.data.objects)
-    bpy.ops.wm.obj_import(filepath=str(path))
+    with stdout_to_stderr():  # the importer prints its timing to stdout
+        bpy.ops.wm.obj_import(filepath=str(path))
     ob = next(o for o in bpy.data.objects if o not in before and o.type == "MESH")
     if name:
         ob.name = ob.data.name = name

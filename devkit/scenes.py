@@ -25,6 +25,11 @@ def empty_scene(width=320, height=180, engine="PENUMBRA"):
     scene.view_settings.exposure = 0.0
     scene.view_settings.gamma = 1.0
     scene.render.dither_intensity = 0.0
+    if hasattr(scene, "penumbra"):
+        # Scenes start from one sample (the single-sample frame most tests measure); the
+        # sampling tests and tools that compare samples set their own counts.
+        scene.penumbra.render_samples = 1
+        scene.penumbra.viewport_samples = 1
     scene.world = bpy.data.worlds.new("World")
     set_world(scene, (0.0, 0.0, 0.0))
     return scene

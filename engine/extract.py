@@ -62,6 +62,10 @@ class Light:
     use_shadow: bool = True
     size: float = 0.0  # area lights: the larger side (for PCSS softness)
     bias_scale: float = 1.0  # light.penumbra.bias_scale
+    size_x: float = 0.0  # area lights: the sides along the light's local X and Y
+    size_y: float = 0.0
+    shape: str = "SQUARE"  # area lights: SQUARE, RECTANGLE, DISK or ELLIPSE
+    penumbra_scale: float = 1.0  # the light size PCSS sees, relative (1/sqrt(samples) when sampled)
 
     @property
     def shadow_radius(self):
@@ -460,10 +464,10 @@ def light_from_blender(data, matrix):
         light.angle = float(data.angle)
     elif data.type == "AREA":
         light.radius = 0.0
-        sizes = [float(data.size)]
-        if data.shape in {"RECTANGLE", "ELLIPSE"}:
-            sizes.append(float(data.size_y))
-        light.size = max(sizes)
+        light.shape = data.shape
+        light.size_x = float(data.size)
+        light.size_y = float(data.size_y) if data.shape in {"RECTANGLE", "ELLIPSE"} else light.size_x
+        light.size = max(light.size_x, light.size_y)
     settings = getattr(data, "penumbra", None)
     if settings is not None:
         light.bias_scale = float(settings.bias_scale)

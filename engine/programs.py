@@ -155,6 +155,32 @@ TILE_COPY = Program(
 )
 
 
+# Multi-sample frames: accumulation += weight * sample (additive blending into float32), then
+# resolve = accumulation / total weight. WITH_SHADOW carries the Shadow pass along.
+ACCUMULATE = Program(
+    name="accumulate",
+    vertex="fullscreen.vert.glsl",
+    fragment="accumulate.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "weight"),),
+    samplers=(("FLOAT_2D", "sample_color"), ("FLOAT_2D", "sample_shadow")),
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
+)
+ACCUMULATE_COLOR = replace(
+    ACCUMULATE, name="accumulate_color", samplers=ACCUMULATE.samplers[:1], outputs=ACCUMULATE.outputs[:1]
+)
+RESOLVE = Program(
+    name="resolve",
+    vertex="fullscreen.vert.glsl",
+    fragment="resolve.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "inv_weight"),),
+    samplers=(("FLOAT_2D", "accum_color"), ("FLOAT_2D", "accum_shadow")),
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
+)
+RESOLVE_COLOR = replace(RESOLVE, name="resolve_color", samplers=RESOLVE.samplers[:1], outputs=RESOLVE.outputs[:1])
+
+
 def shadow_program(depth_format):
     """The depth pass of a map stored as ``depth_format``."""
     return SHADOW_DEPTH_ONLY if DEPTH_FORMAT[depth_format].depth_only else SHADOW_DEPTH

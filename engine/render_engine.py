@@ -9,6 +9,8 @@ import numpy as np
 from .extract import SceneCache, camera_from_scene, camera_from_view
 from .output import mist_pass, render_views, render_window, unsupported_in_use, view_distance_scale
 
+ENDLESS_SAMPLES = 64  # how finely soft lights are split when the viewport refines without end
+
 
 class PenumbraEngineCore:
     """What the viewport and final renders share. Kept apart from the registered class so
@@ -30,10 +32,22 @@ class PenumbraEngineCore:
         self._shown = None
         self.cache.clear()
 
-    def render_frame(self, depsgraph, camera, width, height, pixel_scale=1.0, aux=True):
-        """Extract, then render one frame; returns the renderer's FrameOutput. ``pixel_scale``
-        scales the post layers' sizes in pixels (a final render's resolution %); ``aux``: also
-        produce the depth, shadow and normal targets (passes), not only colour."""
+    def render_frame(
+        self,
+        depsgraph,
+        camera,
+        width,
+        height,
+        pixel_scale=1.0,
+        aux=True,
+        samples=(0, 1),
+        sample_count=1,
+        on_sample=None,
+    ):
+        """Extract, then render samples ``samples`` of a frame of ``sample_count`` samples
+        (``Renderer.render``); returns the renderer's FrameOutput. ``pixel_scale`` scales the
+        post layers' sizes in pixels (a final render's resolution %); ``aux``: also produce the
+        depth, shadow and normal targets (passes), not only colour."""
         from .renderer import Renderer
 
         if self.renderer is None:
@@ -43,29 +57,69 @@ class PenumbraEngineCore:
         settings = scene.penumbra.render_settings(
             frame=scene.frame_current, film_transparent=scene.render.film_transparent, pixel_scale=pixel_scale
         )
-        out = self.renderer.render(snapshot, camera, settings, width, height, aux=aux)
+        out = self.renderer.render(
+            snapshot, camera, settings, width, height, aux, samples, sample_count, on_sample=on_sample
+        )
         self.last_stats = out.stats
         return out
 
     def viewport_frame(self, depsgraph, view_matrix, window_matrix, width, height):
-        """The frame a viewport redraw shows. Nothing changed since the last full-resolution
-        frame (``view_update`` calls ``scene_changed``): the last frame again, nothing rendered.
-        The view moved since the last frame: a frame at ``navigation_scale`` of the region's
-        resolution (post sizes scaled alike). The view stopped after moving: the full-resolution
-        frame. Returns (FrameOutput, whether it rendered); ``out.width < width`` means the
-        frame is a navigation preview and a redraw should follow to refine it."""
+        """The frame a viewport redraw shows, one sample at a time:
+        * the view moved since the last frame: one sample at ``navigation_scale`` of the
+          region's resolution (post sizes scaled alike);
+        * otherwise, after any change (``view_update`` calls ``scene_changed``) or a stop: the
+          first full-resolution sample, then one more sample per redraw, accumulated, until
+          ``viewport_samples`` (0: without end); then the same frame again, nothing rendered.
+        Sample k of the viewport is sample k of a final render, so N redraws show what a final
+        render of N samples shows. Returns (FrameOutput, whether it rendered); ``refining()``
+        says whether another redraw would render more."""
         key = (width, height, tuple(map(tuple, view_matrix)), tuple(map(tuple, window_matrix)))
+        settings = depsgraph.scene.penumbra
+        target = int(settings.viewport_samples)
+        count = target if target > 0 else ENDLESS_SAMPLES
         shown = self._shown
         if shown is not None and shown[0] == key and shown[1].width == width:
-            return shown[1], False
-        scale = float(depsgraph.scene.penumbra.navigation_scale)
+            done = shown[2]
+            if not self._wants_sample(done, target):
+                return shown[1], False
+            camera = camera_from_view(view_matrix, window_matrix)
+            out = self.render_frame(
+                depsgraph, camera, width, height, aux=False, samples=(done, done + 1), sample_count=count
+            )
+            self._shown = (key, out, done + 1, target)
+            return out, True
+        scale = float(settings.navigation_scale)
         moving = shown is not None and shown[0][:2] == (width, height) and shown[0] != key and scale < 1.0
-        w, h = (max(1, round(width * scale)), max(1, round(height * scale))) if moving else (width, height)
         camera = camera_from_view(view_matrix, window_matrix)
         self._shown = None
-        out = self.render_frame(depsgraph, camera, w, h, pixel_scale=w / width, aux=False)
-        self._shown = (key, out)
+        if moving:
+            w, h = max(1, round(width * scale)), max(1, round(height * scale))
+            out = self.render_frame(depsgraph, camera, w, h, pixel_scale=w / width, aux=False)
+            self._shown = (key, out, 0, target)
+        else:
+            out = self.render_frame(depsgraph, camera, width, height, aux=False, samples=(0, 1), sample_count=count)
+            self._shown = (key, out, 1, target)
         return out, True
+
+    @staticmethod
+    def _wants_sample(done, target):
+        return target == 0 or done < target
+
+    def refining(self):
+        """Whether the next redraw would render more (a navigation preview to refine, or
+        samples still to accumulate)."""
+        shown = self._shown
+        if shown is None:
+            return False
+        key, out, done, target = shown
+        return out.width < key[0] or self._wants_sample(done, target)
+
+    def viewport_status(self):
+        """'Sample k/N' of the frame the viewport shows ('' before the first)."""
+        if self._shown is None or self._shown[2] == 0:
+            return ""
+        done, target = self._shown[2], self._shown[3]
+        return f"Sample {done}/{target}" if target else f"Sample {done}"
 
     def scene_changed(self):
         """Something in the scene changed: the next viewport redraw renders afresh."""
@@ -155,7 +209,27 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     )
                 else:
                     camera = camera_from_scene(depsgraph, scene, width, height)
-                out = self.render_frame(depsgraph, camera, width, height, r.resolution_percentage / 100.0, aux)
+                count = int(scene.penumbra.render_samples)
+                label = f"Penumbra | {layer}{' | ' + view if view else ''}"
+
+                def on_sample(done, index=index, count=count, label=label):
+                    self.update_stats("", f"{label} | Sample {done}/{count}")
+                    self.update_progress((index + done / count) / len(views))
+                    return not self.test_break()
+
+                out = self.render_frame(
+                    depsgraph,
+                    camera,
+                    width,
+                    height,
+                    r.resolution_percentage / 100.0,
+                    aux,
+                    samples=(0, count),
+                    sample_count=count,
+                    on_sample=on_sample,
+                )
+                if out.stats.cancelled:
+                    return  # cancelled: no result is written for this view
                 for message in out.stats.messages:
                     if message not in reported:
                         reported.add(message)
@@ -229,10 +303,10 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         self._reported = None
         # What the final render would put in its report (lights left out, clamped maps) shows
         # in the viewport's text overlay, as Blender's engines show their status there.
-        self.update_stats("", " | ".join(out.stats.messages))
+        self.update_stats("", " | ".join([self.viewport_status(), *out.stats.messages]).strip(" |"))
         self.draw_display(depsgraph.scene, out.color, width, height)
-        if out.width < width:
-            self.tag_redraw()  # a navigation preview: the next redraw refines it if the view stopped
+        if self.refining():
+            self.tag_redraw()  # the next redraw refines: full resolution, or one more sample
 
 
 def _gpu_texture_limit():

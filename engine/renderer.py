@@ -3,16 +3,28 @@ The same code serves the viewport and final renders; only where the camera comes
 where the result goes differ.
 """
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels, light_bins
+from . import kernels, light_bins, sampling
 from .extract import Material
 from .frame_data import build_frame_data, select_lights
 from .post import post_stack
 from .post.base import PostContext
-from .programs import JITTER_SIZE, LIT, LIT_COLOR, MAX_LIGHTS, MAX_SHADOW_TILES, SHADOW_SAMPLER
+from .programs import (
+    ACCUMULATE,
+    ACCUMULATE_COLOR,
+    JITTER_SIZE,
+    LIT,
+    LIT_COLOR,
+    MAX_LIGHTS,
+    MAX_SHADOW_TILES,
+    RESOLVE,
+    RESOLVE_COLOR,
+    SHADOW_SAMPLER,
+)
 from .shadows import ShadowAtlas, plan_shadows
 
 DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
@@ -32,6 +44,8 @@ class FrameStats:
     texture_bytes: int = 0
     shadow_bytes: int = 0  # the shadow atlas (and its one-tile scratch target, if any)
     shaders_compiled: int = 0
+    samples: int = 0  # samples rendered by this call
+    cancelled: bool = False  # on_sample asked to stop before the last sample
     lights_out_of_view: int = 0  # lights that reach no visible surface: no map, no shading
     binned: bool = False  # the lit pass looped over each screen bin's lights only
     messages: list = field(default_factory=list)  # what the user must be told about this frame
@@ -47,8 +61,12 @@ class FrameOutput:
     height: int
     lit: object = None  # GPUTexture, the lit pass before the post stack
     normal: object = None  # GPUTexture, world-space shading normal (0 for the background)
+    depth_data: object = None  # arrays of the centred sample when several were accumulated
+    normal_data: object = None
 
     def normal_array(self):
+        if self.normal_data is not None:
+            return self.normal_data[..., :3]
         return texture_array(self.normal, 4)[..., :3]
 
     def lit_array(self):
@@ -58,6 +76,8 @@ class FrameOutput:
         return texture_array(self.color, 4)
 
     def depth_array(self):
+        if self.depth_data is not None:
+            return self.depth_data
         return texture_array(self.depth, 1)[..., 0]
 
     def shadow_array(self):
@@ -110,12 +130,23 @@ class Renderer:
         self._ubos = {}
         self._dummy_shadow = None
         self._bins_tex = None
+        self._accum_color = self._accum_shadow = self._accum_fb = self._resolve_fb = None
+        self._fullscreen_batch = None
+        self._weight_sum = 0.0
+        self._centre = None  # (depth, normal) arrays of a multi-sample frame's centred sample
 
     # --- the frame ------------------------------------------------------------------------
 
-    def render(self, snapshot, camera, settings, width, height, aux=True):
-        """One frame. ``aux``: also write the depth, shadow and normal targets (a final
-        render's passes); the viewport needs colour only and skips them."""
+    def render(
+        self, snapshot, camera, settings, width, height, aux=True, samples=(0, 1), sample_count=1, on_sample=None
+    ):
+        """Samples ``samples[0] .. samples[1] - 1`` of a frame of ``sample_count`` samples
+        (``engine/sampling.py``), added to the samples this renderer already accumulated for
+        it (a start of 0 begins the frame afresh), then the post stack on their filtered
+        average. One sample of one is exactly the single-sample frame, with no accumulation.
+        ``aux``: also write the depth, shadow and normal targets (a final render's passes;
+        depth and normal are the centred sample's, shadow is averaged like colour).
+        ``on_sample(done)`` after each sample; returning False stops the frame there (cancel)."""
         stats = FrameStats()
         compiled_before = self.shaders.compiled
         self._ensure_targets(width, height, aux)
@@ -126,11 +157,59 @@ class Renderer:
                 f"Penumbra: {len(snapshot.lights)} lights; only the {MAX_LIGHTS} that contribute most to the view "
                 "are lit"
             )
-        lights, rects = self._lights_in_view(lights, draws, camera, width, height, stats)
+        start, stop = samples
+        accumulate = sample_count > 1
+        if accumulate:
+            self._ensure_accumulation(aux)
+            if start == 0:
+                self._accum_color.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+                if self._accum_shadow is not None:
+                    self._accum_shadow.clear(format="FLOAT", value=(0.0,))
+                self._weight_sum = 0.0
+        plan = None
+        for s in range(start, stop):
+            dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
+            view_camera = camera
+            if dx or dy:
+                jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
+                view_camera = dataclasses.replace(camera, projection=jittered)
+            sample_lights = [sampling.light_at_sample(lt, i, s, sample_count) for i, lt in enumerate(lights)]
+            plan = self._sample(draws, sample_lights, camera, view_camera, snapshot, settings, aux, stats)
+            if accumulate:
+                self._accumulate(weight, aux)
+                self._weight_sum += weight
+            if aux and accumulate and s == 0:  # the centred sample's depth and normal
+                self._centre = (texture_array(self._depth, 1)[..., 0].copy(), texture_array(self._normal, 4).copy())
+            stats.samples += 1
+            if on_sample is not None and on_sample(s + 1) is False:
+                stats.cancelled = True
+                break
+        if accumulate and stats.samples:
+            self._resolve(aux)
+        color = self._post_pass(settings, stats)
+        target_bytes = 16 + 4 + (4 + 4 + 8 if aux else 0)  # colour, z-buffer, depth, shadow, normal
+        if accumulate:
+            target_bytes += 16 + (4 if aux else 0)
+        stats.shadow_bytes = self.shadows.memory_bytes if plan is not None and plan.tiles else 0
+        stats.texture_bytes = width * height * target_bytes + stats.shadow_bytes + self._post_ctx.memory_bytes
+        stats.shaders_compiled = self.shaders.compiled - compiled_before
+        if not aux:
+            return FrameOutput(color, None, None, stats, width, height, lit=self._color)
+        out = FrameOutput(color, self._depth, self._shadow, stats, width, height, lit=self._color, normal=self._normal)
+        if accumulate and self._centre is not None:
+            out.depth_data, out.normal_data = self._centre
+        return out
+
+    def _sample(self, draws, lights, camera, view_camera, snapshot, settings, aux, stats):
+        """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
+        does not move between samples keeps its map), then the lit pass seen through
+        ``view_camera``. Returns the shadow plan."""
+        width, height = self._size
+        lights, rects = self._lights_in_view(lights, draws, view_camera, width, height, stats)
         plan = self._shadow_pass(draws, lights, camera, settings, stats)
         data = build_frame_data(
             lights,
-            camera,
+            view_camera,
             snapshot.world_color,
             settings,
             plan,
@@ -142,15 +221,8 @@ class Renderer:
             size=(width, height),
         )
         stats.binned = data.bins is not None
-        self._lit_pass(_front_to_back(draws, camera), data, plan, snapshot.world_color, settings, aux, stats)
-        color = self._post_pass(settings, stats)
-        target_bytes = 16 + 4 + (4 + 4 + 8 if aux else 0)  # colour, z-buffer, depth, shadow, normal
-        stats.shadow_bytes = self.shadows.memory_bytes if plan.tiles else 0
-        stats.texture_bytes = width * height * target_bytes + stats.shadow_bytes + self._post_ctx.memory_bytes
-        stats.shaders_compiled = self.shaders.compiled - compiled_before
-        if not aux:
-            return FrameOutput(color, None, None, stats, width, height, lit=self._color)
-        return FrameOutput(color, self._depth, self._shadow, stats, width, height, lit=self._color, normal=self._normal)
+        self._lit_pass(_front_to_back(draws, view_camera), data, plan, snapshot.world_color, settings, aux, stats)
+        return plan
 
     # --- stages ---------------------------------------------------------------------------
 
@@ -290,6 +362,68 @@ class Renderer:
             self._fb = gpu.types.GPUFrameBuffer(
                 depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow, self._normal)
             )
+
+    def _ensure_accumulation(self, aux):
+        """The float32 accumulation targets of a multi-sample frame (colour, and shadow for a
+        final render's Shadow pass), and the targets their resolve writes."""
+        import gpu
+
+        width, height = self._size
+        if self._accum_color is None or (self._accum_color.width, self._accum_color.height) != (width, height):
+            self._accum_color = gpu.types.GPUTexture((width, height), format="RGBA32F")
+            self._accum_shadow = None
+            self._accum_fb = gpu.types.GPUFrameBuffer(color_slots=(self._accum_color,))
+        if aux and self._accum_shadow is None:
+            self._accum_shadow = gpu.types.GPUTexture((width, height), format="R32F")
+            self._accum_fb = gpu.types.GPUFrameBuffer(color_slots=(self._accum_color, self._accum_shadow))
+        self._centre = None
+
+    def _fullscreen(self, program, framebuffer, defines, samplers, uniforms, blend="NONE"):
+        import gpu
+        from gpu_extras.batch import batch_for_shader
+
+        shader = self.shaders.get(program, defines)
+        if self._fullscreen_batch is None:
+            self._fullscreen_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
+        width, height = self._size
+        with framebuffer.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            gpu.state.depth_test_set("NONE")
+            gpu.state.blend_set(blend)
+            shader.bind()
+            for name, tex in samplers.items():
+                shader.uniform_sampler(name, tex)
+            for name, value in uniforms.items():
+                shader.uniform_float(name, value)
+            self._fullscreen_batch.draw(shader)
+            gpu.state.blend_set("NONE")
+
+    def _accumulate(self, weight, aux):
+        """accumulation += weight * this sample (colour, and shadow with ``aux``)."""
+        with_shadow = aux and self._accum_shadow is not None
+        samplers = {"sample_color": self._color}
+        if with_shadow:
+            samplers["sample_shadow"] = self._shadow
+        program = ACCUMULATE if with_shadow else ACCUMULATE_COLOR
+        self._fullscreen(
+            program, self._accum_fb, {"WITH_SHADOW": with_shadow}, samplers, {"weight": weight}, "ADDITIVE_PREMULT"
+        )
+
+    def _resolve(self, aux):
+        """The filtered average (accumulation / total weight) into the colour (and shadow)
+        targets, which the post stack and the passes read as a single-sample frame's."""
+        import gpu
+
+        with_shadow = aux and self._accum_shadow is not None
+        if self._resolve_fb is None or self._resolve_fb[0] != (self._size, with_shadow):
+            slots = (self._color, self._shadow) if with_shadow else (self._color,)
+            self._resolve_fb = ((self._size, with_shadow), gpu.types.GPUFrameBuffer(color_slots=slots))
+        samplers = {"accum_color": self._accum_color}
+        if with_shadow:
+            samplers["accum_shadow"] = self._accum_shadow
+        program = RESOLVE if with_shadow else RESOLVE_COLOR
+        inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
+        self._fullscreen(program, self._resolve_fb[1], {"WITH_SHADOW": with_shadow}, samplers, {"inv_weight": inverse})
 
     def _ubo(self, name, data):
         import gpu

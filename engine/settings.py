@@ -119,11 +119,46 @@ def values(params, source):
 
 # --- scene settings (scene.penumbra) ------------------------------------------------------
 
+SAMPLING = "sampling"
 SHADOWS = "shadows"
 LIGHTING = "lighting"
 VIEWPORT = "viewport"
 
 SCENE_PARAMS = (
+    Param(
+        "render_samples",
+        "INT",
+        16,
+        "Samples per pixel of a final render: each one jitters the image within the pixel filter and "
+        "lights soft lights from another point of themselves",
+        min=1,
+        max=4096,
+        soft_max=256,
+        label="Render",
+        section=SAMPLING,
+    ),
+    Param(
+        "viewport_samples",
+        "INT",
+        16,
+        "Samples the viewport accumulates while nothing changes (0: keep refining)",
+        min=0,
+        max=4096,
+        soft_max=256,
+        label="Viewport",
+        section=SAMPLING,
+    ),
+    Param(
+        "filter_size",
+        "FLOAT",
+        1.5,
+        "Width of the pixel filter (Blackman-Harris) the samples are spread over and weighted by, in pixels",
+        min=0.0,
+        max=10.0,
+        label="Filter Size",
+        section=SAMPLING,
+        subtype="PIXEL",
+    ),
     Param("shadow_filter", "ENUM", "PCF", "How shadow edges are filtered", enum=SHADOW_FILTER, section=SHADOWS),
     Param(
         "shadow_map_size",

@@ -45,6 +45,11 @@ class _SettingsPanel(PenumbraPanel):
         draw_params(layout, context.scene.penumbra, settings.SCENE_PARAMS, self.section)
 
 
+class PENUMBRA_PT_sampling(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Sampling"
+    section = settings.SAMPLING
+
+
 class PENUMBRA_PT_shadows(_SettingsPanel, bpy.types.Panel):
     bl_label = "Shadows"
     section = settings.SHADOWS
@@ -165,6 +170,7 @@ class PENUMBRA_PT_render_layers(PenumbraPanel, bpy.types.Panel):
 
 
 classes = (
+    PENUMBRA_PT_sampling,
     PENUMBRA_PT_film,
     PENUMBRA_PT_passes,
     PENUMBRA_PT_shadows,

@@ -1,0 +1,175 @@
+"""Render samples: where each sample looks from and where each soft light shines from.
+
+Plain numpy, no bpy and no gpu. A frame of N samples renders sample s = 0 .. N-1 and averages
+them with the film filter's weights:
+
+* **Pixels.** Sample s shifts the whole image by a sub-pixel offset: sample 0 by nothing (the
+  pixel centre), sample s > 0 by the Halton (2, 3) point s mapped through the inverse CDF of
+  the Blackman-Harris filter of width ``filter_size`` pixels (Cycles' "pixel filter width"),
+  so offsets are distributed as the filter and the plain average converges to the image
+  convolved with it.
+* **Soft lights.** A light with size (sun ``angle``, point/spot ``shadow_soft_size``, area
+  ``size``/``size_y`` and shape) shines from a different point of itself in each sample: the
+  centre in sample 0, then Halton points (bases 5, 7, 11, rotated per light so lights do not
+  move in step) on its disc, ball or area. Every sample's shadow map is a hard shadow from that
+  point, so the average converges to the true visibility (Heckbert-Herf accumulation), and an
+  area light's irradiance to the integral over its surface. Each sample stands for 1/N of the
+  light, so PCSS in that sample sees a light 1/sqrt(N) the size (``penumbra_scale``): the
+  penumbra is not blurred twice, and one sample is exactly the single-sample frame.
+* A light without size is the same in every sample, so its map is drawn once and reused.
+
+Sequences depend only on (s, N, light index): the viewport's k-th redraw and a final render's
+k-th sample are the same sample, so N redraws show what a final render of N samples shows.
+"""
+
+import dataclasses
+import functools
+import math
+
+import numpy as np
+
+PIXEL_BASES = (2, 3)
+LIGHT_BASES = (5, 7, 11)
+
+
+def radical_inverse(index, base):
+    """The van der Corput radical inverse of ``index`` in ``base`` (Halton coordinate)."""
+    result, f = 0.0, 1.0 / base
+    i = int(index)
+    while i > 0:
+        result += f * (i % base)
+        i //= base
+        f /= base
+    return result
+
+
+def blackman_harris(x, width):
+    """The Blackman-Harris window of total ``width`` at offset ``x`` (1 at the centre, 0 at
+    +-width/2 and beyond)."""
+    if width <= 0.0:
+        return 1.0 if x == 0.0 else 0.0
+    t = x / width + 0.5
+    if t <= 0.0 or t >= 1.0:
+        return 0.0
+    a = 2.0 * math.pi * t
+    return 0.35875 - 0.48829 * math.cos(a) + 0.14128 * math.cos(2 * a) - 0.01168 * math.cos(3 * a)
+
+
+@functools.lru_cache(maxsize=8)
+def _filter_cdf(filter_size, table=1024):
+    x = (np.arange(table + 1) / table - 0.5) * filter_size
+    pdf = np.array([blackman_harris(v, filter_size) for v in x])
+    cdf = np.concatenate([[0.0], np.cumsum(0.5 * (pdf[1:] + pdf[:-1]))])
+    return cdf / cdf[-1], x
+
+
+def _filter_inverse_cdf(u, filter_size):
+    """The offset (pixels) below which a fraction ``u`` of the Blackman-Harris filter's weight
+    lies: offsets drawn this way are distributed as the filter, so samples need equal weights
+    (importance sampling; far less noise than weighting uniform offsets)."""
+    cdf, x = _filter_cdf(float(filter_size))
+    return float(np.interp(u, cdf, x))
+
+
+def pixel_offset(s, filter_size):
+    """(dx, dy, weight) of sample ``s``: its image offset in pixels, distributed as the film
+    filter (Halton points through the filter's inverse CDF, sample 0 at the centre), and its
+    weight (1: the distribution already carries the filter)."""
+    if s == 0 or filter_size <= 0.0:
+        return 0.0, 0.0, 1.0
+    dx = _filter_inverse_cdf(radical_inverse(s, PIXEL_BASES[0]), filter_size)
+    dy = _filter_inverse_cdf(radical_inverse(s, PIXEL_BASES[1]), filter_size)
+    return dx, dy, 1.0
+
+
+def jittered_projection(projection, dx, dy, width, height):
+    """``projection`` shifted by (dx, dy) pixels on a ``width`` x ``height`` image (the clip
+    space translation, so it is exact for perspective and orthographic cameras alike)."""
+    p = np.array(projection, dtype=np.float64)
+    shift = np.eye(4)
+    shift[0, 3] = 2.0 * dx / width
+    shift[1, 3] = 2.0 * dy / height
+    return shift @ p
+
+
+def _light_point(s, light_index, dims):
+    """Sample ``s``'s point in [0, 1)^dims for light ``light_index`` (Halton, rotated)."""
+    rng = np.random.default_rng(0x9E3779B1 + 7919 * light_index)  # a fixed rotation per light
+    rotation = rng.random(dims)
+    return [(radical_inverse(s, LIGHT_BASES[d]) + rotation[d]) % 1.0 for d in range(dims)]
+
+
+def concentric_disk(u, v):
+    """Shirley-Chiu map of [0, 1)^2 to the unit disk (area-preserving, low distortion)."""
+    a, b = 2.0 * u - 1.0, 2.0 * v - 1.0
+    if a == 0.0 and b == 0.0:
+        return 0.0, 0.0
+    if abs(a) > abs(b):
+        r, phi = a, (math.pi / 4.0) * (b / a)
+    else:
+        r, phi = b, math.pi / 2.0 - (math.pi / 4.0) * (a / b)
+    return r * math.cos(phi), r * math.sin(phi)
+
+
+def _basis(axis):
+    """Two unit vectors perpendicular to ``axis`` and to each other."""
+    helper = np.eye(3)[int(np.argmin(np.abs(axis)))]
+    u = np.cross(axis, helper)
+    u /= np.linalg.norm(u)
+    return u, np.cross(axis, u)
+
+
+def has_size(light):
+    """Whether the light's shadow depends on the sample (a light with an extent)."""
+    if light.type == "SUN":
+        return light.angle > 0.0
+    if light.type == "AREA":
+        return max(light.size_x, light.size_y) > 0.0
+    return light.radius > 0.0
+
+
+def light_at_sample(light, light_index, s, count):
+    """``light`` as it shines in sample ``s`` of ``count``: moved to a point of itself (a
+    direction inside its cone for a sun), with PCSS's light size scaled by 1/sqrt(count).
+    Lights without size, ``count`` 1 and sample 0 keep the light's centre."""
+    if count <= 1 or not has_size(light):
+        return light
+    scale = 1.0 / math.sqrt(count)
+    if s == 0:
+        return dataclasses.replace(light, penumbra_scale=scale)
+    m = np.array(light.matrix, dtype=np.float64)
+    if light.type == "SUN":
+        x, y = concentric_disk(*_light_point(s, light_index, 2))
+        d = light.direction
+        u, v = _basis(d)
+        tan_half = math.tan(0.5 * min(light.angle, math.pi * 0.99))
+        nd = d + tan_half * (x * u + y * v)
+        nd /= np.linalg.norm(nd)
+        # Lights shine along their local -Z: rotate the matrix's Z axis onto -nd.
+        z = -nd
+        xa = np.cross(m[:3, 1], z)
+        if np.linalg.norm(xa) < 1e-12:
+            xa = _basis(z)[0]
+        xa /= np.linalg.norm(xa)
+        m[:3, 0], m[:3, 1], m[:3, 2] = xa, np.cross(z, xa), z
+    elif light.type == "AREA":
+        u, v = _light_point(s, light_index, 2)
+        if light.shape in ("DISK", "ELLIPSE"):
+            x, y = concentric_disk(u, v)
+            x, y = 0.5 * x, 0.5 * y
+        else:
+            x, y = u - 0.5, v - 0.5
+        local = np.array([x * light.size_x, y * light.size_y, 0.0, 1.0])
+        m[:3, 3] = (m @ local)[:3]  # the light's own axes carry its object scale
+    elif light.type == "SPOT":
+        x, y = concentric_disk(*_light_point(s, light_index, 2))
+        u, v = _basis(light.direction)
+        m[:3, 3] = m[:3, 3] + light.radius * (x * u + y * v)
+    else:  # POINT: uniform in the ball, which looks the same from every direction
+        u, v, w = _light_point(s, light_index, 3)
+        z = 1.0 - 2.0 * u
+        r_xy = math.sqrt(max(0.0, 1.0 - z * z))
+        phi = 2.0 * math.pi * v
+        direction = np.array([r_xy * math.cos(phi), r_xy * math.sin(phi), z])
+        m[:3, 3] = m[:3, 3] + light.radius * w ** (1.0 / 3.0) * direction
+    return dataclasses.replace(light, matrix=m, penumbra_scale=scale)

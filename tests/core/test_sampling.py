@@ -1,0 +1,87 @@
+"""Sample sequences (engine/sampling.py): pixel offsets cover the filter and are weighted by
+it, soft lights move over their own extent, and one sample is the single-sample frame."""
+
+import math
+
+import numpy as np
+import pytest
+
+from devkit.session import load_penumbra
+
+load_penumbra()
+from penumbra.engine import sampling  # noqa: E402
+from penumbra.engine.extract import Light  # noqa: E402
+
+
+def _light(kind, **kw):
+    m = np.eye(4)
+    m[:3, 3] = (1.0, 2.0, 3.0)
+    return Light(type=kind, color=np.ones(3), matrix=m, radius=kw.pop("radius", 0.0), **kw)
+
+
+def test_first_sample_is_centred_and_offsets_fill_the_filter_width():
+    assert sampling.pixel_offset(0, 1.5) == (0.0, 0.0, 1.0)
+    offsets = np.array([sampling.pixel_offset(s, 2.0)[:2] for s in range(1, 1025)])
+    assert np.all(np.abs(offsets) < 1.0)  # within +-width/2
+    # Low discrepancy: every quarter of the square gets a quarter of the points, +-2.
+    quadrants = np.histogram2d(offsets[:, 0], offsets[:, 1], bins=2, range=[[-1, 1], [-1, 1]])[0]
+    assert np.all(np.abs(quadrants - 256) <= 2)
+    # Distributed as the filter: the histogram of x follows the Blackman-Harris window.
+    counts, edges = np.histogram(offsets[:, 0], bins=8, range=(-1, 1))
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    window = np.array([sampling.blackman_harris(c, 2.0) for c in centres])
+    np.testing.assert_allclose(counts / counts.sum(), window / window.sum(), atol=0.01)
+    assert all(sampling.pixel_offset(s, 0.0) == (0.0, 0.0, 1.0) for s in range(5))  # no filter: no jitter
+
+
+def test_the_filter_is_blackman_harris_and_samples_weigh_alike():
+    assert sampling.blackman_harris(0.0, 1.5) == pytest.approx(1.0)
+    assert sampling.blackman_harris(0.75, 1.5) == pytest.approx(0.0, abs=1e-4)
+    assert sampling.blackman_harris(2.0, 1.5) == 0.0
+    assert all(sampling.pixel_offset(s, 1.5)[2] == 1.0 for s in range(8))
+
+
+def test_jittered_projection_moves_the_image_by_whole_pixels_in_clip_space():
+    proj = np.array([[1.2, 0, 0.1, 0], [0, 2.0, 0, 0], [0, 0, -1.01, -0.2], [0, 0, -1, 0]])
+    point = np.array([0.3, -0.2, -5.0, 1.0])
+    a = proj @ point
+    b = sampling.jittered_projection(proj, 0.5, -0.25, 200, 100) @ point
+    ndc_a, ndc_b = a[:2] / a[3], b[:2] / b[3]
+    np.testing.assert_allclose((ndc_b - ndc_a) * np.array([100, 50]), [0.5, -0.25], atol=1e-12)
+
+
+@pytest.mark.parametrize("kind", ["SPOT", "POINT", "AREA", "SUN"])
+def test_soft_lights_move_within_their_extent_and_hard_lights_never(kind):
+    extra = {"SPOT": {"radius": 0.5}, "POINT": {"radius": 0.5}, "SUN": {"angle": math.radians(10)}}.get(kind, {})
+    if kind == "AREA":
+        extra = {"size_x": 2.0, "size_y": 1.0, "size": 2.0, "shape": "RECTANGLE"}
+    light = _light(kind, **extra)
+    n = 64
+    samples = [sampling.light_at_sample(light, 3, s, n) for s in range(n)]
+    assert np.array_equal(samples[0].matrix, light.matrix)  # sample 0: the centre
+    assert all(s.penumbra_scale == pytest.approx(1 / 8) for s in samples)
+    if kind == "SUN":
+        cos = [float(s.direction @ light.direction) for s in samples]
+        assert min(cos) >= math.cos(math.radians(5)) - 1e-9 and min(cos) < math.cos(math.radians(3))
+    else:
+        offsets = np.array([s.position - light.position for s in samples])
+        if kind == "AREA":
+            assert np.all(np.abs(offsets[:, 0]) <= 1.0 + 1e-9) and np.all(np.abs(offsets[:, 1]) <= 0.5 + 1e-9)
+            assert np.allclose(offsets[:, 2], 0.0)  # on the light's plane
+            assert np.abs(offsets[:, 0]).max() > 0.8
+        else:
+            r = np.linalg.norm(offsets, axis=1)
+            assert r.max() <= 0.5 + 1e-9 and r.max() > 0.4
+        assert abs(offsets[1:].mean(axis=0)).max() < 0.1  # centred on the light
+    hard = _light(kind)
+    assert all(sampling.light_at_sample(hard, 3, s, n) is hard for s in range(4))
+    assert sampling.light_at_sample(light, 3, 0, 1) is light  # one sample: the light itself
+
+
+def test_sequences_are_deterministic_and_differ_between_lights():
+    light = _light("SPOT", radius=1.0)
+    a = [sampling.light_at_sample(light, 0, s, 16).position for s in range(1, 8)]
+    b = [sampling.light_at_sample(light, 0, s, 16).position for s in range(1, 8)]
+    c = [sampling.light_at_sample(light, 1, s, 16).position for s in range(1, 8)]
+    np.testing.assert_array_equal(a, b)
+    assert not np.allclose(a, c)
