@@ -4,6 +4,7 @@ LINES ?= 5.2 4.5
 DEMO_LINE ?= 5.2
 PYTEST_ARGS ?=
 # make bench                                   frame times of every engine on the demo scene
+# make bench BENCH=perf ARGS=--quick           frame cost and scaling against Workbench
 # make bench BENCH=post                        cost of each post layer
 # make bench BENCH=shadows ARGS=--quick        shadow error against time (ARGS: that command's options)
 BENCH ?= frame

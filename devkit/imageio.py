@@ -34,6 +34,17 @@ def read_exr(path):
     return passes
 
 
+def write_png(path, pixels):
+    """Write display-referred ``pixels`` (h, w, channels) in 0..1, top row first, as an 8-bit
+    PNG."""
+    pixels = np.ascontiguousarray(np.clip(pixels, 0.0, 1.0), np.float32)
+    h, w, c = pixels.shape
+    buf = oiio.ImageBuf(oiio.ImageSpec(w, h, c, oiio.UINT8))
+    buf.set_pixels(oiio.ROI(0, w, 0, h, 0, 1, 0, c), pixels)
+    if not buf.write(str(path)):
+        raise RuntimeError(buf.geterror())
+
+
 def read_image(path):
     """Pixels of any image file OpenImageIO reads (PNG, EXR, ...) as float32 (h, w, channels),
     top row first; 8-bit values become 0..1."""

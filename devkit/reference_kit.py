@@ -304,6 +304,24 @@ def cycles_reference(name, samples=512, width=DEFAULT_WIDTH, height=DEFAULT_HEIG
     return vis
 
 
+def cycles_luminance(name, samples=512, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT, cache_dir=DEFAULT_CACHE):
+    """Cycles luminance (the whole shadowed image) of reference scene ``name`` at ``samples``
+    spp, cached beside the visibility references."""
+    path = cache_path(name, samples, width, height, cache_dir).with_suffix(".lum.npy")
+    if path.exists():
+        return np.load(path)
+    scene = build(name, width, height)
+    configure(scene, "CYCLES", samples=samples)
+    lum = render_luminance(scene)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".npy", dir=path.parent)
+    with os.fdopen(fd, "wb") as f:
+        np.save(f, lum)
+    os.chmod(tmp, 0o644)
+    os.replace(tmp, path)
+    return lum
+
+
 # --- contact hardening ----------------------------------------------------------------------
 
 

@@ -45,6 +45,7 @@ class FrameStats:
     shadow_bytes: int = 0  # the shadow atlas (and its one-tile scratch target, if any)
     shaders_compiled: int = 0
     samples: int = 0  # samples rendered by this call
+    lights_sampled: int = 0  # lights that moved between samples (the others kept one map)
     cancelled: bool = False  # on_sample asked to stop before the last sample
     lights_out_of_view: int = 0  # lights that reach no visible surface: no map, no shading
     binned: bool = False  # the lit pass looped over each screen bin's lights only
@@ -167,13 +168,17 @@ class Renderer:
                     self._accum_shadow.clear(format="FLOAT", value=(0.0,))
                 self._weight_sum = 0.0
         plan = None
+        moving = sampling.sampled_lights(lights, self._plan(draws, lights, camera, settings)) if accumulate else set()
+        stats.lights_sampled = len(moving)
         for s in range(start, stop):
             dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
             view_camera = camera
             if dx or dy:
                 jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
                 view_camera = dataclasses.replace(camera, projection=jittered)
-            sample_lights = [sampling.light_at_sample(lt, i, s, sample_count) for i, lt in enumerate(lights)]
+            sample_lights = [
+                sampling.light_at_sample(lt, i, s, sample_count) if i in moving else lt for i, lt in enumerate(lights)
+            ]
             plan = self._sample(draws, sample_lights, camera, view_camera, snapshot, settings, aux, stats)
             if accumulate:
                 self._accumulate(weight, aux)
@@ -263,6 +268,12 @@ class Renderer:
         keep = [i for i, r in enumerate(rects) if r is not None]
         stats.lights_out_of_view = len(lights) - len(keep)
         return [lights[i] for i in keep], [rects[i] for i in keep]
+
+    def _plan(self, draws, lights, camera, settings):
+        """The shadow plan of ``lights`` at their centres (numpy only, nothing drawn)."""
+        corners = np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
+        view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
+        return plan_shadows(lights, corners, max(1, int(settings.shadow_map_size)), view_corners)
 
     def _shadow_pass(self, draws, lights, camera, settings, stats):
         """Plan the maps this frame needs (numpy) and draw the ones whose content changed."""

@@ -128,6 +128,40 @@ def has_size(light):
     return light.radius > 0.0
 
 
+def penumbra_texels(light, fit):
+    """An upper bound of the width, in texels of its map ``fit``, of the penumbra ``light``
+    can cast: sun 2 tan(angle/2) (far - near) / texel; local lights 2 r / (texel per unit of
+    distance * near) (similar triangles with the blocker at the map's near plane)."""
+    if light.type == "SUN":
+        if fit.texel <= 0.0:
+            return math.inf
+        return 2.0 * math.tan(0.5 * min(light.angle, math.pi * 0.99)) * (fit.far - fit.near) / fit.texel
+    if fit.texel_per_distance <= 0.0 or fit.near <= 0.0:
+        return math.inf
+    return 2.0 * light.shadow_radius / (fit.texel_per_distance * fit.near)
+
+
+def sampled_lights(lights, plan):
+    """Indices of the lights that move between samples: area lights (their irradiance is an
+    integral over the surface), and shadowed lights with an extent whose penumbra can be a
+    texel wide or more in their map. Every other light is the same in every sample, so its
+    map is drawn once."""
+    out = set()
+    for i, light in enumerate(lights):
+        if not has_size(light):
+            continue
+        if light.type == "AREA":
+            out.add(i)
+            continue
+        shadow = plan.lights.get(i)
+        if shadow is None:
+            continue
+        fits = [plan.tiles[t].fit for t in shadow.tiles if t >= 0]
+        if any(penumbra_texels(light, fit) >= 1.0 for fit in fits):
+            out.add(i)
+    return out
+
+
 def light_at_sample(light, light_index, s, count):
     """``light`` as it shines in sample ``s`` of ``count``: moved to a point of itself (a
     direction inside its cone for a sun), with PCSS's light size scaled by 1/sqrt(count).

@@ -4,6 +4,8 @@
               -> <out>/benchmark.csv
     perf      frame cost and scaling as ratios to Workbench: resolution, viewport redraw,
               lights, objects, instances, triangles, extraction -> <out>/perf.csv
+    samples   render samples: error against time vs Cycles spp and EEVEE, cost per sample,
+              an edge close-up -> <out>/samples.csv, samples.png, samples_closeup.png
     post      cost of each post layer; separable against direct 2-D blur -> <out>/post_costs.csv
     shadows   shadow error against frame time, scaling, per-frame work, JITTER early out
               -> <out>/shadow_tradeoff.csv, shadow_pareto.png, scaling.csv, scaling.png
@@ -20,9 +22,9 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import frame, perf, post, shadows
+from tools.benchmarks import frame, perf, post, samples, shadows
 
-COMMANDS = {"frame": frame, "perf": perf, "post": post, "shadows": shadows}
+COMMANDS = {"frame": frame, "perf": perf, "post": post, "samples": samples, "shadows": shadows}
 
 
 def main(argv=None):

@@ -85,3 +85,27 @@ def test_sequences_are_deterministic_and_differ_between_lights():
     c = [sampling.light_at_sample(light, 1, s, 16).position for s in range(1, 8)]
     np.testing.assert_array_equal(a, b)
     assert not np.allclose(a, c)
+
+
+def test_only_lights_whose_penumbra_reaches_a_texel_move_between_samples():
+    from penumbra.engine import lightspace, shadows
+
+    def plan_for(fits):
+        plan = shadows.ShadowPlan()
+        for i, fit in enumerate(fits):
+            if fit is not None:
+                plan.lights[i] = shadows.LightShadow("SINGLE", [len(plan.tiles)])
+                plan.tiles.append(shadows.Tile(fit, np.arange(1)))
+        return plan
+
+    ortho = lightspace.Fit(np.eye(4), np.eye(4), near=0.0, far=10.0, texel=0.01)  # 10 m deep, 1 cm texels
+    persp = lightspace.Fit(np.eye(4), np.eye(4), near=2.0, far=10.0, texel_per_distance=0.001)
+    tiny_sun = _light("SUN", angle=math.radians(0.01))  # 2 tan(0.005 deg) * 10 m = 1.7 mm < 1 cm
+    sun = _light("SUN", angle=math.radians(1))  # 17 cm: 17 texels
+    spot = _light("SPOT", radius=0.1)  # 2 * 0.1 / (0.001 * 2) = 100 texels
+    unshadowed_spot = _light("SPOT", radius=0.1)
+    area = _light("AREA", size_x=1.0, size_y=1.0, size=1.0)  # unshadowed: its irradiance still moves
+    assert sampling.penumbra_texels(tiny_sun, ortho) < 1 < sampling.penumbra_texels(sun, ortho)
+    assert sampling.penumbra_texels(spot, persp) == pytest.approx(100.0)
+    lights = [tiny_sun, sun, spot, unshadowed_spot, area]
+    assert sampling.sampled_lights(lights, plan_for([ortho, ortho, persp, None, None])) == {1, 2, 4}

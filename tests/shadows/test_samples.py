@@ -173,8 +173,8 @@ def test_hard_lights_keep_one_map_and_soft_lights_move_theirs(penumbra, gpu_call
     sun.data.angle = math.radians(5)
     soft = gpu_call(job)
     assert hard.samples == soft.samples == 8
-    assert (hard.shadow_maps, hard.shadow_maps_reused) == (1, 7)
-    assert soft.shadow_maps == 8
+    assert (hard.shadow_maps, hard.shadow_maps_reused, hard.lights_sampled) == (1, 7, 0)
+    assert (soft.shadow_maps, soft.lights_sampled) == (8, 1)
 
 
 def test_one_sample_is_the_single_sample_frame(penumbra, gpu_call):
