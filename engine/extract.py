@@ -66,6 +66,7 @@ class Light:
     size_y: float = 0.0
     shape: str = "SQUARE"  # area lights: SQUARE, RECTANGLE, DISK or ELLIPSE
     penumbra_scale: float = 1.0  # the light size PCSS sees, relative (1/sqrt(samples) when sampled)
+    sampled: bool = False  # moves between samples: its shadow is PCSS of its per-sample size
 
     @property
     def shadow_radius(self):

@@ -94,6 +94,8 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "light_count": light_count,
         "shadowed_count": 0,
         "shadowed_mask": (0, 0, 0, 0),
+        "sampled_count": 0,
+        "sampled_mask": (0, 0, 0, 0),
         "world_color": np.asarray(world_color, np.float64)[:3],
         "constant_bias": settings.shadow_bias,
         "slope_bias": settings.shadow_slope_bias,
@@ -107,12 +109,15 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
 
 
 def shading_order(lights, plan):
-    """Light indices as the lit pass loops over them: lights with a shadow map first (in their
-    own order), then the rest. The lit pass runs the shadow filter only in its first loop, so
-    a light without a map never pays for it. Returns (order, number with maps)."""
-    shadowed = [i for i in range(len(lights)) if i in plan.lights]
-    others = [i for i in range(len(lights)) if i not in plan.lights]
-    return shadowed + others, len(shadowed)
+    """Light indices as the lit pass loops over them: lights sampled over their extent with a
+    map first, then the other lights with a map, then the rest (each group in its own order).
+    The lit pass runs a shadow filter only in its first two loops, so a light without a map
+    never pays for one. Returns (order, number sampled, number with maps)."""
+    mapped = [i for i in range(len(lights)) if i in plan.lights]
+    sampled = [i for i in mapped if lights[i].sampled]
+    others = [i for i in mapped if not lights[i].sampled]
+    rest = [i for i in range(len(lights)) if i not in plan.lights]
+    return sampled + others + rest, len(sampled), len(mapped)
 
 
 def build_frame_data(
@@ -137,10 +142,12 @@ def build_frame_data(
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings)
-    order, shadowed = shading_order(lights, plan)
+    order, sampled, shadowed = shading_order(lights, plan)
     frame = frame_row(camera, world_color, len(lights), settings, tile_size, atlas_columns)
     frame["shadowed_count"] = shadowed
     frame["shadowed_mask"] = light_bins.word_masks(0, shadowed, LIGHT_WORDS)
+    frame["sampled_count"] = sampled
+    frame["sampled_mask"] = light_bins.word_masks(0, sampled, LIGHT_WORDS)
     bins = None
     if rects is not None and should_bin(lights):
         bins = light_bins.bin_masks([rects[i] for i in order], size[0], size[1], LIGHT_WORDS)
@@ -149,7 +156,7 @@ def build_frame_data(
         lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i)) for i in order], MAX_LIGHTS),
         tiles=TILE_STRUCT.pack([t.record() for t in plan.tiles], MAX_SHADOW_TILES),
         defines=lit_defines(
-            settings.shadow_filter if shadowed else "NONE",  # no map: no filter code at all
+            settings.shadow_filter if shadowed > sampled else "NONE",  # no map: no filter code at all
             kernels.pcf_weights(settings.pcf_kernel_size),
             settings.specular_model,
             depth_format,
@@ -158,8 +165,9 @@ def build_frame_data(
             aux_outputs,
             bins is not None,
             settings.pcf_spacing,
+            sampled > 0,
         ),
-        disk_samples=disk if shadowed and SHADOW_FILTER[settings.shadow_filter].disk else 0,
+        disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,
         bins=bins,
     )

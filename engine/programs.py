@@ -64,6 +64,8 @@ FRAME_STRUCT = Struct(
         ("INT", "light_count"),
         ("INT", "shadowed_count"),  # lights [0, shadowed_count) have maps and come first
         ("IVEC4", "shadowed_mask"),  # the same lights as bits of the light-bin words
+        ("INT", "sampled_count"),  # lights [0, sampled_count) move between samples (PCSS per sample)
+        ("IVEC4", "sampled_mask"),
         ("VEC3", "world_color"),
         ("FLOAT", "constant_bias"),  # texels
         ("FLOAT", "slope_bias"),  # texels per unit of tan(angle)
@@ -200,13 +202,15 @@ def lit_defines(
     aux_outputs=True,
     binned=False,
     pcf_spacing=1.0,
+    sampled=False,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
     switch for the disk filters. ``aux_outputs``: the variant also writes depth, shadow and
     normal (a final render's passes); without them it writes colour only (the viewport).
     ``binned``: each pixel loops over the lights its screen bin lists (``light_bins``).
-    PCF with taps one texel apart on a one-channel map reads 2x2 texels per fetch (gather)."""
+    PCF with taps one texel apart on a one-channel map reads 2x2 texels per fetch (gather).
+    ``sampled``: some lights move between samples and take the PCSS loop."""
     filt = SHADOW_FILTER[shadow_filter]
     gather = bool(filt.pcf_taps and pcf_spacing == 1.0 and DEPTH_FORMAT[depth_format].channels == 1)
     weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
@@ -216,7 +220,8 @@ def lit_defines(
         "SPECULAR_MODEL": SPECULAR_MODEL.define(specular_model),
         "PCF_RADIUS": len(weights) // 2,
         "PCF_WEIGHTS_LIST": ", ".join(f"{w:.9g}" for w in weights),
-        "DISK_SAMPLES": disk_samples if filt.disk else 8,
+        "DISK_SAMPLES": disk_samples if filt.disk or sampled else 8,
+        "SAMPLED_LIGHTS": bool(sampled),
         "EARLY_OUT": bool(early_out) or not filt.early_out,
         "AUX_OUTPUTS": bool(aux_outputs),
         "LIGHT_BINS": bool(binned),

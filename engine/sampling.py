@@ -13,9 +13,11 @@ them with the film filter's weights:
   centre in sample 0, then Halton points (bases 5, 7, 11, rotated per light so lights do not
   move in step) on its disc, ball or area. Every sample's shadow map is a hard shadow from that
   point, so the average converges to the true visibility (Heckbert-Herf accumulation), and an
-  area light's irradiance to the integral over its surface. Each sample stands for 1/N of the
-  light, so PCSS in that sample sees a light 1/sqrt(N) the size (``penumbra_scale``): the
-  penumbra is not blurred twice, and one sample is exactly the single-sample frame.
+  area light's irradiance to the integral over its surface. Each sample stands for 1/N of
+  the light, so in that sample it is shadowed by PCSS (whatever the scene's filter) with a
+  light 1/sqrt(N) the size (``penumbra_scale``): a few samples already give smooth penumbrae,
+  many converge to the exact one, and the penumbra is not blurred twice. One sample is
+  exactly the single-sample frame.
 * A light without size is the same in every sample, so its map is drawn once and reused.
 
 Sequences depend only on (s, N, light index): the viewport's k-th redraw and a final render's
@@ -170,7 +172,7 @@ def light_at_sample(light, light_index, s, count):
         return light
     scale = 1.0 / math.sqrt(count)
     if s == 0:
-        return dataclasses.replace(light, penumbra_scale=scale)
+        return dataclasses.replace(light, penumbra_scale=scale, sampled=True)
     m = np.array(light.matrix, dtype=np.float64)
     if light.type == "SUN":
         x, y = concentric_disk(*_light_point(s, light_index, 2))
@@ -206,4 +208,4 @@ def light_at_sample(light, light_index, s, count):
         phi = 2.0 * math.pi * v
         direction = np.array([r_xy * math.cos(phi), r_xy * math.sin(phi), z])
         m[:3, 3] = m[:3, 3] + light.radius * w ** (1.0 / 3.0) * direction
-    return dataclasses.replace(light, matrix=m, penumbra_scale=scale)
+    return dataclasses.replace(light, matrix=m, penumbra_scale=scale, sampled=True)

@@ -2,9 +2,10 @@
  * ambient (albedo * world, what Cycles gives an unoccluded surface), each light attenuated
  * by its shadow visibility. Back faces of a light (N.L <= 0) skip the shadow filter.
  *
- * The lit pass pays only for what it uses: lights with a shadow map come first
- * (frame.shadowed_count of them) and only their loop contains the shadow filter; lights
- * without a map take the second loop; a scene without lights runs neither. With several
+ * The lit pass pays only for what it uses: lights sampled over their extent come first
+ * (frame.sampled_count, PCSS of their per-sample size), then the other lights with a shadow
+ * map (up to frame.shadowed_count, the scene's filter), then lights without a map (no filter
+ * code); a scene without lights runs no loop. With several
  * local lights, each pixel loops only over the lights its screen bin lists. */
 
 struct Surface {
@@ -13,9 +14,11 @@ struct Surface {
   float shininess;
 };
 
-/* Add light i's contribution. ``shadowed`` is a literal at each call, so the compiler keeps
- * the shadow filter only where a light has a map. */
-void add_light(int i, const bool shadowed, Surface s, inout vec3 color, inout float arriving,
+#define NO_SHADOW -1
+
+/* Add light i's contribution. ``filter_id`` is a literal at each call (FILTER_* or NO_SHADOW), so
+ * the compiler keeps a shadow filter only where a light has a map, and only that one. */
+void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout float arriving,
                inout float unshadowed)
 {
   LightData L = lights[i];
@@ -29,7 +32,7 @@ void add_light(int i, const bool shadowed, Surface s, inout vec3 color, inout fl
   /* Shadow pass: direct light that arrives over direct light that would arrive unshadowed,
    * each light weighted by the luminance of its irradiance here (1 where no light reaches). */
   float weight = dot(L.color, vec3(0.2126, 0.7152, 0.0722)) * irradiance * NdotL;
-  float visibility = shadowed ? shadow_visibility(L, s.P, s.N, NdotL) : 1.0;
+  float visibility = (filter_id == NO_SHADOW) ? 1.0 : shadow_visibility(L, s.P, s.N, NdotL, filter_id);
   unshadowed += weight;
   arriving += weight * visibility;
 #if SPECULAR_MODEL == SPECULAR_BLINN
@@ -77,12 +80,22 @@ void main()
   /* Only the lights this pixel's screen bin lists (engine/light_bins.py): word w of the bin
    * holds lights w * LIGHT_WORD_BITS + bit, as exact small integers in a float channel. */
   vec4 words = texelFetch(light_bins, ivec2(gl_FragCoord.xy) / LIGHT_BIN_SIZE, 0);
+#  if SAMPLED_LIGHTS
   for (int w = 0; w < LIGHT_WORDS; w++) {
-    uint bits = uint(words[w]) & uint(frame.shadowed_mask[w]);
+    uint bits = uint(words[w]) & uint(frame.sampled_mask[w]);
     while (bits != 0u) {
       int b = findLSB(bits);
       bits &= bits - 1u;
-      add_light(w * LIGHT_WORD_BITS + b, true, s, color, arriving, unshadowed);
+      add_light(w * LIGHT_WORD_BITS + b, FILTER_PCSS, s, color, arriving, unshadowed);
+    }
+  }
+#  endif
+  for (int w = 0; w < LIGHT_WORDS; w++) {
+    uint bits = uint(words[w]) & uint(frame.shadowed_mask[w]) & ~uint(frame.sampled_mask[w]);
+    while (bits != 0u) {
+      int b = findLSB(bits);
+      bits &= bits - 1u;
+      add_light(w * LIGHT_WORD_BITS + b, SHADOW_FILTER, s, color, arriving, unshadowed);
     }
   }
   for (int w = 0; w < LIGHT_WORDS; w++) {
@@ -90,15 +103,20 @@ void main()
     while (bits != 0u) {
       int b = findLSB(bits);
       bits &= bits - 1u;
-      add_light(w * LIGHT_WORD_BITS + b, false, s, color, arriving, unshadowed);
+      add_light(w * LIGHT_WORD_BITS + b, NO_SHADOW, s, color, arriving, unshadowed);
     }
   }
 #else
-  for (int i = 0; i < frame.shadowed_count; i++) {
-    add_light(i, true, s, color, arriving, unshadowed);
+#  if SAMPLED_LIGHTS
+  for (int i = 0; i < frame.sampled_count; i++) {
+    add_light(i, FILTER_PCSS, s, color, arriving, unshadowed);
+  }
+#  endif
+  for (int i = frame.sampled_count; i < frame.shadowed_count; i++) {
+    add_light(i, SHADOW_FILTER, s, color, arriving, unshadowed);
   }
   for (int i = frame.shadowed_count; i < frame.light_count; i++) {
-    add_light(i, false, s, color, arriving, unshadowed);
+    add_light(i, NO_SHADOW, s, color, arriving, unshadowed);
   }
 #endif
   out_color = vec4(color, 1.0);

@@ -86,7 +86,10 @@ float shadow_disk(ivec2 origin, vec2 st, float ref, float r)
   return lit / float(DISK_SAMPLES);
 }
 
-float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
+/* ``filter_id`` is a literal at every call (FILTER_*), so each call compiles to its one filter:
+ * lights sampled over their extent use PCSS with their per-sample size, the others the
+ * scene's filter. */
+float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filter_id)
 {
   int mode = L.shadow_mode;
   if (mode == SHADOW_MODE_NONE) {
@@ -134,17 +137,21 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
   ivec2 origin = ivec2(tile % columns, tile / columns) * size;
   vec2 st = uv * float(size);
 
-#if SHADOW_FILTER == FILTER_NONE
-  return shadow_tap(origin, ivec2(floor(st)), SHADOW_REF(0.0));
-#elif SHADOW_FILTER == FILTER_HARDWARE
-  return shadow_bilinear(origin, st, SHADOW_REF(1.0));
-#elif SHADOW_FILTER == FILTER_PCF
+  if (filter_id == FILTER_NONE) {
+    return shadow_tap(origin, ivec2(floor(st)), SHADOW_REF(0.0));
+  }
+  if (filter_id == FILTER_HARDWARE) {
+    return shadow_bilinear(origin, st, SHADOW_REF(1.0));
+  }
+#if SHADOW_FILTER == FILTER_PCF
+  if (filter_id == FILTER_PCF) {
   /* Separable Gaussian weights compiled in as constants, so both loops unroll. */
   const float w[2 * PCF_RADIUS + 2] = float[](PCF_WEIGHTS_LIST, 0.0); /* one zero past the end */
   float spacing = frame.pcf_spacing;
   float ref = SHADOW_REF(float(PCF_RADIUS) * spacing);
   float lit = 0.0;
 #  if PCF_GATHER
+  {
   /* Taps one texel apart: each textureGather reads a 2x2 block, so an NxN kernel takes
    * ceil(N/2)^2 fetches. Gather order: (x0, y1), (x1, y1), (x1, y0), (x0, y0). The block past
    * the kernel's last row/column gets the zero weight. */
@@ -165,6 +172,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
     }
   }
   return lit;
+  }
 #  endif
   for (int y = -PCF_RADIUS; y <= PCF_RADIUS; y++) {
     float row = 0.0;
@@ -174,10 +182,13 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
     lit += w[y + PCF_RADIUS] * row;
   }
   return lit;
-#elif SHADOW_FILTER == FILTER_JITTER
-  float r = frame.filter_radius;
-  return shadow_disk(origin, st, SHADOW_REF(r), r);
-#elif SHADOW_FILTER == FILTER_PCSS
+  }
+#endif
+  if (filter_id == FILTER_JITTER) {
+    float r = frame.filter_radius;
+    return shadow_disk(origin, st, SHADOW_REF(r), r);
+  }
+  /* FILTER_PCSS */
   /* 1. Blocker search: average depth of the texels that occlude P, over the region a light of
    *    this size can shadow P from. 2. Penumbra width from similar triangles: sun
    *    w = (d_r - d_b) * 2 tan(angle / 2); local light w = 2 r (d_r - d_b) / d_b.
@@ -204,9 +215,6 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL)
                       2.0 * L.shadow_radius * (receiver - blocker) / max(blocker, 1e-30);
   float r = clamp(0.5 * width / texel, 0.5, max_r);
   return shadow_disk(origin, st, SHADOW_REF(r), r);
-#else
-#  error "unknown SHADOW_FILTER"
-#endif
 #undef SHADOW_REF
 }
 

@@ -103,11 +103,51 @@ def _area_light_points(scene, n=48):
     return (local @ np.array(ob.matrix_world).T)[:, :3]
 
 
-def test_area_light_shadow_converges_to_the_unoccluded_fraction_of_the_light(penumbra):
-    scene = _area_scene()
+def _sun_scene(size=64):
+    """The box over the plane under a sun 10 degrees wide, 25 degrees off vertical."""
+    scene = scenes.empty_scene(size, size)
+    scenes.box_over_plane(scene, plane_size=30.0)
+    scenes.light(scene, "L", "SUN", 3.0, rotation=(math.radians(-25), 0, 0), angle=math.radians(10))
+    scenes.top_camera(scene, height=20.0, ortho_scale=5.0)
+    scene.penumbra.shadow_map_size = 1024
+    return scene
+
+
+def _sun_points(scene, receivers, n=40):
+    """Far points along directions filling the sun's disc (a dense polar grid, equal areas)."""
+    ob = scene.objects["L"]
+    d = -np.array(ob.matrix_world.to_3x3().col[2])
+    u = np.cross(d, (1.0, 0.0, 0.0))
+    u /= np.linalg.norm(u)
+    v = np.cross(d, u)
+    tan_half = math.tan(ob.data.angle / 2)
+    r = np.sqrt((np.arange(n) + 0.5) / n)
+    a = 2 * math.pi * (np.arange(2 * n) + 0.5) / (2 * n)
+    R, A = np.meshgrid(r, a)
+    dirs = d + tan_half * (R.ravel()[:, None] * np.cos(A.ravel())[:, None] * u + (R * np.sin(A)).ravel()[:, None] * v)
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    return -dirs * 1e4  # offsets from a receiver towards the sun
+
+
+def _sun_visibility(points, offsets, lo=BOX_LO, hi=BOX_HI):
+    seen = np.zeros(points.shape[:-1])
+    for q in offsets:
+        seen += ~ray_hits_box(points, np.broadcast_to(q, points.shape), lo, hi)
+    return seen / len(offsets)
+
+
+@pytest.mark.parametrize("light", ["AREA", "SUN"])
+def test_soft_shadow_converges_to_the_unoccluded_fraction_of_the_light(penumbra, light):
+    """Mean visibility error, measured on 5.2 at 1/4/16/64/256 samples: area light (2 x 1 m
+    rectangle) 0.170/0.078/0.023/0.0083/0.0041, sun (10 degrees) 0.027/0.016/0.0038/0.0015/
+    0.0008: about N^-0.8 from 4 to 64 samples, N^-0.6 from 16 to 256. Bound at 64: 0.015."""
+    scene = _area_scene() if light == "AREA" else _sun_scene()
     view, proj, w, h = camera_matrices(scene)
     p, _depth = plane_hits(view, proj, w, h)
-    expected = _light_visibility(p, _area_light_points(scene))
+    if light == "AREA":
+        expected = _light_visibility(p, _area_light_points(scene))
+    else:
+        expected = _sun_visibility(p, _sun_points(scene, p))
     # The plane around the box's shadow, less the box's top face (the camera looks straight down).
     under_box = (np.abs(p[..., 0]) < 0.55) & (np.abs(p[..., 1]) < 0.55)
     region = ((expected < 0.999) | (np.abs(p[..., 0]) < 1.5) & (np.abs(p[..., 1]) < 1.5)) & ~under_box
@@ -116,9 +156,9 @@ def test_area_light_shadow_converges_to_the_unoccluded_fraction_of_the_light(pen
         shadow = render(_samples(scene, n), passes=("Combined", "Shadow"))["Shadow"][..., 0]
         errors[n] = float(np.abs(shadow - expected)[region].mean())
     assert errors[4] > errors[16] > errors[64], errors
-    assert errors[64] < 0.03, errors
+    assert errors[64] < 0.015, errors
     penumbra_px = (expected > 0.05) & (expected < 0.95)
-    assert penumbra_px.sum() > 200  # a real penumbra is compared, not a hard edge
+    assert penumbra_px.sum() > 100  # a real penumbra is compared, not a hard edge
 
 
 def test_area_light_irradiance_matches_its_form_factor(penumbra):
