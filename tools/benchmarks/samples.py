@@ -50,6 +50,8 @@ def add_arguments(parser):
     timing.add_runs_argument(parser, None, "timed renders per configuration (default 3; 1 with --quick)")
     parser.add_argument("--quick", action="store_true", help="three scenes at 160x90, up to 64 samples")
     parser.add_argument("--cache", type=Path, default=kit.DEFAULT_CACHE, help="Cycles reference cache folder")
+    parser.add_argument("--width", type=int, default=None, help="frame width (480; 160 with --quick)")
+    parser.add_argument("--height", type=int, default=None, help="frame height (270; 90 with --quick)")
 
 
 def log(message):
@@ -187,6 +189,8 @@ def run(args):
     plan = dict(QUICK if args.quick else FULL)
     if args.runs:
         plan["runs"] = args.runs
+    if args.width or args.height:
+        plan["size"] = (args.width or plan["size"][0], args.height or plan["size"][1])
     args.out.mkdir(parents=True, exist_ok=True)
     session.load_penumbra().register()
     started = time.perf_counter()
