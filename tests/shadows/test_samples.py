@@ -195,6 +195,40 @@ def test_same_frame_and_settings_give_bit_identical_pixels(penumbra):
         np.testing.assert_array_equal(a[name], b[name], err_msg=name)
 
 
+_CHILD = """
+import hashlib, sys
+from devkit import session
+session.isolate()
+from devkit import scenes
+from devkit.render import render
+session.load_penumbra().register()
+scene = scenes.demo_scene(64, 36)
+scene.penumbra.render_samples = 8
+scene.objects["Spot"].data.shadow_soft_size = 0.5
+print("HASH", hashlib.sha256(render(scene)["Combined"].tobytes()).hexdigest())
+sys.stdout.flush()
+session.hard_exit(0)
+"""
+
+
+def test_a_new_process_renders_the_same_bits(penumbra):
+    import hashlib
+    import subprocess
+    import sys
+
+    from devkit.session import ROOT, child_env
+
+    scene = _samples(scenes.demo_scene(64, 36), 8)
+    scene.objects["Spot"].data.shadow_soft_size = 0.5
+    here = hashlib.sha256(render(scene)["Combined"].tobytes()).hexdigest()
+    proc = subprocess.run(
+        [sys.executable, "-c", _CHILD], capture_output=True, text=True, timeout=300, cwd=ROOT, env=child_env()
+    )
+    lines = [line for line in proc.stdout.splitlines() if line.startswith("HASH ")]
+    assert proc.returncode == 0 and lines, proc.stderr[-2000:]
+    assert lines[-1].split()[1] == here
+
+
 def test_hard_lights_keep_one_map_and_soft_lights_move_theirs(penumbra, gpu_call):
     from penumbra.engine.extract import camera_from_scene
 
