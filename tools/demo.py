@@ -24,6 +24,9 @@ def main(argv=None):
 
     session.load_penumbra().register()
     scene = scenes.demo_scene(args.width, args.height)
+    settings = scene.penumbra.bl_rna.properties
+    scene.penumbra.render_samples = settings["render_samples"].default  # what a new scene renders
+    scene.penumbra.viewport_samples = settings["viewport_samples"].default
     scene.view_settings.view_transform = "AgX"
     scene.view_layers[0].use_pass_z = True
     t = time.perf_counter()
