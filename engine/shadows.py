@@ -6,7 +6,8 @@ sampler whatever the number and kind of lights:
          can shadow them, texel-snapped;
   spot   one perspective tile covering the cone, near/far fitted to the casters inside it;
   point  up to six perspective tiles (cube faces); a face with no caster in reach is skipped;
-  area   shadowed like a point light at its centre (softness from its size).
+  area   shadowed like a point light at its centre (softness from its size), without the
+         cube face that looks wholly behind it (an area light emits forward only).
 A light with ``use_shadow`` off, or with no caster in reach, gets no tile and costs nothing.
 Tiles whose fit and casters did not change since the last frame are not redrawn.
 """
@@ -79,6 +80,17 @@ def perspective_tile(position, forward, fov, corners, lo, hi, map_size):
     return Tile(fit, inside)
 
 
+# A cube face's frustum reaches 54.74 degrees (its corners) from its axis; it lies wholly
+# behind an area light when its axis is within 90 - 54.74 degrees of the light's back.
+_BEHIND_COS = math.cos(math.radians(90.0 - math.degrees(math.atan(math.sqrt(2.0)))))
+
+
+def behind_area_light(face_forward, light_direction):
+    """Whether a whole cube face looks into the half-space behind an area light, which it
+    does not light (it emits forward only): that face needs no map."""
+    return float(np.dot(face_forward, -np.asarray(light_direction))) >= _BEHIND_COS
+
+
 def plan_shadows(lights, corners, map_size, view_corners=None):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -110,7 +122,9 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
             mode = "SINGLE"
         else:  # POINT, AREA
             tiles = [
-                perspective_tile(light.position, fwd, math.pi / 2.0, corners, lo, hi, map_size)
+                None
+                if light.type == "AREA" and behind_area_light(fwd, light.direction)
+                else perspective_tile(light.position, fwd, math.pi / 2.0, corners, lo, hi, map_size)
                 for fwd in lightspace.CUBE_FORWARDS
             ]
             mode = "CUBE"

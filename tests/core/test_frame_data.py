@@ -189,3 +189,27 @@ def test_a_frame_without_maps_compiles_no_shadow_filter():
     assert build_frame_data(shadowed, _camera(), (0, 0, 0), _settings(), _plan(shadowed)).defines["SHADOW_FILTER"] == (
         "FILTER_PCF"
     )
+
+
+def test_an_area_light_plans_no_map_for_the_face_behind_it():
+    """Casters above and below a light 4 m up that points down: a point light needs the +Z
+    face for the box above it, an area light (which lights only the half-space in front of
+    it) does not; a tilted area light keeps every face its front half-space reaches."""
+    below = lightspace.box_corners(np.array([-1.0, -1.0, 0.0]), np.array([1.0, 1.0, 1.0]))
+    above = lightspace.box_corners(np.array([-1.0, -1.0, 6.0]), np.array([1.0, 1.0, 7.0]))
+    corners = np.stack([below, above])
+    down = np.eye(4)
+    down[:3, 3] = (0.0, 0.0, 4.0)  # lights look along local -Z: straight down
+    point = Light(type="POINT", color=np.ones(3), matrix=down, radius=0.1)
+    area = Light(type="AREA", color=np.ones(3), matrix=down, radius=0.0, size=1.0, size_x=1.0, size_y=1.0)
+    point_faces = shadows.plan_shadows([point], corners, 64).lights[0].tiles
+    area_faces = shadows.plan_shadows([area], corners, 64).lights[0].tiles
+    plus_z = 4  # CUBE_FORWARDS order: +X, -X, +Y, -Y, +Z, -Z
+    assert np.allclose(lightspace.CUBE_FORWARDS[plus_z], (0, 0, 1))
+    assert point_faces[plus_z] >= 0 and area_faces[plus_z] == -1
+    assert sum(t >= 0 for t in area_faces) == sum(t >= 0 for t in point_faces) - 1
+    tilted = down.copy()
+    tilted[:3, :3] = lightspace.look_at((0, 0, 0), (1.0, 0.0, 0.2))[:3, :3].T  # faces +X, a bit up
+    area_tilted = Light(type="AREA", color=np.ones(3), matrix=tilted, radius=0.0, size=1.0, size_x=1.0, size_y=1.0)
+    assert shadows.behind_area_light(lightspace.CUBE_FORWARDS[1], area_tilted.direction)  # -X is behind
+    assert not shadows.behind_area_light(lightspace.CUBE_FORWARDS[plus_z], area_tilted.direction)
