@@ -10,7 +10,7 @@ them with the film filter's weights:
   convolved with it.
 * **Soft lights.** A light with size (sun ``angle``, point/spot ``shadow_soft_size``, area
   ``size``/``size_y`` and shape) shines from a different point of itself in each sample: the
-  centre in sample 0, then Halton points (bases 5, 7, 11, rotated per light so lights do not
+  points of a Hammersley set of N (stratified for any N, rotated per light so lights do not
   move in step) on its disc, ball or area. Every sample's shadow map is a hard shadow from that
   point, so the average converges to the true visibility (Heckbert-Herf accumulation), and an
   area light's irradiance to the integral over its surface. Each sample stands for 1/N of
@@ -31,7 +31,6 @@ import math
 import numpy as np
 
 PIXEL_BASES = (2, 3)
-LIGHT_BASES = (5, 7, 11)
 
 
 def radical_inverse(index, base):
@@ -94,11 +93,23 @@ def jittered_projection(projection, dx, dy, width, height):
     return shift @ p
 
 
-def _light_point(s, light_index, dims):
-    """Sample ``s``'s point in [0, 1)^dims for light ``light_index`` (Halton, rotated)."""
-    rng = np.random.default_rng(0x9E3779B1 + 7919 * light_index)  # a fixed rotation per light
-    rotation = rng.random(dims)
-    return [(radical_inverse(s, LIGHT_BASES[d]) + rotation[d]) % 1.0 for d in range(dims)]
+@functools.lru_cache(maxsize=256)
+def _light_order(light_index, count):
+    """A fixed shuffled order of the ``count`` points for light ``light_index``, and a fixed
+    rotation: the points do not follow the pixel offsets' sequence, nor other lights'."""
+    rng = np.random.default_rng(0x9E3779B1 + 7919 * light_index)
+    return rng.permutation(count), rng.random(3)
+
+
+def _light_point(s, light_index, dims, count):
+    """Sample ``s``'s point in [0, 1)^dims for light ``light_index`` of a frame of ``count``
+    samples: a point of the Hammersley set of ``count`` points ((j + 1/2) / count, then radical
+    inverses in bases 2 and 3), which is stratified for every count (four samples land in four
+    quarters), visited in a shuffled order and rotated per light."""
+    order, rotation = _light_order(light_index, count)
+    j = int(order[s % count])
+    coords = [(j + 0.5) / count, radical_inverse(j, 2), radical_inverse(j, 3)][:dims]
+    return [(c + rotation[d]) % 1.0 for d, c in enumerate(coords)]
 
 
 def concentric_disk(u, v):
@@ -167,15 +178,13 @@ def sampled_lights(lights, plan):
 def light_at_sample(light, light_index, s, count):
     """``light`` as it shines in sample ``s`` of ``count``: moved to a point of itself (a
     direction inside its cone for a sun), with PCSS's light size scaled by 1/sqrt(count).
-    Lights without size, ``count`` 1 and sample 0 keep the light's centre."""
+    Lights without size, and every light in a frame of one sample, keep the light's centre."""
     if count <= 1 or not has_size(light):
         return light
     scale = 1.0 / math.sqrt(count)
-    if s == 0:
-        return dataclasses.replace(light, penumbra_scale=scale, sampled=True)
     m = np.array(light.matrix, dtype=np.float64)
     if light.type == "SUN":
-        x, y = concentric_disk(*_light_point(s, light_index, 2))
+        x, y = concentric_disk(*_light_point(s, light_index, 2, count))
         d = light.direction
         u, v = _basis(d)
         tan_half = math.tan(0.5 * min(light.angle, math.pi * 0.99))
@@ -189,7 +198,7 @@ def light_at_sample(light, light_index, s, count):
         xa /= np.linalg.norm(xa)
         m[:3, 0], m[:3, 1], m[:3, 2] = xa, np.cross(z, xa), z
     elif light.type == "AREA":
-        u, v = _light_point(s, light_index, 2)
+        u, v = _light_point(s, light_index, 2, count)
         if light.shape in ("DISK", "ELLIPSE"):
             x, y = concentric_disk(u, v)
             x, y = 0.5 * x, 0.5 * y
@@ -198,11 +207,11 @@ def light_at_sample(light, light_index, s, count):
         local = np.array([x * light.size_x, y * light.size_y, 0.0, 1.0])
         m[:3, 3] = (m @ local)[:3]  # the light's own axes carry its object scale
     elif light.type == "SPOT":
-        x, y = concentric_disk(*_light_point(s, light_index, 2))
+        x, y = concentric_disk(*_light_point(s, light_index, 2, count))
         u, v = _basis(light.direction)
         m[:3, 3] = m[:3, 3] + light.radius * (x * u + y * v)
     else:  # POINT: uniform in the ball, which looks the same from every direction
-        u, v, w = _light_point(s, light_index, 3)
+        u, v, w = _light_point(s, light_index, 3, count)
         z = 1.0 - 2.0 * u
         r_xy = math.sqrt(max(0.0, 1.0 - z * z))
         phi = 2.0 * math.pi * v
