@@ -145,42 +145,27 @@ SHADOW_DEPTH = Program(
 # needs no colour target and no second buffer.
 SHADOW_DEPTH_ONLY = replace(SHADOW_DEPTH, name="shadow_depth_only", outputs=(), depth_write="ANY")
 
-# Copies a tile rendered in the scratch target into its place in the atlas (FLOAT16, RGBA8).
-TILE_COPY = Program(
-    name="tile_copy",
+# out = scale * src at (pixel - origin): a shadow tile from the scratch target into its place in
+# the atlas (scale 1, origin the tile's corner; FLOAT16, RGBA8), a sample added to the
+# accumulation (scale its weight, additive blending) and the accumulation resolved (scale
+# 1 / total weight). The _SHADOW variant carries the Shadow pass along in a second target.
+SCALED_COPY = Program(
+    name="scaled_copy",
     vertex="fullscreen.vert.glsl",
-    fragment="tile_copy.frag.glsl",
+    fragment="scaled_copy.frag.glsl",
     vertex_in=(("VEC2", "pos"),),
-    push_constants=(("IVEC2", "origin"),),
-    samplers=(("FLOAT_2D", "tile_color"),),
+    push_constants=(("IVEC2", "origin"), ("FLOAT", "scale")),
+    samplers=(("FLOAT_2D", "src_color"),),
     outputs=(("VEC4", "out_color"),),
+    defines=(("WITH_SHADOW", False),),
 )
-
-
-# Multi-sample frames: accumulation += weight * sample (additive blending into float32), then
-# resolve = accumulation / total weight. WITH_SHADOW carries the Shadow pass along.
-ACCUMULATE = Program(
-    name="accumulate",
-    vertex="fullscreen.vert.glsl",
-    fragment="accumulate.frag.glsl",
-    vertex_in=(("VEC2", "pos"),),
-    push_constants=(("FLOAT", "weight"),),
-    samplers=(("FLOAT_2D", "sample_color"), ("FLOAT_2D", "sample_shadow")),
+SCALED_COPY_SHADOW = replace(
+    SCALED_COPY,
+    name="scaled_copy_shadow",
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "src_shadow")),
     outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
+    defines=(("WITH_SHADOW", True),),
 )
-ACCUMULATE_COLOR = replace(
-    ACCUMULATE, name="accumulate_color", samplers=ACCUMULATE.samplers[:1], outputs=ACCUMULATE.outputs[:1]
-)
-RESOLVE = Program(
-    name="resolve",
-    vertex="fullscreen.vert.glsl",
-    fragment="resolve.frag.glsl",
-    vertex_in=(("VEC2", "pos"),),
-    push_constants=(("FLOAT", "inv_weight"),),
-    samplers=(("FLOAT_2D", "accum_color"), ("FLOAT_2D", "accum_shadow")),
-    outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
-)
-RESOLVE_COLOR = replace(RESOLVE, name="resolve_color", samplers=RESOLVE.samplers[:1], outputs=RESOLVE.outputs[:1])
 
 
 def shadow_program(depth_format):

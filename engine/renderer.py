@@ -14,15 +14,13 @@ from .frame_data import build_frame_data, select_lights
 from .post import post_stack
 from .post.base import PostContext
 from .programs import (
-    ACCUMULATE,
-    ACCUMULATE_COLOR,
     JITTER_SIZE,
     LIT,
     LIT_COLOR,
     MAX_LIGHTS,
     MAX_SHADOW_TILES,
-    RESOLVE,
-    RESOLVE_COLOR,
+    SCALED_COPY,
+    SCALED_COPY_SHADOW,
     SHADOW_SAMPLER,
 )
 from .shadows import ShadowAtlas, plan_shadows
@@ -269,18 +267,18 @@ class Renderer:
         stats.lights_out_of_view = len(lights) - len(keep)
         return [lights[i] for i in keep], [rects[i] for i in keep]
 
-    def _plan(self, draws, lights, camera, settings):
-        """The shadow plan of ``lights`` at their centres (numpy only, nothing drawn)."""
+    def _plan(self, draws, lights, camera, settings, map_size=None):
+        """The shadow plan of ``lights`` (numpy only, nothing drawn), with maps of
+        ``map_size`` (default: the setting)."""
         corners = np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
         view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
-        return plan_shadows(lights, corners, max(1, int(settings.shadow_map_size)), view_corners)
+        size = max(1, int(settings.shadow_map_size)) if map_size is None else map_size
+        return plan_shadows(lights, corners, size, view_corners)
 
     def _shadow_pass(self, draws, lights, camera, settings, stats):
         """Plan the maps this frame needs (numpy) and draw the ones whose content changed."""
-        corners = np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
         map_size = max(1, int(settings.shadow_map_size))
-        view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
-        plan = plan_shadows(lights, corners, map_size, view_corners)
+        plan = self._plan(draws, lights, camera, settings, map_size)
         if not plan.tiles:
             return plan
         columns, _rows = self.shadows.grid(len(plan.tiles))
@@ -291,7 +289,7 @@ class Renderer:
                 "GPU's largest texture"
             )
             map_size = clamped
-            plan = plan_shadows(lights, corners, map_size, view_corners)
+            plan = self._plan(draws, lights, camera, settings, map_size)
         if plan.unshadowed:
             stats.messages.append(
                 f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
@@ -389,11 +387,11 @@ class Renderer:
             self._accum_fb = gpu.types.GPUFrameBuffer(color_slots=(self._accum_color, self._accum_shadow))
         self._centre = None
 
-    def _fullscreen(self, program, framebuffer, defines, samplers, uniforms, blend="NONE"):
+    def _fullscreen(self, program, framebuffer, samplers, uniforms, blend="NONE"):
         import gpu
         from gpu_extras.batch import batch_for_shader
 
-        shader = self.shaders.get(program, defines)
+        shader = self.shaders.get(program)
         if self._fullscreen_batch is None:
             self._fullscreen_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
         width, height = self._size
@@ -404,6 +402,7 @@ class Renderer:
             shader.bind()
             for name, tex in samplers.items():
                 shader.uniform_sampler(name, tex)
+            shader.uniform_int("origin", (0, 0))
             for name, value in uniforms.items():
                 shader.uniform_float(name, value)
             self._fullscreen_batch.draw(shader)
@@ -411,14 +410,7 @@ class Renderer:
 
     def _accumulate(self, weight, aux):
         """accumulation += weight * this sample (colour, and shadow with ``aux``)."""
-        with_shadow = aux and self._accum_shadow is not None
-        samplers = {"sample_color": self._color}
-        if with_shadow:
-            samplers["sample_shadow"] = self._shadow
-        program = ACCUMULATE if with_shadow else ACCUMULATE_COLOR
-        self._fullscreen(
-            program, self._accum_fb, {"WITH_SHADOW": with_shadow}, samplers, {"weight": weight}, "ADDITIVE_PREMULT"
-        )
+        self._scaled_copy(self._accum_fb, (self._color, self._shadow), weight, aux, blend="ADDITIVE_PREMULT")
 
     def _resolve(self, aux):
         """The filtered average (accumulation / total weight) into the colour (and shadow)
@@ -429,12 +421,18 @@ class Renderer:
         if self._resolve_fb is None or self._resolve_fb[0] != (self._size, with_shadow):
             slots = (self._color, self._shadow) if with_shadow else (self._color,)
             self._resolve_fb = ((self._size, with_shadow), gpu.types.GPUFrameBuffer(color_slots=slots))
-        samplers = {"accum_color": self._accum_color}
-        if with_shadow:
-            samplers["accum_shadow"] = self._accum_shadow
-        program = RESOLVE if with_shadow else RESOLVE_COLOR
         inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
-        self._fullscreen(program, self._resolve_fb[1], {"WITH_SHADOW": with_shadow}, samplers, {"inv_weight": inverse})
+        self._scaled_copy(self._resolve_fb[1], (self._accum_color, self._accum_shadow), inverse, aux)
+
+    def _scaled_copy(self, framebuffer, sources, scale, aux, blend="NONE"):
+        """framebuffer (<blend>)= scale * sources: colour, and shadow when ``aux`` and the
+        accumulation carries it."""
+        with_shadow = aux and self._accum_shadow is not None
+        samplers = {"src_color": sources[0]}
+        if with_shadow:
+            samplers["src_shadow"] = sources[1]
+        program = SCALED_COPY_SHADOW if with_shadow else SCALED_COPY
+        self._fullscreen(program, framebuffer, samplers, {"scale": scale}, blend)
 
     def _ubo(self, name, data):
         import gpu

@@ -19,7 +19,7 @@ import numpy as np
 
 from . import lightspace
 from .enums import DEPTH_FORMAT
-from .programs import MAX_SHADOW_TILES, TILE_COPY, TILE_STRUCT, depth_defines, shadow_program
+from .programs import MAX_SHADOW_TILES, SCALED_COPY, TILE_STRUCT, depth_defines, shadow_program
 
 
 @dataclass
@@ -283,12 +283,13 @@ class ShadowAtlas:
         import gpu
         from gpu_extras.batch import batch_for_shader
 
-        shader = shaders.get(TILE_COPY)
+        shader = shaders.get(SCALED_COPY)
         if self._copy_batch is None:
             self._copy_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
         with self._framebuffer.bind():
             gpu.state.viewport_set(x0, y0, self.size, self.size)
             shader.bind()
             shader.uniform_int("origin", (x0, y0))
-            shader.uniform_sampler("tile_color", self._scratch[0])
+            shader.uniform_float("scale", 1.0)
+            shader.uniform_sampler("src_color", self._scratch[0])
             self._copy_batch.draw(shader)
