@@ -321,3 +321,57 @@ def test_cancelling_keeps_the_samples_done_and_raises_nothing(penumbra, gpu_call
     (samples, cancelled, calls, image), three = gpu_call(job)
     assert samples == 3 and cancelled and calls == [1, 2, 3]
     np.testing.assert_array_equal(image, three)
+
+
+# --- parameter extremes -----------------------------------------------------------------------
+
+
+def test_filter_size_zero_and_ten_and_hard_lights_at_many_samples(penumbra, gpu_call):
+    """filter_size 0 jitters nothing: with only hard lights every sample is the same, so any
+    sample count gives the one-sample image. filter_size 10 (its maximum) stays finite and
+    keeps the mean brightness (the filter is normalised)."""
+    from penumbra.engine.extract import camera_from_scene
+
+    scene = scenes.demo_scene(48, 27)
+    scene.penumbra.layers.clear()
+    for ob in scene.objects:
+        if ob.type == "LIGHT":
+            ob.data.shadow_soft_size = 0.0
+            if ob.data.type == "SUN":
+                ob.data.angle = 0.0
+
+    def frames(filter_size):
+        scene.penumbra.filter_size = filter_size
+
+        def job(engine, depsgraph):
+            cam = camera_from_scene(depsgraph, scene, 48, 27)
+            one = engine.render_frame(depsgraph, cam, 48, 27).color_array().copy()
+            many = engine.render_frame(depsgraph, cam, 48, 27, samples=(0, 8), sample_count=8).color_array().copy()
+            return one, many
+
+        return gpu_call(job)
+
+    one, many = frames(0.0)
+    np.testing.assert_allclose(many, one, rtol=1e-6, atol=1e-7)
+    one, wide = frames(10.0)
+    assert np.isfinite(wide).all()
+    assert abs(wide[..., :3].mean() - one[..., :3].mean()) < 0.05 * one[..., :3].mean()
+    assert np.abs(wide - one).max() > 0.05  # a 10-pixel filter does blur the 48x27 frame
+
+
+def test_smallest_navigation_scale_on_a_tiny_region(penumbra, gpu_call):
+    scene = scenes.demo_scene(5, 3)
+    scene.penumbra.navigation_scale = 0.1
+
+    def job(engine, depsgraph):
+        cam = scene.camera.evaluated_get(depsgraph)
+        view = cam.matrix_world.inverted()
+        window = cam.calc_matrix_camera(depsgraph, x=5, y=3, scale_x=1.0, scale_y=1.0)
+        engine.viewport_frame(depsgraph, view, window, 5, 3)
+        moved = view.copy()
+        moved.translation.x += 0.1
+        out, _ = engine.viewport_frame(depsgraph, moved, window, 5, 3)
+        return out.width, out.height, out.color_array().copy()
+
+    w, h, image = gpu_call(job)
+    assert (w, h) == (1, 1) and np.isfinite(image).all()
