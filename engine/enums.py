@@ -155,6 +155,7 @@ SPECULAR_MODEL = Enum(
     (
         ("BLINN", "Blinn-Phong", "Normalised Blinn-Phong highlight (half vector)", 0),
         ("PHONG", "Phong", "Normalised Phong highlight (reflection vector)", 1),
+        ("GGX", "GGX", "GGX microfacet highlight with Smith shadowing and Fresnel, as the Principled BSDF", 2),
     ),
 )
 

@@ -11,15 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .materials import material_from_blender, world_from_blender
+
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
-
-
-@dataclass
-class Material:
-    base_color: tuple = (0.8, 0.8, 0.8, 1.0)
-    roughness: float = 0.5
-    specular: float = 0.5
-    metallic: float = 0.0
 
 
 @dataclass
@@ -35,6 +29,10 @@ class Geometry:
     indices: np.ndarray  # (triangles, 3) int32 into positions
     ranges: list  # (material index, first triangle, triangle count)
     bounds: np.ndarray  # (2, 3) local min/max of the drawn vertices; NaN when empty
+    uvs: np.ndarray | None = None  # (vertices, 2) float32: the UV map a material's textures read
+    colors: np.ndarray | None = None  # (vertices, 4) float32 linear: a colour attribute
+    tangents: np.ndarray | None = None  # (vertices, 4) float32 MikkTSpace tangent and sign; w 0: none
+    messages: tuple = ()
     deps: frozenset = frozenset()
     serial: int = 0  # distinguishes rebuilt geometry of the same key (GPU batches key on it)
 
@@ -43,11 +41,42 @@ class Geometry:
         return len(self.indices)
 
 
+@dataclass(frozen=True)
+class Needs:
+    """Vertex data beyond positions and normals that an object's materials read."""
+
+    uv_map: str | None = None  # "" = the active render UV map
+    color_attribute: str | None = None  # "" = the active render colour attribute
+    tangents: bool = False  # MikkTSpace tangents of ``uv_map`` (normal maps)
+
+    @classmethod
+    def of(cls, materials):
+        uv_maps, colors, tangents = [], [], False
+        for mat in materials:
+            if mat is None:
+                continue
+            uv_maps += [m for m in mat.uv_maps if m not in uv_maps]
+            if mat.color_attribute is not None and mat.color_attribute not in colors:
+                colors.append(mat.color_attribute)
+            tangents |= "normal" in mat.textures
+        return cls(uv_maps[0] if uv_maps else None, colors[0] if colors else None, tangents), (
+            uv_maps[1:],
+            colors[1:],
+        )
+
+    @property
+    def any(self):
+        return self.uv_map is not None or self.color_attribute is not None
+
+
 @dataclass
 class MeshInstance:
     key: tuple
     matrix: np.ndarray  # (4, 4) world matrix
     materials: list  # Material per slot (index = material index)
+    shadow: bool = True  # casts shadows (Object > Visibility > Ray Visibility > Shadow)
+    camera: bool = True  # seen by the camera (Ray Visibility > Camera)
+    holdout: bool = False  # Object > Visibility > Holdout: alpha 0 where it covers
 
 
 @dataclass
@@ -109,8 +138,11 @@ class Camera:
 class Snapshot:
     instances: list
     lights: list
-    world_color: np.ndarray
+    world_color: np.ndarray  # the world's mean radiance (and the background colour)
     geometry: dict  # key -> Geometry (shared with the cache)
+    world: object = None  # materials.World: the world's light as spherical harmonics
+    messages: tuple = ()  # what the scene uses that is not drawn (materials, world, objects)
+    images_changed: frozenset = frozenset()  # images updated since the last snapshot
 
 
 def matrix_np(m):
@@ -151,74 +183,6 @@ def camera_from_view(view_matrix, window_matrix):
     return Camera(view=matrix_np(view_matrix), projection=proj, is_ortho=abs(proj[3, 3] - 1.0) < 1e-9)
 
 
-# --- materials ---------------------------------------------------------------------------
-
-_SPECULAR_INPUTS = ("Specular IOR Level", "Specular")
-
-
-def _input_value(node, name, default):
-    sock = node.inputs.get(name)
-    if sock is None:
-        return default
-    return sock.default_value
-
-
-def _principled(mat):
-    tree = getattr(mat, "node_tree", None)
-    if tree is None:
-        return None
-    nodes = tree.nodes
-    for out in nodes:
-        if out.bl_idname == "ShaderNodeOutputMaterial" and out.is_active_output:
-            surface = out.inputs.get("Surface")
-            if surface is not None and surface.is_linked:
-                node = surface.links[0].from_node
-                if node.bl_idname == "ShaderNodeBsdfPrincipled":
-                    return node
-    for node in nodes:
-        if node.bl_idname == "ShaderNodeBsdfPrincipled":
-            return node
-    return None
-
-
-def material_from_blender(mat):
-    if mat is None:
-        return Material()
-    node = _principled(mat) if getattr(mat, "use_nodes", True) else None
-    if node is not None:
-        spec = 0.5
-        for name in _SPECULAR_INPUTS:
-            if name in node.inputs:
-                spec = float(_input_value(node, name, 0.5))
-                break
-        return Material(
-            base_color=tuple(_input_value(node, "Base Color", (0.8, 0.8, 0.8, 1.0))),
-            roughness=float(_input_value(node, "Roughness", 0.5)),
-            specular=spec,
-            metallic=float(_input_value(node, "Metallic", 0.0)),
-        )
-    return Material(
-        base_color=tuple(mat.diffuse_color),
-        roughness=float(mat.roughness),
-        specular=float(mat.specular_intensity),
-        metallic=float(mat.metallic),
-    )
-
-
-def world_color(scene):
-    world = scene.world
-    if world is None:
-        return np.zeros(3)
-    tree = getattr(world, "node_tree", None)
-    if tree is not None and getattr(world, "use_nodes", True):
-        for node in tree.nodes:
-            if node.bl_idname == "ShaderNodeBackground":
-                color = node.inputs["Color"].default_value
-                strength = node.inputs["Strength"].default_value
-                return np.array(color[:3], dtype=np.float64) * float(strength)
-    return np.array(world.color[:3], dtype=np.float64)
-
-
 # --- geometry ----------------------------------------------------------------------------
 
 
@@ -237,11 +201,14 @@ def _attribute(mesh, name, prop, count, dtype, width=1):
     return _read(attr.data, prop, count, dtype, width)
 
 
-def geometry_from_mesh(mesh):
+def geometry_from_mesh(mesh, needs=None):
     """A Blender mesh as an indexed triangle buffer (``Geometry``), read with ``foreach_get``
     from Blender's own arrays (the attribute API): positions, corner vertices, each triangle's
     corners and face, the faces' material indices, and normals on points (smooth meshes) or
     corners (``Mesh.normals_domain``).
+
+    ``needs`` (``Needs``): also read a UV map, a colour attribute and MikkTSpace tangents
+    (Blender's ``Mesh.calc_tangents``); vertices are then face corners, where those live.
 
     Triangles with a non-finite vertex are dropped (NaN/Inf positions must not reach the GPU).
     """
@@ -263,14 +230,24 @@ def geometry_from_mesh(mesh):
         mat = np.zeros(n, np.int32)  # no attribute: every face uses the first slot
     else:
         mat = face_material[_read(mesh.loop_triangle_polygons, "value", n, np.int32)]
-    if mesh.normals_domain == "POINT":  # smooth throughout: one vertex per mesh vertex
+    extras = needs is not None and needs.any
+    if mesh.normals_domain == "POINT" and not extras:  # smooth throughout: one vertex per mesh vertex
         positions = co
         normals = _read(mesh.vertex_normals, "vector", nv, np.float32, 3)
         tris = corner_vert[corners]
     else:  # flat or mixed: one vertex per face corner
         positions = co[corner_vert]
-        normals = _read(mesh.corner_normals, "vector", nc, np.float32, 3)
+        if mesh.normals_domain == "POINT":
+            normals = _read(mesh.vertex_normals, "vector", nv, np.float32, 3)[corner_vert]
+        else:
+            normals = _read(mesh.corner_normals, "vector", nc, np.float32, 3)
         tris = corners
+    uvs = colors = tangents = None
+    messages = []
+    if extras:
+        uvs, tangents = _corner_uvs(mesh, needs, nc, messages)
+        if needs.color_attribute is not None:
+            colors = _corner_colors(mesh, needs.color_attribute, corner_vert, nc, messages)
     dropped = False
     if not np.isfinite(positions).all():
         vertex_ok = np.isfinite(positions).all(axis=1)
@@ -307,7 +284,59 @@ def geometry_from_mesh(mesh):
         np.ascontiguousarray(tris, np.int32),
         ranges,
         bounds.astype(np.float64),
+        uvs=uvs,
+        colors=colors,
+        tangents=tangents,
+        messages=tuple(messages),
     )
+
+
+def _corner_uvs(mesh, needs, nc, messages):
+    """(uvs, tangents) per face corner for ``needs.uv_map`` ("" = the active render map);
+    zeros (and a message) when the mesh has no such map."""
+    if needs.uv_map is None:
+        return None, None
+    layers = mesh.uv_layers
+    layer = layers.get(needs.uv_map) if needs.uv_map else next((u for u in layers if u.active_render), None)
+    if layer is None:
+        want = f"UV map '{needs.uv_map}'" if needs.uv_map else "a UV map"
+        messages.append(f"mesh '{mesh.name}' has no {want}: its textures read UV (0, 0)")
+        zeros = np.zeros((nc, 2), np.float32)
+        return zeros, (np.zeros((nc, 4), np.float32) if needs.tangents else None)
+    uvs = _read(layer.uv, "vector", nc, np.float32, 2)
+    tangents = None
+    if needs.tangents:
+        tangents = np.zeros((nc, 4), np.float32)
+        try:
+            mesh.calc_tangents(uvmap=layer.name)
+        except RuntimeError:
+            # N-gons: MikkTSpace needs triangles and quads; the shader then derives the
+            # tangent frame from screen-space derivatives of the UVs (w = 0).
+            messages.append(f"mesh '{mesh.name}': tangents from UV derivatives (it has n-gons)")
+        else:
+            tangents[:, :3] = _read(mesh.loops, "tangent", nc, np.float32, 3)
+            tangents[:, 3] = _read(mesh.loops, "bitangent_sign", nc, np.float32)
+            mesh.free_tangents()
+    if not np.isfinite(uvs).all():
+        uvs = np.where(np.isfinite(uvs), uvs, 0.0).astype(np.float32)
+    return uvs, tangents
+
+
+def _corner_colors(mesh, name, corner_vert, nc, messages):
+    """Linear RGBA per face corner of colour attribute ``name`` ("" = the active render one);
+    white (and a message) when it is missing."""
+    attrs = mesh.color_attributes
+    attr = attrs.get(name) if name else None
+    if attr is None and not name:
+        index = attrs.render_color_index
+        attr = attrs[index] if 0 <= index < len(attrs) else None
+    if attr is None or attr.domain not in {"POINT", "CORNER"}:
+        want = f"colour attribute '{name}'" if name else "a colour attribute"
+        messages.append(f"mesh '{mesh.name}' has no {want} on points or corners: white is used")
+        return np.ones((nc, 4), np.float32)
+    count = len(mesh.vertices) if attr.domain == "POINT" else nc
+    values = _read(attr.data, "color", count, np.float32, 4)
+    return np.ascontiguousarray(values[corner_vert] if attr.domain == "POINT" else values)
 
 
 def _geometry_key(inst, ob, own_data):
@@ -344,11 +373,13 @@ class SceneCache:
         self.built = 0  # geometries extracted since creation (tests and stats read it)
         self.materials = {}  # material name -> Material, until an update changes it
         self.materials_read = 0
+        self.images_changed = set()  # image names updated since the renderer last looked
+        self.world = None  # (world name, materials.World) until a world or image update
 
     def apply_updates(self, depsgraph):
         """Drop the geometry of every datablock whose geometry the depsgraph says changed, and
         the material read of every material (or, for a node group, every material) that
-        changed."""
+        changed; note changed images (their GPU textures are re-uploaded) and worlds."""
         changed = set()
         for update in depsgraph.updates:
             id_orig = update.id.original if update.id.original is not None else update.id
@@ -358,6 +389,11 @@ class SceneCache:
             elif kind == "NODETREE" and not getattr(id_orig, "is_embedded_data", False):
                 self.materials.clear()  # a node group may feed any material (a material's own
                 # tree is embedded data: its material is updated too)
+            elif kind == "IMAGE":
+                self.images_changed.add(id_orig.name_full)
+                self.world = None  # an environment image may have changed
+            elif kind in {"WORLD", "SCENE"}:
+                self.world = None
             if update.is_updated_geometry:
                 changed.add(id_orig.name_full)
         if changed:
@@ -382,17 +418,24 @@ class SceneCache:
     def clear(self):
         self.geometry.clear()
         self.materials.clear()
+        self.world = None
 
-    def _geometry_for(self, inst, ob, key, deps):
+    def _world(self, scene):
+        name = scene.world.name_full if scene.world is not None else ""
+        if self.world is None or self.world[0] != name:
+            self.world = (name, world_from_blender(scene))
+        return self.world[1]
+
+    def _geometry_for(self, inst, ob, key, deps, needs):
         geo = self.geometry.get(key)
         if geo is not None:
             return geo
         if ob.type == "MESH":
-            geo = geometry_from_mesh(ob.data)
+            geo = geometry_from_mesh(ob.data, needs)
         else:
             mesh = ob.to_mesh()
             try:
-                geo = geometry_from_mesh(mesh) if mesh is not None else None
+                geo = geometry_from_mesh(mesh, needs) if mesh is not None else None
             finally:
                 ob.to_mesh_clear()
             if geo is None:
@@ -418,6 +461,7 @@ class SceneCache:
                 own[key] = data.as_pointer() if data is not None else 0
             return own[key]
 
+        messages = []
         for inst in depsgraph.object_instances:
             ob = inst.object
             if ob.type == "LIGHT":
@@ -425,32 +469,86 @@ class SceneCache:
                 if light is not None:
                     lights.append(light)
                 continue
+            if ob.type == "CURVES":
+                messages.append(f"hair curves object '{ob.name}' is not drawn (hair is not supported)")
+                continue
             if ob.type not in GEOMETRY_TYPES:
                 continue
+            _note_hair(ob, inst, messages)
+            if not inst.is_instance and not inst.show_self:
+                continue  # a particle emitter with Show Emitter off for this render
             matrix = matrix_np(inst.matrix_world)
             if not np.all(np.isfinite(matrix)):
                 print(f"Penumbra: object '{ob.name}' has a non-finite matrix; skipped", file=sys.stderr)
                 continue
+            orig = ob.original if ob.original is not None else ob
+            camera, shadow = bool(orig.visible_camera), bool(orig.visible_shadow)
+            if not (camera or shadow):
+                continue
+            materials = [self._material(slot.material) for slot in ob.material_slots]
+            needs, extra = Needs.of(materials)
+            if extra[0] or extra[1]:
+                messages.append(
+                    f"object '{ob.name}': its materials read several UV maps or colour attributes; only "
+                    f"{needs.uv_map or 'the active UV map'} / {needs.color_attribute or 'the active colour attribute'} "
+                    "is drawn"
+                )
             key, deps = _geometry_key(inst, ob, own_data)
-            geo = self._geometry_for(inst, ob, key, deps)
+            if needs.any:
+                key = (*key, needs)
+            geo = self._geometry_for(inst, ob, key, deps, needs)
             if geo is None or geo.triangle_count == 0:
                 continue
             used.add(key)
-            materials = [self._material(slot.material) for slot in ob.material_slots]
-            instances.append(MeshInstance(key=key, matrix=matrix, materials=materials))
+            messages += geo.messages
+            for mat in materials:
+                if mat is not None:
+                    messages += mat.messages
+            instances.append(
+                MeshInstance(
+                    key=key,
+                    matrix=matrix,
+                    materials=materials,
+                    shadow=shadow,
+                    camera=camera,
+                    holdout=bool(getattr(orig, "is_holdout", False)),
+                )
+            )
         # Forget geometry no longer in the scene so its GPU buffers are freed.
         for key in [k for k in self.geometry if k not in used]:
             del self.geometry[key]
+        world = self._world(scene)
+        messages += world.messages
         return Snapshot(
             instances=instances,
             lights=lights,
-            world_color=world_color(scene),
+            world_color=world.mean,
             geometry=self.geometry,
+            world=world,
+            messages=tuple(f"Penumbra: {m}" for m in dict.fromkeys(messages)),
+            images_changed=frozenset(self._take_images_changed()),
         )
+
+    def _take_images_changed(self):
+        changed, self.images_changed = self.images_changed, set()
+        return changed
+
+
+def _note_hair(ob, inst, messages):
+    if inst.is_instance:
+        return
+    for psys in getattr(ob, "particle_systems", ()):
+        settings = psys.settings
+        if settings.type == "HAIR" and settings.render_type == "PATH":
+            messages.append(
+                f"hair of particle system '{psys.name}' on '{ob.name}' is not drawn (hair is not supported)"
+            )
 
 
 def light_from_blender(data, matrix):
     color = np.array(data.color[:3], dtype=np.float64) * float(data.energy)
+    if getattr(data, "use_temperature", False):
+        color *= np.array(data.temperature_color[:3], dtype=np.float64)  # Blender's blackbody colour
     color *= 2.0 ** float(getattr(data, "exposure", 0.0))
     if not np.all(np.isfinite(color)) or not np.all(np.isfinite(matrix)):
         return None

@@ -97,6 +97,8 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "sampled_count": 0,
         "sampled_mask": (0, 0, 0, 0),
         "world_color": np.asarray(world_color, np.float64)[:3],
+        "alpha_offset": 0.5,
+        **{f"world_sh{k}": (0.0, 0.0, 0.0, 0.0) for k in range(1, 9)},
         "constant_bias": settings.shadow_bias,
         "slope_bias": settings.shadow_slope_bias,
         "normal_offset": settings.shadow_normal_offset,
@@ -132,18 +134,28 @@ def build_frame_data(
     aux_outputs=True,
     rects=None,
     size=None,
+    alpha_offset=0.5,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
     the atlas the plan was drawn into (1/1 when no map was drawn); ``aux_outputs``: whether
     the variant writes the depth, shadow and normal targets as well as colour; ``rects``: per
     light, the screen rectangle it can light (``light_bins.screen_rects``) on a frame of
-    ``size`` (width, height) pixels, which bins the lights when several are local."""
+    ``size`` (width, height) pixels, which bins the lights when several are local.
+    ``world_color``: a ``materials.World`` (its SH light) or a constant colour;
+    ``alpha_offset``: this sample's shift of the alpha-hash threshold ((s + 0.5) / N)."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings)
     order, sampled, shadowed = shading_order(lights, plan)
-    frame = frame_row(camera, world_color, len(lights), settings, tile_size, atlas_columns)
+    sh = getattr(world_color, "sh", None)  # a materials.World, or a constant colour
+    frame = frame_row(
+        camera, world_color.mean if sh is not None else world_color, len(lights), settings, tile_size, atlas_columns
+    )
+    if sh is not None:
+        for k in range(1, 9):
+            frame[f"world_sh{k}"] = (*sh[k], 0.0)
+    frame["alpha_offset"] = alpha_offset
     frame["shadowed_count"] = shadowed
     frame["shadowed_mask"] = light_bins.word_masks(0, shadowed, LIGHT_WORDS)
     frame["sampled_count"] = sampled

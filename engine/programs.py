@@ -11,6 +11,7 @@ from dataclasses import replace
 from ..shaders.loader import Program, Struct
 from . import light_bins
 from .enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
+from .materials import CHANNELS
 
 MAX_LIGHTS = 64
 LIGHT_WORDS = MAX_LIGHTS // light_bins.WORD_BITS  # channels of a light-bin texel
@@ -66,7 +67,16 @@ FRAME_STRUCT = Struct(
         ("IVEC4", "shadowed_mask"),  # the same lights as bits of the light-bin words
         ("INT", "sampled_count"),  # lights [0, sampled_count) move between samples (PCSS per sample)
         ("IVEC4", "sampled_mask"),
-        ("VEC3", "world_color"),
+        ("VEC3", "world_color"),  # the world's mean radiance (SH band 0)
+        ("FLOAT", "alpha_offset"),  # this sample's offset of the alpha-hash threshold
+        ("VEC4", "world_sh1"),  # SH bands 1 and 2 of the world's radiance (xyz; w unused)
+        ("VEC4", "world_sh2"),
+        ("VEC4", "world_sh3"),
+        ("VEC4", "world_sh4"),
+        ("VEC4", "world_sh5"),
+        ("VEC4", "world_sh6"),
+        ("VEC4", "world_sh7"),
+        ("VEC4", "world_sh8"),
         ("FLOAT", "constant_bias"),  # texels
         ("FLOAT", "slope_bias"),  # texels per unit of tan(angle)
         ("FLOAT", "normal_offset"),  # texels
@@ -80,6 +90,39 @@ FRAME_STRUCT = Struct(
 
 MESH_VERTEX_IN = (("VEC3", "pos"), ("VEC3", "nor"))
 
+# One material's values and, per texture channel (materials.CHANNELS), the rows of its UV
+# transform (uv' = (dot(row_u, uv1), dot(row_v, uv1))) and its mode (interpolation,
+# extension, 1 = the image's alpha output, 0).
+MATERIAL_STRUCT = Struct(
+    "MaterialData",
+    (
+        ("VEC4", "base_color"),
+        ("VEC3", "emission"),
+        ("FLOAT", "roughness"),
+        ("FLOAT", "metallic"),
+        ("FLOAT", "specular"),
+        ("FLOAT", "alpha"),
+        ("FLOAT", "normal_strength"),
+        *(f for c in CHANNELS for f in (("VEC4", f"{c}_uv_u"), ("VEC4", f"{c}_uv_v"), ("IVEC4", f"{c}_mode"))),
+    ),
+)
+ALPHA_MODES = {"OPAQUE": 0, "HASHED": 1, "BLEND": 2}
+
+
+def material_defines(features):
+    """Defines of a material variant: which channels sample a texture (TEX_<CHANNEL>), which
+    vertex data exist (HAS_UV, HAS_VCOL, HAS_TANGENT), the alpha mode, holdout."""
+    out = {f"TEX_{c.upper()}": f"TEX_{c.upper()}" in features for c in CHANNELS}
+    uv = any(out.values())
+    out["HAS_UV"] = uv
+    out["HAS_VCOL"] = "VCOL" in features
+    out["HAS_TANGENT"] = "TEX_NORMAL" in features
+    mode = next((m for m in ALPHA_MODES if f"ALPHA_{m}" in features), "OPAQUE")
+    out["ALPHA_MODE"] = ALPHA_MODES[mode]
+    out["HOLDOUT"] = "HOLDOUT" in features
+    return out
+
+
 _ENUM_DEFINES = {
     **DEPTH_FORMAT.defines(),
     **LIGHT_TYPE.defines(),
@@ -92,25 +135,26 @@ LIT = Program(
     name="lit",
     vertex="mesh.vert.glsl",
     fragment="lit.frag.glsl",
-    libs=("lib/common.glsl", "lib/lights.glsl", "lib/depth_encoding.glsl", "lib/shadow_filters.glsl"),
     vertex_in=MESH_VERTEX_IN,
     varyings=(
         ("smooth", "VEC3", "v_world"),
         ("smooth", "VEC3", "v_normal"),
         ("smooth", "FLOAT", "v_view_depth"),
     ),
-    push_constants=(
-        ("MAT4", "model"),
-        ("VEC4", "base_color"),
-        ("FLOAT", "roughness"),
-        ("FLOAT", "specular"),
-        ("FLOAT", "metallic"),
+    libs=(
+        "lib/common.glsl",
+        "lib/lights.glsl",
+        "lib/depth_encoding.glsl",
+        "lib/shadow_filters.glsl",
+        "lib/material.glsl",
     ),
+    push_constants=(("MAT4", "model"),),
     samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex"), ("FLOAT_2D", "light_bins")),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
         (LIGHT_STRUCT, "lights", MAX_LIGHTS),
         (TILE_STRUCT, "shadow_tiles", MAX_SHADOW_TILES),
+        (MATERIAL_STRUCT, "material", 0),
     ),
     outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth"), ("FLOAT", "out_shadow"), ("VEC4", "out_normal")),
     defines=tuple(
@@ -120,12 +164,47 @@ LIT = Program(
             "LIGHT_BIN_SIZE": light_bins.BIN_SIZE,
             "LIGHT_WORD_BITS": light_bins.WORD_BITS,
             "LIGHT_WORDS": LIGHT_WORDS,
+            **material_defines(frozenset()),
         }.items()
     ),
 )
 
 # The viewport's lit pass: colour only, no auxiliary targets to clear or write.
 LIT_COLOR = replace(LIT, name="lit_color", outputs=LIT.outputs[:1])
+
+_FEATURE_INPUTS = {  # vertex data a material feature reads: (type, name, varying)
+    "UV": ("VEC2", "uv", "v_uv"),
+    "VCOL": ("VEC4", "col", "v_color"),
+    "TANGENT": ("VEC4", "tan", "v_tangent"),
+}
+
+
+def _with_features(program, features, name):
+    """``program`` with the vertex inputs, varyings and texture samplers ``features`` read."""
+    defines = material_defines(features)
+    kinds = [
+        k
+        for k, on in (("UV", defines["HAS_UV"]), ("VCOL", defines["HAS_VCOL"]), ("TANGENT", defines["HAS_TANGENT"]))
+        if on
+    ]
+    samplers = tuple(("FLOAT_2D", f"tex_{c}") for c in CHANNELS if defines[f"TEX_{c.upper()}"])
+    return replace(
+        program,
+        name=name,
+        vertex_in=program.vertex_in + tuple(_FEATURE_INPUTS[k][:2] for k in kinds),
+        varyings=program.varyings + tuple(("smooth", _FEATURE_INPUTS[k][0], _FEATURE_INPUTS[k][2]) for k in kinds),
+        samplers=program.samplers + samplers,
+        defines=program.defines + tuple(defines.items()),
+    )
+
+
+def lit_program(features=frozenset(), aux=True):
+    """The lit pass program of a material variant (``Material.features``, plus "HOLDOUT")."""
+    base = LIT if aux else LIT_COLOR
+    if not features:
+        return base
+    return _with_features(base, features, f"{base.name}_{'_'.join(sorted(features)).lower()}")
+
 
 SHADOW_DEPTH = Program(
     name="shadow_depth",
@@ -137,13 +216,14 @@ SHADOW_DEPTH = Program(
     push_constants=(("MAT4", "model"),),
     uniform_blocks=((TILE_STRUCT, "tile", 0),),
     outputs=(("VEC4", "out_depth"),),
-    defines=tuple(DEPTH_FORMAT.defines().items()),
+    defines=tuple({**DEPTH_FORMAT.defines(), "ALPHA_CUTOUT": False, "HAS_UV": False}.items()),
 )
 
 
 # FLOAT32 maps are the depth buffer itself: the linear depth goes to gl_FragDepth, so a tile
 # needs no colour target and no second buffer.
 SHADOW_DEPTH_ONLY = replace(SHADOW_DEPTH, name="shadow_depth_only", outputs=(), depth_write="ANY")
+
 
 # out = scale * src at (pixel - origin): a shadow tile from the scratch target into its place in
 # the atlas (scale 1, origin the tile's corner; FLOAT16, RGBA8), a sample added to the
@@ -165,6 +245,43 @@ SCALED_COPY_SHADOW = replace(
     samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "src_shadow")),
     outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
     defines=(("WITH_SHADOW", True),),
+)
+
+
+# Shadow casters with alpha (leaves, fences, glass panes drawn with alpha): a texel is
+# covered in a fraction alpha of the samples (``textured``: the alpha comes from a texture).
+def shadow_cutout_program(depth_format, textured):
+    base = shadow_program(depth_format)
+    program = replace(
+        base,
+        libs=base.libs + ("lib/material.glsl",),
+        push_constants=base.push_constants + (("FLOAT", "alpha_offset"),),
+        uniform_blocks=base.uniform_blocks + ((MATERIAL_STRUCT, "material", 0),),
+        defines=base.defines + (("ALPHA_CUTOUT", True),),
+    )
+    features = frozenset({"TEX_ALPHA"}) if textured else frozenset()
+    defines = material_defines(features)
+    program = replace(program, defines=program.defines + tuple(defines.items()))
+    if not textured:
+        return replace(program, name=f"{base.name}_alpha")
+    return _with_features(program, features, f"{base.name}_alpha_tex")
+
+
+# The world's Environment Texture behind everything (materials.World.image).
+BACKGROUND = Program(
+    name="background",
+    vertex="fullscreen.vert.glsl",
+    fragment="background.frag.glsl",
+    libs=("lib/common.glsl", "lib/material.glsl"),
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(
+        ("MAT4", "inverse_view_proj"),
+        ("VEC2", "viewport_origin"),
+        ("VEC2", "viewport_size"),
+        ("FLOAT", "strength"),
+    ),
+    samplers=(("FLOAT_2D", "env"),),
+    outputs=(("VEC4", "out_color"),),
 )
 
 

@@ -9,21 +9,23 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import kernels, light_bins, sampling
-from .extract import Material
 from .frame_data import build_frame_data, select_lights
+from .materials import CHANNELS, EXTENSION, INTERPOLATION, Material
 from .post import post_stack
 from .post.base import PostContext
 from .programs import (
+    BACKGROUND,
     JITTER_SIZE,
-    LIT,
-    LIT_COLOR,
+    MATERIAL_STRUCT,
     MAX_LIGHTS,
     MAX_SHADOW_TILES,
     SCALED_COPY,
     SCALED_COPY_SHADOW,
     SHADOW_SAMPLER,
+    lit_program,
 )
 from .shadows import ShadowAtlas, plan_shadows
+from .textures import TextureCache
 
 DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
 _CORNER_BITS = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=bool)  # box corners
@@ -95,6 +97,11 @@ class Draw:
     identity: tuple  # what a shadow tile's content depends on
     corners: np.ndarray  # (8, 3) world corners of the instance's bounds
 
+    def material(self, index):
+        materials = self.instance.materials
+        mat = materials[index] if 0 <= index < len(materials) else None
+        return mat or DEFAULT_MATERIAL
+
 
 def buffer_array(buf):
     """A ``gpu.types.Buffer`` as a C-ordered numpy array of its dimensions.
@@ -120,6 +127,8 @@ class Renderer:
         self.shadows = ShadowAtlas()
         self.post = post_stack()
         self._batches = {}  # (geometry key, serial) -> (whole, parts)
+        self.textures = TextureCache()
+        self._material_ubos = {}  # id(Material) -> (Material, GPUUniformBuf)
         self._jitter_tex = None
         self._jitter_dummy = None
         self._size = None
@@ -150,6 +159,8 @@ class Renderer:
         compiled_before = self.shaders.compiled
         self._ensure_targets(width, height, aux)
         draws = self._draw_list(snapshot, stats)
+        stats.messages.extend(getattr(snapshot, "messages", ()))
+        self.textures.forget(getattr(snapshot, "images_changed", ()))
         lights = select_lights(snapshot.lights, camera.position, MAX_LIGHTS)
         if len(lights) < len(snapshot.lights):
             stats.messages.append(
@@ -177,7 +188,8 @@ class Renderer:
             sample_lights = [
                 sampling.light_at_sample(lt, i, s, sample_count) if i in moving else lt for i, lt in enumerate(lights)
             ]
-            plan = self._sample(draws, sample_lights, camera, view_camera, snapshot, settings, aux, stats)
+            alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
+            plan = self._sample(draws, sample_lights, camera, view_camera, snapshot, settings, aux, stats, alpha_offset)
             if accumulate:
                 self._accumulate(weight, aux)
                 self._weight_sum += weight
@@ -194,7 +206,9 @@ class Renderer:
         if accumulate:
             target_bytes += 16 + (4 if aux else 0)
         stats.shadow_bytes = self.shadows.memory_bytes if plan is not None and plan.tiles else 0
-        stats.texture_bytes = width * height * target_bytes + stats.shadow_bytes + self._post_ctx.memory_bytes
+        stats.texture_bytes = (
+            width * height * target_bytes + stats.shadow_bytes + self._post_ctx.memory_bytes + self.textures.bytes
+        )
         stats.shaders_compiled = self.shaders.compiled - compiled_before
         if not aux:
             return FrameOutput(color, None, None, stats, width, height, lit=self._color)
@@ -203,17 +217,17 @@ class Renderer:
             out.depth_data, out.normal_data = self._centre
         return out
 
-    def _sample(self, draws, lights, camera, view_camera, snapshot, settings, aux, stats):
+    def _sample(self, draws, lights, camera, view_camera, snapshot, settings, aux, stats, alpha_offset=0.5):
         """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
         does not move between samples keeps its map), then the lit pass seen through
         ``view_camera``. Returns the shadow plan."""
         width, height = self._size
         lights, rects = self._lights_in_view(lights, draws, view_camera, width, height, stats)
-        plan = self._shadow_pass(draws, lights, camera, settings, stats)
+        plan = self._shadow_pass(draws, lights, camera, settings, stats, alpha_offset)
         data = build_frame_data(
             lights,
             view_camera,
-            snapshot.world_color,
+            snapshot.world if snapshot.world is not None else snapshot.world_color,
             settings,
             plan,
             tile_size=self.shadows.size if plan.tiles else 1,
@@ -222,9 +236,11 @@ class Renderer:
             aux_outputs=aux,
             rects=rects,
             size=(width, height),
+            alpha_offset=alpha_offset,
         )
         stats.binned = data.bins is not None
-        self._lit_pass(_front_to_back(draws, view_camera), data, plan, snapshot.world_color, settings, aux, stats)
+        seen = [d for d in draws if d.instance.camera]
+        self._lit_pass(seen, view_camera, data, plan, snapshot.world_color, settings, aux, stats, snapshot.world)
         return plan
 
     # --- stages ---------------------------------------------------------------------------
@@ -275,7 +291,7 @@ class Renderer:
         size = max(1, int(settings.shadow_map_size)) if map_size is None else map_size
         return plan_shadows(lights, corners, size, view_corners)
 
-    def _shadow_pass(self, draws, lights, camera, settings, stats):
+    def _shadow_pass(self, draws, lights, camera, settings, stats, alpha_offset=0.5):
         """Plan the maps this frame needs (numpy) and draw the ones whose content changed."""
         map_size = max(1, int(settings.shadow_map_size))
         plan = self._plan(draws, lights, camera, settings, map_size)
@@ -295,14 +311,75 @@ class Renderer:
                 f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
             )
         self.shadows.ensure(map_size, len(plan.tiles), settings.shadow_depth_format)
-        shadow_draws = [(d.whole, d.model, d.det, d.identity) for d in draws]
-        self.shadows.render(plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats)
+        shadow_draws = [self._caster(d) for d in draws]
+        self.shadows.render(plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats, alpha_offset)
         return plan
 
-    def _lit_pass(self, draws, data, plan, world_color, settings, aux, stats):
+    def _caster(self, d):
+        """What instance ``d`` draws into shadow maps (``shadows.Caster``), or None when it
+        casts no shadow (Ray Visibility > Shadow off). Parts with alpha cover each map texel
+        in a fraction alpha of the samples (``shadows.ShadowAtlas.render``)."""
+        from .shadows import Caster
+
+        if not d.instance.shadow:
+            return None
+        mats = [(index, batch, d.material(index)) for index, batch in d.parts]
+        if not any(m.uses_alpha for _i, _b, m in mats):
+            return Caster([d.whole], d.model, d.det, d.identity)
+        solid, cutouts = [], []
+        for _index, batch, mat in mats:
+            if not mat.uses_alpha:
+                solid.append(batch)
+            elif "alpha" in mat.textures:
+                cutouts.append((batch, self._material_ubo(mat), self.textures.get(mat.textures["alpha"].image)))
+            elif mat.alpha > 0.0:
+                cutouts.append((batch, self._material_ubo(mat), None))
+        identity = (*d.identity, tuple(id(m) for _i, _b, m in mats))
+        return Caster(solid, d.model, d.det, identity, cutouts)
+
+    def _material_ubo(self, mat):
+        """The MaterialData block of ``mat``, built once per Material read."""
         import gpu
 
-        shader = self.shaders.get(LIT if aux else LIT_COLOR, data.defines)
+        cached = self._material_ubos.get(id(mat))
+        if cached is not None and cached[0] is mat:
+            return cached[1]
+        row = {
+            "base_color": tuple(mat.base_color)[:4],
+            "emission": tuple(mat.emission)[:3],
+            "roughness": float(mat.roughness),
+            "metallic": float(mat.metallic),
+            "specular": float(mat.specular),
+            "alpha": float(mat.alpha),
+            "normal_strength": float(mat.normal_strength),
+        }
+        for channel in CHANNELS:
+            ref = mat.textures.get(channel)
+            rows = ref.transform if ref is not None else ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+            row[f"{channel}_uv_u"] = (*rows[0], 0.0)
+            row[f"{channel}_uv_v"] = (*rows[1], 0.0)
+            mode = (0, 0, 0, 0)
+            if ref is not None:
+                mode = (
+                    INTERPOLATION.get(ref.interpolation, 1),
+                    EXTENSION.get(ref.extension, 0),
+                    int(ref.output == "Alpha"),
+                    0,
+                )
+            row[f"{channel}_mode"] = mode
+        ubo = gpu.types.GPUUniformBuf(MATERIAL_STRUCT.pack([row]).tobytes())
+        if len(self._material_ubos) > 4096:
+            self._material_ubos.clear()
+        self._material_ubos[id(mat)] = (mat, ubo)
+        return ubo
+
+    def _lit_pass(self, draws, camera, data, plan, world_color, settings, aux, stats, world=None):
+        """Every visible part, grouped by material variant: opaque and alpha-hashed parts
+        nearest first, then alpha-blended parts farthest first, blended over them (their
+        depth, normal and shadow stay those of what is behind; EEVEE too keeps blended
+        surfaces out of its depth)."""
+        import gpu
+
         shadow_tex = self.shadows.texture if plan.tiles else self._shadow_dummy()
         # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
         bg = (0.0, 0.0, 0.0, 0.0) if settings.film_transparent else (*map(float, world_color[:3]), 1.0)
@@ -313,13 +390,24 @@ class Renderer:
             self._depth.clear(format="FLOAT", value=(1e10,))
             self._shadow.clear(format="FLOAT", value=(1.0,))
             self._normal.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+        if world is not None and world.image is not None and not settings.film_transparent:
+            self._background(world, camera)
+        opaque, blended = [], []
+        for rank, d in enumerate(_front_to_back(draws, camera)):
+            for mat_index, batch in d.parts:
+                mat = d.material(mat_index)
+                features = mat.features | ({"HOLDOUT"} if d.instance.holdout else set())
+                entry = (features, rank, d, batch, mat)
+                (blended if "ALPHA_BLEND" in features and not d.instance.holdout else opaque).append(entry)
+        opaque.sort(key=lambda e: (sorted(e[0]), e[1]))
+        blended.sort(key=lambda e: -e[1])
         width, height = self._size
-        fb = self._fb if aux else self._fb_color
-        with fb.bind():
-            gpu.state.viewport_set(0, 0, width, height)
-            fb.clear(depth=1.0)
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(True)
+        bound = {"shader": None}
+
+        def bind(features, with_aux):
+            shader = self.shaders.get(lit_program(frozenset(features), with_aux), data.defines)
+            if bound["shader"] is shader:
+                return shader
             shader.bind()
             shader.uniform_block("frame", self._ubo("frame", data.frame))
             shader.uniform_block("lights", self._ubo("lights", data.lights))
@@ -327,21 +415,64 @@ class Renderer:
             shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
             shader.uniform_sampler("jitter_tex", self._jitter(data.disk_samples))
             shader.uniform_sampler("light_bins", self._bins_texture(data.bins))
-            for d in draws:
-                shader.uniform_float("model", d.model)
-                materials = d.instance.materials
-                for mat_index, batch in d.parts:
-                    mat = materials[mat_index] if 0 <= mat_index < len(materials) else None
-                    mat = mat or DEFAULT_MATERIAL
-                    shader.uniform_float("base_color", tuple(mat.base_color))
-                    shader.uniform_float("roughness", float(mat.roughness))
-                    shader.uniform_float("specular", float(mat.specular))
-                    shader.uniform_float("metallic", float(mat.metallic))
-                    batch.draw(shader)
-                    stats.draws += 1
-            gpu.state.depth_test_set("NONE")
-            gpu.state.depth_mask_set(False)
+            bound["shader"] = shader
+            return shader
+
+        def draw(entries, with_aux):
+            last = None
+            for features, _rank, d, batch, mat in entries:
+                shader = bind(features, with_aux)
+                if last is not d or bound.get("model_shader") is not shader:
+                    shader.uniform_float("model", d.model)
+                    last, bound["model_shader"] = d, shader
+                shader.uniform_block("material", self._material_ubo(mat))
+                for channel, ref in mat.textures.items():
+                    shader.uniform_sampler(f"tex_{channel}", self.textures.get(ref.image))
+                batch.draw(shader)
+                stats.draws += 1
+
+        fb = self._fb if aux else self._fb_color
+        with fb.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            fb.clear(depth=1.0)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            draw(opaque, aux)
+        if blended:
+            bound["shader"] = None
+            with self._fb_color.bind():
+                gpu.state.viewport_set(0, 0, width, height)
+                gpu.state.depth_test_set("LESS_EQUAL")
+                gpu.state.depth_mask_set(False)
+                gpu.state.blend_set("ALPHA_PREMULT")
+                draw(blended, False)
+                gpu.state.blend_set("NONE")
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
         stats.passes += 1
+
+    def _background(self, world, camera):
+        """The world's Environment Texture behind the scene (``programs.BACKGROUND``)."""
+        from mathutils import Matrix
+
+        width, height = self._size
+        try:
+            inverse = np.linalg.inv(camera.projection @ camera.view)
+        except np.linalg.LinAlgError:
+            return
+        if not np.all(np.isfinite(inverse)):
+            return
+        self._fullscreen(
+            BACKGROUND,
+            self._fb_color,
+            {"env": self.textures.get(world.image)},
+            {
+                "inverse_view_proj": Matrix(inverse.tolist()),
+                "viewport_origin": (0.0, 0.0),
+                "viewport_size": (float(width), float(height)),
+                "strength": float(world.strength),
+            },
+        )
 
     def _post_pass(self, settings, stats):
         ctx = self._post_ctx
@@ -402,7 +533,8 @@ class Renderer:
             shader.bind()
             for name, tex in samplers.items():
                 shader.uniform_sampler(name, tex)
-            shader.uniform_int("origin", (0, 0))
+            if any(pc[1] == "origin" for pc in program.push_constants):
+                shader.uniform_int("origin", (0, 0))
             for name, value in uniforms.items():
                 shader.uniform_float(name, value)
             self._fullscreen_batch.draw(shader)
@@ -454,11 +586,13 @@ class Renderer:
         if cached is not None:
             return cached
         fmt = gpu.types.GPUVertFormat()
-        fmt.attr_add(id="pos", comp_type="F32", len=3, fetch_mode="FLOAT")
-        fmt.attr_add(id="nor", comp_type="F32", len=3, fetch_mode="FLOAT")
+        attrs = {"pos": geo.positions, "nor": geo.normals, "uv": geo.uvs, "col": geo.colors, "tan": geo.tangents}
+        attrs = {name: data for name, data in attrs.items() if data is not None}
+        for name, data in attrs.items():
+            fmt.attr_add(id=name, comp_type="F32", len=data.shape[1], fetch_mode="FLOAT")
         vbo = gpu.types.GPUVertBuf(fmt, len(geo.positions))
-        vbo.attr_fill("pos", geo.positions)
-        vbo.attr_fill("nor", geo.normals)
+        for name, data in attrs.items():
+            vbo.attr_fill(name, data)
         whole = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices))
         parts = []
         for mat_index, first, count in geo.ranges:

@@ -274,7 +274,7 @@ SCENE_PARAMS = (
     Param(
         "specular_model",
         "ENUM",
-        "BLINN",
+        "GGX",
         "Shape of the specular highlight",
         enum=SPECULAR_MODEL,
         label="Specular",

@@ -19,7 +19,7 @@ import numpy as np
 
 from . import lightspace
 from .enums import DEPTH_FORMAT
-from .programs import MAX_SHADOW_TILES, SCALED_COPY, TILE_STRUCT, depth_defines, shadow_program
+from .programs import MAX_SHADOW_TILES, SCALED_COPY, TILE_STRUCT, depth_defines, shadow_cutout_program, shadow_program
 
 
 @dataclass
@@ -89,6 +89,17 @@ def behind_area_light(face_forward, light_direction):
     """Whether a whole cube face looks into the half-space behind an area light, which it
     does not light (it emits forward only): that face needs no map."""
     return float(np.dot(face_forward, -np.asarray(light_direction))) >= _BEHIND_COS
+
+
+@dataclass
+class Caster:
+    """One instance as it draws into shadow maps."""
+
+    batches: list  # GPUBatches drawn whole (opaque material parts)
+    model: object  # mathutils.Matrix
+    det: float  # sign of the model matrix (winding under negative scale)
+    identity: tuple  # what a tile's content depends on
+    cutouts: list = field(default_factory=list)  # (batch, material UBO, alpha texture): alpha >= 0.5 casts
 
 
 def plan_shadows(lights, corners, map_size, view_corners=None):
@@ -226,20 +237,26 @@ class ShadowAtlas:
         self._ubos[index].update(raw)
         return self._ubos[index]
 
-    def render(self, plan, draws, shaders, cull_front, stats):
-        """Draw every tile of ``plan`` whose content changed. ``draws``: per instance
-        (batch, model Matrix, det, identity key); a tile's key is its fit and its casters."""
+    def render(self, plan, draws, shaders, cull_front, stats, alpha_offset=0.5):
+        """Draw every tile of ``plan`` whose content changed. ``draws``: per instance a
+        ``Caster``, or None for an instance that casts no shadow; a tile's key is its fit and
+        its casters."""
         import gpu
 
         depth_only = DEPTH_FORMAT[self.depth_format].depth_only
         shader = shaders.get(shadow_program(self.depth_format), depth_defines(self.depth_format))
+        defines = depth_defines(self.depth_format)
+        cutout = {t: shaders.get(shadow_cutout_program(self.depth_format, t), defines) for t in (False, True)}
         for index, tile in enumerate(plan.tiles):
+            casters = [draws[c] for c in tile.casters if draws[c] is not None]
             key = (
                 tile.fit.view_proj.tobytes(),
                 tile.fit.near,
                 tile.fit.far,
                 cull_front,
-                tuple(draws[c][3] for c in tile.casters),
+                tuple(c.identity for c in casters),
+                # Alpha casters cover other texels in each sample: such a map is redrawn per sample.
+                alpha_offset if any(c.cutouts for c in casters) else None,
             )
             if self._contents[index] == key:
                 stats.shadow_maps_reused += 1
@@ -258,16 +275,30 @@ class ShadowAtlas:
                     target.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
                 gpu.state.depth_test_set("LESS")
                 gpu.state.depth_mask_set(True)
+                tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record()]))
                 shader.bind()
-                shader.uniform_block("tile", self._tile_ubo(index, TILE_STRUCT.pack([tile.record()])))
-                for c in tile.casters:
-                    batch, model, det, _key = draws[c]
+                shader.uniform_block("tile", tile_ubo)
+                for caster in casters:
                     if cull_front:
                         gpu.state.face_culling_set("FRONT")
-                        gpu.state.front_facing_set(det < 0.0)
-                    shader.uniform_float("model", model)
-                    batch.draw(shader)
-                    stats.draws += 1
+                        gpu.state.front_facing_set(caster.det < 0.0)
+                    shader.uniform_float("model", caster.model)
+                    for batch in caster.batches:
+                        batch.draw(shader)
+                        stats.draws += 1
+                gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
+                for caster in casters:
+                    for batch, material_ubo, texture in caster.cutouts:
+                        program = cutout[texture is not None]
+                        program.bind()
+                        program.uniform_block("tile", tile_ubo)
+                        program.uniform_float("alpha_offset", alpha_offset)
+                        program.uniform_float("model", caster.model)
+                        program.uniform_block("material", material_ubo)
+                        if texture is not None:
+                            program.uniform_sampler("tex_alpha", texture)
+                        batch.draw(program)
+                        stats.draws += 1
                 gpu.state.face_culling_set("NONE")
                 gpu.state.front_facing_set(False)
                 gpu.state.depth_test_set("NONE")

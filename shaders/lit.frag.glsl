@@ -1,6 +1,12 @@
-/* Forward lighting: Lambert diffuse + normalised Blinn or Phong specular, world colour as
- * ambient (albedo * world, what Cycles gives an unoccluded surface), each light attenuated
- * by its shadow visibility. Back faces of a light (N.L <= 0) skip the shadow filter.
+/* Forward lighting: Lambert diffuse + GGX (or normalised Blinn/Phong) specular; the world
+ * lights every surface as ambient: diffuse from its spherical-harmonic irradiance, specular
+ * (what makes metals look like metal) from its radiance around the reflected direction,
+ * blurred by roughness and weighted by an analytic environment BRDF. Each light is attenuated
+ * by its shadow visibility; back faces of a light (N.L <= 0) skip the shadow filter.
+ * Emission adds after lighting and is never shadowed.
+ *
+ * The material comes from the MaterialData block and, per variant (engine/programs.py
+ * material_defines), image textures, a colour attribute, a normal map and the alpha mode.
  *
  * The lit pass pays only for what it uses: lights sampled over their extent come first
  * (frame.sampled_count, PCSS of their per-sample size), then the other lights with a shadow
@@ -10,8 +16,10 @@
 
 struct Surface {
   vec3 P, N, V;
+  vec3 Ng; /* the interpolated mesh normal, before any normal map: what shadow biases follow */
   vec3 albedo, f0;
   float shininess;
+  float alpha; /* GGX roughness (Principled roughness squared) */
 };
 
 #define NO_SHADOW -1
@@ -32,22 +40,119 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   /* Shadow pass: direct light that arrives over direct light that would arrive unshadowed,
    * each light weighted by the luminance of its irradiance here (1 where no light reaches). */
   float weight = dot(L.color, vec3(0.2126, 0.7152, 0.0722)) * irradiance * NdotL;
-  float visibility = (filter_id == NO_SHADOW) ? 1.0 : shadow_visibility(L, s.P, s.N, NdotL, filter_id);
+  float NgdotL = dot(s.Ng, to_light);
+  float visibility = (filter_id == NO_SHADOW) ? 1.0 :
+                     (NgdotL <= 0.0) ? 0.0 :
+                                       shadow_visibility(L, s.P, s.Ng, NgdotL, filter_id);
   unshadowed += weight;
   arriving += weight * visibility;
-#if SPECULAR_MODEL == SPECULAR_BLINN
+#if SPECULAR_MODEL == SPECULAR_GGX
+  vec3 H = normalize(to_light + s.V);
+  float NdotH = max(dot(s.N, H), 0.0);
+  float NdotV = max(dot(s.N, s.V), 1e-4);
+  float a2 = s.alpha * s.alpha;
+  float dd = NdotH * NdotH * (a2 - 1.0) + 1.0;
+  float D = a2 / (M_PI * dd * dd);
+  /* Height-correlated Smith visibility G / (4 N.L N.V). */
+  float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
+  float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
+  float Vis = 0.5 / max(gv + gl, 1e-8);
+  float fw = pow(clamp(1.0 - dot(to_light, H), 0.0, 1.0), 5.0);
+  /* Schlick Fresnel towards f90; a surface without specular (f0 ~ 0) has none at grazing
+   * angles either, as the Principled BSDF at Specular 0. */
+  float f90 = clamp(50.0 * dot(s.f0, vec3(0.3333)), 0.0, 1.0);
+  vec3 spec = (s.f0 + (f90 - s.f0) * fw) * (D * Vis);
+  vec3 E = L.color * (irradiance * NdotL * visibility);
+  color += E * (s.albedo / M_PI + spec);
+#else
+#  if SPECULAR_MODEL == SPECULAR_BLINN
   vec3 H = normalize(to_light + s.V);
   float spec = (s.shininess + 8.0) / (8.0 * M_PI) * pow(max(dot(s.N, H), 0.0), s.shininess);
-#else
+#  else
   vec3 R = reflect(-to_light, s.N);
   float spec = (s.shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, s.V), 0.0), s.shininess);
-#endif
+#  endif
   vec3 E = L.color * (irradiance * NdotL * visibility);
   color += E * (s.albedo / M_PI + s.f0 * spec);
+#endif
+}
+
+/* The world's radiance around direction d from its SH coefficients, each band scaled by
+ * g.x (band 1) and g.y (band 2): (1, 1) is the radiance itself, (2/3, 1/4) the cosine-lobe
+ * convolution (irradiance / pi). */
+vec3 world_sh(vec3 d, vec2 g)
+{
+  vec3 r = frame.world_color;
+  r += g.x * 0.4886025 * (frame.world_sh1.xyz * d.y + frame.world_sh2.xyz * d.z + frame.world_sh3.xyz * d.x);
+  r += g.y * (1.0925484 * (frame.world_sh4.xyz * d.x * d.y + frame.world_sh5.xyz * d.y * d.z +
+                           frame.world_sh7.xyz * d.x * d.z) +
+              0.3153916 * frame.world_sh6.xyz * (3.0 * d.z * d.z - 1.0) +
+              0.5462742 * frame.world_sh8.xyz * (d.x * d.x - d.y * d.y));
+  return max(r, vec3(0.0));
+}
+
+/* The split-sum environment BRDF (scale and bias of f0), an analytic fit (Karis, "Physically
+ * based shading on mobile"); a surface without specular (f0 ~ 0) gets no Fresnel rim. */
+vec2 env_brdf(vec3 f0, float rough, float NdotV)
+{
+  vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
+  vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
+  vec4 r = rough * c0 + c1;
+  float a004 = min(r.x * r.x, exp2(-9.28 * NdotV)) * r.x + r.y;
+  vec2 ab = vec2(-1.04, 1.04) * a004 + r.zw;
+  ab.y *= clamp(50.0 * dot(f0, vec3(0.3333)), 0.0, 1.0);
+  return ab;
+}
+
+/* Light from the world: diffuse irradiance, and specular radiance around the reflected
+ * direction, wider with roughness, weighted by the environment BRDF ``ab``. */
+vec3 world_light(Surface s, float rough, vec2 ab)
+{
+  vec3 diffuse = s.albedo * world_sh(s.N, vec2(2.0 / 3.0, 0.25));
+  vec3 R = reflect(-s.V, s.N);
+  float t = rough * rough;
+  vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
+  return diffuse + radiance * (s.f0 * ab.x + ab.y);
 }
 
 void main()
 {
+  /* --- the material --- */
+  vec4 base = material.base_color;
+  float rough = material.roughness;
+  float metal = material.metallic;
+  float coverage = material.alpha;
+  vec3 emission = material.emission;
+#if TEX_BASE_COLOR
+  base *= SAMPLE_COLOR(base_color, v_uv);
+#endif
+#if HAS_VCOL
+  base *= v_color;
+#endif
+#if TEX_ROUGHNESS
+  rough *= SAMPLE_VALUE(roughness, v_uv);
+#endif
+#if TEX_METALLIC
+  metal *= SAMPLE_VALUE(metallic, v_uv);
+#endif
+#if TEX_ALPHA
+  coverage *= SAMPLE_VALUE(alpha, v_uv);
+#endif
+#if TEX_EMISSION
+  emission *= SAMPLE_COLOR(emission, v_uv).rgb;
+#endif
+#if ALPHA_MODE == 1
+  /* Hashed (EEVEE's Dithered): the surface covers a pixel in a fraction alpha of the samples
+   * (stratified over the frame's samples by frame.alpha_offset). */
+  if (coverage <= fract(pixel_hash(gl_FragCoord.xy) + frame.alpha_offset)) {
+    discard;
+  }
+#elif ALPHA_MODE == 2
+  if (coverage <= 0.0) {
+    discard;
+  }
+#endif
+
   Surface s;
   s.P = v_world;
   vec3 N = v_normal;
@@ -60,21 +165,56 @@ void main()
   N = (nlen > 1e-30) ? N / nlen : vec3(0.0, 0.0, 1.0);
 
   s.V = (frame.is_ortho != 0) ? -frame.camera_forward : normalize(frame.camera_position - s.P);
+  s.Ng = (dot(N, s.V) < 0.0) ? -N : N;
+#if TEX_NORMAL
+  {
+    /* Tangent-space normal map (Blender's Normal Map node): MikkTSpace tangent and sign from
+     * the mesh, or a frame from screen-space derivatives of the UVs where it has none. */
+    vec3 mapped = SAMPLE_COLOR(normal, v_uv).rgb * 2.0 - 1.0;
+    vec3 T = v_tangent.xyz;
+    float sign_b = v_tangent.w;
+    if (sign_b == 0.0 || !(dot(T, T) > 1e-20)) {
+      vec3 dp1 = dFdx(s.P), dp2 = dFdy(s.P);
+      vec2 du1 = dFdx(v_uv), du2 = dFdy(v_uv);
+      vec3 dp2perp = cross(dp2, N), dp1perp = cross(N, dp1);
+      T = dp2perp * du1.x + dp1perp * du2.x;
+      vec3 B = dp2perp * du1.y + dp1perp * du2.y;
+      sign_b = (dot(cross(N, T), B) < 0.0) ? -1.0 : 1.0;
+    }
+    T = T - N * dot(N, T);
+    float tl = length(T);
+    if (tl > 1e-20) {
+      T /= tl;
+      vec3 B = sign_b * cross(N, T);
+      vec3 perturbed = normalize(T * mapped.x + B * mapped.y + N * mapped.z);
+      N = normalize(mix(N, perturbed, max(material.normal_strength, 0.0)));
+    }
+  }
+#endif
   if (dot(N, s.V) < 0.0) {
     N = -N; /* two-sided, as Blender draws meshes */
   }
   s.N = N;
 
-  vec3 base = base_color.rgb;
-  float rough = clamp(roughness, 0.0, 1.0);
-  float spec_level = max(specular, 0.0);
-  float metal = clamp(metallic, 0.0, 1.0);
-  s.albedo = base * (1.0 - metal);
-  s.f0 = mix(vec3(0.08 * spec_level), base, metal);
+  rough = clamp(rough, 0.0, 1.0);
+  float spec_level = max(material.specular, 0.0);
+  metal = clamp(metal, 0.0, 1.0);
+  s.albedo = base.rgb * (1.0 - metal);
+  s.f0 = mix(vec3(0.08 * spec_level), base.rgb, metal);
   float alpha = max(rough * rough, 0.02);
   s.shininess = 2.0 / (alpha * alpha) - 2.0;
+  s.alpha = max(rough * rough, 0.002);
 
-  vec3 color = s.albedo * frame.world_color;
+  /* Energy: light reflected by the specular layer does not reach the diffuse one below (the
+   * Principled BSDF's layering), estimated per pixel from the directional albedo. */
+  float NdotV = max(dot(s.N, s.V), 1e-4);
+  vec2 ab = env_brdf(s.f0, rough, NdotV);
+  /* Metallic mixes a metal and a dielectric; only the dielectric's own specular (f0 from the
+   * Specular level) sits over its diffuse. */
+  float f0_dielectric = 0.08 * spec_level;
+  vec2 ab_dielectric = env_brdf(vec3(f0_dielectric), rough, NdotV);
+  s.albedo *= clamp(1.0 - (f0_dielectric * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
+  vec3 color = world_light(s, rough, ab);
   float arriving = 0.0, unshadowed = 0.0;
 #if LIGHT_BINS
   /* Only the lights this pixel's screen bin lists (engine/light_bins.py): word w of the bin
@@ -119,7 +259,15 @@ void main()
     add_light(i, NO_SHADOW, s, color, arriving, unshadowed);
   }
 #endif
+  color += emission;
+#if HOLDOUT
+  out_color = vec4(0.0); /* Object > Visibility > Holdout: a hole in the film */
+#elif ALPHA_MODE == 2
+  float a = clamp(coverage, 0.0, 1.0);
+  out_color = vec4(color * a, a); /* premultiplied, blended over what is behind */
+#else
   out_color = vec4(color, 1.0);
+#endif
 #if AUX_OUTPUTS
   out_depth = v_view_depth;
   out_shadow = (unshadowed > 0.0) ? arriving / unshadowed : 1.0;

@@ -1,6 +1,7 @@
 /* World-space position and normal for the lit pass. The normal matrix is the cofactor of the
  * model matrix (det * inverse-transpose): defined for zero scale, and its sign flip keeps
- * normals outward under negative scale. */
+ * normals outward under negative scale. Tangents (normal maps) move with the model matrix;
+ * their bitangent sign flips with a mirroring one. */
 void main()
 {
   vec4 wp = model * vec4(pos, 1.0);
@@ -10,5 +11,14 @@ void main()
   v_normal = cof * nor * (det < 0.0 ? -1.0 : 1.0);
   v_world = wp.xyz;
   v_view_depth = -(frame.view * wp).z;
+#if HAS_UV
+  v_uv = uv;
+#endif
+#if HAS_VCOL
+  v_color = col;
+#endif
+#if HAS_TANGENT
+  v_tangent = vec4(m * tan.xyz, tan.w * (det < 0.0 ? -1.0 : 1.0));
+#endif
   gl_Position = frame.view_proj * wp;
 }

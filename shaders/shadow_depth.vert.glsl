@@ -4,6 +4,9 @@ void main()
 {
   vec4 view_pos = tile.view * (model * vec4(pos, 1.0));
   v_distance = -view_pos.z;
+#if HAS_UV
+  v_uv = uv;
+#endif
   vec4 t = tile.proj_tex * view_pos;
   gl_Position = vec4(2.0 * t.xyz - t.w, t.w);
 }

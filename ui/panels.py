@@ -107,6 +107,31 @@ class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
         draw_params(col, context.light.penumbra, settings.LIGHT_PARAMS)
 
 
+class PENUMBRA_PT_material(PenumbraPanel, bpy.types.Panel):
+    """What Penumbra draws of the active material, and each part of its node tree it does not
+    read (the same messages the render report gives)."""
+
+    bl_label = "Penumbra"
+    bl_context = "material"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and getattr(context, "material", None) is not None
+
+    def draw(self, context):
+        from ..engine.materials import material_from_blender
+
+        read = material_from_blender(context.material)
+        col = self.layout.column(align=True)
+        textures = ", ".join(c.replace("_", " ") for c in read.textures) or "none"
+        col.label(text=f"Textures: {textures}", icon="TEXTURE")
+        if read.color_attribute is not None:
+            col.label(text=f"Colour attribute: {read.color_attribute or 'active'}", icon="GROUP_VCOL")
+        col.label(text=f"Alpha: {read.blend.lower()}", icon="IMAGE_ALPHA")
+        for message in read.messages:
+            col.label(text=message.split(": ", 1)[-1], icon="ERROR")
+
+
 class PENUMBRA_UL_layers(bpy.types.UIList):
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
         effect = EFFECTS.get(item.effect)
@@ -170,6 +195,7 @@ class PENUMBRA_PT_render_layers(PenumbraPanel, bpy.types.Panel):
 
 
 classes = (
+    PENUMBRA_PT_material,
     PENUMBRA_PT_sampling,
     PENUMBRA_PT_film,
     PENUMBRA_PT_passes,

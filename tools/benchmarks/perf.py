@@ -17,6 +17,9 @@ Sections (``--sections``, all by default):
   instances   1 and 16 collection instances of the Stanford bunny (69k triangles): F12
   triangles   one grid mesh of 70k ... 2M triangles: F12, and extraction against a bare copy
               of the same data with ``foreach_get`` (the limit for reading a mesh from Python)
+  materials   16 UV spheres on a ground at 960x540 with constant materials, a 1024² image
+              on Base Color, and Base Color + Roughness + a normal map (the textured variants'
+              cost against the constant one)
 
 Writes ``<out>/perf.csv``; Markdown tables for the README go to stdout, progress and
 Blender's own output to stderr. ``--quick``: fewer sizes and counts, 3 runs.
@@ -33,7 +36,7 @@ import numpy as np
 from devkit import assets, engines, report, scenes, session
 
 HELP = "frame cost and scaling as ratios to Workbench (AA off, shadows on)"
-SECTIONS = ("resolution", "viewport", "lights", "objects", "instances", "triangles")
+SECTIONS = ("resolution", "viewport", "lights", "objects", "instances", "triangles", "materials")
 CSV_FIELDS = ["section", "case", "penumbra_ms", "workbench_ms", "ratio", "note", "runs", "blender"]
 
 
@@ -399,6 +402,51 @@ def section_triangles(plan):
         copy, extract = statistics.median(copies), statistics.median(extracts)
         note = f"extraction {extract * 1e3:.0f} ms = {extract / copy:.2f}x the bare copy ({copy * 1e3:.0f} ms)"
         rows.append(_row("triangles", f"{2 * n * n:,} triangles", t, note, plan["runs"]))
+    return rows
+
+
+def textured_field(kind):
+    """16 UV spheres (with UV maps) over a ground under a sun, every material ``kind``:
+    'constant', 'base' (a 1024² image on Base Color) or 'maps' (Base Color, Roughness and a
+    normal map, each a 1024² image)."""
+    scene = scenes.empty_scene(960, 540)
+    mat = scenes.material("Field", (0.7, 0.6, 0.5), roughness=0.5)
+    if kind != "constant":
+        rng = np.random.default_rng(1)
+        tree = mat.node_tree
+        bsdf = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+        inputs = {"base": ("Base Color",), "maps": ("Base Color", "Roughness", "Normal")}[kind]
+        for name in inputs:
+            image = bpy.data.images.new(name, 1024, 1024)
+            image.pixels.foreach_set(rng.random(1024 * 1024 * 4, dtype=np.float32))
+            node = tree.nodes.new("ShaderNodeTexImage")
+            node.image = image
+            if name == "Normal":
+                image.colorspace_settings.name = "Non-Color"
+                normal_map = tree.nodes.new("ShaderNodeNormalMap")
+                normal_map.inputs["Strength"].default_value = 0.3
+                tree.links.new(node.outputs["Color"], normal_map.inputs["Color"])
+                tree.links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
+            else:
+                tree.links.new(node.outputs["Color"], bsdf.inputs[name])
+    bpy.ops.mesh.primitive_plane_add(size=14.0)
+    bpy.context.object.data.materials.append(mat)
+    for i in range(16):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.6, location=((i % 4) * 1.6 - 2.4, (i // 4) * 1.6 - 2.4, 0.6))
+        bpy.context.object.data.materials.append(mat)
+        bpy.ops.object.shade_smooth()
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(35), 0, math.radians(25)))
+    scenes.look_at(scene, (0.0, -9.0, 7.0), (0.0, 0.0, 0.0))
+    return scene
+
+
+def section_materials(plan):
+    rows = []
+    base = None
+    for kind, label in (("constant", "constant"), ("base", "Base Color image"), ("maps", "colour+roughness+normal")):
+        t = paired(textured_field(kind), plan["runs"])
+        base = base or t["PENUMBRA"]
+        rows.append(_row("materials", f"16 spheres, {label}", t, f"{t['PENUMBRA'] / base:.2f}x constant", plan["runs"]))
     return rows
 
 

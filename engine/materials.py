@@ -1,0 +1,556 @@
+"""Materials and the world as Penumbra draws them, read from Blender's node trees.
+
+A Principled BSDF is read through Blender's own ``PrincipledBSDFWrapper`` (the reader its
+importers and exporters use): base colour, roughness, metallic, specular level, alpha,
+emission colour and strength, and the normal map, each as a value or an image texture with
+its UV map and Mapping node. Besides what the wrapper follows, an input may come from a
+Color Attribute / Attribute node (vertex colours), an RGB or Value node, or through reroutes.
+Emission and Diffuse BSDF surfaces are read directly.
+
+Anything else (a Mix Shader, a procedural texture into Base Color, ...) falls back to the
+material's viewport display values, and the material carries a message that says so: the
+engine reports it once per render and the Material panel shows it. Nothing is dropped
+silently.
+
+No gpu here: the result is plain data (``Material``, ``TextureRef``) the renderer turns
+into shader variants and uniforms.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+# Channels a texture can drive, in the order of the shader's texture slots.
+CHANNELS = ("base_color", "roughness", "metallic", "alpha", "emission", "normal")
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # Rec.709: Blender's colour -> value conversion
+INTERPOLATION = {"Closest": 0, "Linear": 1, "Cubic": 1, "Smart": 1}
+EXTENSION = {"REPEAT": 0, "EXTEND": 1, "CLIP": 2, "MIRROR": 3}
+BLEND_MODES = ("OPAQUE", "HASHED", "BLEND")
+
+
+@dataclass(frozen=True)
+class TextureRef:
+    """One image texture feeding one channel."""
+
+    image: str  # image datablock name (the GPU texture cache key)
+    uv_map: str = ""  # "" = the mesh's active render UV map
+    output: str = "Color"  # the Image Texture socket used: "Color" or "Alpha"
+    interpolation: str = "Linear"
+    extension: str = "REPEAT"
+    transform: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))  # uv' = M @ (u, v, 1) (Mapping node)
+
+
+@dataclass
+class Material:
+    base_color: tuple = (0.8, 0.8, 0.8, 1.0)
+    roughness: float = 0.5
+    specular: float = 0.5
+    metallic: float = 0.0
+    alpha: float = 1.0
+    emission: tuple = (0.0, 0.0, 0.0)  # colour * strength
+    normal_strength: float = 0.0  # 0: no normal map
+    textures: dict = field(default_factory=dict)  # channel -> TextureRef
+    color_attribute: str | None = None  # base colour from this colour attribute ("" = active)
+    blend: str = "OPAQUE"  # OPAQUE, HASHED (dithered alpha) or BLEND (sorted, blended)
+    messages: tuple = ()  # what could not be read, for the render report and the panel
+
+    @property
+    def uv_maps(self):
+        """UV maps the material's textures read ("" = the active render map)."""
+        return tuple(sorted({t.uv_map for t in self.textures.values()}))
+
+    @property
+    def uses_alpha(self):
+        return self.blend != "OPAQUE" and (self.alpha < 1.0 or "alpha" in self.textures)
+
+    @property
+    def features(self):
+        """What the shader variant of this material samples (frozenset of names)."""
+        out = {f"TEX_{c.upper()}" for c in self.textures}
+        if self.color_attribute is not None:
+            out.add("VCOL")
+        if self.uses_alpha:
+            out.add(f"ALPHA_{self.blend}")
+        return frozenset(out)
+
+
+# --- reading ------------------------------------------------------------------------------
+
+
+def _source(socket):
+    """The node and output socket feeding ``socket`` (through reroutes), or (None, None)."""
+    seen = 0
+    while socket is not None and socket.is_linked and seen < 64:
+        link = socket.links[0]
+        if not getattr(link, "is_valid", True) or getattr(link, "is_muted", False):
+            return None, None
+        node, out = link.from_node, link.from_socket
+        if node.bl_idname == "NodeReroute":
+            socket = node.inputs[0]
+            seen += 1
+            continue
+        return node, out
+    return None, None
+
+
+def _mapping_transform(mapping):
+    """A Mapping node as a 2x3 affine map of (u, v, 1), or (transform, message)."""
+    if mapping is None:
+        return TextureRef.transform, None
+    kind = mapping.vector_type
+    loc = mapping.inputs["Location"].default_value if "Location" in mapping.inputs else (0, 0, 0)
+    rot = mapping.inputs["Rotation"].default_value if "Rotation" in mapping.inputs else (0, 0, 0)
+    scale = mapping.inputs["Scale"].default_value if "Scale" in mapping.inputs else (1, 1, 1)
+    message = None
+    if any(s.is_linked for s in mapping.inputs) or abs(rot[0]) > 1e-6 or abs(rot[1]) > 1e-6:
+        message = "a Mapping node with linked inputs or X/Y rotation (only its 2-D part is used)"
+    c, s = math.cos(rot[2]), math.sin(rot[2])
+    rotation = np.array([[c, -s], [s, c]])
+    scale2 = np.array([scale[0], scale[1]], dtype=np.float64)
+    loc2 = np.array([loc[0], loc[1]], dtype=np.float64)
+    if kind in {"POINT", "VECTOR"}:
+        lin = rotation @ np.diag(scale2)
+        off = loc2 if kind == "POINT" else np.zeros(2)
+    elif kind == "TEXTURE":  # the inverse of POINT
+        inv_scale = np.where(np.abs(scale2) > 1e-12, 1.0 / np.where(scale2 == 0, 1, scale2), 0.0)
+        lin = np.diag(inv_scale) @ rotation.T
+        off = -lin @ loc2
+    else:  # NORMAL
+        return TextureRef.transform, "a Mapping node of type Normal"
+    return tuple(tuple(float(x) for x in row) for row in np.column_stack([lin, off])), message
+
+
+def _image_ref(node, output, notes):
+    """A TextureRef for Image Texture ``node`` read through its ``output`` socket."""
+    image = node.image
+    if image is None:
+        return None
+    uv_map = ""
+    vector_node, vector_out = _source(node.inputs["Vector"])
+    mapping = None
+    if vector_node is not None and vector_node.bl_idname == "ShaderNodeMapping":
+        mapping = vector_node
+        vector_node, vector_out = _source(mapping.inputs["Vector"])
+    if vector_node is not None:
+        if vector_node.bl_idname == "ShaderNodeUVMap":
+            uv_map = vector_node.uv_map
+        elif vector_node.bl_idname == "ShaderNodeTexCoord" and vector_out.name == "UV":
+            pass
+        else:
+            notes.append(f"texture coordinates from '{vector_node.name}' (UV is used)")
+    if node.projection != "FLAT":
+        notes.append(f"image projection {node.projection} (flat UV is used)")
+    if node.interpolation in {"Cubic", "Smart"}:
+        notes.append(f"{node.interpolation} interpolation (drawn as Linear)")
+    transform, message = _mapping_transform(mapping)
+    if message:
+        notes.append(message)
+    return TextureRef(
+        image=image.name_full,
+        uv_map=uv_map,
+        output=output,
+        interpolation=node.interpolation,
+        extension=node.extension,
+        transform=transform,
+    )
+
+
+def _input(socket, kind, notes, label):
+    """What feeds input ``socket`` of a shader node: ('value', v) for its own value or an
+    RGB/Value node, ('texture', TextureRef), ('attribute', name), or ('unsupported', value)
+    after noting why. ``kind``: 'color' or 'value'."""
+    node, out = _source(socket)
+    if node is None:
+        value = socket.default_value
+        return "value", (tuple(value) if kind == "color" else float(value))
+    idname = node.bl_idname
+    if idname == "ShaderNodeTexImage":
+        ref = _image_ref(node, out.name, notes)
+        if ref is not None:
+            return "texture", ref
+        notes.append(f"{label}: an Image Texture node without an image")
+        return "value", ((0.0, 0.0, 0.0, 1.0) if kind == "color" else 0.0)
+    if idname == "ShaderNodeVertexColor" and kind == "color":
+        return "attribute", node.layer_name
+    if idname == "ShaderNodeAttribute" and kind == "color" and node.attribute_type == "GEOMETRY":
+        return "attribute", node.attribute_name
+    if idname == "ShaderNodeRGB":
+        value = out.default_value
+        return "value", (tuple(value) if kind == "color" else float(np.dot(LUMINANCE, value[:3])))
+    if idname == "ShaderNodeValue":
+        v = float(out.default_value)
+        return "value", ((v, v, v, 1.0) if kind == "color" else v)
+    notes.append(f"{label} from a '{node.bl_label or idname}' node")
+    return "unsupported", None
+
+
+def _surface(mat):
+    """The shader node the active Material Output's Surface socket draws, or None."""
+    tree = getattr(mat, "node_tree", None)
+    if tree is None:
+        return None
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    active = [n for n in outputs if n.is_active_output and n.target in {"ALL", "EEVEE"}] or outputs
+    for out in active:
+        node, _socket = _source(out.inputs["Surface"])
+        if node is not None:
+            return node
+    return None
+
+
+def _display(mat, notes, reason):
+    """The material's viewport display values, used when its shader cannot be drawn."""
+    notes.append(reason)
+    return Material(
+        base_color=tuple(mat.diffuse_color),
+        roughness=float(mat.roughness),
+        specular=float(getattr(mat, "specular_intensity", 0.5)),
+        metallic=float(mat.metallic),
+    )
+
+
+def _blend_mode(mat):
+    method = getattr(mat, "surface_render_method", None)
+    if method == "BLENDED":
+        return "BLEND"
+    return "HASHED"  # DITHERED (EEVEE's default): alpha as coverage, converging over samples
+
+
+def material_from_blender(mat):
+    """A Blender material as Penumbra draws it (``Material``), with a message for every part
+    it could not read."""
+    if mat is None:
+        return Material()
+    notes = []
+    if not getattr(mat, "use_nodes", True) or getattr(mat, "node_tree", None) is None:
+        out = Material(
+            base_color=tuple(mat.diffuse_color),
+            roughness=float(mat.roughness),
+            specular=float(getattr(mat, "specular_intensity", 0.5)),
+            metallic=float(mat.metallic),
+        )
+        return out
+    out = _shader(mat, _surface(mat), notes)
+    if out is None:
+        out = _display(mat, notes, "its surface shader is drawn with the viewport display colour")
+    elif "alpha" in out.textures or out.alpha < 1.0:
+        out.blend = _blend_mode(mat)
+    out.messages = tuple(f"material '{mat.name}': {n}" for n in dict.fromkeys(notes))
+    return out
+
+
+def _black():
+    """What an unlinked shader socket gives: no light at all."""
+    return Material(base_color=(0.0, 0.0, 0.0, 1.0), specular=0.0, roughness=1.0)
+
+
+def _shader(mat, node, notes, depth=0):
+    """The Material of shader ``node`` (None: not understood; ``notes`` says why)."""
+    if node is None:
+        return _black()
+    idname = node.bl_idname
+    if idname == "ShaderNodeBsdfPrincipled":
+        return _principled(mat, node, notes)
+    if idname == "ShaderNodeEmission":
+        return _emission_shader(node, notes)
+    if idname == "ShaderNodeBsdfDiffuse":
+        return _diffuse_shader(node, notes)
+    if idname in {"ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic"}:
+        out = Material(metallic=1.0)
+        out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
+        out.roughness = _value_channel(node.inputs["Roughness"], notes, "Roughness", out, "roughness", 0.5)
+        return out
+    if idname == "ShaderNodeBsdfTransparent":
+        out = _black()
+        out.alpha = 0.0
+        return out
+    if idname == "ShaderNodeMixShader" and depth < 8:
+        return _mix_shader(mat, node, notes, depth)
+    notes.append(f"'{node.bl_label or idname}' shader")
+    return None
+
+
+_MIXED = ("roughness", "specular", "metallic", "alpha", "normal_strength")
+
+
+def _mix_shader(mat, node, notes, depth):
+    """A Mix Shader with a constant factor of two shaders Penumbra reads: their values mixed
+    (a Transparent BSDF mixed in gives alpha). Textured sides are not mixed: the side with
+    the larger weight is drawn, with a message."""
+    fac_in = node.inputs[0]
+    if fac_in.is_linked:
+        notes.append("a Mix Shader with a linked factor")
+        return None
+    fac = min(max(float(fac_in.default_value), 0.0), 1.0)
+    sides = [_shader(mat, _source(node.inputs[i])[0], notes, depth + 1) for i in (1, 2)]
+    if any(side is None for side in sides):
+        return None
+    a, b = sides
+    if fac in (0.0, 1.0):
+        return b if fac == 1.0 else a
+    if a.textures or b.textures or a.color_attribute is not None or b.color_attribute is not None:
+        notes.append("a Mix Shader of textured shaders (the side with the larger factor is drawn)")
+        return b if fac >= 0.5 else a
+    out = Material()
+    # A transparent side contributes no surface: the mix's surface values are the other side's.
+    wa, wb = (1.0 - fac) * a.alpha, fac * b.alpha
+    total = wa + wb
+    ta = wa / total if total > 0.0 else 0.5
+    for name in _MIXED:
+        setattr(out, name, ta * getattr(a, name) + (1.0 - ta) * getattr(b, name))
+    # Keep the mixed diffuse albedo (what the eye reads as the colour): base * (1 - metallic).
+    albedo = ta * np.array(a.base_color[:3]) * (1.0 - a.metallic) + (1.0 - ta) * np.array(b.base_color[:3]) * (
+        1.0 - b.metallic
+    )
+    if out.metallic < 0.999:
+        base = albedo / (1.0 - out.metallic)
+    else:
+        base = ta * np.array(a.base_color[:3]) + (1.0 - ta) * np.array(b.base_color[:3])
+    out.base_color = (*(float(c) for c in base), 1.0)
+    out.alpha = total
+    out.emission = tuple((1.0 - fac) * x + fac * y for x, y in zip(a.emission, b.emission, strict=True))
+    return out
+
+
+def _color_channel(socket, notes, label, out, channel, fallback):
+    kind, value = _input(socket, "color", notes, label)
+    if kind == "texture":
+        out.textures[channel] = value
+        return (1.0, 1.0, 1.0, 1.0)
+    if kind == "attribute":
+        out.color_attribute = value
+        return (1.0, 1.0, 1.0, 1.0)
+    if kind == "unsupported":
+        return fallback
+    return tuple(value)
+
+
+def _value_channel(socket, notes, label, out, channel, fallback):
+    kind, value = _input(socket, "value", notes, label)
+    if kind == "texture" and channel is None:
+        notes.append(f"a texture into {label} (its value is used)")
+        return float(socket.default_value)
+    if kind == "texture":
+        out.textures[channel] = value
+        return 1.0
+    if kind in {"unsupported", "attribute"}:
+        return fallback
+    return float(value)
+
+
+def _principled(mat, node, notes):
+    from bpy_extras.node_shader_utils import PrincipledBSDFWrapper
+
+    wrapper = PrincipledBSDFWrapper(mat, is_readonly=True)
+    if wrapper.node_principled_bsdf != node:
+        wrapper = None  # another Principled node is wired elsewhere: read the drawn one directly
+    out = Material()
+    inputs = node.inputs
+    display = tuple(mat.diffuse_color)
+    out.base_color = _color_channel(inputs["Base Color"], notes, "Base Color", out, "base_color", display)
+    out.roughness = _value_channel(inputs["Roughness"], notes, "Roughness", out, "roughness", float(mat.roughness))
+    out.metallic = _value_channel(inputs["Metallic"], notes, "Metallic", out, "metallic", float(mat.metallic))
+    spec_name = "Specular IOR Level" if "Specular IOR Level" in inputs else "Specular"
+    out.specular = _value_channel(inputs[spec_name], notes, spec_name, out, None, 0.5)
+    alpha = _value_channel(inputs["Alpha"], notes, "Alpha", out, "alpha", 1.0)
+    out.alpha = alpha
+    emit_name = "Emission Color" if "Emission Color" in inputs else "Emission"
+    emission = _color_channel(inputs[emit_name], notes, "Emission Color", out, "emission", (0.0, 0.0, 0.0, 1.0))
+    strength_in = inputs.get("Emission Strength")
+    strength = 1.0 if strength_in is None else _value_channel(strength_in, notes, "Emission Strength", out, None, 1.0)
+    out.emission = tuple(float(c) * strength for c in emission[:3])
+    if "emission" in out.textures and strength == 0.0:
+        del out.textures["emission"]
+    _normal_map(wrapper, node, notes, out)
+    if "alpha" in out.textures or alpha < 1.0:
+        out.blend = "HASHED"  # the material's render method decides (material_from_blender)
+    for name in ("Transmission Weight", "Transmission", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
+        sock = inputs.get(name)
+        if sock is not None and (sock.is_linked or float(sock.default_value) > 0.0):
+            notes.append(f"{name} is not drawn")
+    return out
+
+
+def _normal_map(wrapper, node, notes, out):
+    normal_node, _ = _source(node.inputs["Normal"])
+    if normal_node is None:
+        return
+    if normal_node.bl_idname != "ShaderNodeNormalMap":
+        notes.append(f"Normal from a '{normal_node.bl_label}' node (not drawn)")
+        return
+    if normal_node.space != "TANGENT":
+        notes.append(f"{normal_node.space.lower()}-space normal maps (only tangent space is drawn)")
+        return
+    strength_in = normal_node.inputs["Strength"]
+    strength = float(wrapper.normalmap_strength if wrapper is not None else strength_in.default_value)
+    kind, value = _input(normal_node.inputs["Color"], "color", notes, "Normal Map color")
+    if kind != "texture" or strength == 0.0:
+        return
+    ref = value
+    if normal_node.uv_map:
+        ref = TextureRef(**{**ref.__dict__, "uv_map": normal_node.uv_map})
+    out.textures["normal"] = ref
+    out.normal_strength = strength
+
+
+def _emission_shader(node, notes):
+    out = Material(base_color=(0.0, 0.0, 0.0, 1.0), specular=0.0, roughness=1.0)
+    color = _color_channel(node.inputs["Color"], notes, "Emission Color", out, "emission", (1.0, 1.0, 1.0, 1.0))
+    strength = _value_channel(node.inputs["Strength"], notes, "Emission Strength", out, None, 1.0)
+    out.emission = tuple(float(c) * strength for c in color[:3])
+    if out.color_attribute is not None:
+        notes.append("a colour attribute into Emission (not drawn)")
+        out.color_attribute = None
+    return out
+
+
+def _diffuse_shader(node, notes):
+    out = Material(specular=0.0, roughness=1.0)
+    out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
+    return out
+
+
+# --- world --------------------------------------------------------------------------------
+
+
+@dataclass
+class World:
+    """Light from the world: ``sh`` are order-2 spherical-harmonic coefficients (9, 3) of its
+    radiance (a constant world has only the first), ``background`` the colour the film shows
+    where nothing is drawn."""
+
+    sh: np.ndarray
+    background: np.ndarray
+    messages: tuple = ()
+    image: str | None = None  # an Environment Texture image drawn behind the scene
+    strength: float = 1.0  # its Background strength
+
+    @property
+    def mean(self):
+        return self.sh[0] * SH_C0
+
+    @classmethod
+    def constant(cls, color, messages=()):
+        color = np.asarray(color, dtype=np.float64)[:3]
+        sh = np.zeros((9, 3))
+        sh[0] = color / SH_C0
+        return cls(sh=sh, background=color.copy(), messages=tuple(messages))
+
+
+SH_C0 = 0.28209479177387814  # Y_0^0
+
+
+def sh_basis(d):
+    """The nine real SH basis functions at unit directions ``d`` (..., 3) -> (..., 9)."""
+    x, y, z = d[..., 0], d[..., 1], d[..., 2]
+    return np.stack(
+        [
+            np.full_like(x, SH_C0),
+            0.4886025119029199 * y,
+            0.4886025119029199 * z,
+            0.4886025119029199 * x,
+            1.0925484305920792 * x * y,
+            1.0925484305920792 * y * z,
+            0.31539156525252005 * (3.0 * z * z - 1.0),
+            1.0925484305920792 * x * z,
+            0.5462742152960396 * (x * x - y * y),
+        ],
+        axis=-1,
+    )
+
+
+def equirect_sh(rgb):
+    """SH coefficients (9, 3) of an equirectangular radiance image ``rgb`` (h, w, 3), row 0
+    at the bottom (Blender's pixel order), as Blender maps it: u = atan2(y, -x) / 2pi + 0.5,
+    v = atan2(z, hypot(x, y)) / pi + 0.5."""
+    h, w = rgb.shape[:2]
+    v = (np.arange(h) + 0.5) / h
+    u = (np.arange(w) + 0.5) / w
+    lat = (v - 0.5) * math.pi  # elevation
+    lon = (u - 0.5) * 2.0 * math.pi  # atan2(y, -x)
+    cl = np.cos(lat)[:, None]
+    d = np.stack(
+        [-np.cos(lon)[None, :] * cl, np.sin(lon)[None, :] * cl, np.broadcast_to(np.sin(lat)[:, None], (h, w))],
+        axis=-1,
+    )
+    solid_angle = (2.0 * math.pi / w) * (math.pi / h) * np.broadcast_to(cl, (h, w))
+    basis = sh_basis(d)  # (h, w, 9)
+    return np.einsum("hwk,hwc,hw->kc", basis, rgb.astype(np.float64), solid_angle)
+
+
+def image_pixels(image):
+    """An image's pixels as float32 (h, w, 4), row 0 at the bottom, scene-linear colour with
+    straight alpha (as the Image Texture node outputs them), or None when it has none."""
+    w, h = image.size
+    channels = image.channels
+    if w == 0 or h == 0 or channels == 0:
+        return None
+    data = np.empty(w * h * channels, np.float32)
+    image.pixels.foreach_get(data)
+    data = data.reshape(h, w, channels)
+    out = np.ones((h, w, 4), np.float32)
+    if channels >= 3:
+        out[..., :3] = data[..., :3]
+    else:
+        out[..., :3] = data[..., :1]
+    if channels in (2, 4):
+        out[..., 3] = data[..., -1]
+    settings = image.colorspace_settings
+    if not image.is_float and not settings.is_data and settings.name in {"sRGB", "sRGB EOTF"}:
+        out[..., :3] = srgb_to_linear(out[..., :3])
+    elif image.is_float and image.alpha_mode != "STRAIGHT" and channels == 4:
+        # Float buffers hold premultiplied scene-linear colour; the node outputs it straight.
+        a = out[..., 3:4]
+        out[..., :3] = np.where(a > 0.0, out[..., :3] / np.where(a > 0.0, a, 1.0), out[..., :3])
+    return out
+
+
+def srgb_to_linear(c):
+    c = np.asarray(c, dtype=np.float32)
+    return np.where(c <= 0.04045, c / 12.92, ((np.maximum(c, 0.04045) + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+def world_from_blender(scene):
+    """The scene world's light (``World``): a Background shader's colour x strength, or an
+    Environment Texture image's radiance as SH; anything else its colour with a message."""
+    world = scene.world
+    if world is None:
+        return World.constant((0.0, 0.0, 0.0))
+    tree = getattr(world, "node_tree", None)
+    if tree is None or not getattr(world, "use_nodes", True):
+        return World.constant(world.color)
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld"]
+    active = [n for n in outputs if n.is_active_output] or outputs
+    node = None
+    for out in active:
+        node, _ = _source(out.inputs["Surface"])
+        if node is not None:
+            break
+    if node is None:
+        return World.constant((0.0, 0.0, 0.0))
+    if node.bl_idname != "ShaderNodeBackground":
+        return World.constant(
+            world.color, (f"world '{world.name}': '{node.bl_label}' shader (the world's viewport colour is used)",)
+        )
+    strength_in = node.inputs["Strength"]
+    strength = float(strength_in.default_value)
+    messages = []
+    if strength_in.is_linked:
+        messages.append(f"world '{world.name}': a linked Strength (its value is used)")
+    src, out = _source(node.inputs["Color"])
+    if src is None:
+        return World.constant(np.array(node.inputs["Color"].default_value[:3]) * strength, messages)
+    if src.bl_idname == "ShaderNodeTexEnvironment" and src.image is not None:
+        pixels = image_pixels(src.image)
+        if pixels is not None:
+            if src.projection != "EQUIRECTANGULAR":
+                messages.append(f"world '{world.name}': {src.projection} projection (read as equirectangular)")
+            sh = equirect_sh(pixels[..., :3]) * strength
+            return World(
+                sh=sh, background=sh[0] * SH_C0, messages=tuple(messages), image=src.image.name_full, strength=strength
+            )
+    if src.bl_idname == "ShaderNodeRGB":
+        return World.constant(np.array(out.default_value[:3]) * strength, messages)
+    messages.append(f"world '{world.name}': Color from a '{src.bl_label}' node (the world's viewport colour is used)")
+    return World.constant(np.array(world.color[:3]) * strength, messages)

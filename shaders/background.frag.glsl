@@ -1,0 +1,15 @@
+/* The world's Environment Texture behind the scene: the view ray of each pixel (through the
+ * inverse view-projection) looked up in the equirectangular image as Blender maps it,
+ * u = atan2(y, -x) / 2pi + 0.5, v = atan2(z, hypot(x, y)) / pi + 0.5, times the Background
+ * strength. */
+void main()
+{
+  vec2 ndc = 2.0 * (gl_FragCoord.xy - viewport_origin) / viewport_size - 1.0;
+  vec4 near = inverse_view_proj * vec4(ndc, -1.0, 1.0);
+  vec4 far = inverse_view_proj * vec4(ndc, 1.0, 1.0);
+  vec3 d = far.xyz / far.w - near.xyz / near.w;
+  float len = length(d);
+  d = (len > 0.0) ? d / len : vec3(0.0, 0.0, 1.0);
+  vec2 uv = vec2(atan(d.y, -d.x) / (2.0 * M_PI) + 0.5, atan(d.z, length(d.xy)) / M_PI + 0.5);
+  out_color = vec4(strength * sample_image(env, uv, ivec4(1, 0, 0, 0)).rgb, 1.0);
+}
