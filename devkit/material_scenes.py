@@ -167,9 +167,11 @@ def uv_plane(scene, name="Plane", size=PLANE, z=0.0, mat=None):
 
 
 def default_engine():
-    """'PENUMBRA' when the engine is registered, else EEVEE (the builders work without it)."""
-    items = {item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items}
-    return "PENUMBRA" if "PENUMBRA" in items else engines.eevee_id()
+    """'PENUMBRA' when the engine is registered, else EEVEE (the builders work without it).
+    Add-on engines are not listed in the RNA enum's static items, so ask RenderEngine."""
+    if any(getattr(cls, "bl_idname", "") == "PENUMBRA" for cls in bpy.types.RenderEngine.__subclasses__()):
+        return "PENUMBRA"
+    return engines.eevee_id()
 
 
 def base(width, height, world=WORLD):

@@ -299,7 +299,7 @@ def _corner_uvs(mesh, needs, nc, messages):
     layers = mesh.uv_layers
     layer = layers.get(needs.uv_map) if needs.uv_map else next((u for u in layers if u.active_render), None)
     if layer is None:
-        want = f"UV map '{needs.uv_map}'" if needs.uv_map else "a UV map"
+        want = f"UV map '{needs.uv_map}'" if needs.uv_map else "UV map"
         messages.append(f"mesh '{mesh.name}' has no {want}: its textures read UV (0, 0)")
         zeros = np.zeros((nc, 2), np.float32)
         return zeros, (np.zeros((nc, 4), np.float32) if needs.tangents else None)
@@ -331,7 +331,7 @@ def _corner_colors(mesh, name, corner_vert, nc, messages):
         index = attrs.render_color_index
         attr = attrs[index] if 0 <= index < len(attrs) else None
     if attr is None or attr.domain not in {"POINT", "CORNER"}:
-        want = f"colour attribute '{name}'" if name else "a colour attribute"
+        want = f"colour attribute '{name}'" if name else "colour attribute"
         messages.append(f"mesh '{mesh.name}' has no {want} on points or corners: white is used")
         return np.ones((nc, 4), np.float32)
     count = len(mesh.vertices) if attr.domain == "POINT" else nc

@@ -103,7 +103,8 @@ def _mapping_transform(mapping):
     rot = mapping.inputs["Rotation"].default_value if "Rotation" in mapping.inputs else (0, 0, 0)
     scale = mapping.inputs["Scale"].default_value if "Scale" in mapping.inputs else (1, 1, 1)
     message = None
-    if any(s.is_linked for s in mapping.inputs) or abs(rot[0]) > 1e-6 or abs(rot[1]) > 1e-6:
+    linked = any(s.is_linked for s in mapping.inputs if s.name != "Vector")
+    if linked or abs(rot[0]) > 1e-6 or abs(rot[1]) > 1e-6:
         message = "a Mapping node with linked inputs or X/Y rotation (only its 2-D part is used)"
     c, s = math.cos(rot[2]), math.sin(rot[2])
     rotation = np.array([[c, -s], [s, c]])
@@ -411,6 +412,19 @@ def _diffuse_shader(node, notes):
     return out
 
 
+def summary(read):
+    """What the Material panel shows of a read ``Material``: (icon, text) lines, the messages
+    last (the same words as the render report, without the material's name)."""
+    textures = ", ".join(c.replace("_", " ") for c in read.textures) or "none"
+    lines = [("TEXTURE", f"Textures: {textures}")]
+    if read.color_attribute is not None:
+        lines.append(("GROUP_VCOL", f"Colour attribute: {read.color_attribute or 'the active one'}"))
+    alpha = {"OPAQUE": "opaque", "HASHED": "dithered (hashed over samples)", "BLEND": "blended"}[read.blend]
+    lines.append(("IMAGE_ALPHA", f"Alpha: {alpha}"))
+    lines += [("ERROR", m.split(": ", 1)[-1]) for m in read.messages]
+    return lines
+
+
 # --- world --------------------------------------------------------------------------------
 
 
@@ -498,7 +512,10 @@ def image_pixels(image):
         out[..., 3] = data[..., -1]
     settings = image.colorspace_settings
     if not image.is_float and not settings.is_data and settings.name in {"sRGB", "sRGB EOTF"}:
-        out[..., :3] = srgb_to_linear(out[..., :3])
+        # Byte images hold k / 255: decode through a 256-entry table (exact, and much faster
+        # than the power function over every texel).
+        codes = np.clip(np.rint(out[..., :3] * 255.0), 0, 255).astype(np.uint8)
+        out[..., :3] = _SRGB_TABLE[codes]
     elif image.is_float and image.alpha_mode != "STRAIGHT" and channels == 4:
         # Float buffers hold premultiplied scene-linear colour; the node outputs it straight.
         a = out[..., 3:4]
@@ -507,8 +524,12 @@ def image_pixels(image):
 
 
 def srgb_to_linear(c):
+    """The sRGB transfer function, decoded to linear."""
     c = np.asarray(c, dtype=np.float32)
     return np.where(c <= 0.04045, c / 12.92, ((np.maximum(c, 0.04045) + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+_SRGB_TABLE = srgb_to_linear(np.arange(256) / 255.0)  # byte code -> linear
 
 
 def world_from_blender(scene):

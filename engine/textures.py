@@ -52,7 +52,9 @@ class TextureCache:
         if pixels is None:
             print(f"Penumbra: image '{name}' has no pixels (missing file?): drawn magenta", file=sys.stderr)
             pixels = np.array(MISSING, np.float32).reshape(1, 1, 4)
-        pixels = np.ascontiguousarray(np.nan_to_num(pixels, nan=0.0, posinf=65504.0, neginf=-65504.0), np.float32)
+        if image is not None and image.is_float:  # byte images cannot hold NaN/Inf
+            pixels = np.nan_to_num(pixels, nan=0.0, posinf=65504.0, neginf=-65504.0)
+        pixels = np.ascontiguousarray(pixels, np.float32)
         h, w = pixels.shape[:2]
         limit = gpu.capabilities.max_texture_size_get()
         if w > limit or h > limit:

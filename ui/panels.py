@@ -119,17 +119,11 @@ class PENUMBRA_PT_material(PenumbraPanel, bpy.types.Panel):
         return super().poll(context) and getattr(context, "material", None) is not None
 
     def draw(self, context):
-        from ..engine.materials import material_from_blender
+        from ..engine.materials import material_from_blender, summary
 
-        read = material_from_blender(context.material)
         col = self.layout.column(align=True)
-        textures = ", ".join(c.replace("_", " ") for c in read.textures) or "none"
-        col.label(text=f"Textures: {textures}", icon="TEXTURE")
-        if read.color_attribute is not None:
-            col.label(text=f"Colour attribute: {read.color_attribute or 'active'}", icon="GROUP_VCOL")
-        col.label(text=f"Alpha: {read.blend.lower()}", icon="IMAGE_ALPHA")
-        for message in read.messages:
-            col.label(text=message.split(": ", 1)[-1], icon="ERROR")
+        for icon, text in summary(material_from_blender(context.material)):
+            col.label(text=text, icon=icon)
 
 
 class PENUMBRA_UL_layers(bpy.types.UIList):

@@ -135,6 +135,23 @@ def test_unsupported_input_falls_back_to_the_viewport_colour_and_says_so(penumbr
     assert any("Glass" in m and "viewport display colour" in m for m in read.messages)
 
 
+def test_material_panel_lists_what_is_drawn_and_what_is_not(penumbra):
+    from penumbra.engine.materials import material_from_blender, summary
+    from penumbra.ui.panels import PENUMBRA_PT_material
+
+    assert PENUMBRA_PT_material.bl_context == "material" and "PENUMBRA" in PENUMBRA_PT_material.COMPAT_ENGINES
+    scene = _builder("alpha_checker_shadow")
+    checker = next(ob for ob in scene.objects if ob.name == "Checker")
+    mat = checker.material_slots[0].material
+    noise = mat.node_tree.nodes.new("ShaderNodeTexNoise")
+    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    mat.node_tree.links.new(noise.outputs["Fac"], bsdf.inputs["Roughness"])
+    lines = summary(material_from_blender(mat))
+    assert ("TEXTURE", "Textures: base color, alpha") in lines
+    assert ("IMAGE_ALPHA", "Alpha: dithered (hashed over samples)") in lines
+    assert [text for icon, text in lines if icon == "ERROR"] == ["Roughness from a 'Noise Texture' node"]
+
+
 def test_render_reports_each_unsupported_case_once(penumbra, capfd):
     scene = _builder("hair")
     _penumbra(scene, samples=2)
@@ -332,3 +349,33 @@ def test_images_upload_once_and_reupload_after_an_update(penumbra, gpu_call):
     finally:
         bpy.app.handlers.depsgraph_update_post.remove(handler)
     assert cache.images_changed == {image.name_full}
+
+
+def test_bad_texture_inputs_render_finite_with_messages(penumbra, capfd):
+    """A float image with NaN/Inf texels, an image whose file is missing, and a mesh without
+    the UV map a texture asks for: the frame is finite, the missing image draws magenta (as in
+    Blender), and each case is named."""
+    scene = _builder("texture_base_color")
+    plane = next(ob for ob in scene.objects if ob.type == "MESH")
+    bad = bpy.data.images.new("BadFloat", 4, 4, float_buffer=True)
+    px = np.full((4, 4, 4), 0.5, np.float32)
+    px[0, 0] = (np.nan, np.inf, -np.inf, 1.0)
+    bad.pixels.foreach_set(px.ravel())
+    mat = plane.material_slots[0].material
+    node = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeTexImage")
+    node.image = bad
+    image = _penumbra(scene, samples=1)
+    assert np.isfinite(image).all()
+
+    missing = bpy.data.images.new("Missing", 8, 8)
+    missing.source = "FILE"
+    missing.filepath = "/nonexistent/texture.png"
+    node.image = missing
+    plane.data.uv_layers.remove(plane.data.uv_layers[0])
+    image = _penumbra(scene, samples=1)
+    out = capfd.readouterr()
+    assert np.isfinite(image).all()
+    centre = image[SIZE // 2, SIZE // 2, :3]
+    assert centre[0] > 5 * centre[1] and centre[2] > 5 * centre[1]  # magenta
+    assert "image 'Missing' has no pixels" in out.err
+    assert "Penumbra: mesh 'Plane' has no UV map: its textures read UV (0, 0)" in out.out

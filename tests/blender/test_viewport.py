@@ -46,9 +46,19 @@ def _viewport_frame(gpu_call, scene):
     return gpu_call(job)
 
 
-@pytest.mark.parametrize("stack", ["demo", "every effect"])
+@pytest.mark.parametrize(
+    "stack", ["demo", "every effect", "normal map", "environment world", "alpha", "colour attribute"]
+)
 def test_viewport_matches_final_render(penumbra, gpu_call, stack):
-    scene = scenes.demo_scene(160, 90)
+    from devkit import material_scenes
+
+    builders = {
+        "normal map": material_scenes.normal_map,
+        "environment world": material_scenes.world_hdri,
+        "alpha": material_scenes.alpha_quarter,
+        "colour attribute": material_scenes.color_attribute,
+    }
+    scene = builders[stack](64, 64) if stack in builders else scenes.demo_scene(160, 90)
     if stack == "every effect":
         from penumbra.engine.post import EFFECTS
 
