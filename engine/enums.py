@@ -191,5 +191,6 @@ SHADOW_MODE = Enum(
         ("NONE", "None", "No shadow map", -1),
         ("SINGLE", "Single", "One map (sun, spot)", 0),
         ("CUBE", "Cube", "Up to six cube faces (point, area)", 1),
+        ("CASCADE", "Cascade", "Up to four maps over slices of the visible depth range (sun)", 2),
     ),
 )

@@ -76,7 +76,7 @@ def influence_planes(light):
     return _unit_planes(rows)
 
 
-def _polytope_vertices(planes, tolerance):
+def polytope_vertices(planes, tolerance):
     """Vertices of {x : n . x <= d for every row}: every triple of planes intersected, the
     points inside all of them kept. (k, 3); empty when the polytope is empty."""
     triples = np.array(list(itertools.combinations(range(len(planes)), 3)))
@@ -109,7 +109,7 @@ def screen_rects(lights, view_proj, lo, hi, width, height):
             rects.append(full)
             continue
         tolerance = 1e-6 * (1.0 + scale + np.abs(planes[:, 3]).max())
-        verts = _polytope_vertices(planes, tolerance)
+        verts = polytope_vertices(planes, tolerance)
         if len(verts) == 0:
             rects.append(None)
             continue

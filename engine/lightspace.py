@@ -5,7 +5,11 @@ values. Matrices are 4x4 float64, column-vector convention (``clip = P @ V @ wor
 as Blender's ``mathutils`` and OpenGL.
 """
 
+import math
+
 import numpy as np
+
+from . import light_bins
 
 # Maps clip-space xyz in [-1, 1] to texture space [0, 1] (seed 004's "bias matrix").
 BIAS_MATRIX = np.array(
@@ -197,6 +201,104 @@ def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2
     hi[2] = max(hi[2], bhi[casters, 2].max())
     scale = float(np.abs(np.concatenate([lo, hi])).max())
     return _ortho_fit(view, lo, hi, scale, map_size, padding_texels), casters
+
+
+MAX_CASCADES = 4
+CASCADE_RATIO = 20.0  # farthest / nearest depth one cascade covers when chosen automatically
+CASCADE_LAMBDA = 1.0  # practical split scheme: weight of the logarithmic split (the range
+# is the visible geometry's, so logarithmic splits give every cascade the same depth ratio)
+
+
+def view_depth_range(projection, view, corners, is_ortho):
+    """(near, far) view depths of the geometry the camera can see: the camera's clip range
+    narrowed to the depth range of the boxes (``corners`` (N, 8, 3)) that overlap the view
+    frustum. None when nothing is seen."""
+    clip = clip_range(projection, is_ortho)
+    if clip is None:
+        return None
+    boxes = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
+    if len(boxes) == 0:
+        return None
+    try:
+        fc = frustum_corners(projection @ view)
+    except np.linalg.LinAlgError:
+        return None
+    flo, fhi = fc.min(axis=0), fc.max(axis=0)
+    lo, hi = boxes.min(axis=1), boxes.max(axis=1)
+    seen = np.all((lo <= fhi) & (hi >= flo), axis=1)
+    if not seen.any():
+        return None
+    # Boxes inside the frustum count whole; a box that crosses its sides (a ground plane
+    # under the camera) counts only the part inside it: the vertices of box ∩ frustum.
+    planes = light_bins.frustum_planes(projection @ view)
+    inside = np.all(np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) <= planes[None, None, :, 3] + 1e-9, axis=(1, 2))
+    points = [boxes[seen & inside].reshape(-1, 3)]
+    for i in np.nonzero(seen & ~inside)[0]:
+        clipped = np.concatenate([planes, light_bins.box_planes(lo[i], hi[i])])
+        tolerance = 1e-6 * max(1.0, float(np.abs(boxes[i]).max()), clip[1])
+        points.append(light_bins.polytope_vertices(clipped, tolerance))
+    points = np.concatenate(points)
+    if len(points) == 0:
+        return None
+    depth = -(points @ view[2, :3] + view[2, 3])  # view depth of every visible vertex
+    near = max(clip[0], float(depth.min()))
+    far = min(clip[1], float(depth.max()))
+    if not (far > near > 0.0 or (is_ortho and far > near)):
+        return None
+    return near, far
+
+
+def clip_range(projection, is_ortho):
+    """The (near, far) clip distances of an OpenGL projection matrix."""
+    p22, p23 = float(projection[2, 2]), float(projection[2, 3])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if is_ortho:
+            near, far = (p23 + 1.0) / p22, (p23 - 1.0) / p22
+        else:
+            near, far = p23 / (p22 - 1.0), p23 / (p22 + 1.0)
+    if not (np.isfinite(near) and np.isfinite(far) and far > near):
+        return None
+    return near, far
+
+
+def cascade_count(near, far, requested=0):
+    """How many cascades: ``requested`` (1-4), or with 0 enough for each to span at most
+    CASCADE_RATIO in depth (1 for most scenes, up to 4 for a long view over a large ground)."""
+    if requested:
+        return int(min(max(requested, 1), MAX_CASCADES))
+    if near <= 0.0:
+        return 1
+    return int(min(max(math.ceil(math.log(far / near) / math.log(CASCADE_RATIO) - 1e-9), 1), MAX_CASCADES))
+
+
+def cascade_splits(near, far, count, lam=CASCADE_LAMBDA):
+    """``count + 1`` view depths from ``near`` to ``far``: the practical split scheme, a blend
+    of logarithmic (weight ``lam``) and uniform splits."""
+    i = np.arange(count + 1) / count
+    uniform = near + (far - near) * i
+    log = near * (far / near) ** i if near > 0.0 else uniform
+    out = lam * log + (1.0 - lam) * uniform
+    out[0], out[-1] = near, far
+    return out
+
+
+def slice_corners(view_corners, near_clip, far_clip, a, b):
+    """The 8 world corners of the part of the view frustum between view depths ``a`` and
+    ``b`` (``view_corners``: the frustum's corners, near face first, from ``frustum_corners``;
+    its near and far planes at ``near_clip``, ``far_clip``). Depth is linear along each
+    corner's ray from the near face to the far face."""
+    vc = np.asarray(view_corners, dtype=np.float64)
+    # frustum_corners orders corners by box_corners: z = -1 (near) first for each (x, y).
+    near_face, far_face = vc[vc_index(False)], vc[vc_index(True)]
+    span = far_clip - near_clip
+    ta, tb = (a - near_clip) / span, (b - near_clip) / span
+    return np.concatenate([near_face + (far_face - near_face) * ta, near_face + (far_face - near_face) * tb])
+
+
+def vc_index(far):
+    """Indices of the near (or far) face's corners in ``frustum_corners``' order."""
+    ndc = box_corners((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
+    return np.nonzero(ndc[:, 2] > 0 if far else ndc[:, 2] < 0)[0]
 
 
 # Cube-map faces: +X, -X, +Y, -Y, +Z, -Z. The GLSL face selection (cube_face) uses this order.

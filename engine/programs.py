@@ -37,6 +37,7 @@ LIGHT_STRUCT = Struct(
         ("IVEC4", "tiles"),  # atlas tile of cube faces 0..3 (x: the single map); -1: none
         ("IVEC2", "tiles_45"),  # atlas tiles of cube faces 4, 5
         ("FLOAT", "bias_scale"),  # light.penumbra.bias_scale
+        ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
     ),
 )
 

@@ -289,7 +289,7 @@ class Renderer:
         corners = np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
         view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
         size = max(1, int(settings.shadow_map_size)) if map_size is None else map_size
-        return plan_shadows(lights, corners, size, view_corners)
+        return plan_shadows(lights, corners, size, view_corners, camera, int(settings.shadow_cascades))
 
     def _shadow_pass(self, draws, lights, camera, settings, stats, alpha_offset=0.5):
         """Plan the maps this frame needs (numpy) and draw the ones whose content changed."""

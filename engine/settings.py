@@ -180,6 +180,17 @@ SCENE_PARAMS = (
         section=SHADOWS,
     ),
     Param(
+        "shadow_cascades",
+        "INT",
+        0,
+        "Shadow maps a sun splits the visible depth range into (View fit): 0 chooses 1 to 4 from the ratio "
+        "of the farthest to the nearest visible depth",
+        min=0,
+        max=4,
+        label="Sun Cascades",
+        section=SHADOWS,
+    ),
+    Param(
         "pcf_kernel_size",
         "INT",
         5,

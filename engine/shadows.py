@@ -41,8 +41,9 @@ class Tile:
 
 @dataclass
 class LightShadow:
-    mode: str  # 'SINGLE' | 'CUBE'
-    tiles: list = field(default_factory=list)  # per face (or one): index into plan.tiles, or -1
+    mode: str  # 'SINGLE' | 'CUBE' | 'CASCADE'
+    tiles: list = field(default_factory=list)  # per face, cascade (or one): index into plan.tiles, or -1
+    splits: tuple = ()  # CASCADE: the view depth where each cascade ends
 
 
 @dataclass
@@ -102,15 +103,18 @@ class Caster:
     cutouts: list = field(default_factory=list)  # (batch, material UBO, alpha texture): alpha >= 0.5 casts
 
 
-def plan_shadows(lights, corners, map_size, view_corners=None):
+def plan_shadows(lights, corners, map_size, view_corners=None, camera=None, cascades=0):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
-    what the camera sees (all geometry when None). Returns a ShadowPlan; tiles beyond
+    what the camera sees (all geometry when None). With ``camera`` (an ``extract.Camera``) a
+    sun splits the visible depth range into ``cascades`` maps (0: chosen from the range, see
+    ``lightspace.cascade_count``), each fitted to its slice. Returns a ShadowPlan; tiles beyond
     MAX_SHADOW_TILES are not planned (``plan.unshadowed`` counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
     corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(corners) == 0:
         return plan
+    slices = _cascade_slices(corners, view_corners, camera, cascades)
     lo = corners.min(axis=1)
     hi = corners.max(axis=1)
     everything = np.arange(len(corners))
@@ -122,10 +126,13 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
             if view_corners is None:
                 fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), map_size)
                 tiles = [Tile(fit, everything)] if fit is not None else []
-            else:
+            elif slices is None:
                 fitted = lightspace.fit_sun_to_view(light.direction, corners, view_corners, map_size)
                 tiles = [Tile(*fitted)] if fitted is not None else []
-            mode = "SINGLE"
+            else:
+                fits = [lightspace.fit_sun_to_view(light.direction, corners, sc, map_size) for sc, _end in slices]
+                tiles = [Tile(*f) if f is not None else None for f in fits]
+            mode = "CASCADE" if view_corners is not None and slices is not None and len(slices) > 1 else "SINGLE"
         elif light.type == "SPOT":
             fov = min(light.spot_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
             tile = perspective_tile(light.position, light.direction, fov, corners, lo, hi, map_size)
@@ -146,6 +153,8 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
             dropped += 1
             continue
         entry = LightShadow(mode)
+        if mode == "CASCADE":
+            entry.splits = tuple(end for _sc, end in slices)
         for t in tiles:
             if t is None:
                 entry.tiles.append(-1)
@@ -155,6 +164,31 @@ def plan_shadows(lights, corners, map_size, view_corners=None):
         plan.lights[i] = entry
     plan.unshadowed = dropped
     return plan
+
+
+def _cascade_slices(corners, view_corners, camera, requested):
+    """[(slice corners, view depth where the slice ends)] of the visible depth range: one
+    slice (the view frustum cut to the depth range of what it sees, so a far clip plane
+    beyond the geometry does not widen the map), or one per sun cascade. None when the range
+    is unknown (then the whole frustum is fitted). Cascades are widened by CASCADE_OVERLAP of
+    their depth on both sides, so filters near a split still read inside a map."""
+    if camera is None or view_corners is None:
+        return None
+    depth = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
+    clip = lightspace.clip_range(camera.projection, camera.is_ortho)
+    if depth is None or clip is None:
+        return None
+    count = lightspace.cascade_count(*depth, requested)
+    splits = lightspace.cascade_splits(*depth, count)
+    out = []
+    for a, b in zip(splits[:-1], splits[1:], strict=True):
+        pad = CASCADE_OVERLAP * (b - a) if count > 1 else 0.0
+        lo, hi = max(a - pad, clip[0]), min(b + pad, clip[1])
+        out.append((lightspace.slice_corners(view_corners, clip[0], clip[1], lo, hi), float(b)))
+    return out
+
+
+CASCADE_OVERLAP = 0.1
 
 
 class ShadowAtlas:
