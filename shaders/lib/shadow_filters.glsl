@@ -99,6 +99,13 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
   if (mode == SHADOW_MODE_SINGLE) {
     tile = L.tiles.x;
   }
+  else if (mode == SHADOW_MODE_CASCADE) {
+    /* The slice of the visible depth range P lies in (view depth along the camera axis). */
+    float d = dot(P - frame.camera_position, frame.camera_forward);
+    vec4 ends = L.cascade_splits;
+    int c = (d < ends.x) ? 0 : (d < ends.y) ? 1 : (d < ends.z) ? 2 : 3;
+    tile = L.tiles[c];
+  }
   else {
     int face = cube_face(P - L.position);
     tile = (face < 4) ? L.tiles[face] : L.tiles_45[face - 4];
