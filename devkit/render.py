@@ -15,6 +15,7 @@ def render(scene=None, passes=("Combined",)):
     image (the orientation of GPU textures and Blender's pixel buffers)."""
     scene = scene or bpy.context.scene
     scene.view_layers[0].use_pass_z = "Depth" in passes
+    scene.view_layers[0].use_pass_emit = "Emission" in passes
     if hasattr(scene.view_layers[0], "penumbra"):
         scene.view_layers[0].penumbra.use_pass_shadow = "Shadow" in passes
         scene.view_layers[0].penumbra.use_pass_lit = "Lit" in passes
@@ -29,7 +30,8 @@ def render(scene=None, passes=("Combined",)):
             data = read_exr(path)
         finally:
             scene.render.filepath = old
-    return {k: v[::-1] for k, v in data.items()}
+    # The Emission pass is "Emit" up to Blender 4.5: one name for callers on every line.
+    return {("Emission" if k == "Emit" else k): v[::-1] for k, v in data.items()}
 
 
 def engine_frame(runner, scene, width, height):

@@ -194,11 +194,11 @@ def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2
     rls = transform_points(view, region)
     lo, hi = rls.min(axis=0), rls.max(axis=0)
     # Casters: anything whose light-space footprint overlaps the fitted region, at any depth
-    # towards the light; the depth range grows to hold them.
+    # towards the light. The depth range stays the region's: casters nearer the light than its
+    # near plane are flattened onto it by the depth pass ("pancaking", shadow_depth.vert), where
+    # they still occlude everything in the region, so a large ground or a tall caster does not
+    # stretch the range and cost depth precision (a 1 km ground in FLOAT16).
     casters = np.nonzero(np.all((blo[:, :2] <= hi[:2]) & (bhi[:, :2] >= lo[:2]), axis=1))[0]
-    hi = hi.copy()
-    lo = lo.copy()
-    hi[2] = max(hi[2], bhi[casters, 2].max())
     scale = float(np.abs(np.concatenate([lo, hi])).max())
     return _ortho_fit(view, lo, hi, scale, map_size, padding_texels), casters
 

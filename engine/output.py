@@ -63,7 +63,6 @@ _UNSUPPORTED = (
     ("camera", "dof.use_dof", "camera depth of field is not rendered"),
     ("render", "use_motion_blur", "motion blur is not rendered"),
     ("render", "use_freestyle", "Freestyle lines are not rendered"),
-    ("view_layer", "use_pass_emit", "the Emission pass is not written"),
     ("view_layer", "use_pass_diffuse_color", "the Diffuse Color pass is not written"),
     ("view_layer", "use_pass_ambient_occlusion", "the Ambient Occlusion pass is not written"),
     ("view_layer", "use_pass_cryptomatte_object", "Cryptomatte passes are not written"),

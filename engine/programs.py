@@ -166,6 +166,7 @@ LIT = Program(
             "LIGHT_WORD_BITS": light_bins.WORD_BITS,
             "LIGHT_WORDS": LIGHT_WORDS,
             **material_defines(frozenset()),
+            "EMISSION_OUTPUT": False,
         }.items()
     ),
 )
@@ -199,9 +200,19 @@ def _with_features(program, features, name):
     )
 
 
-def lit_program(features=frozenset(), aux=True):
-    """The lit pass program of a material variant (``Material.features``, plus "HOLDOUT")."""
-    base = LIT if aux else LIT_COLOR
+# A final render with the Emission pass: the lit pass also writes each surface's emission.
+LIT_EMIT = replace(
+    LIT,
+    name="lit_emit",
+    outputs=LIT.outputs + (("VEC4", "out_emission"),),
+    defines=LIT.defines + (("EMISSION_OUTPUT", True),),
+)
+
+
+def lit_program(features=frozenset(), aux=True, emission=False):
+    """The lit pass program of a material variant (``Material.features``, plus "HOLDOUT");
+    ``emission``: the variant also writes the Emission pass's target."""
+    base = LIT_EMIT if emission else (LIT if aux else LIT_COLOR)
     if not features:
         return base
     return _with_features(base, features, f"{base.name}_{'_'.join(sorted(features)).lower()}")

@@ -11,6 +11,10 @@ from .output import mist_pass, render_views, render_window, unsupported_in_use, 
 
 ENDLESS_SAMPLES = 64  # how finely soft lights are split when the viewport refines without end
 
+# The Emission pass's name on this Blender line, as its own engines register it (the
+# compositor's Render Layers socket): "Emit" up to 4.5, "Emission" from 5.0.
+EMISSION_PASS = "Emission" if bpy.app.version >= (5, 0, 0) else "Emit"
+
 
 class PenumbraEngineCore:
     """What the viewport and final renders share. Kept apart from the registered class so
@@ -43,6 +47,7 @@ class PenumbraEngineCore:
         samples=(0, 1),
         sample_count=1,
         on_sample=None,
+        emission=False,
     ):
         """Extract, then render samples ``samples`` of a frame of ``sample_count`` samples
         (``Renderer.render``); returns the renderer's FrameOutput. ``pixel_scale`` scales the
@@ -58,7 +63,16 @@ class PenumbraEngineCore:
             frame=scene.frame_current, film_transparent=scene.render.film_transparent, pixel_scale=pixel_scale
         )
         out = self.renderer.render(
-            snapshot, camera, settings, width, height, aux, samples, sample_count, on_sample=on_sample
+            snapshot,
+            camera,
+            settings,
+            width,
+            height,
+            aux,
+            samples,
+            sample_count,
+            on_sample=on_sample,
+            emission=emission,
         )
         self.last_stats = out.stats
         return out
@@ -160,6 +174,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.register_pass(scene, renderlayer, "Mist", 1, "Z", "VALUE")
         if renderlayer.penumbra.use_pass_lit:
             self.register_pass(scene, renderlayer, "Lit", 4, "RGBA", "COLOR")
+        if renderlayer.use_pass_emit:
+            self.register_pass(scene, renderlayer, EMISSION_PASS, 3, "RGB", "COLOR")
 
     def render(self, depsgraph):
         """Render the pixels Blender asks for: the render region of the frame at Blender's
@@ -180,7 +196,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             return
         views = render_views(r)
         vl = depsgraph.view_layer
-        aux = vl.use_pass_z or vl.use_pass_mist or vl.use_pass_normal or vl.penumbra.use_pass_shadow
+        aux = vl.use_pass_z or vl.use_pass_mist or vl.use_pass_normal or vl.penumbra.use_pass_shadow or vl.use_pass_emit
         reported = set()
         for message in unsupported_in_use(scene.camera.data, r, depsgraph.view_layer):
             self.report({"WARNING"}, message)
@@ -227,6 +243,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     samples=(0, count),
                     sample_count=count,
                     on_sample=on_sample,
+                    emission=vl.use_pass_emit,
                 )
                 if out.stats.cancelled:
                     return  # cancelled: no result is written for this view
@@ -246,6 +263,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     passes["Normal"] = window.cut(out.normal_array())
                 if depsgraph.view_layer.use_pass_mist:
                     passes["Mist"] = window.cut(self._mist(scene, camera, out, width, height))
+                if depsgraph.view_layer.use_pass_emit:
+                    passes[EMISSION_PASS] = window.cut(out.emission_array())
                 self._write_result(window, layer, view, passes)
                 self.update_progress((index + 1) / len(views))
         except Exception as exc:  # a render must end with a message, never a crash

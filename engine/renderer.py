@@ -64,6 +64,10 @@ class FrameOutput:
     normal: object = None  # GPUTexture, world-space shading normal (0 for the background)
     depth_data: object = None  # arrays of the centred sample when several were accumulated
     normal_data: object = None
+    emission: object = None  # GPUTexture, the Emission pass (when asked for)
+
+    def emission_array(self):
+        return texture_array(self.emission, 4)[..., :3]
 
     def normal_array(self):
         if self.normal_data is not None:
@@ -142,11 +146,23 @@ class Renderer:
         self._fullscreen_batch = None
         self._weight_sum = 0.0
         self._centre = None  # (depth, normal) arrays of a multi-sample frame's centred sample
+        self._emission = self._fb_emit = self._emission_targets = None
+        self._emission_on = False
 
     # --- the frame ------------------------------------------------------------------------
 
     def render(
-        self, snapshot, camera, settings, width, height, aux=True, samples=(0, 1), sample_count=1, on_sample=None
+        self,
+        snapshot,
+        camera,
+        settings,
+        width,
+        height,
+        aux=True,
+        samples=(0, 1),
+        sample_count=1,
+        on_sample=None,
+        emission=False,
     ):
         """Samples ``samples[0] .. samples[1] - 1`` of a frame of ``sample_count`` samples
         (``engine/sampling.py``), added to the samples this renderer already accumulated for
@@ -154,10 +170,13 @@ class Renderer:
         average. One sample of one is exactly the single-sample frame, with no accumulation.
         ``aux``: also write the depth, shadow and normal targets (a final render's passes;
         depth and normal are the centred sample's, shadow is averaged like colour).
-        ``on_sample(done)`` after each sample; returning False stops the frame there (cancel)."""
+        ``on_sample(done)`` after each sample; returning False stops the frame there (cancel).
+        ``emission`` (with ``aux``): also write the Emission pass's target, averaged like colour."""
         stats = FrameStats()
         compiled_before = self.shaders.compiled
-        self._ensure_targets(width, height, aux)
+        emission = bool(emission and aux)
+        self._emission_on = emission
+        self._ensure_targets(width, height, aux, emission)
         draws = self._draw_list(snapshot, stats)
         stats.messages.extend(getattr(snapshot, "messages", ()))
         self.textures.forget(getattr(snapshot, "images_changed", ()))
@@ -175,6 +194,8 @@ class Renderer:
                 self._accum_color.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
                 if self._accum_shadow is not None:
                     self._accum_shadow.clear(format="FLOAT", value=(0.0,))
+                if emission:
+                    self._emission_accumulation().clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
                 self._weight_sum = 0.0
         plan = None
         moving = sampling.sampled_lights(lights, self._plan(draws, lights, camera, settings)) if accumulate else set()
@@ -192,6 +213,11 @@ class Renderer:
             plan = self._sample(draws, sample_lights, camera, view_camera, snapshot, settings, aux, stats, alpha_offset)
             if accumulate:
                 self._accumulate(weight, aux)
+                if emission:
+                    accum, accum_fb, _resolve_fb = self._emission_targets
+                    self._fullscreen(
+                        SCALED_COPY, accum_fb, {"src_color": self._emission}, {"scale": weight}, "ADDITIVE_PREMULT"
+                    )
                 self._weight_sum += weight
             if aux and accumulate and s == 0:  # the centred sample's depth and normal
                 self._centre = (texture_array(self._depth, 1)[..., 0].copy(), texture_array(self._normal, 4).copy())
@@ -201,6 +227,10 @@ class Renderer:
                 break
         if accumulate and stats.samples:
             self._resolve(aux)
+            if emission:
+                accum, _accum_fb, resolve_fb = self._emission_targets
+                inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
+                self._fullscreen(SCALED_COPY, resolve_fb, {"src_color": accum}, {"scale": inverse})
         color = self._post_pass(settings, stats)
         target_bytes = 16 + 4 + (4 + 4 + 8 if aux else 0)  # colour, z-buffer, depth, shadow, normal
         if accumulate:
@@ -213,6 +243,7 @@ class Renderer:
         if not aux:
             return FrameOutput(color, None, None, stats, width, height, lit=self._color)
         out = FrameOutput(color, self._depth, self._shadow, stats, width, height, lit=self._color, normal=self._normal)
+        out.emission = self._emission if emission else None
         if accumulate and self._centre is not None:
             out.depth_data, out.normal_data = self._centre
         return out
@@ -404,8 +435,13 @@ class Renderer:
         width, height = self._size
         bound = {"shader": None}
 
+        emission = aux and getattr(self, "_emission_on", False)
+        if emission:
+            self._emission.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+
         def bind(features, with_aux):
-            shader = self.shaders.get(lit_program(frozenset(features), with_aux), data.defines)
+            program = lit_program(frozenset(features), with_aux, emission and with_aux)
+            shader = self.shaders.get(program, data.defines)
             if bound["shader"] is shader:
                 return shader
             shader.bind()
@@ -431,7 +467,7 @@ class Renderer:
                 batch.draw(shader)
                 stats.draws += 1
 
-        fb = self._fb if aux else self._fb_color
+        fb = self._fb_emit if emission else (self._fb if aux else self._fb_color)
         with fb.bind():
             gpu.state.viewport_set(0, 0, width, height)
             fb.clear(depth=1.0)
@@ -483,9 +519,9 @@ class Renderer:
 
     # --- resources ------------------------------------------------------------------------
 
-    def _ensure_targets(self, width, height, aux):
+    def _ensure_targets(self, width, height, aux, emission=False):
         """The lit pass's targets at this size; the auxiliary ones (depth, shadow, normal) only
-        once a frame asks for them."""
+        once a frame asks for them, the Emission pass's likewise."""
         import gpu
 
         if self._size != (width, height):
@@ -493,6 +529,7 @@ class Renderer:
             self._zbuffer = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
             self._fb_color = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self._color,))
             self._depth = self._shadow = self._normal = self._fb = None
+            self._emission = self._fb_emit = self._emission_targets = None
             self._post_ctx = PostContext(self.shaders, width, height)
             self._size = (width, height)
         if aux and self._fb is None:
@@ -502,6 +539,27 @@ class Renderer:
             self._fb = gpu.types.GPUFrameBuffer(
                 depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow, self._normal)
             )
+        if emission and self._fb_emit is None:
+            self._emission = gpu.types.GPUTexture((width, height), format="RGBA32F")
+            self._fb_emit = gpu.types.GPUFrameBuffer(
+                depth_slot=self._zbuffer,
+                color_slots=(self._color, self._depth, self._shadow, self._normal, self._emission),
+            )
+
+    def _emission_accumulation(self):
+        """The Emission pass's accumulation target (and the framebuffers that add to it and
+        resolve it into the pass's target), made on first use at this size."""
+        import gpu
+
+        if self._emission_targets is None:
+            width, height = self._size
+            accum = gpu.types.GPUTexture((width, height), format="RGBA32F")
+            self._emission_targets = (
+                accum,
+                gpu.types.GPUFrameBuffer(color_slots=(accum,)),
+                gpu.types.GPUFrameBuffer(color_slots=(self._emission,)),
+            )
+        return self._emission_targets[0]
 
     def _ensure_accumulation(self, aux):
         """The float32 accumulation targets of a multi-sample frame (colour, and shadow for a

@@ -273,4 +273,11 @@ void main()
   out_shadow = (unshadowed > 0.0) ? arriving / unshadowed : 1.0;
   out_normal = vec4(N, 0.0); /* world-space shading normal, facing the camera (Normal pass) */
 #endif
+#if EMISSION_OUTPUT
+#  if HOLDOUT
+  out_emission = vec4(0.0);
+#  else
+  out_emission = vec4(emission, 1.0); /* the Emission pass: what the surface emits */
+#  endif
+#endif
 }

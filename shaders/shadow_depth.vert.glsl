@@ -9,4 +9,10 @@ void main()
 #endif
   vec4 t = tile.proj_tex * view_pos;
   gl_Position = vec4(2.0 * t.xyz - t.w, t.w);
+  /* Pancaking: a caster nearer the light than the tile's near plane is flattened onto it
+   * (depth 0) instead of clipped away, so it still occludes what is behind it; the tile's
+   * depth range then only has to span the receivers. (x, y do not depend on z.) */
+  if (gl_Position.w > 0.0) {
+    gl_Position.z = max(gl_Position.z, -gl_Position.w);
+  }
 }

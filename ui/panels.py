@@ -88,6 +88,7 @@ class PENUMBRA_PT_passes(PenumbraPanel, bpy.types.Panel):
         col.prop(view_layer, "use_pass_z")
         col.prop(view_layer, "use_pass_mist")
         col.prop(view_layer, "use_pass_normal")
+        col.prop(view_layer, "use_pass_emit")
         draw_params(col, view_layer.penumbra, settings.VIEW_LAYER_PARAMS)
 
 

@@ -379,3 +379,28 @@ def test_bad_texture_inputs_render_finite_with_messages(penumbra, capfd):
     assert centre[0] > 5 * centre[1] and centre[2] > 5 * centre[1]  # magenta
     assert "image 'Missing' has no pixels" in out.err
     assert "Penumbra: mesh 'Plane' has no UV map: its textures read UV (0, 0)" in out.out
+
+
+@pytest.fixture(scope="module")
+def eevee_emission(penumbra):
+    return render(engines.configure(_builder("emission"), "EEVEE"), passes=("Combined", "Emission"))["Emission"]
+
+
+@pytest.mark.parametrize("samples", [1, 4])
+def test_emission_pass_is_what_surfaces_emit(penumbra, samples, eevee_emission):
+    """The Emission pass (View Layer > Passes > Emission) holds each surface's emission
+    (colour x strength, 0 elsewhere), averaged over samples like Combined: on the emissive
+    sphere it equals EEVEE's, and it is anti-aliased like Combined."""
+    scene = engines.configure(_builder("emission"), "PENUMBRA", render_samples=samples)
+    ours = render(scene, passes=("Combined", "Emission"))
+    emit = ours["Emission"]
+    centre = emit[SIZE // 2, SIZE // 2, :3]
+    np.testing.assert_allclose(centre, (2.0, 1.0, 0.4), rtol=1e-3)  # (1, 0.5, 0.2) x strength 2
+    assert np.abs(emit[:3, :3]).max() == 0.0  # the background emits nothing
+    ref = eevee_emission
+    inside = np.abs(ref[..., :3] - np.array((2.0, 1.0, 0.4))).max(axis=-1) < 1e-3
+    assert inside.sum() > 0.2 * SIZE * SIZE
+    np.testing.assert_allclose(emit[inside, :3], ref[inside, :3], rtol=1e-3)
+    if samples > 1:  # anti-aliased like Combined: edge pixels are partial
+        partial = (emit[..., 0] > 0.05) & (emit[..., 0] < 1.95)
+        assert partial.sum() > 10
