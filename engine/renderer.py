@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels, light_bins, sampling
+from . import kernels, light_bins, lightspace, sampling
 from .frame_data import build_frame_data, select_lights
 from .materials import CHANNELS, EXTENSION, INTERPOLATION, Material
 from .post import post_stack
@@ -27,6 +27,7 @@ from .programs import (
 from .shadows import ShadowAtlas, plan_shadows
 from .textures import TextureCache
 
+_UNSET = object()
 DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
 _CORNER_BITS = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=bool)  # box corners
 
@@ -148,6 +149,7 @@ class Renderer:
         self._centre = None  # (depth, normal) arrays of a multi-sample frame's centred sample
         self._emission = self._fb_emit = self._emission_targets = None
         self._emission_on = False
+        self._depth_range = _UNSET  # the frame's visible depth range, once computed
 
     # --- the frame ------------------------------------------------------------------------
 
@@ -174,6 +176,7 @@ class Renderer:
         ``emission`` (with ``aux``): also write the Emission pass's target, averaged like colour."""
         stats = FrameStats()
         compiled_before = self.shaders.compiled
+        self._depth_range = _UNSET
         emission = bool(emission and aux)
         self._emission_on = emission
         self._ensure_targets(width, height, aux, emission)
@@ -320,7 +323,13 @@ class Renderer:
         corners = np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
         view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
         size = max(1, int(settings.shadow_map_size)) if map_size is None else map_size
-        return plan_shadows(lights, corners, size, view_corners, camera, int(settings.shadow_cascades))
+        if self._depth_range is _UNSET:
+            # The visible depth range depends only on the unjittered camera and the instances'
+            # bounds: once per frame, not per sample.
+            self._depth_range = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
+        return plan_shadows(
+            lights, corners, size, view_corners, camera, int(settings.shadow_cascades), self._depth_range
+        )
 
     def _shadow_pass(self, draws, lights, camera, settings, stats, alpha_offset=0.5):
         """Plan the maps this frame needs (numpy) and draw the ones whose content changed."""

@@ -103,18 +103,19 @@ class Caster:
     cutouts: list = field(default_factory=list)  # (batch, material UBO, alpha texture): alpha >= 0.5 casts
 
 
-def plan_shadows(lights, corners, map_size, view_corners=None, camera=None, cascades=0):
+def plan_shadows(lights, corners, map_size, view_corners=None, camera=None, cascades=0, depth_range=None):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
     what the camera sees (all geometry when None). With ``camera`` (an ``extract.Camera``) a
     sun splits the visible depth range into ``cascades`` maps (0: chosen from the range, see
-    ``lightspace.cascade_count``), each fitted to its slice. Returns a ShadowPlan; tiles beyond
+    ``lightspace.cascade_count``), each fitted to its slice; ``depth_range``: the camera's
+    visible (near, far), when the caller already has it. Returns a ShadowPlan; tiles beyond
     MAX_SHADOW_TILES are not planned (``plan.unshadowed`` counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
     corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(corners) == 0:
         return plan
-    slices = _cascade_slices(corners, view_corners, camera, cascades)
+    slices = _cascade_slices(corners, view_corners, camera, cascades, depth_range)
     lo = corners.min(axis=1)
     hi = corners.max(axis=1)
     everything = np.arange(len(corners))
@@ -166,7 +167,7 @@ def plan_shadows(lights, corners, map_size, view_corners=None, camera=None, casc
     return plan
 
 
-def _cascade_slices(corners, view_corners, camera, requested):
+def _cascade_slices(corners, view_corners, camera, requested, depth=None):
     """[(slice corners, view depth where the slice ends)] of the visible depth range: one
     slice (the view frustum cut to the depth range of what it sees, so a far clip plane
     beyond the geometry does not widen the map), or one per sun cascade. None when the range
@@ -174,7 +175,8 @@ def _cascade_slices(corners, view_corners, camera, requested):
     their depth on both sides, so filters near a split still read inside a map."""
     if camera is None or view_corners is None:
         return None
-    depth = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
+    if depth is None:
+        depth = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
     clip = lightspace.clip_range(camera.projection, camera.is_ortho)
     if depth is None or clip is None:
         return None

@@ -112,24 +112,17 @@ def test_shader_set_ups_match_eevee(penumbra, name, bound):
 def test_unsupported_input_falls_back_to_the_viewport_colour_and_says_so(penumbra):
     from penumbra.engine.materials import material_from_blender
 
-    mat = bpy.data.materials.new("Noisy")
-    mat.use_nodes = True
+    mat, bsdf, _output = material_scenes.node_material("Noisy")
     mat.diffuse_color = (0.1, 0.7, 0.2, 1.0)
-    tree = mat.node_tree
-    bsdf = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
-    noise = tree.nodes.new("ShaderNodeTexNoise")
-    tree.links.new(noise.outputs["Color"], bsdf.inputs["Base Color"])
+    noise = mat.node_tree.nodes.new("ShaderNodeTexNoise")
+    mat.node_tree.links.new(noise.outputs["Color"], bsdf.inputs["Base Color"])
     read = material_from_blender(mat)
     assert read.base_color[:3] == pytest.approx((0.1, 0.7, 0.2))
     assert len(read.messages) == 1 and "Noise Texture" in read.messages[0] and "Noisy" in read.messages[0]
 
-    glass = bpy.data.materials.new("Glass")
-    glass.use_nodes = True
+    glass, _bsdf, _output = material_scenes.node_material("Glass")
     glass.diffuse_color = (0.3, 0.3, 0.9, 1.0)
-    tree = glass.node_tree
-    out = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
-    node = tree.nodes.new("ShaderNodeBsdfGlass")
-    tree.links.new(node.outputs[0], out.inputs["Surface"])
+    material_scenes.replace_shader(glass, "ShaderNodeBsdfGlass")
     read = material_from_blender(glass)
     assert read.base_color[:3] == pytest.approx((0.3, 0.3, 0.9))
     assert any("Glass" in m and "viewport display colour" in m for m in read.messages)

@@ -168,3 +168,25 @@ def test_every_depth_format_holds_under_a_huge_ground(penumbra, depth_format, gr
     assert on_ground.mean() > 0.9
     assert iou(shadow[on_ground], analytic[on_ground]) > 0.97
     assert (shadow & on_ground & ~analytic).sum() / (on_ground & ~analytic).sum() < 0.005
+
+
+def test_visible_depth_range_is_computed_once_per_frame(penumbra, gpu_call, monkeypatch):
+    """It depends only on the unjittered camera and the instances' bounds: a frame of 4
+    samples (a soft sun, refitted every sample) computes it once, not per sample."""
+    from penumbra.engine import lightspace
+
+    calls = []
+    real = lightspace.view_depth_range
+    monkeypatch.setattr(lightspace, "view_depth_range", lambda *a: calls.append(1) or real(*a))
+    scene = small_box_scene(horizon=True)
+    scene.objects["Sun"].data.angle = math.radians(5.0)
+
+    def job(engine, depsgraph):
+        from penumbra.engine.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, scene, 160, 90)
+        out = engine.render_frame(depsgraph, camera, 160, 90, samples=(0, 4), sample_count=4)
+        return out.stats.samples, out.stats.lights_sampled
+
+    assert gpu_call(job) == (4, 1)
+    assert len(calls) == 1
