@@ -19,6 +19,21 @@ contact    a tall thin box (0.5 x 0.5 x 3) standing on the plane, sun with angle
            the shadow is sharp where the box meets the plane and soft far from it
 =========  ============================================================================
 
+Detailed casters on large grounds (``DETAILED_SCENES``; shared meshes from ``devkit.assets``,
+rendered at DETAILED_WIDTH x DETAILED_HEIGHT), where the maps' fit and bias decide the result:
+
+=========  ============================================================================
+bunny      the scanned bunny (69k triangles, 0.6 m) on a 2 km ground, sharp sun (0.5 deg)
+           at 40 deg, camera 2.4 m away with a 1 km far clip: fine self-shadowing
+suzanne    smooth-shaded Suzanne (subdivided once) on the same ground and sun: smooth
+           low-poly self-shadowing (the shadow terminator)
+grazing    three cows (6k triangles each) on the ground under a sun 4 deg above the
+           horizon: long thin shadows, legs, contact at the feet
+tiny       a 15 cm bunny on a 1 km ground, camera 0.6 m away, far clip 500 m
+room       a point light (radius 0.05) in a closed 6 x 5 x 3 m room with a table and the
+           bunny: cube-face seams cross floor and wall shadows
+=========  ============================================================================
+
 Visibility is (render with shadows) / (render with the light's ``use_shadow`` off), in
 luminance, so light units, falloff and cone shapes cancel and only the shadow term remains.
 Engines are set up by ``devkit.engines``; its Cycles renders direct light only, so indirect
@@ -157,6 +172,127 @@ def contact(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
     return scene
 
 
+# --- detailed casters on large grounds ------------------------------------------------------
+
+DETAILED_WIDTH, DETAILED_HEIGHT = 320, 180
+BIG_GROUND = 2000.0
+
+
+def _big_stage(width, height, ground=BIG_GROUND, far=1000.0):
+    scene, grey = _stage(width, height)
+    ground_ob = scene.objects["Ground"]
+    ground_ob.scale = (ground / 24.0,) * 3
+    return scene, grey, far
+
+
+def _sharp_sun(scene, elevation_deg, azimuth_deg=30.0, angle_deg=0.5):
+    sun = scenes.light(scene, "Sun", "SUN", 3.0, angle=math.radians(angle_deg))
+    sun.rotation_euler = (-(math.pi / 2 - math.radians(elevation_deg)), 0.0, math.radians(azimuth_deg))
+    return _hide_from_camera(sun)
+
+
+def _camera(scene, location, target, lens, far):
+    cam = scenes.look_at(scene, location, target, lens=lens)
+    cam.data.clip_end = far
+    cam.data.clip_start = min(0.1, far * 1e-4)
+    return cam
+
+
+def _mesh(scene, path, height, material, location=(0.0, 0.0, 0.0), rotation_z=0.0, name=None):
+    from devkit import assets
+
+    ob = assets.import_mesh(scene, path, height=height, name=name)
+    ob.location = location
+    ob.rotation_euler = (0.0, 0.0, math.radians(rotation_z))
+    ob.data.materials.clear()
+    ob.data.materials.append(material)
+    return ob
+
+
+def bunny(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    from devkit import assets
+
+    scene, grey, far = _big_stage(width, height)
+    _mesh(scene, assets.BUNNY, 0.6, grey, rotation_z=-30.0, name="Bunny")
+    _sharp_sun(scene, 40.0, azimuth_deg=40.0)
+    _camera(scene, (0.9, -2.1, 0.9), (0.0, 0.0, 0.22), 45.0, far)
+    return scene
+
+
+def suzanne(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    import bmesh
+
+    scene, grey, far = _big_stage(width, height)
+    me = bpy.data.meshes.new("Suzanne")
+    bm = bmesh.new()
+    bmesh.ops.create_monkey(bm)
+    bmesh.ops.subdivide_edges(bm, edges=bm.edges[:], cuts=1, use_grid_fill=True, smooth=1.0)
+    bmesh.ops.triangulate(bm, faces=[f for f in bm.faces if len(f.verts) > 4])
+    bm.to_mesh(me)
+    bm.free()
+    for poly in me.polygons:
+        poly.use_smooth = True
+    ob = scenes.link(scene, bpy.data.objects.new("Suzanne", me))
+    # Suzanne faces -Y; standing 1 m tall on the ground, her face towards the camera.
+    ob.scale = (0.5, 0.5, 0.5)
+    ob.location = (0.0, 0.0, 0.6)
+    ob.rotation_euler = (math.radians(10.0), 0.0, math.radians(20.0))
+    me.materials.append(grey)
+    _sharp_sun(scene, 45.0, azimuth_deg=-35.0)
+    _camera(scene, (0.6, -3.2, 1.5), (0.0, 0.0, 0.55), 50.0, far)
+    return scene
+
+
+def grazing(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    from devkit import assets
+
+    scene, grey, far = _big_stage(width, height)
+    cows = [((-1.4, 0.6, 0.0), 20.0), ((0.4, -0.2, 0.0), -50.0), ((1.8, 1.4, 0.0), 100.0)]
+    for k, (loc, rot) in enumerate(cows):
+        _mesh(scene, assets.SPOT, 0.9, grey, location=loc, rotation_z=rot, name=f"Cow{k}")
+    # The sun 4 deg above the horizon, from behind and to the side: shadows 13 m long.
+    _sharp_sun(scene, 4.0, azimuth_deg=150.0)
+    _camera(scene, (1.0, -7.5, 3.2), (0.2, 1.0, 0.2), 35.0, far)
+    return scene
+
+
+def tiny(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    from devkit import assets
+
+    scene, grey, _far = _big_stage(width, height, ground=1000.0)
+    _mesh(scene, assets.BUNNY, 0.15, grey, rotation_z=-30.0, name="Bunny")
+    _sharp_sun(scene, 50.0, azimuth_deg=40.0)
+    _camera(scene, (0.22, -0.5, 0.3), (0.0, 0.0, 0.05), 45.0, 500.0)
+    return scene
+
+
+def room(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    from devkit import assets
+
+    scene, grey = _stage(width, height)
+    scene.objects["Ground"].scale = (6.0 / 24.0, 5.0 / 24.0, 1.0)
+    white = scenes.white("Walls", PLANE_ALBEDO)
+    # Walls and ceiling as thin boxes, so every surface casts and receives from both sides.
+    t = 0.1
+    for name, center, size in (
+        ("Ceiling", (0.0, 0.0, 3.0 + t / 2), (6.0, 5.0, t)),
+        ("WallN", (0.0, 2.5 + t / 2, 1.5), (6.0, t, 3.0)),
+        ("WallS", (0.0, -2.5 - t / 2, 1.5), (6.0, t, 3.0)),
+        ("WallE", (3.0 + t / 2, 0.0, 1.5), (t, 5.0, 3.0)),
+        ("WallW", (-3.0 - t / 2, 0.0, 1.5), (t, 5.0, 3.0)),
+    ):
+        scenes.box(scene, name, center=center, size=size, mat=white)
+    scenes.box(scene, "Table", center=(0.6, 0.5, 0.75), size=(1.4, 0.8, 0.06), mat=grey)
+    for k, (x, y) in enumerate(((0.0, 0.2), (1.2, 0.2), (0.0, 0.8), (1.2, 0.8))):
+        scenes.box(scene, f"Leg{k}", center=(x, y, 0.36), size=(0.06, 0.06, 0.72), mat=grey)
+    _mesh(scene, assets.BUNNY, 0.5, grey, location=(-1.2, -0.4, 0.0), rotation_z=20.0, name="Bunny")
+    ob = scenes.light(scene, "Point", "POINT", 600.0, location=(0.2, -0.6, 2.1), shadow_soft_size=0.05)
+    _hide_from_camera(ob)
+    cam = _camera(scene, (2.6, -2.3, 2.2), (-0.6, 0.6, 0.6), 24.0, 100.0)
+    cam.data.clip_start = 0.05
+    return scene
+
+
 SCENES = {
     "sun_hard": sun_hard,
     "sun_soft": sun_soft,
@@ -164,8 +300,15 @@ SCENES = {
     "point": point,
     "area": area,
     "contact": contact,
+    "bunny": bunny,
+    "suzanne": suzanne,
+    "grazing": grazing,
+    "tiny": tiny,
+    "room": room,
 }
+LIGHT_SCENES = ("sun_hard", "sun_soft", "spot", "point", "area", "contact")
 SOFT_SCENES = ("sun_soft", "spot", "point", "area", "contact")  # visibly soft shadows in Cycles
+DETAILED_SCENES = ("bunny", "suzanne", "grazing", "tiny", "room")  # detailed casters, large grounds
 
 
 def build(name, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):

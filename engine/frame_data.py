@@ -18,11 +18,11 @@ from .programs import (
     LIGHT_STRUCT,
     LIGHT_WORDS,
     MAX_DISK_SAMPLES,
-    MAX_FILTER_RADIUS,
     MAX_LIGHTS,
     MAX_SHADOW_TILES,
     TILE_STRUCT,
     lit_defines,
+    max_filter_radius,
 )
 
 
@@ -105,7 +105,7 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "normal_offset": settings.shadow_normal_offset,
         "pcf_spacing": settings.pcf_spacing,
         "filter_radius": settings.shadow_filter_radius,
-        "max_filter_radius": MAX_FILTER_RADIUS,
+        "max_filter_radius": max_filter_radius(tile_size),
         "tile_size": tile_size,
         "atlas_columns": atlas_columns,
     }

@@ -170,35 +170,207 @@ def frustum_corners(view_proj):
     return h[:, :3] / h[:, 3:4]
 
 
-def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2.0):
+def hull_planes(corners):
+    """The face planes (rows n, d meaning n . x <= d, unit n) of the convex hexahedron with
+    ``corners`` (8, 3) in ``box_corners`` order: a box, a view frustum or a slice of one.
+    Degenerate faces are left out."""
+    c = np.asarray(corners, dtype=np.float64).reshape(8, 3)
+    centre = c.mean(axis=0)
+    rows = []
+    for face in ((0, 2, 6, 4), (1, 5, 7, 3), (0, 4, 5, 1), (2, 3, 7, 6), (0, 1, 3, 2), (4, 6, 7, 5)):
+        p = c[list(face)]
+        n = np.cross(p[2] - p[0], p[3] - p[1])  # the quad's diagonals: robust for thin faces
+        length = float(np.linalg.norm(n))
+        if not np.isfinite(length) or length <= 0.0:
+            continue
+        n /= length
+        d = float(n @ p.mean(axis=0))
+        if n @ centre > d:
+            n, d = -n, -d
+        rows.append((*n, d))
+    return np.array(rows, dtype=np.float64).reshape(-1, 4)
+
+
+def clipped_points(boxes, planes, per_box=False):
+    """The part of each box (``boxes`` (N, 8, 3) corners; each taken as its world bounds) inside
+    the convex region ``planes``: boxes wholly inside give their corners, boxes crossing it
+    the vertices of box ∩ region. Returns (points (k, 3), seen (N,) bool: the box reaches into
+    the region); with ``per_box`` the points are a list of one array per box (empty if unseen)."""
+    boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 8, 3)
+    seen = np.zeros(len(boxes), dtype=bool)
+    parts = [np.zeros((0, 3))] * len(boxes)
+    if len(boxes) and len(planes):
+        scale = max(1.0, float(np.abs(planes[:, 3]).max()))
+        s = np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) - planes[None, None, :, 3]
+        tol = 1e-9 * np.maximum(scale, np.abs(boxes).max(axis=(1, 2)))
+        inside = np.all(s <= tol[:, None, None], axis=(1, 2))
+        outside = np.any(np.all(s > tol[:, None, None], axis=1), axis=1)
+        for i in np.nonzero(inside)[0]:
+            parts[i] = boxes[i]
+        seen |= inside
+        lo, hi = boxes.min(axis=1), boxes.max(axis=1)
+        for i in np.nonzero(~inside & ~outside)[0]:
+            clipped = np.concatenate([planes, light_bins.box_planes(lo[i], hi[i])])
+            v = light_bins.polytope_vertices(clipped, 1e-6 * max(scale, float(np.abs(boxes[i]).max())))
+            if len(v):
+                seen[i] = True
+                parts[i] = v
+    if per_box:
+        return parts, seen
+    return (np.concatenate(parts) if parts else np.zeros((0, 3))), seen
+
+
+FLAT = 1e-6  # a box this thin relative to its longest edge is a flat (planar) mesh's
+MAX_FLAT_TESTS = 16  # flat boxes tested for casting nothing (the largest: grounds and walls)
+
+
+def flat_casters_without_shadow(boxes, direction):
+    """(N,) bool: flat boxes (planar meshes: grounds, walls, cards) that cannot shadow anything
+    under a sun shining along ``direction``, because no other box reaches behind their plane
+    (the side the light travels towards) or the light grazes them edge-on. A planar mesh never
+    shadows itself, so such a box is left out of the sun's maps: it costs nothing to draw and
+    does not widen the map. Only the MAX_FLAT_TESTS largest flat boxes are tested."""
+    boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 8, 3)
+    n_boxes = len(boxes)
+    free = np.zeros(n_boxes, dtype=bool)
+    if n_boxes == 0:
+        return free
+    edges = boxes[:, [1, 2, 4]] - boxes[:, [0]]  # the box's three edges from corner 0
+    lengths = np.linalg.norm(edges, axis=2)
+    longest = lengths.max(axis=1)
+    thin = lengths.argmin(axis=1)
+    rows = np.arange(n_boxes)
+    a, b = edges[rows, (thin + 1) % 3], edges[rows, (thin + 2) % 3]
+    normal = np.cross(a, b)
+    area = np.linalg.norm(normal, axis=1)
+    flat = (lengths[rows, thin] <= FLAT * longest) & (area > 1e-12 * longest**2) & np.isfinite(area)
+    candidates = np.nonzero(flat)[0]
+    candidates = candidates[np.argsort(-area[candidates])][:MAX_FLAT_TESTS]
+    light = normalize(direction)
+    for i in candidates:
+        n = normal[i] / area[i]
+        d = float(n @ boxes[i, 0])
+        s = float(n @ light)
+        if abs(s) <= 1e-9:
+            free[i] = True  # edge-on to the light: its shadow has no area
+            continue
+        reach = np.sign(s) * (boxes @ n - d)  # > 0: behind the plane, where it could shadow
+        reach[i] = 0.0
+        tolerance = 1e-5 * max(float(np.abs(boxes[i]).max()), longest[i])
+        free[i] = not bool((reach.max(axis=1) > tolerance).any())
+    return free
+
+
+MAX_EXACT_CROPS = 32  # receivers cut exactly to a sun map's rectangle (the largest first)
+
+
+def max_filter_radius(map_size):
+    """The widest disk kernel (texels) of a map of ``map_size``: a quarter of it, at least 32
+    texels (``programs.max_filter_radius``, which the shaders read, is this). Maps are fitted
+    to their casters, so a penumbra may span a good part of one; a cap in texels would make
+    larger maps draw narrower penumbrae."""
+    return max(32.0, float(map_size) / 4.0)
+
+
+def _rect_planes(view, lo, hi):
+    """World planes of the light-space prism lo <= (x, y) <= hi of an orthographic ``view``."""
+    rows = []
+    for axis in (0, 1):
+        n, o = view[axis, :3], view[axis, 3]
+        rows.append((*n, hi[axis] - o))
+        rows.append((*(-n), o - lo[axis]))
+    return np.array(rows, dtype=np.float64)
+
+
+def _receivers_in_rect(parts, view, lo, hi):
+    """Light-space points of the receivers (``parts``: per box, its points inside the view)
+    that lie over the rectangle [lo, hi] (x, y). Boxes wholly over it or off it are decided by
+    their points; the MAX_EXACT_CROPS largest that straddle it are cut exactly (a ground
+    plane's far reaches drop out), the rest count whole (conservative)."""
+    out, straddle = [], []
+    for p in parts:
+        if len(p) == 0:
+            continue
+        q = p @ view[:3, :3].T + view[:3, 3]
+        over = np.all((q[:, :2] >= lo[:2]) & (q[:, :2] <= hi[:2]), axis=1)
+        if over.all():
+            out.append(q)
+        elif (q[:, 0].max() >= lo[0]) & (q[:, 0].min() <= hi[0]) & (q[:, 1].max() >= lo[1]) & (q[:, 1].min() <= hi[1]):
+            straddle.append((float(np.ptp(p, axis=0).max()), p, q))
+    straddle.sort(key=lambda t: -t[0])
+    rect = _rect_planes(view, lo, hi)
+    for k, (_size, p, q) in enumerate(straddle):
+        if k >= MAX_EXACT_CROPS:
+            out.append(q)
+            continue
+        # The box's visible part is convex: cut the hull of its points by the prism. Its
+        # points' bounds are a box containing that part, so clip that box (exact for a
+        # ground plane, whose visible part is a polygon in its plane).
+        cut, _seen = clipped_points(box_corners(p.min(axis=0), p.max(axis=0))[None], rect)
+        if len(cut):
+            out.append(cut @ view[:3, :3].T + view[:3, 3])
+    return np.concatenate(out) if out else np.zeros((0, 3))
+
+
+def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0):
     """Tight sun fit (seed 002: a loose box wastes the map): the map covers only the receivers
-    the camera can see, and reaches towards the light far enough to keep every caster that can
-    shadow them. ``corners``: (N, 8, 3) world box corners of all geometry; ``view_corners``: the
-    camera frustum's 8 world corners. Returns ``(Fit, caster indices)`` or ``None`` when the
-    camera sees no geometry."""
+    the camera can see that some caster can shadow, and every caster that can shadow them.
+    ``corners``: (N, 8, 3) world box corners of all geometry; ``view_corners``: the 8 world
+    corners of the camera frustum (or of the slice of it a cascade covers); ``soft``: the
+    tangent of the half-angle the filter spreads shadows over (PCSS of a sun's angle; 0 for a
+    fixed kernel). Returns ``(Fit, caster indices)``, or ``None`` when nothing the camera sees
+    can be shadowed.
+
+    Receivers: the part of every box inside the frustum (box ∩ frustum, exact for a ground
+    plane under a perspective camera). Casters: every box except flat ones that shadow
+    nothing (``flat_casters_without_shadow``: a ground with everything standing on it). The
+    map covers the receivers' light-space rectangle cut to the casters' footprints in it (a
+    receiver outside every caster's footprint cannot be in shadow), widened by how far a
+    penumbra reaches out of a footprint (``soft`` x the receivers' depth span there); its
+    depth range is that of the receivers over the rectangle."""
     boxes = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(boxes) == 0:
         return None
     view = look_at((0.0, 0.0, 0.0), direction)
-    # Receivers the camera can see: boxes overlapping the frustum's world bounds, cropped to
-    # those bounds in world space (a ground plane crops to the frustum's footprint on it).
-    wlo, whi = boxes.min(axis=1), boxes.max(axis=1)
-    vc = np.asarray(view_corners, dtype=np.float64)
-    flo, fhi = vc.min(axis=0), vc.max(axis=0)
-    seen = np.all((wlo <= fhi) & (whi >= flo), axis=1)
+    parts, seen = clipped_points(boxes, hull_planes(view_corners), per_box=True)
     if not seen.any():
         return None
-    region = box_corners(np.maximum(wlo[seen].min(axis=0), flo), np.minimum(whi[seen].max(axis=0), fhi))
+    rls = np.concatenate([p for p in parts if len(p)]) @ view[:3, :3].T + view[:3, 3]
+    lo, hi = rls.min(axis=0), rls.max(axis=0)
     ls = boxes @ view[:3, :3].T + view[:3, 3]
     blo, bhi = ls.min(axis=1), ls.max(axis=1)
-    rls = transform_points(view, region)
-    lo, hi = rls.min(axis=0), rls.max(axis=0)
-    # Casters: anything whose light-space footprint overlaps the fitted region, at any depth
-    # towards the light. The depth range stays the region's: casters nearer the light than its
-    # near plane are flattened onto it by the depth pass ("pancaking", shadow_depth.vert), where
-    # they still occlude everything in the region, so a large ground or a tall caster does not
-    # stretch the range and cost depth precision (a 1 km ground in FLOAT16).
-    casters = np.nonzero(np.all((blo[:, :2] <= hi[:2]) & (bhi[:, :2] >= lo[:2]), axis=1))[0]
+    can_cast = ~flat_casters_without_shadow(boxes, direction)
+    # Casters: boxes whose footprint overlaps the receivers' rectangle, at any depth towards
+    # the light and not wholly behind the receivers. The depth range stays the receivers':
+    # casters nearer the light than its near plane are flattened onto it by the depth pass
+    # ("pancaking", shadow_depth.vert), where they still occlude everything in the region, so
+    # a tall caster does not stretch the range and cost depth precision.
+    overlap = np.all((blo[:, :2] <= hi[:2]) & (bhi[:, :2] >= lo[:2]), axis=1) & (bhi[:, 2] >= lo[2])
+    casters = np.nonzero(overlap & can_cast)[0]
+    if len(casters) == 0:
+        return None
+    seen_lo, seen_hi = lo[:2].copy(), hi[:2].copy()
+    lo[:2] = np.maximum(lo[:2], blo[casters, :2].min(axis=0))
+    hi[:2] = np.minimum(hi[:2], bhi[casters, :2].max(axis=0))
+    inside = _receivers_in_rect(parts, view, lo, hi)
+    if len(inside) == 0:
+        return None
+    if soft > 0.0:
+        reach = float(soft) * float(inside[:, 2].max() - inside[:, 2].min())
+        lo[:2] = np.maximum(seen_lo, lo[:2] - reach)
+        hi[:2] = np.minimum(seen_hi, hi[:2] + reach)
+        inside = _receivers_in_rect(parts, view, lo, hi)
+        if len(inside) == 0:
+            return None
+        casters = casters[np.all((blo[casters, :2] <= hi[:2]) & (bhi[casters, :2] >= lo[:2]), axis=1)]
+    lo[2], hi[2] = inside[:, 2].min(), inside[:, 2].max()
+    if soft > 0.0:
+        # PCSS reads the blocker's depth: casters nearer the light than the receivers keep
+        # their true depth up to the distance where the penumbra reaches the widest kernel
+        # (beyond it the kernel is capped anyway); only casters farther still are pancaked.
+        texel = float(max(hi[0] - lo[0], hi[1] - lo[1])) / max(int(map_size) - 4, 1)
+        reach = max_filter_radius(map_size) * texel / float(soft)
+        hi[2] = max(hi[2], min(float(bhi[casters, 2].max()), hi[2] + reach))
     scale = float(np.abs(np.concatenate([lo, hi])).max())
     return _ortho_fit(view, lo, hi, scale, map_size, padding_texels), casters
 
@@ -219,25 +391,7 @@ def view_depth_range(projection, view, corners, is_ortho):
     boxes = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(boxes) == 0:
         return None
-    try:
-        fc = frustum_corners(projection @ view)
-    except np.linalg.LinAlgError:
-        return None
-    flo, fhi = fc.min(axis=0), fc.max(axis=0)
-    lo, hi = boxes.min(axis=1), boxes.max(axis=1)
-    seen = np.all((lo <= fhi) & (hi >= flo), axis=1)
-    if not seen.any():
-        return None
-    # Boxes inside the frustum count whole; a box that crosses its sides (a ground plane
-    # under the camera) counts only the part inside it: the vertices of box ∩ frustum.
-    planes = light_bins.frustum_planes(projection @ view)
-    inside = np.all(np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) <= planes[None, None, :, 3] + 1e-9, axis=(1, 2))
-    points = [boxes[seen & inside].reshape(-1, 3)]
-    for i in np.nonzero(seen & ~inside)[0]:
-        clipped = np.concatenate([planes, light_bins.box_planes(lo[i], hi[i])])
-        tolerance = 1e-6 * max(1.0, float(np.abs(boxes[i]).max()), clip[1])
-        points.append(light_bins.polytope_vertices(clipped, tolerance))
-    points = np.concatenate(points)
+    points, _seen = clipped_points(boxes, light_bins.frustum_planes(projection @ view))
     if len(points) == 0:
         return None
     depth = -(points @ view[2, :3] + view[2, 3])  # view depth of every visible vertex

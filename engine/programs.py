@@ -9,7 +9,7 @@ comment.
 from dataclasses import replace
 
 from ..shaders.loader import Program, Struct
-from . import light_bins
+from . import light_bins, lightspace
 from .enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
 from .materials import CHANNELS
 
@@ -18,7 +18,10 @@ LIGHT_WORDS = MAX_LIGHTS // light_bins.WORD_BITS  # channels of a light-bin texe
 MAX_SHADOW_TILES = 48
 JITTER_SIZE = 32  # the jitter texture repeats every 32x32 pixels
 MAX_DISK_SAMPLES = 64
-MAX_FILTER_RADIUS = 32.0  # texels: the widest JITTER/PCSS kernel
+# The widest JITTER/PCSS kernel, in texels: a fixed fraction of the map's side.
+max_filter_radius = lightspace.max_filter_radius
+
+
 SHADOW_SAMPLER = "shadow_atlas"
 
 LIGHT_STRUCT = Struct(

@@ -328,7 +328,15 @@ class Renderer:
             # bounds: once per frame, not per sample.
             self._depth_range = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
         return plan_shadows(
-            lights, corners, size, view_corners, camera, int(settings.shadow_cascades), self._depth_range
+            lights,
+            corners,
+            size,
+            view_corners,
+            camera,
+            int(settings.shadow_cascades),
+            self._depth_range,
+            kernel=_fixed_kernel(settings),
+            pcss=settings.shadow_filter == "PCSS",
         )
 
     def _shadow_pass(self, draws, lights, camera, settings, stats, alpha_offset=0.5):
@@ -726,6 +734,17 @@ def _front_to_back(draws, camera):
         key = np.linalg.norm(np.maximum(0.0, np.maximum(lo - position, position - hi)), axis=1)
     key = np.where(np.isfinite(key), key, np.inf)
     return [draws[i] for i in np.argsort(key, kind="stable")]
+
+
+def _fixed_kernel(settings):
+    """The radius in texels the scene's shadow filter reads around a lookup (not PCSS, whose
+    kernel follows each light's size)."""
+    kind = settings.shadow_filter
+    if kind == "PCF":
+        return (max(int(settings.pcf_kernel_size), 1) // 2) * max(float(settings.pcf_spacing), 0.0) + 1.0
+    if kind == "JITTER":
+        return max(float(settings.shadow_filter_radius), 0.0) + 1.0
+    return 1.0
 
 
 def _view_corners(camera):

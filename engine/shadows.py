@@ -19,7 +19,14 @@ import numpy as np
 
 from . import lightspace
 from .enums import DEPTH_FORMAT
-from .programs import MAX_SHADOW_TILES, SCALED_COPY, TILE_STRUCT, depth_defines, shadow_cutout_program, shadow_program
+from .programs import (
+    MAX_SHADOW_TILES,
+    SCALED_COPY,
+    TILE_STRUCT,
+    depth_defines,
+    shadow_cutout_program,
+    shadow_program,
+)
 
 
 @dataclass
@@ -61,23 +68,49 @@ def _near_bound(position, lo, hi, half_fov):
     return float(d.min()) / math.sqrt(1.0 + 2.0 * math.tan(half_fov) ** 2)
 
 
-def perspective_tile(position, forward, fov, corners, lo, hi, map_size):
-    """A perspective tile at ``position`` along ``forward``, or None without casters in it."""
+CUBE_PAD_FRACTION = 1.0 / 16.0
+
+
+def perspective_tile(position, forward, fov, corners, lo, hi, map_size, kernel=0.0, soft_radius=0.0):
+    """A perspective tile at ``position`` along ``forward``, or None without casters in it.
+
+    ``kernel`` (texels) or ``soft_radius`` (world: a PCSS light's radius) widen the map past
+    ``fov`` by the widest filter kernel it can be read with, so a filter near its edge reads
+    texels of this map instead of "nothing there": cube faces then meet without a lit seam.
+    A PCSS kernel is widest for the nearest caster: radius / near, in texels of the map; the
+    widening stops at CUBE_PAD_FRACTION of the map per side (wider penumbrae may still show a
+    faint seam)."""
     reach = float(np.linalg.norm(corners.reshape(-1, 3) - position, axis=1).max()) * 1.01
     if not np.isfinite(reach) or reach <= 0.0:
         return None
     view = lightspace.look_at(position, forward)
-    probe = lightspace.perspective(fov, 1.0, reach * 1e-6, reach) @ view
-    inside = np.nonzero(lightspace.boxes_in_frustum(probe, corners))[0]
-    if len(inside) == 0:
+
+    def fitted(fov):
+        probe = lightspace.perspective(fov, 1.0, reach * 1e-6, reach) @ view
+        inside = np.nonzero(lightspace.boxes_in_frustum(probe, corners))[0]
+        if len(inside) == 0:
+            return None
+        z = -(corners[inside].reshape(-1, 3) @ view[:3, :3].T + view[:3, 3])[:, 2]
+        far = float(z.max()) * 1.01
+        if far <= 0.0:
+            return None
+        near = max(_near_bound(position, lo[inside], hi[inside], fov / 2.0) * 0.99, far * 1e-5)
+        return inside, near, far
+
+    got = fitted(fov)
+    if got is None:
         return None
-    z = -(corners[inside].reshape(-1, 3) @ view[:3, :3].T + view[:3, 3])[:, 2]
-    far = float(z.max()) * 1.01
-    if far <= 0.0:
-        return None
-    near = max(_near_bound(position, lo[inside], hi[inside], fov / 2.0) * 0.99, far * 1e-5)
+    size = max(int(map_size), 1)
+    if kernel > 0.0 or soft_radius > 0.0:
+        per_distance = 2.0 * math.tan(fov / 2.0) / size  # a texel's width at distance 1
+        widest = soft_radius / (got[1] * per_distance) if soft_radius > 0.0 else kernel
+        pad = min(widest, CUBE_PAD_FRACTION * size) + 1.0
+        if 2.0 * pad < size:
+            fov = 2.0 * math.atan(math.tan(fov / 2.0) * size / (size - 2.0 * pad))
+            got = fitted(fov) or got
+    inside, near, far = got
     proj = lightspace.perspective(fov, 1.0, near, far)
-    fit = lightspace.Fit(view, proj, near, far, texel_per_distance=2.0 * math.tan(fov / 2.0) / map_size)
+    fit = lightspace.Fit(view, proj, near, far, texel_per_distance=2.0 * math.tan(fov / 2.0) / size)
     return Tile(fit, inside)
 
 
@@ -103,13 +136,17 @@ class Caster:
     cutouts: list = field(default_factory=list)  # (batch, material UBO, alpha texture): alpha >= 0.5 casts
 
 
-def plan_shadows(lights, corners, map_size, view_corners=None, camera=None, cascades=0, depth_range=None):
+def plan_shadows(
+    lights, corners, map_size, view_corners=None, camera=None, cascades=0, depth_range=None, kernel=2.0, pcss=False
+):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
     what the camera sees (all geometry when None). With ``camera`` (an ``extract.Camera``) a
     sun splits the visible depth range into ``cascades`` maps (0: chosen from the range, see
     ``lightspace.cascade_count``), each fitted to its slice; ``depth_range``: the camera's
-    visible (near, far), when the caller already has it. Returns a ShadowPlan; tiles beyond
+    visible (near, far), when the caller already has it. ``kernel``: the radius (texels) of
+    the scene's fixed shadow filter; ``pcss``: the scene's filter is PCSS (lights sampled
+    over their extent always are); maps are widened by what their filter reads. Returns a ShadowPlan; tiles beyond
     MAX_SHADOW_TILES are not planned (``plan.unshadowed`` counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
     corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
@@ -123,15 +160,22 @@ def plan_shadows(lights, corners, map_size, view_corners=None, camera=None, casc
     for i, light in enumerate(lights):
         if not light.use_shadow:
             continue
+        soft = light.sampled or pcss
         if light.type == "SUN":
+            # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
+            angle = min(max(light.angle, 0.0), math.pi * 0.99)
+            spread = math.tan(0.5 * angle) * light.penumbra_scale if soft else 0.0
             if view_corners is None:
                 fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), map_size)
                 tiles = [Tile(fit, everything)] if fit is not None else []
             elif slices is None:
-                fitted = lightspace.fit_sun_to_view(light.direction, corners, view_corners, map_size)
+                fitted = lightspace.fit_sun_to_view(light.direction, corners, view_corners, map_size, soft=spread)
                 tiles = [Tile(*fitted)] if fitted is not None else []
             else:
-                fits = [lightspace.fit_sun_to_view(light.direction, corners, sc, map_size) for sc, _end in slices]
+                fits = [
+                    lightspace.fit_sun_to_view(light.direction, corners, sc, map_size, soft=spread)
+                    for sc, _end in slices
+                ]
                 tiles = [Tile(*f) if f is not None else None for f in fits]
             mode = "CASCADE" if view_corners is not None and slices is not None and len(slices) > 1 else "SINGLE"
         elif light.type == "SPOT":
@@ -143,7 +187,17 @@ def plan_shadows(lights, corners, map_size, view_corners=None, camera=None, casc
             tiles = [
                 None
                 if light.type == "AREA" and behind_area_light(fwd, light.direction)
-                else perspective_tile(light.position, fwd, math.pi / 2.0, corners, lo, hi, map_size)
+                else perspective_tile(
+                    light.position,
+                    fwd,
+                    math.pi / 2.0,
+                    corners,
+                    lo,
+                    hi,
+                    map_size,
+                    kernel=1.0 if soft else kernel,
+                    soft_radius=light.shadow_radius * light.penumbra_scale if soft else 0.0,
+                )
                 for fwd in lightspace.CUBE_FORWARDS
             ]
             mode = "CUBE"

@@ -159,3 +159,76 @@ def test_sun_fit_to_view_covers_visible_receivers_and_their_casters():
     assert fit.texel < whole.texel / 50  # the view-fitted map is far sharper
     ndc = lightspace.transform_points(fit.view_proj, caster)
     assert np.all(np.abs(ndc) <= 1.0)
+
+
+def _flat(lo, hi):
+    return lightspace.box_corners(lo, hi)
+
+
+def test_flat_ground_with_everything_on_it_casts_nothing():
+    ground = _flat((-100, -100, 0), (100, 100, 0))
+    standing = lightspace.box_corners((-1, -1, 0), (1, 1, 2))
+    below = lightspace.box_corners((-1, -1, -3), (1, 1, -1))
+    sun = (0.3, 0.2, -1.0)
+    free = lightspace.flat_casters_without_shadow(np.stack([ground, standing]), sun)
+    assert free.tolist() == [True, False]  # a solid box is never dropped
+    # Something below the ground (a basement): the ground can shadow it.
+    free = lightspace.flat_casters_without_shadow(np.stack([ground, standing, below]), sun)
+    assert free.tolist() == [False, False, False]
+    # A light from below shines at the ground's other side: now "behind" is above it.
+    free = lightspace.flat_casters_without_shadow(np.stack([ground, standing]), (0.0, 0.0, 1.0))
+    assert free.tolist() == [False, False]
+    assert lightspace.flat_casters_without_shadow(np.stack([ground, below]), (0.0, 0.0, 1.0)).tolist() == [
+        True,
+        False,
+    ]
+    # Edge-on to the light, a wall's shadow has no area.
+    wall = _flat((0, -5, 0), (0, 5, 3))
+    assert lightspace.flat_casters_without_shadow(np.stack([wall, standing]), (0.0, 1.0, 0.0)).tolist() == [
+        True,
+        False,
+    ]
+    # A rotated flat box (its corners no longer axis-aligned) is still recognised.
+    rot = np.array([[0.8, -0.6, 0.0], [0.6, 0.8, 0.0], [0.0, 0.0, 1.0]]) @ np.array(
+        [[1, 0, 0], [0, 0.6, -0.8], [0, 0.8, 0.6]]
+    )
+    tilted = ground @ rot.T
+    free = lightspace.flat_casters_without_shadow(np.stack([tilted, standing + (0, 0, 200)]), -rot[:, 2])
+    assert free.tolist() == [True, False]
+
+
+def test_hull_planes_and_clipped_points_of_a_box_crossing_a_frustum():
+    cam = lightspace.orthographic(-1, 1, -1, 1, 1.0, 10.0)  # the box x, y in [-1, 1], z in [-10, -1]
+    corners = lightspace.frustum_corners(cam)
+    planes = lightspace.hull_planes(corners)
+    assert planes.shape == (6, 4)
+    np.testing.assert_allclose(np.linalg.norm(planes[:, :3], axis=1), 1.0)
+    assert np.all(corners @ planes[:, :3].T <= planes[:, 3] + 1e-9)  # every corner inside every plane
+    crossing = lightspace.box_corners((0.5, -3, -5), (4, 3, -4))
+    inside = lightspace.box_corners((-0.5, -0.5, -3), (0.5, 0.5, -2))
+    outside = lightspace.box_corners((5, 5, -3), (6, 6, -2))
+    points, seen = lightspace.clipped_points(np.stack([crossing, inside, outside]), planes)
+    assert seen.tolist() == [True, True, False]
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    np.testing.assert_allclose(lo, (-0.5, -1.0, -5.0), atol=1e-9)  # the crossing box cut at x = 1, |y| = 1
+    np.testing.assert_allclose(hi, (1.0, 1.0, -2.0), atol=1e-9)
+
+
+def test_sun_fit_crops_to_the_casters_footprint_and_skips_a_flat_ground():
+    ground = _flat((-1000, -1000, 0), (1000, 1000, 0))
+    caster = lightspace.box_corners((-0.1, -0.1, 0.0), (0.1, 0.1, 0.3))
+    view = lightspace.look_at((0, -10, 3), (0, 1, -0.1))  # looking out to the horizon
+    cam = lightspace.perspective(np.radians(50), 1.5, 0.1, 500.0) @ view
+    fit, casters = lightspace.fit_sun_to_view(
+        (0.2, 0.5, -1.0), np.stack([ground, caster]), lightspace.frustum_corners(cam), 1024
+    )
+    assert casters.tolist() == [1]  # the flat ground is not drawn into the map
+    assert fit.texel < 0.5 / 1024 * 2  # the map spans about the 0.2 x 0.4 m footprint, not the ground
+    ndc = lightspace.transform_points(fit.view_proj, caster)
+    assert np.all(np.abs(ndc[:, :2]) <= 1.0)
+    # Nothing the camera sees can be shadowed (the caster is out of view and its shadow too).
+    away = caster + (300.0, -300.0, 0.0)
+    assert (
+        lightspace.fit_sun_to_view((0.2, 0.5, -1.0), np.stack([ground, away]), lightspace.frustum_corners(cam), 1024)
+        is None
+    )

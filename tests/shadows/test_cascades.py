@@ -18,12 +18,18 @@ BOX = 0.15
 TILT = math.radians(40.0)
 
 
-def small_box_scene(horizon, cascades=0):
+def small_box_scene(horizon, cascades=0, slab=False):
     """The box on the ground; ``horizon``: the camera looks nearly level, so the ground is
-    seen out to the far clip (500 m), else down at it (seen out to about 1.3 m)."""
+    seen out to the far clip (500 m), else down at it (seen out to about 1.3 m). ``slab``: the
+    ground is a 1 m thick box (its top at z = 0), which casts shadows like any solid, so the
+    sun maps must cover all of it that the camera sees; a flat ground casts none (nothing
+    stands below it) and the maps crop to the box's footprint."""
     scene = scenes.empty_scene(160, 90)
     mat = scenes.white()
-    scenes.plane(scene, "Ground", size=1000.0, mat=mat)
+    if slab:
+        scenes.box(scene, "Ground", center=(0.0, 0.0, -0.5), size=(1000.0, 1000.0, 1.0), mat=mat)
+    else:
+        scenes.plane(scene, "Ground", size=1000.0, mat=mat)
     scenes.box(scene, "Box", center=(0.0, 0.0, BOX / 2), size=(BOX,) * 3, mat=mat)
     scenes.light(scene, "Sun", "SUN", 3.0, rotation=(TILT, 0.0, 0.0))
     eye, target = ((0.5, -0.2, 0.12), (0.0, 0.08, 0.04)) if horizon else ((0.5, -0.2, 0.35), (0.0, 0.08, 0.0))
@@ -64,13 +70,22 @@ def test_small_object_keeps_its_shadow_under_a_far_clip_plane(penumbra, cascades
 
 
 def test_cascades_keep_the_shadow_when_the_ground_reaches_the_horizon(penumbra):
-    """Seen out to 500 m, one map covers the whole visible ground and the box gets about one
-    texel (IoU 0.013 measured with ``shadow_cascades = 1``); the automatic split (3 cascades
-    here) gives IoU 0.96, and the ground out to the horizon stays free of acne."""
-    single, _false = shadow_score(small_box_scene(horizon=True, cascades=1))
-    score, false = shadow_score(small_box_scene(horizon=True))
+    """Seen out to 500 m, one map covers the whole visible (solid) ground and the box gets
+    about one texel (IoU 0.013 measured with ``shadow_cascades = 1``); the automatic split (3
+    cascades here) gives IoU 0.96, and the ground out to the horizon stays free of acne."""
+    single, _false = shadow_score(small_box_scene(horizon=True, cascades=1, slab=True))
+    score, false = shadow_score(small_box_scene(horizon=True, slab=True))
     assert single < 0.5  # the failure the cascades fix is real in this scene
     assert score >= 0.9, f"IoU {score:.3f}"
+    assert false < 0.002
+
+
+def test_flat_ground_casts_nothing_so_one_map_crops_to_the_caster(penumbra):
+    """With a flat ground nothing stands below, so it shadows nothing: it is left out of the
+    sun's map, which crops to the box's footprint; one map then gives the box its shadow out
+    to the horizon (IoU 0.994 measured; 0.013 when the map covered the visible ground)."""
+    score, false = shadow_score(small_box_scene(horizon=True, cascades=1))
+    assert score >= 0.95, f"IoU {score:.3f}"
     assert false < 0.002
 
 
@@ -145,12 +160,15 @@ def test_sub_texel_camera_steps_leave_the_shadow_still(penumbra):
 @pytest.mark.parametrize("depth_format", ["FLOAT32", "FLOAT16", "RGBA8"])
 @pytest.mark.parametrize("ground", [1e3, 1e6])
 def test_every_depth_format_holds_under_a_huge_ground(penumbra, depth_format, ground):
-    """A 1 m box over a ground of 1 km and 1000 km: the sun map's depth range spans what the
+    """A 1 m box over a solid ground of 1 km and 1000 km: the sun map's depth range spans what the
     camera sees (casters nearer the light are flattened onto its near plane), so even half
     floats keep the shadow exact (FLOAT16 with a 1 km ground was 94 % false shadow when the
     range spanned the whole ground's light-space depth)."""
     scene = scenes.empty_scene(128, 128)
-    scenes.box_over_plane(scene, plane_size=ground, box_center=(0, 0, 1.5), box_size=1.0)
+    # A solid ground (1 m thick, top at z = 0) is drawn into the map; a flat one would not be.
+    mat = scenes.white()
+    scenes.box(scene, "Ground", center=(0, 0, -0.5), size=(ground, ground, 1.0), mat=mat)
+    scenes.box(scene, "Box", center=(0, 0, 1.5), size=(1.0, 1.0, 1.0), mat=mat)
     scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(45.0), 0.0, 0.0))
     forward = np.array([0.0, math.sin(math.radians(35)), -math.cos(math.radians(35))])
     scenes.camera(

@@ -28,40 +28,42 @@ CACHE = Path(os.environ.get("PENUMBRA_REFERENCE_CACHE", kit.DEFAULT_CACHE))
 # frame, most of them fully lit, so its absolute size is small; the ratios between filters are
 # what it shows. IoU of the shadowed region (visibility < 0.5) is about 0.93-0.98 even for
 # good filters: one pixel of disagreement along a boundary costs that much at 128x72.
+# "uncropped": measured before sun maps were cropped to their casters' footprints and cube
+# faces widened by their filter (when they differ). The cropped sun maps have 3-5x finer
+# texels: hard shadows match better (sun_hard IoU 0.97 -> 0.998), but a fixed kernel in
+# texels then blurs less, so HARDWARE/PCF/JITTER, which do not model a light's size, lose
+# the accidental softness that had matched the 0.5 and 10 degree suns (MAE up to +0.004).
 BOUNDS = {
-    ("sun_hard", "NONE"): (0.95, 0.009),  # 0.9689 / 0.0060
-    ("sun_hard", "HARDWARE"): (0.96, 0.007),  # 0.9769 / 0.0043
-    ("sun_hard", "PCF"): (0.95, 0.005),  # 0.9689 / 0.0028
-    ("sun_hard", "JITTER"): (0.95, 0.005),  # 0.9666 / 0.0025
-    ("sun_hard", "PCSS"): (0.95, 0.007),  # 0.9723 / 0.0043
-    ("sun_soft", "NONE"): (0.94, 0.033),  # 0.9559 / 0.0253
-    ("sun_soft", "HARDWARE"): (0.94, 0.031),  # 0.9640 / 0.0235
-    ("sun_soft", "PCF"): (0.94, 0.028),  # 0.9559 / 0.0210
-    ("sun_soft", "JITTER"): (0.94, 0.027),  # 0.9627 / 0.0202
-    ("sun_soft", "PCSS"): (0.91, 0.009),  # 0.9347 / 0.0062
+    ("sun_hard", "NONE"): (0.98, 0.008),  # 0.9977 / 0.0054  (uncropped: 0.9689 / 0.0060)
+    ("sun_hard", "HARDWARE"): (0.98, 0.008),  # 0.9977 / 0.0053  (uncropped: 0.9769 / 0.0043)
+    ("sun_hard", "PCF"): (0.98, 0.008),  # 0.9977 / 0.0050  (uncropped: 0.9689 / 0.0028)
+    ("sun_hard", "JITTER"): (0.98, 0.008),  # 0.9977 / 0.0049  (uncropped: 0.9666 / 0.0025)
+    ("sun_hard", "PCSS"): (0.98, 0.007),  # 0.9965 / 0.0044  (uncropped: 0.9723 / 0.0043)
+    ("sun_soft", "NONE"): (0.94, 0.033),  # 0.9641 / 0.0253  (uncropped: 0.9559 / 0.0253)
+    ("sun_soft", "HARDWARE"): (0.94, 0.033),  # 0.9641 / 0.0251  (uncropped: 0.9640 / 0.0235)
+    ("sun_soft", "PCF"): (0.94, 0.032),  # 0.9641 / 0.0248  (uncropped: 0.9559 / 0.0210)
+    ("sun_soft", "JITTER"): (0.94, 0.032),  # 0.9641 / 0.0248  (uncropped: 0.9627 / 0.0202)
+    ("sun_soft", "PCSS"): (0.92, 0.009),  # 0.9396 / 0.0058  (uncropped: 0.9347 / 0.0062)
     ("spot", "NONE"): (0.96, 0.015),  # 0.9814 / 0.0110
     ("spot", "HARDWARE"): (0.96, 0.015),  # 0.9814 / 0.0107
-    ("spot", "PCF"): (0.96, 0.019),  # 0.9814 / 0.0137  (acne where the spot shines straight down)
-    ("spot", "JITTER"): (0.96, 0.018),  # 0.9814 / 0.0131  (the same acne)
-    ("spot", "PCSS"): (0.94, 0.006),  # 0.9645 / 0.0035
-    ("point", "NONE"): (0.95, 0.021),  # 0.9715 / 0.0159
-    ("point", "HARDWARE"): (0.95, 0.021),  # 0.9715 / 0.0157
+    ("spot", "PCF"): (0.96, 0.019),  # 0.9814 / 0.0137
+    ("spot", "JITTER"): (0.96, 0.018),  # 0.9814 / 0.0131
+    ("spot", "PCSS"): (0.94, 0.006),  # 0.9645 / 0.0036
+    ("point", "NONE"): (0.95, 0.021),  # 0.9680 / 0.0158  (uncropped: 0.9715 / 0.0159)
+    ("point", "HARDWARE"): (0.95, 0.021),  # 0.9691 / 0.0155  (uncropped: 0.9715 / 0.0157)
     ("point", "PCF"): (0.95, 0.020),  # 0.9715 / 0.0152
-    ("point", "JITTER"): (0.95, 0.020),  # 0.9727 / 0.0152
-    ("point", "PCSS"): (0.94, 0.010),  # 0.9631 / 0.0065
-    ("area", "NONE"): (0.91, 0.032),  # 0.9333 / 0.0247
-    ("area", "HARDWARE"): (0.91, 0.032),  # 0.9333 / 0.0245
-    ("area", "PCF"): (0.91, 0.032),  # 0.9333 / 0.0242
-    ("area", "JITTER"): (0.91, 0.031),  # 0.9333 / 0.0240
-    ("area", "PCSS"): (0.91, 0.022),  # 0.9255 / 0.0163
-    # One sample of a soft sun: the filters other than PCSS draw a hard shadow, whose tip (since
-    # the sun map is fitted to the visible depth range, with finer texels) reaches past Cycles'
-    # 50 % contour, where the penumbra eats the tip: 0.9375 before that fit.
+    ("point", "JITTER"): (0.95, 0.020),  # 0.9738 / 0.0151
+    ("point", "PCSS"): (0.94, 0.008),  # 0.9593 / 0.0052  (uncropped: 0.9631 / 0.0065)
+    ("area", "NONE"): (0.92, 0.032),  # 0.9361 / 0.0247  (uncropped: 0.9333 / 0.0247)
+    ("area", "HARDWARE"): (0.92, 0.032),  # 0.9361 / 0.0245  (uncropped: 0.9333 / 0.0245)
+    ("area", "PCF"): (0.91, 0.032),  # 0.9348 / 0.0241
+    ("area", "JITTER"): (0.92, 0.031),  # 0.9387 / 0.0240  (uncropped: 0.9333 / 0.0240)
+    ("area", "PCSS"): (0.91, 0.011),  # 0.9251 / 0.0078  (uncropped: 0.9255 / 0.0163)
     ("contact", "NONE"): (0.89, 0.014),  # 0.9076 / 0.0103
-    ("contact", "HARDWARE"): (0.89, 0.013),  # 0.9076 / 0.0098
-    ("contact", "PCF"): (0.89, 0.012),  # 0.9080 / 0.0091
-    ("contact", "JITTER"): (0.89, 0.012),  # 0.9080 / 0.0090
-    ("contact", "PCSS"): (0.91, 0.005),  # 0.9351 / 0.0027 (0.9123 before)
+    ("contact", "HARDWARE"): (0.89, 0.014),  # 0.9076 / 0.0103  (uncropped: 0.9076 / 0.0098)
+    ("contact", "PCF"): (0.89, 0.014),  # 0.9076 / 0.0102  (uncropped: 0.9080 / 0.0091)
+    ("contact", "JITTER"): (0.89, 0.014),  # 0.9076 / 0.0102  (uncropped: 0.9080 / 0.0090)
+    ("contact", "PCSS"): (0.89, 0.005),  # 0.9123 / 0.0027  (uncropped: 0.9351 / 0.0027)
 }
 
 
@@ -82,7 +84,7 @@ def score(name, shadow_filter):
 
 
 @pytest.mark.parametrize("shadow_filter", FILTERS)
-@pytest.mark.parametrize("name", list(kit.SCENES))
+@pytest.mark.parametrize("name", list(kit.LIGHT_SCENES))
 def test_visibility_matches_cycles(penumbra, name, shadow_filter):
     result = score(name, shadow_filter)
     min_iou, max_mae = BOUNDS[name, shadow_filter]

@@ -27,7 +27,7 @@ from devkit.engines import EEVEE_SAMPLES, configure
 HELP = "render samples: error against time vs Cycles spp and EEVEE, cost per sample, edge close-up"
 
 FULL = {
-    "scenes": tuple(kit.SCENES),
+    "scenes": kit.LIGHT_SCENES,
     "samples": (1, 4, 16, 64, 256),
     "cycles_spp": (1, 4, 16, 64),
     "reference_spp": 512,

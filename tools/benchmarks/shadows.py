@@ -60,7 +60,7 @@ class Plan:
 
 
 FULL = Plan(
-    scenes=tuple(kit.SCENES),
+    scenes=kit.LIGHT_SCENES,
     map_sizes=(512, 1024, 2048, 4096),
     samples=(8, 16, 32),
     cycles_spp=(1, 4, 16, 64),
