@@ -30,6 +30,8 @@ suzanne    smooth-shaded Suzanne (subdivided once) on the same ground and sun: s
 grazing    three cows (6k triangles each) on the ground under a sun 4 deg above the
            horizon: long thin shadows, legs, contact at the feet
 tiny       a 15 cm bunny on a 1 km ground, camera 0.6 m away, far clip 500 m
+lamp       the bunny on the 2 km ground under a street lamp: a spot light 5 m up with a
+           150 deg cone (radius 0.02)
 room       a point light (radius 0.05) in a closed 6 x 5 x 3 m room with a table and the
            bunny: cube-face seams cross floor and wall shadows
 =========  ============================================================================
@@ -266,6 +268,27 @@ def tiny(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
     return scene
 
 
+def lamp(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    from devkit import assets
+
+    scene, grey, far = _big_stage(width, height)
+    _mesh(scene, assets.BUNNY, 0.6, grey, rotation_z=-30.0, name="Bunny")
+    ob = scenes.light(
+        scene,
+        "Lamp",
+        "SPOT",
+        2000.0,
+        location=(1.2, 1.0, 5.0),
+        shadow_soft_size=0.02,
+        spot_size=math.radians(150.0),
+        spot_blend=0.3,
+    )
+    scenes.aim(ob, (0.0, 0.0, 0.0))
+    _hide_from_camera(ob)
+    _camera(scene, (0.9, -2.1, 0.9), (0.0, 0.0, 0.22), 45.0, far)
+    return scene
+
+
 def room(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
     from devkit import assets
 
@@ -304,11 +327,12 @@ SCENES = {
     "suzanne": suzanne,
     "grazing": grazing,
     "tiny": tiny,
+    "lamp": lamp,
     "room": room,
 }
 LIGHT_SCENES = ("sun_hard", "sun_soft", "spot", "point", "area", "contact")
 SOFT_SCENES = ("sun_soft", "spot", "point", "area", "contact")  # visibly soft shadows in Cycles
-DETAILED_SCENES = ("bunny", "suzanne", "grazing", "tiny", "room")  # detailed casters, large grounds
+DETAILED_SCENES = ("bunny", "suzanne", "grazing", "tiny", "lamp", "room")  # detailed casters, large grounds
 
 
 def build(name, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):

@@ -220,16 +220,92 @@ def clipped_points(boxes, planes, per_box=False):
     return (np.concatenate(parts) if parts else np.zeros((0, 3))), seen
 
 
+def off_center_perspective(left, right, bottom, top, near, far):
+    """OpenGL perspective projection of the window [left, right] x [bottom, top] given in
+    tangent units (x / -z, y / -z), view-space z in [-far, -near] mapped to NDC [-1, 1]."""
+    m = np.zeros((4, 4))
+    m[0, 0] = 2.0 / (right - left)
+    m[0, 2] = (right + left) / (right - left)
+    m[1, 1] = 2.0 / (top - bottom)
+    m[1, 2] = (top + bottom) / (top - bottom)
+    m[2, 2] = (far + near) / (near - far)
+    m[2, 3] = 2.0 * far * near / (near - far)
+    m[3, 2] = -1.0
+    return m
+
+
+class Receivers:
+    """What the camera sees, as world points of convex pieces: ``whole`` (m, 8, 3) the boxes
+    wholly inside the view frustum, ``pieces`` the vertices of each box that crosses it, cut to
+    it. Built once per frame (``visible_receivers``) and shared by every light's fit."""
+
+    __slots__ = ("whole", "pieces")
+
+    def __init__(self, whole, pieces):
+        self.whole, self.pieces = whole, pieces
+
+
+def visible_receivers(corners, view_proj):
+    """``Receivers`` of the boxes ``corners`` (N, 8, 3) inside the camera's ``view_proj``."""
+    boxes = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
+    planes = light_bins.frustum_planes(view_proj)
+    if len(boxes) == 0:
+        return Receivers(boxes, [])
+    s = np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) - planes[None, None, :, 3]
+    tol = 1e-9 * max(1.0, float(np.abs(planes[:, 3]).max()))
+    inside = np.all(s <= tol, axis=(1, 2))
+    outside = np.any(np.all(s > tol, axis=1), axis=1)
+    crossing = ~inside & ~outside
+    return Receivers(boxes[inside], pieces_in(planes, boxes[crossing]) if crossing.any() else [])
+
+
+def window(points, view, near):
+    """(lo, hi) of the tangent-space window (x / -z, y / -z) of world ``points`` (all in front
+    of the near plane)."""
+    q = points @ view[:3, :3].T + view[:3, 3]
+    uv = q[:, :2] / np.maximum(-q[:, 2:3], near)
+    return uv.min(axis=0), uv.max(axis=0)
+
+
+def pieces_in(planes, boxes, pieces=()):
+    """The parts of ``boxes`` (n, 8, 3) and of the convex ``pieces`` (point arrays) inside
+    the convex region ``planes``, as a list of point arrays."""
+    out = []
+    if len(boxes):
+        s = np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) - planes[None, None, :, 3]
+        scale = 1e-9 * max(1.0, float(np.abs(planes[:, 3]).max()))
+        inside = np.all(s <= scale, axis=(1, 2))
+        outside = np.any(np.all(s > scale, axis=1), axis=1)
+        if inside.any():
+            out.append(boxes[inside].reshape(-1, 3))
+        pieces = list(pieces) + [b for b in boxes[~inside & ~outside]]
+    for p in pieces:
+        s = p @ planes[:, :3].T - planes[:, 3]
+        if np.any(np.all(s > 0.0, axis=0)):
+            continue
+        if np.all(s <= 0.0):
+            out.append(p)
+            continue
+        lo, hi = p.min(axis=0), p.max(axis=0)
+        v = light_bins.polytope_vertices(
+            np.concatenate([planes, light_bins.box_planes(lo, hi)]), 1e-6 * max(1.0, float(np.abs(p).max()))
+        )
+        if len(v):
+            out.append(v)
+    return out
+
+
 FLAT = 1e-6  # a box this thin relative to its longest edge is a flat (planar) mesh's
 MAX_FLAT_TESTS = 16  # flat boxes tested for casting nothing (the largest: grounds and walls)
 
 
-def flat_casters_without_shadow(boxes, direction):
+def flat_casters_without_shadow(boxes, direction=None, position=None):
     """(N,) bool: flat boxes (planar meshes: grounds, walls, cards) that cannot shadow anything
-    under a sun shining along ``direction``, because no other box reaches behind their plane
-    (the side the light travels towards) or the light grazes them edge-on. A planar mesh never
-    shadows itself, so such a box is left out of the sun's maps: it costs nothing to draw and
-    does not widen the map. Only the MAX_FLAT_TESTS largest flat boxes are tested."""
+    under a sun shining along ``direction`` (or a light at ``position``), because no other box
+    reaches behind their plane (the side away from the light) or the light grazes them
+    edge-on. A planar mesh never shadows itself, so such a box is left out of the light's
+    maps: it costs nothing to draw and does not widen the map. Only the MAX_FLAT_TESTS
+    largest flat boxes are tested."""
     boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 8, 3)
     n_boxes = len(boxes)
     free = np.zeros(n_boxes, dtype=bool)
@@ -246,12 +322,17 @@ def flat_casters_without_shadow(boxes, direction):
     flat = (lengths[rows, thin] <= FLAT * longest) & (area > 1e-12 * longest**2) & np.isfinite(area)
     candidates = np.nonzero(flat)[0]
     candidates = candidates[np.argsort(-area[candidates])][:MAX_FLAT_TESTS]
-    light = normalize(direction)
+    light = normalize(direction) if position is None else None
     for i in candidates:
         n = normal[i] / area[i]
         d = float(n @ boxes[i, 0])
-        s = float(n @ light)
-        if abs(s) <= 1e-9:
+        if light is not None:
+            s = float(n @ light)
+            grazing = abs(s) <= 1e-9
+        else:
+            s = d - float(n @ np.asarray(position, dtype=np.float64))  # > 0: the light below the plane
+            grazing = abs(s) <= 1e-9 * max(1.0, abs(d))
+        if grazing:
             free[i] = True  # edge-on to the light: its shadow has no area
             continue
         reach = np.sign(s) * (boxes @ n - d)  # > 0: behind the plane, where it could shadow

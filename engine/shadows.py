@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import lightspace
+from . import light_bins, lightspace
 from .enums import DEPTH_FORMAT
 from .programs import (
     MAX_SHADOW_TILES,
@@ -71,7 +71,9 @@ def _near_bound(position, lo, hi, half_fov):
 CUBE_PAD_FRACTION = 1.0 / 16.0
 
 
-def perspective_tile(position, forward, fov, corners, lo, hi, map_size, kernel=0.0, soft_radius=0.0):
+def perspective_tile(
+    position, forward, fov, corners, lo, hi, map_size, kernel=0.0, soft_radius=0.0, receivers=None, flat_free=None
+):
     """A perspective tile at ``position`` along ``forward``, or None without casters in it.
 
     ``kernel`` (texels) or ``soft_radius`` (world: a PCSS light's radius) widen the map past
@@ -79,7 +81,13 @@ def perspective_tile(position, forward, fov, corners, lo, hi, map_size, kernel=0
     texels of this map instead of "nothing there": cube faces then meet without a lit seam.
     A PCSS kernel is widest for the nearest caster: radius / near, in texels of the map; the
     widening stops at CUBE_PAD_FRACTION of the map per side (wider penumbrae may still show a
-    faint seam)."""
+    faint seam).
+
+    With ``receivers`` (``lightspace.Receivers``: what the camera sees) the map is cropped to
+    the window, in the light's view, of the visible receivers that some caster can shadow:
+    the casters' window (``flat_free``: flat boxes that shadow nothing are not casters),
+    widened by how far a penumbra reaches out of it, cut to the receivers' window. No
+    visible receiver in reach of a caster: no map."""
     reach = float(np.linalg.norm(corners.reshape(-1, 3) - position, axis=1).max()) * 1.01
     if not np.isfinite(reach) or reach <= 0.0:
         return None
@@ -108,10 +116,77 @@ def perspective_tile(position, forward, fov, corners, lo, hi, map_size, kernel=0
         if 2.0 * pad < size:
             fov = 2.0 * math.atan(math.tan(fov / 2.0) * size / (size - 2.0 * pad))
             got = fitted(fov) or got
+    else:
+        pad = 0.0
     inside, near, far = got
+    if receivers is not None:
+        crop = _crop(view, fov, near, far, size, corners, inside, receivers, flat_free, pad, soft_radius)
+        if crop is _NOTHING:
+            return None
+        if crop is not None:
+            proj, per_distance, inside, far = crop
+            return Tile(lightspace.Fit(view, proj, near, far, texel_per_distance=per_distance), inside)
     proj = lightspace.perspective(fov, 1.0, near, far)
     fit = lightspace.Fit(view, proj, near, far, texel_per_distance=2.0 * math.tan(fov / 2.0) / size)
     return Tile(fit, inside)
+
+
+_NOTHING = object()  # _crop: no visible receiver in reach of a caster
+
+
+def _crop(view, fov, near, far, size, corners, inside, receivers, flat_free, pad, soft_radius):
+    """A perspective map cut to what it must hold (see ``perspective_tile``): (projection,
+    texel per distance, casters, far), None when cropping gains nothing, or _NOTHING."""
+    half = math.tan(fov / 2.0)
+    planes = light_bins.frustum_planes(lightspace.perspective(fov, 1.0, near, far) @ view)
+    seen = lightspace.pieces_in(planes, receivers.whole, receivers.pieces)
+    if not seen:
+        return _NOTHING
+    seen = np.concatenate(seen)
+    r_lo, r_hi = lightspace.window(seen, view, near)
+    casters = inside if flat_free is None else inside[~flat_free[inside]]
+    if len(casters) == 0:
+        return _NOTHING
+    footprint = lightspace.pieces_in(planes, corners[casters])
+    if not footprint:
+        return _NOTHING
+    c_lo, c_hi = lightspace.window(np.concatenate(footprint), view, near)
+    spread = soft_radius / near  # how far (tangent units) a penumbra reaches out of a caster's window
+    w_lo = np.maximum(np.maximum(r_lo, c_lo - spread), -half)
+    w_hi = np.minimum(np.minimum(r_hi, c_hi + spread), half)
+    if np.any(w_hi < w_lo):
+        return _NOTHING
+    # Square texels, the extent quantised in 2^(1/4) steps and the window snapped to whole
+    # texels, so small camera moves do not move texel boundaries; ``pad`` texels each side.
+    extent = max(float(np.max(w_hi - w_lo)), 2.0 * half * 1e-4)
+    extent = 2.0 ** (math.ceil(math.log2(extent) * 4.0) / 4.0)
+    total = extent * size / max(size - 2.0 * max(pad, 2.0), 1.0)
+    if total >= 2.0 * half:
+        return None
+    texel = total / size
+    centre = np.floor(0.5 * (w_lo + w_hi) / texel) * texel
+    left, bottom = centre - 0.5 * total
+    right, top = centre + 0.5 * total
+    # Casters whose window misses the map's cannot shadow into it (those reaching behind the
+    # light's near plane are kept).
+    q = corners[casters] @ view[:3, :3].T + view[:3, 3]
+    depth = -q[..., 2]
+    front = np.all(depth >= near * 0.5, axis=1)
+    uv = q[..., :2] / np.maximum(depth, near * 0.5)[..., None]
+    overlap = np.all((uv.min(axis=1) <= (right, top)) & (uv.max(axis=1) >= (left, bottom)), axis=1)
+    casters = casters[~front | overlap]
+    if len(casters) == 0:
+        return _NOTHING
+    proj = lightspace.off_center_perspective(left, right, bottom, top, near, far)
+    # Nothing beyond the farthest visible receiver in the map's window needs a depth.
+    held = lightspace.pieces_in(light_bins.frustum_planes(proj @ view), receivers.whole, receivers.pieces)
+    if not held:
+        return _NOTHING
+    deepest = -float((np.concatenate(held) @ view[2, :3] + view[2, 3]).min())
+    if near < deepest * 1.01 < far:
+        far = deepest * 1.01
+        proj = lightspace.off_center_perspective(left, right, bottom, top, near, far)
+    return proj, texel, casters, far
 
 
 # A cube face's frustum reaches 54.74 degrees (its corners) from its axis; it lies wholly
@@ -153,6 +228,8 @@ def plan_shadows(
     if len(corners) == 0:
         return plan
     slices = _cascade_slices(corners, view_corners, camera, cascades, depth_range)
+    # What the camera sees, once for every spot, point and area map of the frame.
+    receivers = None if camera is None else lightspace.visible_receivers(corners, camera.projection @ camera.view)
     lo = corners.min(axis=1)
     hi = corners.max(axis=1)
     everything = np.arange(len(corners))
@@ -180,10 +257,21 @@ def plan_shadows(
             mode = "CASCADE" if view_corners is not None and slices is not None and len(slices) > 1 else "SINGLE"
         elif light.type == "SPOT":
             fov = min(light.spot_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
-            tile = perspective_tile(light.position, light.direction, fov, corners, lo, hi, map_size)
+            tile = perspective_tile(
+                light.position,
+                light.direction,
+                fov,
+                corners,
+                lo,
+                hi,
+                map_size,
+                receivers=receivers,
+                flat_free=lightspace.flat_casters_without_shadow(corners, position=light.position),
+            )
             tiles = [tile] if tile is not None else []
             mode = "SINGLE"
         else:  # POINT, AREA
+            flat_free = lightspace.flat_casters_without_shadow(corners, position=light.position)
             tiles = [
                 None
                 if light.type == "AREA" and behind_area_light(fwd, light.direction)
@@ -197,6 +285,8 @@ def plan_shadows(
                     map_size,
                     kernel=1.0 if soft else kernel,
                     soft_radius=light.shadow_radius * light.penumbra_scale if soft else 0.0,
+                    receivers=receivers,
+                    flat_free=flat_free,
                 )
                 for fwd in lightspace.CUBE_FORWARDS
             ]

@@ -33,7 +33,8 @@ def test_lights_beyond_the_table_drop_the_weakest_and_say_so(penumbra, capfd):
 
 def test_more_shadow_maps_than_the_atlas_holds_is_reported(penumbra, capfd):
     scene = scenes.empty_scene(32, 32)
-    scenes.plane(scene)
+    # A solid ground (a flat one shadows nothing and would need no map), all of it in view.
+    scenes.box(scene, "Ground", center=(0, 0, -0.5), size=(10.0, 10.0, 1.0))
     scenes.box(scene, center=(0, 0, 0.5))
     scenes.top_camera(scene, height=10.0, ortho_scale=10.0)
     _grid_of_lights(scene, 16, 20.0, shadow=True)  # 16 point lights, several cube faces each: > 48 tiles

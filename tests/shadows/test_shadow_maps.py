@@ -23,12 +23,40 @@ def test_light_without_shadow_gets_no_shadow_map(penumbra, gpu_call):
 
 
 def test_point_light_skips_cube_faces_without_casters(shadow_scene, gpu_call):
+    """A face gets a map only when a caster it can see may shadow something: the flat plane
+    shadows nothing (nothing lies below it), so only the faces that see the box draw one."""
+    from penumbra.engine import lightspace
+
     scene = shadow_scene("POINT", "PCF")
     stats, _ = engine_frame(gpu_call, scene, 64, 36)
+    light = np.array(scene.objects["L"].location)
+    box = lightspace.box_corners((-0.5, -0.5, 1.0), (0.5, 0.5, 2.0))[None]
+    seeing = sum(
+        bool(
+            lightspace.boxes_in_frustum(
+                lightspace.perspective(np.pi / 2, 1, 0.01, 100) @ lightspace.look_at(light, f), box
+            )[0]
+        )
+        for f in lightspace.CUBE_FORWARDS
+    )
+    assert 1 <= seeing < 5
+    assert stats.shadow_maps == seeing
+    # A solid ground (a box 1 m thick) can shadow itself: every face that sees a part of it in
+    # view draws one (the camera now sees the whole ground).
+    scene.camera.data.ortho_scale = 60.0
+    scenes.box(scene, "Slab", center=(0.0, 0.0, -0.5), size=(30.0, 30.0, 1.0))
+    bpy_remove(scene.objects["Plane"])
+    stats, _ = engine_frame(gpu_call, scene, 64, 36)
     assert stats.shadow_maps == 5  # the +Z face sees nothing
-    scene.objects["L"].location = (0.0, 0.0, 100.0)  # far above a 30 m plane: side faces see nothing either
+    scene.objects["L"].location = (0.0, 0.0, 100.0)  # far above: the side faces see nothing either
     stats, _ = engine_frame(gpu_call, scene, 64, 36)
     assert stats.shadow_maps == 1
+
+
+def bpy_remove(ob):
+    import bpy
+
+    bpy.data.objects.remove(ob)
 
 
 def test_no_caster_no_shadow_map(penumbra, gpu_call):
@@ -99,9 +127,9 @@ def test_gathered_pcf_equals_the_tap_by_tap_kernel(shadow_scene, kind, kernel):
     texel edge). Point lights cover cube-face tiles with neighbours in the atlas."""
     scene = shadow_scene(kind, "PCF")
     scene.penumbra.pcf_kernel_size = kernel
-    # Coarse texels, so the kernel spans a visible penumbra (the sun's map covers only the
-    # box's footprint, a point light's faces a quarter of the sky each).
-    scene.penumbra.shadow_map_size = 32 if kind == "SUN" else 256
+    # Coarse texels, so the kernel spans a visible penumbra (maps cover only what the box can
+    # shadow in view).
+    scene.penumbra.shadow_map_size = 32 if kind == "SUN" else 64
     gathered = render(scene, passes=("Combined", "Shadow"))["Shadow"][..., 0]
     scene.penumbra.pcf_spacing = 1.0 + 1e-6
     tapped = render(scene, passes=("Combined", "Shadow"))["Shadow"][..., 0]

@@ -32,6 +32,7 @@ from pathlib import Path
 
 import bpy
 import numpy as np
+from mathutils import Vector
 
 from devkit import reference_kit as kit
 from devkit import report, scenes, session, timing
@@ -487,6 +488,88 @@ def early_out(plan, width=1280, height=720, samples=(16, 32, 64)):
     return rows, (width, height)
 
 
+# --- 5. detailed casters on large grounds ----------------------------------------------------------
+
+DETAILED_SPP = 64  # Cycles reference: sharp lights, the 50 % contour has converged
+DETAILED_FILTERS = ("PCF", "PCSS")
+
+
+def texels_per_metre(runner, scene):
+    """Shadow-map texels per metre at the detailed caster (the largest mesh that is not the
+    ground or a wall): the finest map of the light, at the caster's distance for local lights.
+    Read from the frame's own shadow plan (``Renderer._plan``)."""
+    from penumbra.engine import renderer as renderer_module
+
+    plans = []
+    original = renderer_module.Renderer._plan
+
+    def recording(self, *args, **kwargs):
+        plans.append(original(self, *args, **kwargs))
+        return plans[-1]
+
+    light = kit.scene_light(scene)
+    meshes = [ob for ob in scene.objects if ob.type == "MESH" and len(ob.data.polygons) > 12]
+    caster = max(meshes, key=lambda ob: len(ob.data.polygons))
+    centre = np.mean([caster.matrix_world @ Vector(c) for c in caster.bound_box], axis=0)
+    distance = float(np.linalg.norm(centre - np.array(light.matrix_world.translation)))
+
+    def job(engine, depsgraph):
+        from penumbra.engine.extract import camera_from_scene
+
+        w, h = scene.render.resolution_x, scene.render.resolution_y
+        engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, w, h), w, h)
+
+    renderer_module.Renderer._plan = recording
+    try:
+        runner(job)
+    finally:
+        renderer_module.Renderer._plan = original
+    sizes = [t.fit.texel + t.fit.texel_per_distance * distance for p in plans for t in p.tiles]
+    return 1.0 / min(sizes) if sizes else float("nan")
+
+
+def detailed(plan, cache_dir):
+    """Per detailed scene and filter: IoU, missed and false shadow fractions against Cycles,
+    texels per metre at the caster and the median frame time (and Workbench's, the same run)."""
+    width, height = kit.DETAILED_WIDTH, kit.DETAILED_HEIGHT
+    runner = session.GpuRunner()
+    runner.register()
+    rows = []
+    try:
+        for name in kit.DETAILED_SCENES:
+            log(f"detailed scene {name}")
+            ref = kit.cycles_reference(name, DETAILED_SPP, width, height, cache_dir)
+            scene = kit.build(name, width, height)
+            configure(scene, "WORKBENCH")
+            bpy.ops.render.render(write_still=False)
+            workbench = timing.render(plan.runs, warmup=0).median
+            for filt in DETAILED_FILTERS:
+                configure(scene, "PENUMBRA", shadow_filter=filt)
+                with_shadow(scene, False)
+                unshadowed = kit.render_luminance(scene)
+                with_shadow(scene, True)
+                vis = kit.visibility_from(kit.render_luminance(scene), unshadowed)
+                seconds = timing.render(plan.runs, warmup=0).median
+                valid = np.isfinite(vis) & np.isfinite(ref)
+                n = max(int(valid.sum()), 1)
+                rows.append(
+                    {
+                        "scene": name,
+                        "filter": filt,
+                        "iou": kit.compare(vis, ref)["iou"],
+                        "missed": float(((ref < 0.5) & (vis >= 0.5) & valid).sum() / n),
+                        "false": float(((ref >= 0.5) & (vis < 0.5) & valid).sum() / n),
+                        "texels_per_m": texels_per_metre(runner, scene),
+                        "time_s": seconds,
+                        "workbench_s": workbench,
+                    }
+                )
+                log(f"  {rows[-1]}")
+    finally:
+        runner.unregister()
+    return rows
+
+
 # --- output ----------------------------------------------------------------------------------------
 
 
@@ -554,6 +637,24 @@ def md_work(rows):
     return report.markdown_table(header, cells)
 
 
+def md_detailed(rows):
+    cells = [
+        [
+            r["scene"],
+            r["filter"],
+            f"{r['iou']:.3f}",
+            f"{r['missed'] * 100:.2f} %",
+            f"{r['false'] * 100:.2f} %",
+            f"{r['texels_per_m']:,.0f}",
+            f"{r['time_s'] * 1e3:.0f}",
+            f"{r['time_s'] / r['workbench_s']:.2f}x",
+        ]
+        for r in rows
+    ]
+    header = ["Scene", "Filter", "IoU", "Missed", "False", "Texels/m at caster", "ms/frame", "/ Workbench"]
+    return report.markdown_table(header, cells, align="llrrrrrr")
+
+
 def md_early_out(rows, size):
     cells = [[r["samples"], f"{r['on'] * 1e3:.0f}", f"{r['off'] * 1e3:.0f}", f"{r['off'] / r['on']:.2f}"] for r in rows]
     header = [f"JITTER samples ({size[0]}x{size[1]})", "Early out on (ms)", "Off (ms)", "Off / on"]
@@ -570,6 +671,14 @@ def add_arguments(parser):
     parser.add_argument("--width", type=int, default=None, help="trade-off resolution (default 160)")
     parser.add_argument("--height", type=int, default=None, help="trade-off resolution (default 90)")
     parser.add_argument("--cache", type=Path, default=kit.DEFAULT_CACHE, help="Cycles reference cache folder")
+    parser.add_argument(
+        "--sections",
+        default=",".join(SECTIONS),
+        help=f"comma-separated subset of {', '.join(SECTIONS)} (default: all)",
+    )
+
+
+SECTIONS = ("tradeoff", "scaling", "work", "early_out", "detailed")
 
 
 def run(args):
@@ -581,42 +690,62 @@ def run(args):
     session.load_penumbra().register()
     started = time.perf_counter()
 
+    sections = [x.strip() for x in args.sections.split(",") if x.strip()]
+    unknown = sorted(set(sections) - set(SECTIONS))
+    if unknown:
+        raise SystemExit(f"bench shadows: unknown section(s) {', '.join(unknown)}; known: {', '.join(SECTIONS)}")
     with session.stdout_to_stderr():
-        rows = tradeoff(plan, args.cache)
-        summary = summarise(rows)
-        scale_rows = scaling(plan)
-        work_rows = frame_work(plan)
-        early_rows, early_size = early_out(plan)
+        rows = tradeoff(plan, args.cache) if "tradeoff" in sections else None
+        scale_rows = scaling(plan) if "scaling" in sections else None
+        work_rows = frame_work(plan) if "work" in sections else None
+        early = early_out(plan) if "early_out" in sections else None
+        detailed_rows = detailed(plan, args.cache) if "detailed" in sections else None
     gpu = session.gpu_renderer() or "n/a"
-
-    fields = ["engine", "filter", "map_size", "samples", "scene", "time_s", "mae", "mae_penumbra", "iou", "pareto"]
-    report.write_csv(args.out / "shadow_tradeoff.csv", rows + summary, fields)
-    plot_pareto(summary, args.out / "shadow_pareto.png", plan)
-    scaling_fields = ["engine", "width", "height", "triangles", "time_s", "ratio"]
-    report.write_csv(args.out / "scaling.csv", scale_rows, scaling_fields)
-    plot_scaling(scale_rows, plan, args.out / "scaling.png")
+    written = []
+    if rows is not None:
+        summary = summarise(rows)
+        fields = ["engine", "filter", "map_size", "samples", "scene", "time_s", "mae", "mae_penumbra", "iou", "pareto"]
+        report.write_csv(args.out / "shadow_tradeoff.csv", rows + summary, fields)
+        plot_pareto(summary, args.out / "shadow_pareto.png", plan)
+        written += ["shadow_tradeoff.csv", "shadow_pareto.png"]
+    if scale_rows is not None:
+        scaling_fields = ["engine", "width", "height", "triangles", "time_s", "ratio"]
+        report.write_csv(args.out / "scaling.csv", scale_rows, scaling_fields)
+        plot_scaling(scale_rows, plan, args.out / "scaling.png")
+        written += ["scaling.csv", "scaling.png"]
+    if detailed_rows is not None:
+        fields = ["scene", "filter", "iou", "missed", "false", "texels_per_m", "time_s", "workbench_s"]
+        report.write_csv(args.out / "shadow_detailed.csv", detailed_rows, fields)
+        written.append("shadow_detailed.csv")
 
     elapsed = time.perf_counter() - started
     conditions = (
         f"Blender {bpy.app.version_string}; GPU: {gpu}; {'--quick' if args.quick else 'full'} run, "
         f"{plan.runs} timed render(s) per configuration after the warm-up; {elapsed / 60:.1f} min in all."
     )
-    print(
-        f"### Shadow error against frame time (mean over {', '.join(plan.scenes)}; "
-        f"{plan.width}x{plan.height}; reference Cycles {plan.reference_spp} spp)\n"
-    )
-    print(md_tradeoff(summary))
-    print("\nPer scene, IoU / MAE:\n")
-    print(md_per_scene(rows, plan))
-    print("\n### Scaling\n")
-    print(md_scaling(scale_rows))
-    print("\n### Per-frame work (Penumbra FrameStats)\n")
-    print(md_work(work_rows))
-    print()
-    print(md_early_out(early_rows, early_size))
+    if rows is not None:
+        print(
+            f"### Shadow error against frame time (mean over {', '.join(plan.scenes)}; "
+            f"{plan.width}x{plan.height}; reference Cycles {plan.reference_spp} spp)\n"
+        )
+        print(md_tradeoff(summary))
+        print("\nPer scene, IoU / MAE:\n")
+        print(md_per_scene(rows, plan))
+    if scale_rows is not None:
+        print("\n### Scaling\n")
+        print(md_scaling(scale_rows))
+    if work_rows is not None:
+        print("\n### Per-frame work (Penumbra FrameStats)\n")
+        print(md_work(work_rows))
+    if early is not None:
+        print()
+        print(md_early_out(*early))
+    if detailed_rows is not None:
+        print(
+            f"\n### Detailed casters on large grounds ({kit.DETAILED_WIDTH}x{kit.DETAILED_HEIGHT}, defaults "
+            f"but the filter; reference Cycles {DETAILED_SPP} spp; missed/false: share of the valid pixels)\n"
+        )
+        print(md_detailed(detailed_rows))
     print(f"\n{conditions}")
-    print(
-        f"Wrote {args.out / 'shadow_tradeoff.csv'}, {args.out / 'shadow_pareto.png'}, "
-        f"{args.out / 'scaling.csv'}, {args.out / 'scaling.png'}."
-    )
+    print(f"Wrote {', '.join(str(args.out / w) for w in written)}.")
     return 0
