@@ -232,3 +232,57 @@ def test_sun_fit_crops_to_the_casters_footprint_and_skips_a_flat_ground():
         lightspace.fit_sun_to_view((0.2, 0.5, -1.0), np.stack([ground, away]), lightspace.frustum_corners(cam), 1024)
         is None
     )
+
+
+def test_off_center_perspective_maps_its_window_to_the_unit_square():
+    m = lightspace.off_center_perspective(-0.2, 0.6, 0.1, 0.3, 0.5, 20.0)
+    for u, v, z in [(-0.2, 0.1, 0.5), (0.6, 0.3, 20.0), (0.2, 0.2, 3.0)]:
+        ndc = lightspace.transform_points(m, [(u * z, v * z, -z)])[0]
+        expected = (2 * (u + 0.2) / 0.8 - 1, 2 * (v - 0.1) / 0.2 - 1)
+        np.testing.assert_allclose(ndc[:2], expected, atol=1e-12)
+    np.testing.assert_allclose(
+        lightspace.transform_points(m, [(0, 0.2 * 0.5, -0.5), (0, 0.2 * 20, -20.0)])[:, 2], (-1, 1)
+    )
+    t = np.tan(np.radians(30))
+    np.testing.assert_allclose(
+        lightspace.off_center_perspective(-t, t, -t, t, 0.1, 9.0), lightspace.perspective(np.radians(60), 1.0, 0.1, 9.0)
+    )
+
+
+def test_local_light_maps_crop_to_what_the_camera_sees_and_the_casters_can_shadow():
+    """A point light 5 m over a 2 km flat ground with a 20 cm box: the ground casts nothing, so
+    the downward face covers the box's window (and its shadow in view), not the whole face."""
+    from penumbra.engine.shadows import perspective_tile
+
+    ground = _flat((-1000, -1000, 0), (1000, 1000, 0))
+    box = lightspace.box_corners((0.4, -0.1, 0.0), (0.6, 0.1, 0.2))
+    corners = np.stack([ground, box])
+    lo, hi = corners.min(axis=1), corners.max(axis=1)
+    light = np.array([0.0, 0.0, 5.0])
+    view = lightspace.look_at((3, -6, 4), (-3, 6, -4))
+    cam = lightspace.perspective(np.radians(40), 1.5, 0.1, 100.0) @ view
+    receivers = lightspace.visible_receivers(corners, cam)
+    flat_free = lightspace.flat_casters_without_shadow(corners, position=light)
+    assert flat_free.tolist() == [True, False]
+    down = np.array([0.0, 0.0, -1.0])
+    full = perspective_tile(light, down, np.pi / 2, corners, lo, hi, 1024)
+    tile = perspective_tile(light, down, np.pi / 2, corners, lo, hi, 1024, receivers=receivers, flat_free=flat_free)
+    assert tile.casters.tolist() == [1]
+    assert tile.fit.texel_per_distance < full.fit.texel_per_distance / 20  # the box spans ~0.05 of the 2.0 face
+    ndc = lightspace.transform_points(tile.fit.view_proj, box)
+    assert np.all(np.abs(ndc[:, :2]) <= 1.0)
+    # Its shadow on the ground (along the rays from the light through the box) is in the map.
+    shadow = light + (box - light) * (5.0 / (5.0 - box[:, 2:3]))
+    assert np.all(np.abs(lightspace.transform_points(tile.fit.view_proj, shadow)[:, :2]) <= 1.0)
+    assert np.all(lightspace.transform_points(tile.fit.view_proj, shadow)[:, 2] <= 1.0)  # before the far plane
+    # Only the ground in reach: nothing to shadow, no map; the box out of view: no map either.
+    assert (
+        perspective_tile(
+            light, down, np.pi / 2, corners[:1], lo[:1], hi[:1], 1024, receivers=receivers, flat_free=flat_free[:1]
+        )
+        is None
+    )
+    away = lightspace.visible_receivers(
+        corners, lightspace.perspective(np.radians(40), 1.5, 0.1, 100.0) @ lightspace.look_at((300, 0, 4), (1, 0, -0.2))
+    )
+    assert perspective_tile(light, down, np.pi / 2, corners, lo, hi, 1024, receivers=away, flat_free=flat_free) is None
