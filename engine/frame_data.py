@@ -82,6 +82,7 @@ def light_row(light, shadow=None):
         "tiles_45": tiles[4:6],
         "bias_scale": light.bias_scale,
         "cascade_splits": (list(shadow.splits) + [3.0e38] * 4)[:4] if shadow and shadow.splits else (3.0e38,) * 4,
+        "cascade_blend": (list(shadow.blend) + [0.0] * 4)[:4] if shadow and shadow.blend else (0.0,) * 4,
     }
 
 

@@ -41,6 +41,7 @@ LIGHT_STRUCT = Struct(
         ("IVEC2", "tiles_45"),  # atlas tiles of cube faces 4, 5
         ("FLOAT", "bias_scale"),  # light.penumbra.bias_scale
         ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
+        ("VEC4", "cascade_blend"),  # CASCADE: depth before each end over which the next one fades in
     ),
 )
 

@@ -51,6 +51,7 @@ class LightShadow:
     mode: str  # 'SINGLE' | 'CUBE' | 'CASCADE'
     tiles: list = field(default_factory=list)  # per face, cascade (or one): index into plan.tiles, or -1
     splits: tuple = ()  # CASCADE: the view depth where each cascade ends
+    blend: tuple = ()  # CASCADE: per split, the depth before it over which the next cascade fades in
 
 
 @dataclass
@@ -300,6 +301,7 @@ def plan_shadows(
         entry = LightShadow(mode)
         if mode == "CASCADE":
             entry.splits = tuple(end for _sc, end in slices)
+            entry.blend = cascade_blend([end for _sc, end in slices], depth_range or ())
         for t in tiles:
             if t is None:
                 entry.tiles.append(-1)
@@ -335,6 +337,23 @@ def _cascade_slices(corners, view_corners, camera, requested, depth=None):
 
 
 CASCADE_OVERLAP = 0.1
+
+
+def cascade_blend(ends, depth_range=()):
+    """Per split between cascades, the view depth before it over which the lit pass moves
+    from one cascade to the next (dithered, stratified over the frame's samples, so a seam
+    becomes a gradual change of texel size): half the overlap both maps cover there, so the
+    next map's filter still reads inside it."""
+    ends = [float(e) for e in ends]
+    if len(ends) < 2:
+        return ()
+    start = float(depth_range[0]) if len(depth_range) else ends[0] - (ends[1] - ends[0])
+    bounds = [start, *ends]
+    out = []
+    for k in range(len(ends) - 1):
+        a, b, c = bounds[k], bounds[k + 1], bounds[k + 2]
+        out.append(0.5 * CASCADE_OVERLAP * min(b - a, c - b))
+    return tuple(out)
 
 
 class ShadowAtlas:

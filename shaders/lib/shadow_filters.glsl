@@ -16,6 +16,8 @@
  *                  deeper, so its slope bias grows with r (receiver-plane reasoning)
  * scaled per light by LightData.bias_scale (light.penumbra.bias_scale). */
 
+float pixel_hash(vec2 frag); /* lib/material.glsl */
+
 int cube_face(vec3 d)
 {
   vec3 a = abs(d);
@@ -100,10 +102,20 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
     tile = L.tiles.x;
   }
   else if (mode == SHADOW_MODE_CASCADE) {
-    /* The slice of the visible depth range P lies in (view depth along the camera axis). */
+    /* The slice of the visible depth range P lies in (view depth along the camera axis). In
+     * the band before a split both maps cover P: the next one takes over with a probability
+     * that rises across the band (a per-pixel hash, moved on every sample), so the seam is a
+     * gradual change of texel size instead of a line. */
     float d = dot(P - frame.camera_position, frame.camera_forward);
     vec4 ends = L.cascade_splits;
     int c = (d < ends.x) ? 0 : (d < ends.y) ? 1 : (d < ends.z) ? 2 : 3;
+    if (c < 3) {
+      float band = L.cascade_blend[c];
+      float into = (band > 0.0) ? (d - (ends[c] - band)) / band : 0.0;
+      if (into > 0.0 && fract(pixel_hash(gl_FragCoord.xy + 61.0) + frame.alpha_offset) < into) {
+        c += 1;
+      }
+    }
     tile = L.tiles[c];
   }
   else {

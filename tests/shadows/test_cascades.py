@@ -208,3 +208,27 @@ def test_visible_depth_range_is_computed_once_per_frame(penumbra, gpu_call, monk
 
     assert gpu_call(job) == (4, 1)
     assert len(calls) == 1
+
+
+def test_cascade_seams_blend_inside_the_overlap_both_maps_cover(penumbra):
+    """Before each split the next cascade fades in over half the depth both maps cover (each
+    slice is widened by CASCADE_OVERLAP of its depth), so a filter there reads inside both."""
+    from penumbra.engine import lightspace, shadows
+
+    splits = lightspace.cascade_splits(0.5, 500.0, 3)
+    blend = shadows.cascade_blend(splits[1:], (0.5, 500.0))
+    assert len(blend) == 2
+    for k, band in enumerate(blend):
+        a, b, c = splits[k], splits[k + 1], splits[k + 2]
+        both = min(shadows.CASCADE_OVERLAP * (b - a), shadows.CASCADE_OVERLAP * (c - b))
+        assert 0.0 < band <= 0.5 * both + 1e-12
+    assert shadows.cascade_blend([40.0]) == ()  # one map: no seam
+
+
+def test_cascade_seams_change_no_shadow(penumbra):
+    """The horizon scene with 4 cascades, blended across seams, against the analytic shadow:
+    the blend never picks a map that does not cover the pixel (IoU and false shadow as with
+    the automatic count)."""
+    score, false = shadow_score(small_box_scene(horizon=True, cascades=4, slab=True))
+    assert score >= 0.9, f"IoU {score:.3f}"
+    assert false < 0.002

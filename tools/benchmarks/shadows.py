@@ -1,6 +1,6 @@
 """Shadow quality against cost: Penumbra's filters, EEVEE and Cycles on the reference scenes.
 
-Four measurements, all in this one process on the same scenes (``devkit.reference_kit``),
+Five measurements, all in this one process on the same scenes (``devkit.reference_kit``),
 engines set up by ``devkit.engines``:
 
 1. Trade-off: every Penumbra configuration of filter x shadow_map_size (x shadow_samples for
@@ -17,6 +17,12 @@ engines set up by ``devkit.engines``:
    shadow maps drawn and reused, passes, draws, texture memory, for the cases that show which
    work a frame skips.
 4. JITTER with ``shadow_early_out`` on and off at 1280x720, interleaved in the same run.
+5. Detailed casters on large grounds (``kit.DETAILED_SCENES``, 320x180, Cycles 64 spp):
+   IoU, missed and false shadow fractions, texels per metre at the caster and frame time
+   against Workbench's in the same run, for PCF and PCSS at the defaults.
+   -> ``<out>/shadow_detailed.csv``.
+
+``--sections`` runs a subset (tradeoff, scaling, work, early_out, detailed).
 
 Machines here are shared and noisy: absolute times only describe this run; compare engines
 and configurations by their ratios. Markdown tables for the README go to stdout, progress and
