@@ -104,6 +104,7 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "constant_bias": settings.shadow_bias,
         "slope_bias": settings.shadow_slope_bias,
         "normal_offset": settings.shadow_normal_offset,
+        "receiver_plane": int(bool(settings.shadow_receiver_plane)),
         "pcf_spacing": settings.pcf_spacing,
         "filter_radius": settings.shadow_filter_radius,
         "max_filter_radius": max_filter_radius(tile_size),

@@ -85,6 +85,7 @@ FRAME_STRUCT = Struct(
         ("FLOAT", "constant_bias"),  # texels
         ("FLOAT", "slope_bias"),  # texels per unit of tan(angle)
         ("FLOAT", "normal_offset"),  # texels
+        ("INT", "receiver_plane"),  # 1: taps biased by the receiver's plane, not by a growing slope bias
         ("FLOAT", "pcf_spacing"),  # texels between PCF taps
         ("FLOAT", "filter_radius"),  # JITTER radius, texels
         ("FLOAT", "max_filter_radius"),  # widest disk kernel, texels

@@ -275,6 +275,16 @@ SCENE_PARAMS = (
         section=SHADOWS,
     ),
     Param(
+        "shadow_receiver_plane",
+        "BOOL",
+        True,
+        "Compare each filter tap with the receiver's own plane at that texel (its facet's slope "
+        "towards the light) instead of a slope bias that grows with the filter's width: fine "
+        "geometry keeps its self-shadowing and contact shadows under wide filters",
+        label="Receiver Plane",
+        section=SHADOWS,
+    ),
+    Param(
         "shadow_cull_front",
         "BOOL",
         False,

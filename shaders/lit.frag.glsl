@@ -17,6 +17,7 @@
 struct Surface {
   vec3 P, N, V;
   vec3 Ng; /* the interpolated mesh normal, before any normal map: what shadow biases follow */
+  vec3 Nf; /* the drawn facet's normal (the plane the shadow map holds), on Ng's side */
   vec3 albedo, f0;
   float shininess;
   float alpha; /* GGX roughness (Principled roughness squared) */
@@ -43,7 +44,7 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   float NgdotL = dot(s.Ng, to_light);
   float visibility = (filter_id == NO_SHADOW) ? 1.0 :
                      (NgdotL <= 0.0) ? 0.0 :
-                                       shadow_visibility(L, s.P, s.Ng, NgdotL, filter_id);
+                                       shadow_visibility(L, s.P, s.Ng, s.Nf, NgdotL, filter_id);
   unshadowed += weight;
   arriving += weight * visibility;
 #if SPECULAR_MODEL == SPECULAR_GGX
@@ -166,6 +167,13 @@ void main()
 
   s.V = (frame.is_ortho != 0) ? -frame.camera_forward : normalize(frame.camera_position - s.P);
   s.Ng = (dot(N, s.V) < 0.0) ? -N : N;
+  {
+    /* Derivatives within the pixel quad come from this triangle: its plane. */
+    vec3 f = cross(dFdx(s.P), dFdy(s.P));
+    float fl = length(f);
+    s.Nf = (fl > 1e-30) ? f / fl : s.Ng;
+    s.Nf = (dot(s.Nf, s.Ng) < 0.0) ? -s.Nf : s.Nf;
+  }
 #if TEX_NORMAL
   {
     /* Tangent-space normal map (Blender's Normal Map node): MikkTSpace tangent and sign from

@@ -11,9 +11,13 @@
  * Bias is in texels of the map at the receiver, so one setting holds at every scene scale:
  *   normal offset  moves P along N by frame.normal_offset texels * sin(theta)
  *   constant       frame.constant_bias texels of depth
- *   slope-scaled   frame.slope_bias texels * tan(theta) * max(1, filter radius), tan clamped
- *                  to 60 (89 degrees): a filter reading texels r away sees the tilted receiver r times
- *                  deeper, so its slope bias grows with r (receiver-plane reasoning)
+ *   slope-scaled   frame.slope_bias texels * tan(theta), tan clamped to 60 (89 degrees)
+ *   receiver plane (frame.receiver_plane) every tap is compared with the depth the receiver's
+ *                  own facet has at that texel's centre (its slope towards the light, from
+ *                  the drawn triangle's normal): a tilted receiver read r texels away is
+ *                  neither acne nor a reason to bias the whole kernel. Without it (or where
+ *                  the facet faces away from the light) the slope bias grows with the
+ *                  kernel: tan(theta) * max(1, r)
  * scaled per light by LightData.bias_scale (light.penumbra.bias_scale). */
 
 float pixel_hash(vec2 frag); /* lib/material.glsl */
@@ -49,16 +53,23 @@ float shadow_depth_at(ivec2 origin, ivec2 st)
   return decode_depth(texelFetch(shadow_atlas, origin + st, 0));
 }
 
+/* The reference depth at texel t: ``ref`` at the lookup point st, moved along the receiver's
+ * plane (``grad``: its normalised depth per texel) to the texel's centre. */
+float plane_ref(ivec2 t, vec2 st, float ref, vec2 grad)
+{
+  return ref + dot(grad, vec2(t) + 0.5 - st);
+}
+
 /* Bilinear-weighted 2x2 comparison: exactly what a linear-filtered compare sampler returns. */
-float shadow_bilinear(ivec2 origin, vec2 st, float ref)
+float shadow_bilinear(ivec2 origin, vec2 st, float ref, vec2 grad)
 {
   vec2 p = st - 0.5;
   vec2 f = fract(p);
   ivec2 b = ivec2(floor(p));
-  float s00 = shadow_tap(origin, b, ref);
-  float s10 = shadow_tap(origin, b + ivec2(1, 0), ref);
-  float s01 = shadow_tap(origin, b + ivec2(0, 1), ref);
-  float s11 = shadow_tap(origin, b + ivec2(1, 1), ref);
+  float s00 = shadow_tap(origin, b, plane_ref(b, st, ref, grad));
+  float s10 = shadow_tap(origin, b + ivec2(1, 0), plane_ref(b + ivec2(1, 0), st, ref, grad));
+  float s01 = shadow_tap(origin, b + ivec2(0, 1), plane_ref(b + ivec2(0, 1), st, ref, grad));
+  float s11 = shadow_tap(origin, b + ivec2(1, 1), plane_ref(b + ivec2(1, 1), st, ref, grad));
   return mix(mix(s00, s10, f.x), mix(s01, s11, f.x), f.y);
 }
 
@@ -71,11 +82,12 @@ vec2 disk_sample(int i)
 
 /* Disk PCF of radius r texels with the per-pixel jittered samples. With EARLY_OUT, the outer
  * ring (the first 8 samples) decides alone when it agrees (fully lit or fully shadowed). */
-float shadow_disk(ivec2 origin, vec2 st, float ref, float r)
+float shadow_disk(ivec2 origin, vec2 st, float ref, float r, vec2 grad)
 {
   float lit = 0.0;
   for (int i = 0; i < 8; i++) {
-    lit += shadow_tap(origin, ivec2(floor(st + disk_sample(i) * r)), ref);
+    ivec2 t = ivec2(floor(st + disk_sample(i) * r));
+    lit += shadow_tap(origin, t, plane_ref(t, st, ref, grad));
   }
 #if EARLY_OUT
   if (lit == 0.0 || lit == 8.0) {
@@ -83,7 +95,8 @@ float shadow_disk(ivec2 origin, vec2 st, float ref, float r)
   }
 #endif
   for (int i = 8; i < DISK_SAMPLES; i++) {
-    lit += shadow_tap(origin, ivec2(floor(st + disk_sample(i) * r)), ref);
+    ivec2 t = ivec2(floor(st + disk_sample(i) * r));
+    lit += shadow_tap(origin, t, plane_ref(t, st, ref, grad));
   }
   return lit / float(DISK_SAMPLES);
 }
@@ -91,7 +104,7 @@ float shadow_disk(ivec2 origin, vec2 st, float ref, float r)
 /* ``filter_id`` is a literal at every call (FILTER_*), so each call compiles to its one filter:
  * lights sampled over their extent use PCSS with their per-sample size, the others the
  * scene's filter. */
-float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filter_id)
+float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, const int filter_id)
 {
   int mode = L.shadow_mode;
   if (mode == SHADOW_MODE_NONE) {
@@ -146,8 +159,18 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
   float receiver = -vp.z;
   float constant_bias = frame.constant_bias * bias_scale * texel;
   float slope_bias = frame.slope_bias * bias_scale * texel * tan_t;
-  /* Reference depth for a filter that reads texels up to r away. */
-#define SHADOW_REF(r) ((receiver - constant_bias - slope_bias * max(1.0, (r)) - near) * depth_scale)
+  /* The receiver's plane in the map: its normalised depth per texel along s and t. */
+  vec2 grad = vec2(0.0);
+  float grows = 1.0; /* how the slope bias grows with the kernel's radius */
+  if (frame.receiver_plane != 0) {
+    vec3 nl = mat3(T.view) * Nf;
+    if (nl.z > 1.0 / 60.0) {
+      grad = (nl.xy / nl.z) * (texel * depth_scale);
+      grows = 0.0;
+    }
+  }
+  /* Reference depth at the lookup point for a filter that reads texels up to r away. */
+#define SHADOW_REF(r) ((receiver - constant_bias - slope_bias * max(1.0, grows * (r)) - near) * depth_scale)
   if (SHADOW_REF(0.0) >= 1.0) {
     return 1.0;
   }
@@ -157,10 +180,11 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
   vec2 st = uv * float(size);
 
   if (filter_id == FILTER_NONE) {
-    return shadow_tap(origin, ivec2(floor(st)), SHADOW_REF(0.0));
+    ivec2 t = ivec2(floor(st));
+    return shadow_tap(origin, t, plane_ref(t, st, SHADOW_REF(0.0), grad));
   }
   if (filter_id == FILTER_HARDWARE) {
-    return shadow_bilinear(origin, st, SHADOW_REF(1.0));
+    return shadow_bilinear(origin, st, SHADOW_REF(1.0), grad);
   }
 #if SHADOW_FILTER == FILTER_PCF
   if (filter_id == FILTER_PCF) {
@@ -184,7 +208,10 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
       bvec4 in_x = lessThan(uvec4(ivec4(b.x, b.x + 1, b.x + 1, b.x)), uvec4(size));
       bvec4 in_y = lessThan(uvec4(ivec4(b.y + 1, b.y + 1, b.y, b.y)), uvec4(size));
       vec4 inside = vec4(in_x) * vec4(in_y);
-      vec4 tap = mix(vec4(1.0), vec4(lessThanEqual(vec4(ref), d)), inside);
+      /* Each texel's reference on the receiver's plane (centres of the gathered 2x2 block). */
+      vec4 refs = ref + grad.x * (vec4(b.x, b.x + 1, b.x + 1, b.x) + 0.5 - st.x) +
+                  grad.y * (vec4(b.y + 1, b.y + 1, b.y, b.y) + 0.5 - st.y);
+      vec4 tap = mix(vec4(1.0), vec4(lessThanEqual(refs, d)), inside);
       vec4 wx = vec4(w[bx + PCF_RADIUS], w[bx + PCF_RADIUS + 1], w[bx + PCF_RADIUS + 1], w[bx + PCF_RADIUS]);
       vec4 wy = vec4(w[by + PCF_RADIUS + 1], w[by + PCF_RADIUS + 1], w[by + PCF_RADIUS], w[by + PCF_RADIUS]);
       lit += dot(tap, wx * wy);
@@ -196,7 +223,8 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
   for (int y = -PCF_RADIUS; y <= PCF_RADIUS; y++) {
     float row = 0.0;
     for (int x = -PCF_RADIUS; x <= PCF_RADIUS; x++) {
-      row += w[x + PCF_RADIUS] * shadow_tap(origin, ivec2(floor(st + vec2(x, y) * spacing)), ref);
+      ivec2 t = ivec2(floor(st + vec2(x, y) * spacing));
+      row += w[x + PCF_RADIUS] * shadow_tap(origin, t, plane_ref(t, st, ref, grad));
     }
     lit += w[y + PCF_RADIUS] * row;
   }
@@ -205,7 +233,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
 #endif
   if (filter_id == FILTER_JITTER) {
     float r = frame.filter_radius;
-    return shadow_disk(origin, st, SHADOW_REF(r), r);
+    return shadow_disk(origin, st, SHADOW_REF(r), r, grad);
   }
   /* FILTER_PCSS */
   /* 1. Blocker search: average depth of the texels that occlude P, over the region a light of
@@ -220,8 +248,9 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
   float ref = SHADOW_REF(search);
   float blockers = 0.0, blocker_sum = 0.0;
   for (int i = 0; i < DISK_SAMPLES; i++) {
-    float d = shadow_depth_at(origin, ivec2(floor(st + disk_sample(i) * search)));
-    if (d < ref) {
+    ivec2 t = ivec2(floor(st + disk_sample(i) * search));
+    float d = shadow_depth_at(origin, t);
+    if (d < plane_ref(t, st, ref, grad)) {
       blockers += 1.0;
       blocker_sum += d;
     }
@@ -233,7 +262,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, float NdotL, const int filt
   float width = sun ? (receiver - blocker) * 2.0 * L.sun_tan_half_angle :
                       2.0 * L.shadow_radius * (receiver - blocker) / max(blocker, 1e-30);
   float r = clamp(0.5 * width / texel, 0.5, max_r);
-  return shadow_disk(origin, st, SHADOW_REF(r), r);
+  return shadow_disk(origin, st, SHADOW_REF(r), r, grad);
 #undef SHADOW_REF
 }
 

@@ -27,9 +27,9 @@ BOUNDS = {
     "bunny": (0.97, 0.002, 0.002),  # 0.991, 0.04 %, 0.02 %   (before: 0.940, 0.33 %, 0.05 %)
     "suzanne": (0.95, 0.002, 0.004),  # 0.967, 0.04 %, 0.20 %   (before: 0.921, 0.37 %, 0.20 %)
     "grazing": (0.95, 0.003, 0.002),  # 0.970, 0.08 %, 0.06 %   (before: 0.772, 1.00 %, 0.08 %)
-    "tiny": (0.97, 0.002, 0.002),  # 0.988, 0.03 %, 0.03 %   (before: 0.958, 0.18 %, 0.04 %)
-    "lamp": (0.96, 0.002, 0.002),  # 0.979, 0.04 %, 0.01 %   (before: 0.731, 0.72 %, 0.05 %)
-    "room": (0.97, 0.002, 0.002),  # 0.991, 0.04 %, 0.03 %   (before: the same)
+    "tiny": (0.97, 0.002, 0.002),  # 0.989, 0.03 %, 0.03 %   (before: 0.958, 0.18 %, 0.04 %)
+    "lamp": (0.96, 0.002, 0.002),  # 0.980, 0.04 %, 0.01 %   (before: 0.731, 0.72 %, 0.05 %)
+    "room": (0.97, 0.002, 0.002),  # 0.990, 0.03 %, 0.04 %   (before: 0.991, 0.04 %, 0.03 %)
 }
 
 
@@ -52,3 +52,19 @@ def test_detailed_caster_matches_cycles_at_the_defaults(penumbra, name):
     assert iou >= low, f"IoU {iou:.3f}"
     assert missed <= most_missed, f"missed {missed:.4%}"
     assert false <= most_false, f"false {false:.4%}"
+
+
+def test_receiver_plane_keeps_fine_self_shadowing_under_wide_kernels(penumbra):
+    """PCSS under the street lamp: a slope bias that grows with the kernel erased the bunny's
+    self-shadowing in its fur folds (IoU 0.914, 0.23 % of the frame missed, measured); each
+    tap compared with the receiver's own plane keeps it (0.979, 0.05 %)."""
+    ref = reference("lamp")
+    scores = {}
+    for plane in (True, False):
+        scene = kit.build("lamp", kit.DETAILED_WIDTH, kit.DETAILED_HEIGHT)
+        vis = kit.measure_visibility(scene, "PENUMBRA", shadow_filter="PCSS", shadow_receiver_plane=plane)
+        valid = np.isfinite(vis) & np.isfinite(ref)
+        missed = ((ref < 0.5) & (vis >= 0.5) & valid).sum() / valid.sum()
+        scores[plane] = (kit.compare(vis, ref)["iou"], missed)
+    assert scores[True][0] >= 0.96 and scores[True][1] <= 0.001, scores
+    assert scores[False][0] < scores[True][0] - 0.03, scores  # the failure it fixes is real here
