@@ -138,3 +138,32 @@ def test_gathered_pcf_equals_the_tap_by_tap_kernel(shadow_scene, kind, kernel):
     differs = np.abs(gathered - tapped) > 1e-4
     assert differs.mean() < 0.002, f"{differs.sum()} pixels differ"
     np.testing.assert_allclose(np.median(np.abs(gathered - tapped)[penumbra]), 0.0, atol=1e-5)
+
+
+@pytest.mark.parametrize("shadow_filter", ["PCF", "PCSS"])
+def test_no_lit_seam_where_a_shadow_crosses_cube_faces(penumbra, analytic_shadow, shadow_filter):
+    """A 6 m beam 1.5 m under a point light: its shadow on the ground runs from x = -6 to 6 and
+    crosses the boundary between the downward cube face and the side faces at |x| = 3. Each
+    face's map is widened by its filter's kernel, so inside the analytic shadow (more than
+    2 px from its edge) no pixel is even a tenth lit, at the seam or anywhere. Before the faces
+    were widened, PCF read "nothing there" past the face edge: 16 pixels at 0.30 across the
+    shadow at the seams (measured with this test)."""
+    scene = scenes.empty_scene(224, 112)
+    scenes.plane(scene, "Ground", size=40.0, mat=scenes.white())
+    lo, hi = (-3.0, -0.15, 1.4), (3.0, 0.15, 1.6)
+    scenes.box(scene, "Beam", center=(0.0, 0.0, 1.5), size=(6.0, 0.3, 0.2), mat=scenes.white())
+    light = scenes.light(scene, "L", "POINT", 2000.0, location=(0.0, 0.0, 3.0), shadow_soft_size=0.05)
+    scenes.camera(scene, (0.0, 0.0, 20.0), (0.0, 0.0, 0.0), ortho_scale=15.0, clip=(1.0, 40.0))
+    scene.penumbra.shadow_filter = shadow_filter
+    scene.penumbra.shadow_map_size = 256  # coarse texels: a kernel past the face edge spans pixels
+    _lum, visibility, on_plane, shadowed = analytic_shadow(scene, light, lo, hi)
+    edge = np.zeros_like(shadowed)
+    for dy in range(-2, 3):
+        for dx in range(-2, 3):
+            edge |= np.roll(np.roll(shadowed, dy, axis=0), dx, axis=1) != shadowed
+    core = shadowed & on_plane & ~edge
+    assert core.sum() > 500  # the shadow is in view, across the seams
+    columns = np.nonzero(core.any(axis=0))[0]
+    assert columns.max() - columns.min() > 0.8 * 12.0 / 15.0 * 224  # from about x = -6 to 6
+    assert (visibility[core] > 0.1).sum() == 0, np.sort(visibility[core])[-10:]
+    assert iou((visibility < 0.5)[on_plane], shadowed[on_plane]) > 0.95
