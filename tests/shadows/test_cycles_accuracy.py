@@ -131,3 +131,18 @@ def test_pcss_is_closer_to_cycles_than_none(penumbra, name):
     pcss, none = score(name, "PCSS"), score(name, "NONE")
     assert pcss["mae"] < 0.8 * none["mae"]
     assert pcss["mae_penumbra"] < 0.75 * none["mae_penumbra"]
+
+
+def test_pcss_penumbra_does_not_narrow_with_a_larger_map(penumbra):
+    """The widest PCSS kernel is a fraction of the map, not a fixed number of texels: the
+    contact scene's far penumbra is as wide with a 4096 map as with 1024, and as wide as
+    Cycles' 0.309 (with a 32-texel cap, as the maps were cropped to their casters: 0.130 at
+    1024 and 0.085 at 4096, measured)."""
+    _, ref_far = contact_widths(reference("contact"))
+    widths = []
+    for size in (1024, 4096):
+        scene = kit.build("contact", WIDTH, HEIGHT)
+        vis = kit.measure_visibility(scene, "PENUMBRA", shadow_filter="PCSS", shadow_map_size=size)
+        widths.append(contact_widths(vis)[1])
+    assert widths[1] == pytest.approx(widths[0], rel=0.15), widths
+    assert widths[1] == pytest.approx(ref_far, rel=0.3), (widths, ref_far)
