@@ -191,6 +191,22 @@ def hull_planes(corners):
     return np.array(rows, dtype=np.float64).reshape(-1, 4)
 
 
+def _classify(boxes, planes):
+    """For boxes (n, 8, 3): (wholly inside the convex region ``planes``, wholly outside one of
+    its planes), with a tolerance relative to the region's and each box's scale."""
+    s = np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) - planes[None, None, :, 3]
+    scale = max(1.0, float(np.abs(planes[:, 3]).max()))
+    tol = 1e-9 * np.maximum(scale, np.abs(boxes).max(axis=(1, 2)))[:, None, None]
+    return np.all(s <= tol, axis=(1, 2)), np.any(np.all(s > tol, axis=1), axis=1)
+
+
+def _cut(planes, points):
+    """The vertices of the bounding box of ``points`` cut by the convex region ``planes``."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    scale = max(1.0, float(np.abs(planes[:, 3]).max()), float(np.abs(points).max()))
+    return light_bins.polytope_vertices(np.concatenate([planes, light_bins.box_planes(lo, hi)]), 1e-6 * scale)
+
+
 def clipped_points(boxes, planes, per_box=False):
     """The part of each box (``boxes`` (N, 8, 3) corners; each taken as its world bounds) inside
     the convex region ``planes``: boxes wholly inside give their corners, boxes crossing it
@@ -200,18 +216,12 @@ def clipped_points(boxes, planes, per_box=False):
     seen = np.zeros(len(boxes), dtype=bool)
     parts = [np.zeros((0, 3))] * len(boxes)
     if len(boxes) and len(planes):
-        scale = max(1.0, float(np.abs(planes[:, 3]).max()))
-        s = np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) - planes[None, None, :, 3]
-        tol = 1e-9 * np.maximum(scale, np.abs(boxes).max(axis=(1, 2)))
-        inside = np.all(s <= tol[:, None, None], axis=(1, 2))
-        outside = np.any(np.all(s > tol[:, None, None], axis=1), axis=1)
+        inside, outside = _classify(boxes, planes)
         for i in np.nonzero(inside)[0]:
             parts[i] = boxes[i]
         seen |= inside
-        lo, hi = boxes.min(axis=1), boxes.max(axis=1)
         for i in np.nonzero(~inside & ~outside)[0]:
-            clipped = np.concatenate([planes, light_bins.box_planes(lo[i], hi[i])])
-            v = light_bins.polytope_vertices(clipped, 1e-6 * max(scale, float(np.abs(boxes[i]).max())))
+            v = _cut(planes, boxes[i])
             if len(v):
                 seen[i] = True
                 parts[i] = v
@@ -248,13 +258,10 @@ class Receivers:
 def visible_receivers(corners, view_proj):
     """``Receivers`` of the boxes ``corners`` (N, 8, 3) inside the camera's ``view_proj``."""
     boxes = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
-    planes = light_bins.frustum_planes(view_proj)
     if len(boxes) == 0:
         return Receivers(boxes, [])
-    s = np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) - planes[None, None, :, 3]
-    tol = 1e-9 * max(1.0, float(np.abs(planes[:, 3]).max()))
-    inside = np.all(s <= tol, axis=(1, 2))
-    outside = np.any(np.all(s > tol, axis=1), axis=1)
+    planes = light_bins.frustum_planes(view_proj)
+    inside, outside = _classify(boxes, planes)
     crossing = ~inside & ~outside
     return Receivers(boxes[inside], pieces_in(planes, boxes[crossing]) if crossing.any() else [])
 
@@ -272,24 +279,15 @@ def pieces_in(planes, boxes, pieces=()):
     the convex region ``planes``, as a list of point arrays."""
     out = []
     if len(boxes):
-        s = np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) - planes[None, None, :, 3]
-        scale = 1e-9 * max(1.0, float(np.abs(planes[:, 3]).max()))
-        inside = np.all(s <= scale, axis=(1, 2))
-        outside = np.any(np.all(s > scale, axis=1), axis=1)
+        inside, outside = _classify(boxes, planes)
         if inside.any():
             out.append(boxes[inside].reshape(-1, 3))
-        pieces = list(pieces) + [b for b in boxes[~inside & ~outside]]
+        pieces = list(pieces) + list(boxes[~inside & ~outside])
     for p in pieces:
         s = p @ planes[:, :3].T - planes[:, 3]
         if np.any(np.all(s > 0.0, axis=0)):
             continue
-        if np.all(s <= 0.0):
-            out.append(p)
-            continue
-        lo, hi = p.min(axis=0), p.max(axis=0)
-        v = light_bins.polytope_vertices(
-            np.concatenate([planes, light_bins.box_planes(lo, hi)]), 1e-6 * max(1.0, float(np.abs(p).max()))
-        )
+        v = p if np.all(s <= 0.0) else _cut(planes, p)
         if len(v):
             out.append(v)
     return out

@@ -150,6 +150,7 @@ class Renderer:
         self._emission = self._fb_emit = self._emission_targets = None
         self._emission_on = False
         self._depth_range = _UNSET  # the frame's visible depth range, once computed
+        self._receivers = None  # and what the camera sees (lightspace.visible_receivers)
 
     # --- the frame ------------------------------------------------------------------------
 
@@ -324,9 +325,10 @@ class Renderer:
         view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
         size = max(1, int(settings.shadow_map_size)) if map_size is None else map_size
         if self._depth_range is _UNSET:
-            # The visible depth range depends only on the unjittered camera and the instances'
-            # bounds: once per frame, not per sample.
+            # The visible depth range and the visible receivers depend only on the unjittered
+            # camera and the instances' bounds: once per frame, not per sample.
             self._depth_range = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
+            self._receivers = lightspace.visible_receivers(corners, camera.projection @ camera.view)
         return plan_shadows(
             lights,
             corners,
@@ -337,6 +339,7 @@ class Renderer:
             self._depth_range,
             kernel=_fixed_kernel(settings),
             pcss=settings.shadow_filter == "PCSS",
+            receivers=self._receivers,
         )
 
     def _shadow_pass(self, draws, lights, camera, settings, stats, alpha_offset=0.5):

@@ -213,7 +213,16 @@ class Caster:
 
 
 def plan_shadows(
-    lights, corners, map_size, view_corners=None, camera=None, cascades=0, depth_range=None, kernel=2.0, pcss=False
+    lights,
+    corners,
+    map_size,
+    view_corners=None,
+    camera=None,
+    cascades=0,
+    depth_range=None,
+    kernel=2.0,
+    pcss=False,
+    receivers=None,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -222,15 +231,18 @@ def plan_shadows(
     ``lightspace.cascade_count``), each fitted to its slice; ``depth_range``: the camera's
     visible (near, far), when the caller already has it. ``kernel``: the radius (texels) of
     the scene's fixed shadow filter; ``pcss``: the scene's filter is PCSS (lights sampled
-    over their extent always are); maps are widened by what their filter reads. Returns a ShadowPlan; tiles beyond
-    MAX_SHADOW_TILES are not planned (``plan.unshadowed`` counts those lights, which render unshadowed)."""
+    over their extent always are); maps are widened by what their filter reads.
+    ``receivers``: ``lightspace.visible_receivers`` of the camera, when the caller has them.
+    Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
+    counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
     corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(corners) == 0:
         return plan
     slices = _cascade_slices(corners, view_corners, camera, cascades, depth_range)
     # What the camera sees, once for every spot, point and area map of the frame.
-    receivers = None if camera is None else lightspace.visible_receivers(corners, camera.projection @ camera.view)
+    if receivers is None and camera is not None:
+        receivers = lightspace.visible_receivers(corners, camera.projection @ camera.view)
     lo = corners.min(axis=1)
     hi = corners.max(axis=1)
     everything = np.arange(len(corners))

@@ -189,13 +189,16 @@ def test_every_depth_format_holds_under_a_huge_ground(penumbra, depth_format, gr
 
 
 def test_visible_depth_range_is_computed_once_per_frame(penumbra, gpu_call, monkeypatch):
-    """It depends only on the unjittered camera and the instances' bounds: a frame of 4
-    samples (a soft sun, refitted every sample) computes it once, not per sample."""
+    """It and the visible receivers depend only on the unjittered camera and the instances'
+    bounds: a frame of 4 samples (a soft sun, refitted every sample) computes them once, not
+    per sample."""
     from penumbra.engine import lightspace
 
-    calls = []
+    calls, seen = [], []
     real = lightspace.view_depth_range
     monkeypatch.setattr(lightspace, "view_depth_range", lambda *a: calls.append(1) or real(*a))
+    real_seen = lightspace.visible_receivers
+    monkeypatch.setattr(lightspace, "visible_receivers", lambda *a: seen.append(1) or real_seen(*a))
     scene = small_box_scene(horizon=True)
     scene.objects["Sun"].data.angle = math.radians(5.0)
 
@@ -208,6 +211,7 @@ def test_visible_depth_range_is_computed_once_per_frame(penumbra, gpu_call, monk
 
     assert gpu_call(job) == (4, 1)
     assert len(calls) == 1
+    assert len(seen) == 1  # what the camera sees, shared by every light's crop in every sample
 
 
 def test_cascade_seams_blend_inside_the_overlap_both_maps_cover(penumbra):
