@@ -195,7 +195,7 @@ def _classify(boxes, planes):
     """For boxes (n, 8, 3): (wholly inside the convex region ``planes``, wholly outside one of
     its planes), with a tolerance relative to the region's and each box's scale."""
     s = np.einsum("nkj,pj->nkp", boxes, planes[:, :3]) - planes[None, None, :, 3]
-    scale = max(1.0, float(np.abs(planes[:, 3]).max()))
+    scale = max(float(np.abs(planes[:, 3]).max()), 1e-300)  # relative: a 0.1 mm scene as a 1 km one
     tol = 1e-9 * np.maximum(scale, np.abs(boxes).max(axis=(1, 2)))[:, None, None]
     return np.all(s <= tol, axis=(1, 2)), np.any(np.all(s > tol, axis=1), axis=1)
 
@@ -203,7 +203,7 @@ def _classify(boxes, planes):
 def _cut(planes, points):
     """The vertices of the bounding box of ``points`` cut by the convex region ``planes``."""
     lo, hi = points.min(axis=0), points.max(axis=0)
-    scale = max(1.0, float(np.abs(planes[:, 3]).max()), float(np.abs(points).max()))
+    scale = max(float(np.abs(planes[:, 3]).max()), float(np.abs(points).max()), 1e-300)
     return light_bins.polytope_vertices(np.concatenate([planes, light_bins.box_planes(lo, hi)]), 1e-6 * scale)
 
 

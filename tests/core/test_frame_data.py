@@ -213,3 +213,74 @@ def test_an_area_light_plans_no_map_for_the_face_behind_it():
     area_tilted = Light(type="AREA", color=np.ones(3), matrix=tilted, radius=0.0, size=1.0, size_x=1.0, size_y=1.0)
     assert shadows.behind_area_light(lightspace.CUBE_FORWARDS[1], area_tilted.direction)  # -X is behind
     assert not shadows.behind_area_light(lightspace.CUBE_FORWARDS[plus_z], area_tilted.direction)
+
+
+def _finite_plan(plan):
+    for t in plan.tiles:
+        for m in (t.fit.view, t.fit.proj):
+            assert np.all(np.isfinite(m))
+        assert t.fit.far > t.fit.near and np.isfinite(t.fit.far)
+        assert t.fit.texel > 0 or t.fit.texel_per_distance > 0
+
+
+@pytest.mark.parametrize(
+    "case",
+    [
+        "light_on_the_ground_plane",
+        "light_inside_the_caster",
+        "camera_inside_the_caster",
+        "nothing_in_view",
+        "tiny",
+        "huge",
+    ],
+)
+def test_cropped_plans_stay_finite_at_degenerate_and_extreme_inputs(case):
+    """The crops' maths (receivers cut to the view, flat-caster tests, off-centre windows) at
+    the inputs where a division or a projection could break: every planned map has finite
+    matrices and a positive depth range and texel, and each case plans what it should."""
+    ground = lightspace.box_corners(np.array([-50.0, -50.0, 0.0]), np.array([50.0, 50.0, 0.0]))
+    caster = lightspace.box_corners(np.array([-0.5, -0.5, 0.0]), np.array([0.5, 0.5, 1.0]))
+    scale, eye, target, light_at = 1.0, (0.0, -6.0, 3.0), (0.0, 1.0, -0.5), (1.0, 1.0, 4.0)
+    if case == "light_on_the_ground_plane":
+        light_at = (3.0, 0.0, 0.0)
+    elif case == "light_inside_the_caster":
+        light_at = (0.0, 0.0, 0.5)
+    elif case == "camera_inside_the_caster":
+        eye = (0.0, 0.0, 0.5)
+    elif case == "nothing_in_view":
+        target = (0.0, -1.0, 0.2)  # looking away, over the ground's far edge... at the sky
+        eye = (0.0, -60.0, 3.0)
+    elif case in ("tiny", "huge"):
+        scale = 1e-4 if case == "tiny" else 1e6
+
+    def plan_at(scale, pcss):
+        corners = np.stack([ground, caster]) * scale
+        view = lightspace.look_at(np.array(eye) * scale, target)
+        projection = lightspace.perspective(math.radians(50), 16 / 9, 0.1 * scale, 1000.0 * scale)
+        camera = Camera(view=view, projection=projection)
+        view_corners = lightspace.frustum_corners(camera.projection @ camera.view)
+        lights = [
+            _light("SUN", angle=math.radians(2)),
+            _light("SPOT", position=np.array(light_at) * scale, spot_size=math.radians(120)),
+            _light("POINT", position=np.array(light_at) * scale),
+            _light("AREA", position=np.array(light_at) * scale, size=1.0 * scale, size_x=scale, size_y=scale),
+        ]
+        for light in lights:
+            light.radius *= scale  # the light's size scales with the scene
+        return shadows.plan_shadows(lights, corners, 512, view_corners, camera, pcss=pcss)
+
+    for pcss in (False, True):
+        plan = plan_at(scale, pcss)
+        _finite_plan(plan)
+        if case == "nothing_in_view":
+            assert not plan.tiles  # nothing the camera sees can be shadowed
+        elif case in ("tiny", "huge"):
+            # Scale changes nothing but the sizes: the same maps, texels scaled with the scene
+            # (to within one 2^(1/4) step of the extent quantisation, whose grid is absolute).
+            unit = plan_at(1.0, pcss)
+            assert [(e.mode, e.tiles) for e in plan.lights.values()] == [
+                (e.mode, e.tiles) for e in unit.lights.values()
+            ]
+            for a, b in zip(plan.tiles, unit.tiles, strict=True):
+                assert a.fit.texel == pytest.approx(b.fit.texel * scale, rel=0.19)
+                assert a.fit.texel_per_distance == pytest.approx(b.fit.texel_per_distance, rel=0.19)
