@@ -272,22 +272,24 @@ def emission(width=SIZE, height=SIZE):
     return sphere_view(scene, mat, sun_strength=0.3)
 
 
-def emission_shader(width=SIZE, height=SIZE):
+def _shader_sphere(width, height, name, node_type, **inputs):
+    """The sphere with a material whose output is one ``node_type`` shader with ``inputs``."""
     scene = base(width, height)
-    mat, _, _ = node_material("EmissionShader")
-    node = replace_shader(mat, "ShaderNodeEmission")
-    node.inputs["Color"].default_value = (0.2, 0.6, 1.0, 1.0)
-    node.inputs["Strength"].default_value = 1.0
+    mat, _, _ = node_material(name)
+    node = replace_shader(mat, node_type)
+    for key, value in inputs.items():
+        node.inputs[key].default_value = value
     return sphere_view(scene, mat)
+
+
+def emission_shader(width=SIZE, height=SIZE):
+    return _shader_sphere(
+        width, height, "EmissionShader", "ShaderNodeEmission", Color=(0.2, 0.6, 1.0, 1.0), Strength=1.0
+    )
 
 
 def diffuse_bsdf(width=SIZE, height=SIZE):
-    scene = base(width, height)
-    mat, _, _ = node_material("Diffuse")
-    node = replace_shader(mat, "ShaderNodeBsdfDiffuse")
-    node.inputs["Color"].default_value = (0.2, 0.6, 0.3, 1.0)
-    node.inputs["Roughness"].default_value = 0.0
-    return sphere_view(scene, mat)
+    return _shader_sphere(width, height, "Diffuse", "ShaderNodeBsdfDiffuse", Color=(0.2, 0.6, 0.3, 1.0), Roughness=0.0)
 
 
 def rgb_node(width=SIZE, height=SIZE):
