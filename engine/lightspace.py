@@ -391,7 +391,7 @@ def _receivers_in_rect(parts, view, lo, hi):
     return np.concatenate(out) if out else np.zeros((0, 3))
 
 
-def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0):
+def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0, flat_free=None):
     """Tight sun fit (seed 002: a loose box wastes the map): the map covers only the receivers
     the camera can see that some caster can shadow, and every caster that can shadow them.
     ``corners``: (N, 8, 3) world box corners of all geometry; ``view_corners``: the 8 world
@@ -418,7 +418,8 @@ def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2
     lo, hi = rls.min(axis=0), rls.max(axis=0)
     ls = boxes @ view[:3, :3].T + view[:3, 3]
     blo, bhi = ls.min(axis=1), ls.max(axis=1)
-    can_cast = ~flat_casters_without_shadow(boxes, direction)
+    # ``flat_free``: the caller's flat_casters_without_shadow for this sun (one per sun, shared by its cascades).
+    can_cast = ~(flat_casters_without_shadow(boxes, direction) if flat_free is None else flat_free)
     # Casters: boxes whose footprint overlaps the receivers' rectangle, at any depth towards
     # the light and not wholly behind the receivers. The depth range stays the receivers':
     # casters nearer the light than its near plane are flattened onto it by the depth pass

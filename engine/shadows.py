@@ -255,15 +255,22 @@ def plan_shadows(
             # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
             angle = min(max(light.angle, 0.0), math.pi * 0.99)
             spread = math.tan(0.5 * angle) * light.penumbra_scale if soft else 0.0
+            sun_flat_free = (
+                None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
+            )
             if view_corners is None:
                 fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), map_size)
                 tiles = [Tile(fit, everything)] if fit is not None else []
             elif slices is None:
-                fitted = lightspace.fit_sun_to_view(light.direction, corners, view_corners, map_size, soft=spread)
+                fitted = lightspace.fit_sun_to_view(
+                    light.direction, corners, view_corners, map_size, soft=spread, flat_free=sun_flat_free
+                )
                 tiles = [Tile(*fitted)] if fitted is not None else []
             else:
                 fits = [
-                    lightspace.fit_sun_to_view(light.direction, corners, sc, map_size, soft=spread)
+                    lightspace.fit_sun_to_view(
+                        light.direction, corners, sc, map_size, soft=spread, flat_free=sun_flat_free
+                    )
                     for sc, _end in slices
                 ]
                 tiles = [Tile(*f) if f is not None else None for f in fits]
