@@ -76,19 +76,35 @@ def influence_planes(light):
     return _unit_planes(rows)
 
 
+_TRIPLES = {}
+
+
+def _triples(count):
+    """(t, 3) indices of every triple of ``count`` planes (cached per count)."""
+    got = _TRIPLES.get(count)
+    if got is None:
+        got = _TRIPLES[count] = np.array(list(itertools.combinations(range(count), 3)), dtype=np.intp).reshape(-1, 3)
+    return got
+
+
 def polytope_vertices(planes, tolerance):
-    """Vertices of {x : n . x <= d for every row}: every triple of planes intersected, the
-    points inside all of them kept. (k, 3); empty when the polytope is empty."""
-    triples = np.array(list(itertools.combinations(range(len(planes)), 3)))
+    """Vertices of {x : n . x <= d for every row}: every triple of planes intersected (Cramer's
+    rule, all triples at once), the points inside all of them kept. (k, 3); empty when the
+    polytope is empty."""
+    planes = np.asarray(planes, dtype=np.float64)
+    triples = _triples(len(planes))
     if len(triples) == 0:
         return np.zeros((0, 3))
-    a = planes[triples, :3]  # (t, 3, 3)
-    b = planes[triples, 3]  # (t, 3)
-    det = np.linalg.det(a)
+    normals = planes[:, :3]
+    pairs = np.cross(normals[:, None], normals[None, :])  # (p, p, 3): every pair's cross product
+    i, j, k = triples.T
+    c12, c20, c01 = pairs[j, k], pairs[k, i], pairs[i, j]
+    d = planes[triples, 3]  # (t, 3)
+    det = np.einsum("ij,ij->i", normals[i], c12)
     ok = np.abs(det) > 1e-9
     if not ok.any():
         return np.zeros((0, 3))
-    x = np.linalg.solve(a[ok], b[ok][..., None])[..., 0]
+    x = (d[ok, 0, None] * c12[ok] + d[ok, 1, None] * c20[ok] + d[ok, 2, None] * c01[ok]) / det[ok, None]
     inside = np.all(x @ planes[:, :3].T - planes[:, 3] <= tolerance, axis=1)
     return x[inside]
 

@@ -343,6 +343,17 @@ def flat_casters_without_shadow(boxes, direction=None, position=None):
 MAX_EXACT_CROPS = 32  # receivers cut exactly to a sun map's rectangle (the largest first)
 
 
+def pixel_footprint(projection, is_ortho, width, height):
+    """(per_depth, constant): a screen pixel at view depth z is ``per_depth * z + constant``
+    wide in the world (the finer of its two sides); (0, 0) for a degenerate projection."""
+    p = np.asarray(projection, dtype=np.float64)
+    sx, sy = abs(float(p[0, 0])) * max(int(width), 1), abs(float(p[1, 1])) * max(int(height), 1)
+    scale = max(sx, sy)
+    if not math.isfinite(scale) or scale <= 0.0:
+        return 0.0, 0.0
+    return (0.0, 2.0 / scale) if is_ortho else (2.0 / scale, 0.0)
+
+
 def max_filter_radius(map_size):
     """The widest disk kernel (texels) of a map of ``map_size``: a quarter of it, at least 32
     texels (``programs.max_filter_radius``, which the shaders read, is this). Maps are fitted

@@ -24,7 +24,7 @@ from .programs import (
     SHADOW_SAMPLER,
     lit_program,
 )
-from .shadows import ShadowAtlas, plan_shadows
+from .shadows import Density, ShadowAtlas, plan_shadows
 from .textures import TextureCache
 
 _UNSET = object()
@@ -38,6 +38,7 @@ class FrameStats:
 
     shadow_maps: int = 0  # maps drawn this frame
     shadow_maps_reused: int = 0  # maps whose fit and casters did not change: not redrawn
+    shadow_texels: int = 0  # texels of the maps drawn (each its size squared: the depth pass's fill)
     passes: int = 0
     post_passes: int = 0
     draws: int = 0
@@ -340,7 +341,17 @@ class Renderer:
             kernel=_fixed_kernel(settings),
             pcss=settings.shadow_filter == "PCSS",
             receivers=self._receivers,
+            density=self._density(camera, settings),
         )
+
+    def _density(self, camera, settings):
+        """How finely this frame's camera sees (``shadows.Density``), or None when maps keep
+        their full size (Texels per Pixel 0)."""
+        per_pixel = float(settings.shadow_texels_per_pixel)
+        if not per_pixel > 0.0 or self._size is None:
+            return None
+        per_depth, constant = lightspace.pixel_footprint(camera.projection, camera.is_ortho, *self._size)
+        return Density(np.asarray(camera.view, dtype=np.float64), per_depth, constant, per_pixel)
 
     def _shadow_pass(self, draws, lights, camera, settings, stats, alpha_offset=0.5):
         """Plan the maps this frame needs (numpy) and draw the ones whose content changed."""
@@ -350,7 +361,7 @@ class Renderer:
             return plan
         columns, _rows = self.shadows.grid(len(plan.tiles))
         clamped = min(map_size, _gpu_texture_limit() // columns)
-        if clamped != map_size:
+        if max(t.size for t in plan.tiles) > clamped:
             stats.messages.append(
                 f"Penumbra: shadow map size {map_size} clamped to {clamped}: {len(plan.tiles)} maps share this "
                 "GPU's largest texture"
@@ -361,7 +372,8 @@ class Renderer:
             stats.messages.append(
                 f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
             )
-        self.shadows.ensure(map_size, len(plan.tiles), settings.shadow_depth_format)
+        # Every tile's slot in the atlas is as wide as the largest map of the frame.
+        self.shadows.ensure(max(t.size for t in plan.tiles), len(plan.tiles), settings.shadow_depth_format)
         shadow_draws = [self._caster(d) for d in draws]
         self.shadows.render(plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats, alpha_offset)
         return plan
@@ -725,7 +737,9 @@ class Renderer:
 
 def _front_to_back(draws, camera):
     """The draws nearest the camera first (by the nearest point of their bounds), so the
-    depth test rejects hidden pixels before they are shaded."""
+    depth test rejects hidden pixels before they are shaded; flat meshes (grounds, walls)
+    after the others: their nearest point is no measure of what they hide, and what stands
+    on them is usually in front of them."""
     if len(draws) < 2:
         return draws
     corners = np.stack([d.corners for d in draws])
@@ -736,7 +750,9 @@ def _front_to_back(draws, camera):
         position = camera.position
         key = np.linalg.norm(np.maximum(0.0, np.maximum(lo - position, position - hi)), axis=1)
     key = np.where(np.isfinite(key), key, np.inf)
-    return [draws[i] for i in np.argsort(key, kind="stable")]
+    extent = np.linalg.norm(corners - corners[:, :1], axis=2)  # edges and diagonals from one corner
+    flat = np.sort(extent, axis=1)[:, 1] <= lightspace.FLAT * extent.max(axis=1)
+    return [draws[i] for i in np.lexsort((key, flat))]
 
 
 def _fixed_kernel(settings):

@@ -169,6 +169,19 @@ SCENE_PARAMS = (
         soft_max=8192,
         section=SHADOWS,
     ),
+    Param(
+        "shadow_texels_per_pixel",
+        "FLOAT",
+        4.0,
+        "Each map gets the fewest texels (a power of two, at most the Shadow Map Size) that still "
+        "give every pixel it shadows this many texels across, times the radius of the PCF or "
+        "jittered-disk kernel: pixels that cannot show more detail cost no more fill. 0: every map "
+        "has the full size",
+        min=0.0,
+        soft_max=8.0,
+        label="Texels per Pixel",
+        section=SHADOWS,
+    ),
     Param("shadow_depth_format", "ENUM", "FLOAT32", "How shadow depth is stored", enum=DEPTH_FORMAT, section=SHADOWS),
     Param(
         "shadow_sun_fit",

@@ -33,6 +33,8 @@ from .programs import (
 class Tile:
     fit: lightspace.Fit
     casters: np.ndarray  # indices into the frame's draws that can cast into this tile
+    size: int = 0  # texels per side of this map (the lower-left square of its atlas slot)
+    held: object = None  # points of the visible receivers inside it, when planning found them
 
     def record(self):
         f = self.fit
@@ -43,6 +45,7 @@ class Tile:
             "far": f.far,
             "texel": f.texel,
             "texel_per_distance": f.texel_per_distance,
+            "size": self.size,
         }
 
 
@@ -72,8 +75,64 @@ def _near_bound(position, lo, hi, half_fov):
 CUBE_PAD_FRACTION = 1.0 / 16.0
 
 
+@dataclass(frozen=True)
+class Density:
+    """How finely the camera sees: a screen pixel at view depth z is ``per_depth * z +
+    constant`` wide in the world (``lightspace.pixel_footprint``); ``camera_view`` maps world
+    to view space; a map should give each pixel ``texels_per_pixel`` texels across."""
+
+    camera_view: np.ndarray
+    per_depth: float
+    constant: float
+    texels_per_pixel: float
+
+
+MIN_MAP_SIZE = 16  # the smallest map density sizing chooses
+
+
+def needed_size(tile, size, receivers, density, per_pixel):
+    """Texels per side that ``tile`` (planned with ``size``) needs for ``per_pixel`` texels
+    across every screen pixel of the visible receivers it holds: a power of two in
+    [MIN_MAP_SIZE, size], or ``size``. The finest need is at a vertex of what it holds (the
+    ratio of texel to pixel width is linear-fractional in the position)."""
+    fit = tile.fit
+    if per_pixel <= 0.0:
+        return size
+    if tile.held is not None:
+        points = tile.held
+    else:
+        held = lightspace.pieces_in(light_bins.frustum_planes(fit.view_proj), receivers.whole, receivers.pieces)
+        if not held:
+            return size
+        points = np.concatenate(held)
+    view = density.camera_view
+    z = np.maximum(-(points @ view[2, :3] + view[2, 3]), 0.0)
+    pixel = density.per_depth * z + density.constant
+    if fit.texel_per_distance > 0.0:
+        texel = fit.texel_per_distance * np.maximum(-(points @ fit.view[2, :3] + fit.view[2, 3]), 0.0)
+    else:
+        texel = np.full(len(points), fit.texel)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = float(np.max(texel / pixel)) * per_pixel
+    if not math.isfinite(ratio) or ratio >= 1.0:
+        return size
+    need = max(ratio * size, float(MIN_MAP_SIZE))
+    return min(size, 2 ** math.ceil(math.log2(need) - 1e-9))
+
+
 def perspective_tile(
-    position, forward, fov, corners, lo, hi, map_size, kernel=0.0, soft_radius=0.0, receivers=None, flat_free=None
+    position,
+    forward,
+    fov,
+    corners,
+    lo,
+    hi,
+    map_size,
+    kernel=0.0,
+    soft_radius=0.0,
+    receivers=None,
+    flat_free=None,
+    memo=None,
 ):
     """A perspective tile at ``position`` along ``forward``, or None without casters in it.
 
@@ -88,13 +147,26 @@ def perspective_tile(
     the window, in the light's view, of the visible receivers that some caster can shadow:
     the casters' window (``flat_free``: flat boxes that shadow nothing are not casters),
     widened by how far a penumbra reaches out of it, cut to the receivers' window. No
-    visible receiver in reach of a caster: no map."""
+    visible receiver in reach of a caster: no map.
+
+    ``memo`` (a dict kept for one light and frame) holds what does not depend on the map's
+    size, for planning the same light again at another size."""
+    memo = {} if memo is None else memo
+    face = np.asarray(forward, dtype=np.float64).tobytes()
     reach = float(np.linalg.norm(corners.reshape(-1, 3) - position, axis=1).max()) * 1.01
     if not np.isfinite(reach) or reach <= 0.0:
         return None
-    view = lightspace.look_at(position, forward)
+    if (face, "view") not in memo:
+        memo[face, "view"] = lightspace.look_at(position, forward)
+    view = memo[face, "view"]
 
     def fitted(fov):
+        key = (face, "fit", fov)
+        if key not in memo:
+            memo[key] = fitted_now(fov)
+        return memo[key]
+
+    def fitted_now(fov):
         probe = lightspace.perspective(fov, 1.0, reach * 1e-6, reach) @ view
         inside = np.nonzero(lightspace.boxes_in_frustum(probe, corners))[0]
         if len(inside) == 0:
@@ -121,12 +193,17 @@ def perspective_tile(
         pad = 0.0
     inside, near, far = got
     if receivers is not None:
-        crop = _crop(view, fov, near, far, size, corners, inside, receivers, flat_free, pad, soft_radius)
+        key = (face, "window", fov, near, far)
+        if key not in memo:
+            memo[key] = _window(view, fov, near, far, corners, inside, receivers, flat_free, soft_radius)
+        crop = _crop(view, fov, near, far, size, corners, receivers, pad, memo[key])
         if crop is _NOTHING:
             return None
         if crop is not None:
-            proj, per_distance, inside, far = crop
-            return Tile(lightspace.Fit(view, proj, near, far, texel_per_distance=per_distance), inside)
+            proj, per_distance, inside, far, held = crop
+            tile = Tile(lightspace.Fit(view, proj, near, far, texel_per_distance=per_distance), inside)
+            tile.held = held
+            return tile
     proj = lightspace.perspective(fov, 1.0, near, far)
     fit = lightspace.Fit(view, proj, near, far, texel_per_distance=2.0 * math.tan(fov / 2.0) / size)
     return Tile(fit, inside)
@@ -135,9 +212,10 @@ def perspective_tile(
 _NOTHING = object()  # _crop: no visible receiver in reach of a caster
 
 
-def _crop(view, fov, near, far, size, corners, inside, receivers, flat_free, pad, soft_radius):
-    """A perspective map cut to what it must hold (see ``perspective_tile``): (projection,
-    texel per distance, casters, far), None when cropping gains nothing, or _NOTHING."""
+def _window(view, fov, near, far, corners, inside, receivers, flat_free, soft_radius):
+    """The window (tangent units, lower and upper corner) of the visible receivers some caster
+    can shadow in a perspective map of ``fov`` and [near, far], with those casters; or
+    _NOTHING. Does not depend on the map's size."""
     half = math.tan(fov / 2.0)
     planes = light_bins.frustum_planes(lightspace.perspective(fov, 1.0, near, far) @ view)
     seen = lightspace.pieces_in(planes, receivers.whole, receivers.pieces)
@@ -157,6 +235,17 @@ def _crop(view, fov, near, far, size, corners, inside, receivers, flat_free, pad
     w_hi = np.minimum(np.minimum(r_hi, c_hi + spread), half)
     if np.any(w_hi < w_lo):
         return _NOTHING
+    return w_lo, w_hi, casters
+
+
+def _crop(view, fov, near, far, size, corners, receivers, pad, window):
+    """A perspective map cut to what it must hold (see ``perspective_tile``): (projection,
+    texel per distance, casters, far, the visible receivers' points it holds), None when
+    cropping gains nothing, or _NOTHING. ``window``: ``_window``'s answer."""
+    if window is _NOTHING:
+        return _NOTHING
+    w_lo, w_hi, casters = window
+    half = math.tan(fov / 2.0)
     # Square texels, the extent quantised in 2^(1/4) steps and the window snapped to whole
     # texels, so small camera moves do not move texel boundaries; ``pad`` texels each side.
     extent = max(float(np.max(w_hi - w_lo)), 2.0 * half * 1e-4)
@@ -183,11 +272,12 @@ def _crop(view, fov, near, far, size, corners, inside, receivers, flat_free, pad
     held = lightspace.pieces_in(light_bins.frustum_planes(proj @ view), receivers.whole, receivers.pieces)
     if not held:
         return _NOTHING
-    deepest = -float((np.concatenate(held) @ view[2, :3] + view[2, 3]).min())
+    held = np.concatenate(held)
+    deepest = -float((held @ view[2, :3] + view[2, 3]).min())
     if near < deepest * 1.01 < far:
         far = deepest * 1.01
         proj = lightspace.off_center_perspective(left, right, bottom, top, near, far)
-    return proj, texel, casters, far
+    return proj, texel, casters, far, held
 
 
 # A cube face's frustum reaches 54.74 degrees (its corners) from its axis; it lies wholly
@@ -223,6 +313,7 @@ def plan_shadows(
     kernel=2.0,
     pcss=False,
     receivers=None,
+    density=None,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -233,6 +324,10 @@ def plan_shadows(
     the scene's fixed shadow filter; ``pcss``: the scene's filter is PCSS (lights sampled
     over their extent always are); maps are widened by what their filter reads.
     ``receivers``: ``lightspace.visible_receivers`` of the camera, when the caller has them.
+    ``density`` (a ``Density``): each light's maps get the fewest texels (a power of two, at
+    most ``map_size``) that still give every visible receiver they hold that many texels per
+    screen pixel (times the fixed filter's radius: its blur stays within half a pixel); the
+    light is then planned again at that size. Tiles carry the size they were planned with.
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
@@ -247,36 +342,43 @@ def plan_shadows(
     hi = corners.max(axis=1)
     everything = np.arange(len(corners))
     dropped = 0
-    for i, light in enumerate(lights):
-        if not light.use_shadow:
-            continue
+
+    def flat_free_of(light):
+        """Flat boxes that shadow nothing under ``light`` (None: not tested)."""
+        if light.type != "SUN":
+            return lightspace.flat_casters_without_shadow(corners, position=light.position)
+        return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
+
+    full_size = map_size
+
+    def light_tiles(light, sizes, flat_free, memo):
+        """The tiles of ``light`` (per cascade or cube face: None where it needs no map) and
+        their mode; ``sizes[k]``: texels a side of the k-th one."""
         soft = light.sampled or pcss
         if light.type == "SUN":
             # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
             angle = min(max(light.angle, 0.0), math.pi * 0.99)
             spread = math.tan(0.5 * angle) * light.penumbra_scale if soft else 0.0
-            sun_flat_free = (
-                None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
-            )
+            sun_flat_free = flat_free
             if view_corners is None:
-                fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), map_size)
+                fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), sizes[0])
                 tiles = [Tile(fit, everything)] if fit is not None else []
             elif slices is None:
                 fitted = lightspace.fit_sun_to_view(
-                    light.direction, corners, view_corners, map_size, soft=spread, flat_free=sun_flat_free
+                    light.direction, corners, view_corners, sizes[0], soft=spread, flat_free=sun_flat_free
                 )
                 tiles = [Tile(*fitted)] if fitted is not None else []
             else:
                 fits = [
                     lightspace.fit_sun_to_view(
-                        light.direction, corners, sc, map_size, soft=spread, flat_free=sun_flat_free
+                        light.direction, corners, sc, sizes[k], soft=spread, flat_free=sun_flat_free
                     )
-                    for sc, _end in slices
+                    for k, (sc, _end) in enumerate(slices)
                 ]
                 tiles = [Tile(*f) if f is not None else None for f in fits]
             mode = "CASCADE" if view_corners is not None and slices is not None and len(slices) > 1 else "SINGLE"
         elif light.type == "SPOT":
-            fov = min(light.spot_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
+            fov = min(light.spot_size * 1.05 + 4.0 / max(full_size, 1), math.radians(170.0))
             tile = perspective_tile(
                 light.position,
                 light.direction,
@@ -284,14 +386,14 @@ def plan_shadows(
                 corners,
                 lo,
                 hi,
-                map_size,
+                sizes[0],
                 receivers=receivers,
-                flat_free=lightspace.flat_casters_without_shadow(corners, position=light.position),
+                flat_free=flat_free,
+                memo=memo,
             )
             tiles = [tile] if tile is not None else []
             mode = "SINGLE"
         else:  # POINT, AREA
-            flat_free = lightspace.flat_casters_without_shadow(corners, position=light.position)
             tiles = [
                 None
                 if light.type == "AREA" and behind_area_light(fwd, light.direction)
@@ -302,15 +404,37 @@ def plan_shadows(
                     corners,
                     lo,
                     hi,
-                    map_size,
+                    sizes[k],
                     kernel=1.0 if soft else kernel,
                     soft_radius=light.shadow_radius * light.penumbra_scale if soft else 0.0,
                     receivers=receivers,
                     flat_free=flat_free,
+                    memo=memo,
                 )
-                for fwd in lightspace.CUBE_FORWARDS
+                for k, fwd in enumerate(lightspace.CUBE_FORWARDS)
             ]
             mode = "CUBE"
+        for k, t in enumerate(tiles):
+            if t is not None:
+                t.size = sizes[k]
+        return tiles, mode
+
+    for i, light in enumerate(lights):
+        if not light.use_shadow:
+            continue
+        flat_free = flat_free_of(light)
+        memo = {}
+        tiles, mode = light_tiles(light, [map_size] * 6, flat_free, memo)
+        if density is not None and receivers is not None and any(t is not None for t in tiles):
+            # A map needs no more texels than the pixels it shadows can show (density): each
+            # map (cascade, cube face) of the light is planned again at the size it needs.
+            soft = light.sampled or pcss
+            per_pixel = density.texels_per_pixel * (1.0 if soft else max(1.0, kernel - 1.0))
+            sizes = [map_size if t is None else needed_size(t, map_size, receivers, density, per_pixel) for t in tiles]
+            if min(sizes, default=map_size) < map_size:
+                smaller, smaller_mode = light_tiles(light, sizes, flat_free, memo)
+                if [t is None for t in smaller] == [t is None for t in tiles]:
+                    tiles, mode = smaller, smaller_mode
         if not any(t is not None for t in tiles):
             continue  # no caster in reach: no map at all
         needed = sum(t is not None for t in tiles)
@@ -465,12 +589,14 @@ class ShadowAtlas:
         shader = shaders.get(shadow_program(self.depth_format), depth_defines(self.depth_format))
         defines = depth_defines(self.depth_format)
         cutout = {t: shaders.get(shadow_cutout_program(self.depth_format, t), defines) for t in (False, True)}
+        work = []
         for index, tile in enumerate(plan.tiles):
             casters = [draws[c] for c in tile.casters if draws[c] is not None]
             key = (
                 tile.fit.view_proj.tobytes(),
                 tile.fit.near,
                 tile.fit.far,
+                tile.size,
                 cull_front,
                 tuple(c.identity for c in casters),
                 # Alpha casters cover other texels in each sample: such a map is redrawn per sample.
@@ -479,17 +605,28 @@ class ShadowAtlas:
             if self._contents[index] == key:
                 stats.shadow_maps_reused += 1
                 continue
+            work.append((index, tile, casters, key))
+        # Every map redrawn (a final render's frame) and filling most of the atlas: one clear of
+        # the whole atlas, not one scissored clear per map (which GL may draw as a quad).
+        used = sum(min(t.size or self.size, self.size) ** 2 for _i, t, _c, _k in work)
+        cleared = depth_only and len(work) == len(plan.tiles) and 2 * used >= self.count * self.size**2
+        if cleared:
+            with self._framebuffer.bind():
+                self._framebuffer.clear(depth=1.0)
+        for index, tile, casters, key in work:
             x0, y0 = (index % self.columns) * self.size, (index // self.columns) * self.size
+            n = min(tile.size or self.size, self.size)  # the map fills the lower-left n x n of its slot
             target = self._framebuffer if depth_only else self._scratch[2]
             with target.bind():
                 if depth_only:
-                    gpu.state.viewport_set(x0, y0, self.size, self.size)
-                    gpu.state.scissor_set(x0, y0, self.size, self.size)
-                    gpu.state.scissor_test_set(True)
-                    target.clear(depth=1.0)
-                    gpu.state.scissor_test_set(False)
+                    gpu.state.viewport_set(x0, y0, n, n)
+                    if not cleared:
+                        gpu.state.scissor_set(x0, y0, n, n)
+                        gpu.state.scissor_test_set(True)
+                        target.clear(depth=1.0)
+                        gpu.state.scissor_test_set(False)
                 else:
-                    gpu.state.viewport_set(0, 0, self.size, self.size)
+                    gpu.state.viewport_set(0, 0, n, n)
                     target.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
                 gpu.state.depth_test_set("LESS")
                 gpu.state.depth_mask_set(True)
@@ -522,13 +659,14 @@ class ShadowAtlas:
                 gpu.state.depth_test_set("NONE")
                 gpu.state.depth_mask_set(False)
             if not depth_only:
-                self._copy_scratch(x0, y0, shaders)
+                self._copy_scratch(x0, y0, n, shaders)
                 stats.passes += 1
             self._contents[index] = key
             stats.passes += 1
             stats.shadow_maps += 1
+            stats.shadow_texels += n * n
 
-    def _copy_scratch(self, x0, y0, shaders):
+    def _copy_scratch(self, x0, y0, n, shaders):
         import gpu
         from gpu_extras.batch import batch_for_shader
 
@@ -536,7 +674,7 @@ class ShadowAtlas:
         if self._copy_batch is None:
             self._copy_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
         with self._framebuffer.bind():
-            gpu.state.viewport_set(x0, y0, self.size, self.size)
+            gpu.state.viewport_set(x0, y0, n, n)
             shader.bind()
             shader.uniform_int("origin", (x0, y0))
             shader.uniform_float("scale", 1.0)

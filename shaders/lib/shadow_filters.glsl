@@ -3,9 +3,10 @@
 
 /* Shadow visibility of world point P for light L (1 = lit, 0 = shadowed).
  *
- * Every map is a square tile of shadow_atlas (frame.tile_size texels wide, frame.atlas_columns
- * tiles to a row) described by shadow_tiles[i]: its light view, its projection to texture
- * space and its linear depth range. Stored depth is the distance along the light's view axis,
+ * Every map is a square tile of shadow_atlas (in a slot frame.tile_size texels wide,
+ * frame.atlas_columns slots to a row; the map fills the lower-left shadow_tiles[i].size texels
+ * of it) described by shadow_tiles[i]: its light view, its projection to texture space and its
+ * linear depth range. Stored depth is the distance along the light's view axis,
  * normalised to [near, far], so every light type compares and biases the same way.
  *
  * Bias is in texels of the map at the receiver, so one setting holds at every scene scale:
@@ -34,11 +35,14 @@ int cube_face(vec3 d)
   return d.z >= 0.0 ? 4 : 5;
 }
 
+/* Texels per side of the map being read (ShadowTile.size), set by shadow_visibility. */
+int tile_texels = 1;
+
 /* 1 when ref is in front of the stored depth at integer texel st of the tile. Texels outside
  * the tile are lit: nothing was fitted to cast there. */
 float shadow_tap(ivec2 origin, ivec2 st, float ref)
 {
-  int size = frame.tile_size;
+  int size = tile_texels;
   if (st.x < 0 || st.y < 0 || st.x >= size || st.y >= size) {
     return 1.0;
   }
@@ -48,7 +52,7 @@ float shadow_tap(ivec2 origin, ivec2 st, float ref)
 
 float shadow_depth_at(ivec2 origin, ivec2 st)
 {
-  int size = frame.tile_size;
+  int size = tile_texels;
   st = clamp(st, ivec2(0), ivec2(size - 1));
   return decode_depth(texelFetch(shadow_atlas, origin + st, 0));
 }
@@ -174,9 +178,10 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, const
   if (SHADOW_REF(0.0) >= 1.0) {
     return 1.0;
   }
-  int size = frame.tile_size;
+  int size = T.size;
+  tile_texels = size;
   int columns = frame.atlas_columns;
-  ivec2 origin = ivec2(tile % columns, tile / columns) * size;
+  ivec2 origin = ivec2(tile % columns, tile / columns) * frame.tile_size;
   vec2 st = uv * float(size);
 
   if (filter_id == FILTER_NONE) {
@@ -241,7 +246,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, const
    *    w = (d_r - d_b) * 2 tan(angle / 2); local light w = 2 r (d_r - d_b) / d_b.
    *    3. Disk PCF of that width: hard at contact, soft far from the caster, as in Cycles. */
   bool sun = L.type == LIGHT_SUN;
-  float max_r = frame.max_filter_radius;
+  float max_r = min(frame.max_filter_radius, max(32.0, 0.25 * float(size)));
   float search_world = sun ? (receiver - near) * 2.0 * L.sun_tan_half_angle :
                              2.0 * L.shadow_radius * (receiver - near) / max(receiver, 1e-30);
   float search = clamp(0.5 * search_world / texel, 1.0, max_r);

@@ -75,6 +75,7 @@ def test_huge_shadow_map_is_clamped_with_a_message(penumbra, capfd):
     scenes.plane(scene)
     scenes.box(scene, center=(0, 0, 1))
     scene.penumbra.shadow_map_size = 1_000_000  # above any GPU's maximum
+    scene.penumbra.shadow_texels_per_pixel = 0.0  # every map at that size (not what the pixels need)
     c = render(scene)["Combined"]
     assert np.all(np.isfinite(c))
     captured = capfd.readouterr()

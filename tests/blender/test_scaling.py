@@ -151,6 +151,7 @@ def test_shadow_atlas_memory_is_what_the_maps_hold(penumbra, gpu_call):
     RGBA8 maps add one tile-sized scratch target, not a second atlas-sized buffer."""
     scene = scenes.demo_scene(64, 36)  # a sun and a spot: two tiles in a 2x1 atlas
     scene.penumbra.shadow_map_size = 256
+    scene.penumbra.shadow_texels_per_pixel = 0.0  # both at the full size
     tile = 256 * 256
     expected = {"FLOAT32": 2 * tile * 4, "FLOAT16": 2 * tile * 2 + tile * (2 + 4), "RGBA8": 2 * tile * 4 + tile * 8}
     for fmt, bytes_ in expected.items():
@@ -193,6 +194,28 @@ def test_a_light_that_reaches_nothing_visible_gets_no_map(penumbra, gpu_call):
     stats, _image = engine_frame(gpu_call, scene, 160, 90)
     assert stats.lights_out_of_view == 1  # the spot pointing at the sky
     assert stats.shadow_maps == 6  # five spots and the sun
+
+
+def test_maps_hold_the_texels_their_pixels_can_show(penumbra, gpu_call):
+    """Five spots and a sun at 160x90 with 2048 maps: sized to the screen (Texels per Pixel
+    4) the spots' maps are 256-512 texels wide (the sun's crop, 12 m wide, needs all 2048),
+    a fifth of the full-size maps' fill, and the image is the full-size maps'. At half the
+    resolution every map is half as wide."""
+    scene = _spot_scene()
+    scene.penumbra.shadow_map_size = 2048
+    scene.penumbra.shadow_texels_per_pixel = 0.0
+    full_stats, full = engine_frame(gpu_call, scene, 160, 90)
+    scene.penumbra.shadow_texels_per_pixel = 4.0
+    stats, sized = engine_frame(gpu_call, scene, 160, 90)
+    assert stats.shadow_maps == full_stats.shadow_maps == 6
+    assert full_stats.shadow_texels == 6 * 2048**2
+    assert stats.shadow_texels * 4 <= full_stats.shadow_texels
+    lum = lambda img: img[..., :3] @ np.array([0.2126, 0.7152, 0.0722])  # noqa: E731
+    assert np.abs(lum(sized) - lum(full)).mean() < 0.01 * lum(full).mean()
+    shadowed = lambda img: lum(img) < 0.5 * lum(full).mean()  # noqa: E731
+    assert (shadowed(sized) != shadowed(full)).sum() <= 0.01 * shadowed(full).sum() + 4
+    half_stats, _half = engine_frame(gpu_call, scene, 80, 45)
+    assert 4 * half_stats.shadow_texels == stats.shadow_texels
 
 
 def test_materials_are_read_once_and_again_only_after_they_change(penumbra):
