@@ -56,7 +56,8 @@ TILE_STRUCT = Struct(
         ("FLOAT", "far"),
         ("FLOAT", "texel"),  # world size of a texel (orthographic maps)
         ("FLOAT", "texel_per_distance"),  # world size of a texel per unit of distance (perspective)
-        ("INT", "size"),  # texels per side of this map: the lower-left square of its atlas slot
+        ("INT", "size"),  # texels per side of this map
+        ("IVEC2", "origin"),  # its lower-left texel in the atlas
     ),
 )
 
@@ -90,7 +91,7 @@ FRAME_STRUCT = Struct(
         ("FLOAT", "pcf_spacing"),  # texels between PCF taps
         ("FLOAT", "filter_radius"),  # JITTER radius, texels
         ("FLOAT", "max_filter_radius"),  # widest disk kernel, texels
-        ("INT", "tile_size"),  # texels per side of a shadow tile's slot in the atlas
+        ("INT", "tile_size"),  # texels per side of the atlas's slots (its widest map)
         ("INT", "atlas_columns"),  # tiles per atlas row
     ),
 )

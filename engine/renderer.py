@@ -372,8 +372,7 @@ class Renderer:
             stats.messages.append(
                 f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
             )
-        # Every tile's slot in the atlas is as wide as the largest map of the frame.
-        self.shadows.ensure(max(t.size for t in plan.tiles), len(plan.tiles), settings.shadow_depth_format)
+        self.shadows.place(plan, settings.shadow_depth_format)
         shadow_draws = [self._caster(d) for d in draws]
         self.shadows.render(plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats, alpha_offset)
         return plan

@@ -33,7 +33,8 @@ from .programs import (
 class Tile:
     fit: lightspace.Fit
     casters: np.ndarray  # indices into the frame's draws that can cast into this tile
-    size: int = 0  # texels per side of this map (the lower-left square of its atlas slot)
+    size: int = 0  # texels per side of this map
+    origin: tuple = (0, 0)  # its lower-left texel in the atlas (ShadowAtlas.place)
     held: object = None  # points of the visible receivers inside it, when planning found them
 
     def record(self):
@@ -46,6 +47,7 @@ class Tile:
             "texel": f.texel,
             "texel_per_distance": f.texel_per_distance,
             "size": self.size,
+            "origin": self.origin,
         }
 
 
@@ -499,9 +501,38 @@ def cascade_blend(ends, depth_range=()):
     return tuple(out)
 
 
+def pack_tiles(sizes):
+    """Square maps of ``sizes`` texels a side packed into square slots as wide as the widest:
+    (slot width, slot count, per map (slot, x, y) of its lower-left texel in its slot). Widest
+    first; each map takes the smallest free cell it fits, and a cell twice as wide as the map
+    or more is split in four (a quadtree), so maps of power-of-two sizes leave no gaps."""
+    if not sizes:
+        return 0, 0, []
+    slot = max(int(n) for n in sizes)
+    free = []  # (width, slot, x, y)
+    count = 0
+    where = [None] * len(sizes)
+    for i in sorted(range(len(sizes)), key=lambda k: (-int(sizes[k]), k)):
+        n = int(sizes[i])
+        fits = [c for c in free if c[0] >= n]
+        if fits:
+            cell = min(fits)
+            free.remove(cell)
+        else:
+            cell = (slot, count, 0, 0)
+            count += 1
+        width, index, x, y = cell
+        while width // 2 >= n:
+            width //= 2
+            free += [(width, index, x + width, y), (width, index, x, y + width), (width, index, x + width, y + width)]
+        where[i] = (index, x, y)
+    return slot, count, where
+
+
 class ShadowAtlas:
-    """The atlas of one engine instance: square tiles in a grid ``columns`` wide. Tiles
-    remember what they hold so unchanged maps are reused.
+    """The atlas of one engine instance: square slots in a grid ``columns`` wide, as wide as
+    the frame's widest map; narrower maps share a slot (``pack_tiles``). Tiles remember what
+    they hold so unchanged maps are reused.
 
     Memory is what the maps hold and one tile more at most: a FLOAT32 atlas is a depth texture
     the depth pass writes directly (4 bytes a texel, nothing else); FLOAT16 and RGBA8 maps are
@@ -518,7 +549,7 @@ class ShadowAtlas:
         self._scratch = None  # (colour, depth, framebuffer) of one tile, non-FLOAT32 formats
         self._copy_batch = None
         self._ubos = []
-        self._contents = []
+        self._contents = {}  # tile index -> what its map holds
 
     @staticmethod
     def grid(count):
@@ -550,7 +581,7 @@ class ShadowAtlas:
             color = gpu.types.GPUTexture((size, size), format=fmt.texture)
             depth = gpu.types.GPUTexture((size, size), format="DEPTH_COMPONENT32F")
             self._scratch = (color, depth, gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=(color,)))
-        self._contents = [None] * self.count
+        self._contents = {}
 
     @property
     def memory_bytes(self):
@@ -566,9 +597,17 @@ class ShadowAtlas:
         self._copy_batch = None
         self.texture = None
         self._ubos = []
-        self._contents = []
+        self._contents = {}
         self.size = self.count = 0
         self.columns = 1
+
+    def place(self, plan, depth_format):
+        """Pack the plan's maps (``pack_tiles``), make the atlas hold them and set each tile's
+        ``origin``."""
+        slot, count, where = pack_tiles([t.size for t in plan.tiles])
+        self.ensure(slot, count, depth_format)
+        for tile, (index, x, y) in zip(plan.tiles, where, strict=True):
+            tile.origin = ((index % self.columns) * self.size + x, (index // self.columns) * self.size + y)
 
     def _tile_ubo(self, index, data):
         import gpu
@@ -597,25 +636,25 @@ class ShadowAtlas:
                 tile.fit.near,
                 tile.fit.far,
                 tile.size,
+                tile.origin,
                 cull_front,
                 tuple(c.identity for c in casters),
                 # Alpha casters cover other texels in each sample: such a map is redrawn per sample.
                 alpha_offset if any(c.cutouts for c in casters) else None,
             )
-            if self._contents[index] == key:
+            if self._contents.get(index) == key:
                 stats.shadow_maps_reused += 1
                 continue
             work.append((index, tile, casters, key))
         # Every map redrawn (a final render's frame) and filling most of the atlas: one clear of
         # the whole atlas, not one scissored clear per map (which GL may draw as a quad).
-        used = sum(min(t.size or self.size, self.size) ** 2 for _i, t, _c, _k in work)
+        used = sum(t.size**2 for _i, t, _c, _k in work)
         cleared = depth_only and len(work) == len(plan.tiles) and 2 * used >= self.count * self.size**2
         if cleared:
             with self._framebuffer.bind():
                 self._framebuffer.clear(depth=1.0)
         for index, tile, casters, key in work:
-            x0, y0 = (index % self.columns) * self.size, (index // self.columns) * self.size
-            n = min(tile.size or self.size, self.size)  # the map fills the lower-left n x n of its slot
+            (x0, y0), n = tile.origin, tile.size
             target = self._framebuffer if depth_only else self._scratch[2]
             with target.bind():
                 if depth_only:

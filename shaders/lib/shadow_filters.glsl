@@ -3,10 +3,9 @@
 
 /* Shadow visibility of world point P for light L (1 = lit, 0 = shadowed).
  *
- * Every map is a square tile of shadow_atlas (in a slot frame.tile_size texels wide,
- * frame.atlas_columns slots to a row; the map fills the lower-left shadow_tiles[i].size texels
- * of it) described by shadow_tiles[i]: its light view, its projection to texture space and its
- * linear depth range. Stored depth is the distance along the light's view axis,
+ * Every map is a square of shadow_atlas, shadow_tiles[i].size texels wide from texel
+ * shadow_tiles[i].origin, described by shadow_tiles[i]: its light view, its projection to
+ * texture space and its linear depth range. Stored depth is the distance along the light's view axis,
  * normalised to [near, far], so every light type compares and biases the same way.
  *
  * Bias is in texels of the map at the receiver, so one setting holds at every scene scale:
@@ -180,8 +179,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, const
   }
   int size = T.size;
   tile_texels = size;
-  int columns = frame.atlas_columns;
-  ivec2 origin = ivec2(tile % columns, tile / columns) * frame.tile_size;
+  ivec2 origin = T.origin;
   vec2 st = uv * float(size);
 
   if (filter_id == FILTER_NONE) {

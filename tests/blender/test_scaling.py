@@ -199,8 +199,9 @@ def test_a_light_that_reaches_nothing_visible_gets_no_map(penumbra, gpu_call):
 def test_maps_hold_the_texels_their_pixels_can_show(penumbra, gpu_call):
     """Five spots and a sun at 160x90 with 2048 maps: sized to the screen (Texels per Pixel
     4) the spots' maps are 256-512 texels wide (the sun's crop, 12 m wide, needs all 2048),
-    a fifth of the full-size maps' fill, and the image is the full-size maps'. At half the
-    resolution every map is half as wide."""
+    a fifth of the full-size maps' fill; the five share one atlas slot (a third of the
+    memory), and the image is the full-size maps'. At half the resolution every map is half
+    as wide."""
     scene = _spot_scene()
     scene.penumbra.shadow_map_size = 2048
     scene.penumbra.shadow_texels_per_pixel = 0.0
@@ -210,6 +211,7 @@ def test_maps_hold_the_texels_their_pixels_can_show(penumbra, gpu_call):
     assert stats.shadow_maps == full_stats.shadow_maps == 6
     assert full_stats.shadow_texels == 6 * 2048**2
     assert stats.shadow_texels * 4 <= full_stats.shadow_texels
+    assert stats.shadow_bytes * 3 <= full_stats.shadow_bytes  # the spots share one slot of the atlas
     lum = lambda img: img[..., :3] @ np.array([0.2126, 0.7152, 0.0722])  # noqa: E731
     assert np.abs(lum(sized) - lum(full)).mean() < 0.01 * lum(full).mean()
     shadowed = lambda img: lum(img) < 0.5 * lum(full).mean()  # noqa: E731

@@ -134,3 +134,24 @@ def test_a_camera_inside_a_receiver_keeps_the_full_size():
     assert plan.tiles
     assert [t.size for t in plan.tiles] == [1024] * len(plan.tiles)
 
+
+@pytest.mark.parametrize(
+    "sizes, slots",
+    [
+        ([2048, 512, 512, 256, 256, 512, 512], 2),  # the small maps share one slot
+        ([512] * 32, 32),
+        ([1024, 1024, 1024, 1024, 2048], 2),
+        ([777, 256, 256, 256, 256, 256], 3),  # no power of two: 4 cells of 388 a slot
+        ([16, 2048, 16, 64, 1024], 2),
+        ([1], 1),
+    ],
+)
+def test_packed_maps_never_overlap_and_share_slots(sizes, slots):
+    slot, count, where = shadows.pack_tiles(sizes)
+    assert slot == max(sizes) and count == slots
+    covered = {}
+    for n, (index, x, y) in zip(sizes, where, strict=True):
+        assert 0 <= index < count and 0 <= x and 0 <= y and x + n <= slot and y + n <= slot
+        covered.setdefault(index, np.zeros((slot, slot), int))[y : y + n, x : x + n] += 1
+    assert all(c.max() == 1 for c in covered.values())  # no texel holds two maps
+    assert shadows.pack_tiles([]) == (0, 0, [])

@@ -103,12 +103,14 @@ def log(message):
 
 
 def penumbra_configs(plan):
-    """``scene.penumbra`` settings of every Penumbra configuration of the sweep."""
+    """``scene.penumbra`` settings of every Penumbra configuration of the sweep. Maps have
+    exactly the swept size (Texels per Pixel 0), not the size the pixels need, so the sweep
+    measures what a map size buys."""
     configs = []
     for filt in FIXED_FILTERS + SAMPLED_FILTERS:
         for size in plan.map_sizes:
             for samples in plan.samples if filt in SAMPLED_FILTERS else (None,):
-                settings = {"shadow_filter": filt, "shadow_map_size": size}
+                settings = {"shadow_filter": filt, "shadow_map_size": size, "shadow_texels_per_pixel": 0.0}
                 if samples is not None:
                     settings["shadow_samples"] = samples
                 configs.append(settings)
