@@ -137,22 +137,24 @@ class PostContext:
     _pool: list = field(default_factory=list)
     _batch: object = None
 
-    def acquire(self, *busy):
-        """A float target of the frame's size whose texture is none of ``busy``."""
+    def acquire(self, *busy, size=None):
+        """A float target of the frame's size (or ``size``, (width, height)) whose texture is
+        none of ``busy``."""
         import gpu
 
+        size = (self.width, self.height) if size is None else (max(1, int(size[0])), max(1, int(size[1])))
         busy_ids = {id(t) for t in busy}
         for target in self._pool:
-            if id(target.texture) not in busy_ids:
+            if id(target.texture) not in busy_ids and (target.texture.width, target.texture.height) == size:
                 return target
-        tex = gpu.types.GPUTexture((self.width, self.height), format="RGBA32F")
+        tex = gpu.types.GPUTexture(size, format="RGBA32F")
         target = Target(tex, gpu.types.GPUFrameBuffer(color_slots=(tex,)))
         self._pool.append(target)
         return target
 
     @property
     def memory_bytes(self):
-        return len(self._pool) * self.width * self.height * 16
+        return sum(t.texture.width * t.texture.height * 16 for t in self._pool)
 
     def single_pass(self, program, src, mix, uniforms=None, samplers=None, blocks=None, defines=None):
         """The common one-pass layer: read ``src``, blend by ``mix``, write a fresh target."""
@@ -166,19 +168,21 @@ class PostContext:
         )
 
     def fullscreen(self, program, target, defines=None, samplers=None, uniforms=None, blocks=None):
-        """Draw one full-screen pass of ``program`` into ``target``."""
+        """Draw one full-screen pass of ``program`` into ``target`` (over all of it, whatever
+        its size)."""
         import gpu
         from gpu_extras.batch import batch_for_shader
 
         shader = self.shaders.get(program, defines)
         if self._batch is None:
             self._batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
+        width, height = target.texture.width, target.texture.height
         with target.framebuffer.bind():
-            gpu.state.viewport_set(0, 0, self.width, self.height)
+            gpu.state.viewport_set(0, 0, width, height)
             gpu.state.depth_test_set("NONE")
             gpu.state.blend_set("NONE")
             shader.bind()
-            set_uniforms(shader, {"target_size": (float(self.width), float(self.height)), **(uniforms or {})})
+            set_uniforms(shader, {"target_size": (float(width), float(height)), **(uniforms or {})})
             for name, tex in (samplers or {}).items():
                 shader.uniform_sampler(name, tex)
             for name, ubo in (blocks or {}).items():

@@ -125,3 +125,40 @@ def test_nan_and_inf_do_not_spread_through_glow(penumbra, gpu_call):
     # Non-finite components count as 0, in the source and in every blur tap.
     np.testing.assert_allclose(out, glow_reference(img, 1.0, 0.5, 1.0, 6), rtol=1e-5, atol=1e-5)
     assert out[0, 0, 0] == pytest.approx(2.0 + 1.0)  # far away: 2 + bright-pass (2 - 1)
+
+
+@pytest.mark.parametrize("shape", [(37, 53), (36, 52), (1, 1), (2, 7)])
+@pytest.mark.parametrize("radius", [0, 5, 16])
+def test_half_resolution_glow_matches_its_reference(penumbra, gpu_call, shape, radius):
+    """The half-size path (odd and even sizes, a single pixel) against its exact reference:
+    four passes, the same tolerance as the full-size path."""
+    from penumbra.engine.post.glow import glow_reference
+
+    img = hdr_image(*shape, radius + 1)
+    params = dict(threshold=1.2, knee=0.5, intensity=0.7, radius=radius, square_samples=radius == 5)
+    out, stats = run_layers(gpu_call, img, [layer("GLOW", half_resolution=True, **params)])
+    ref = glow_reference(img, 1.2, 0.5, 0.7, radius, radius == 5, half_resolution=True)
+    np.testing.assert_allclose(out, ref, rtol=1e-5, atol=1e-5)
+    np.testing.assert_array_equal(out[..., 3], img[..., 3])
+    assert stats.post_passes == 4
+
+
+def test_half_resolution_glow_is_close_to_the_exact_one_and_keeps_its_energy(penumbra, gpu_call):
+    """What half resolution trades: on scattered HDR highlights at the default radius 16 the
+    added light differs from the full-size glow's by at most 4 % of that glow's peak (measured
+    2.6 %), and its total is the same to 1 % (measured 1e-8: the highlights are far from the
+    edges, where both blurs are normalised)."""
+    from penumbra.engine.post.glow import glow_reference
+
+    rng = np.random.default_rng(7)
+    img = np.full((96, 128, 4), 0.2, np.float32)
+    img[..., 3] = 1.0
+    for y, x in rng.integers(24, (72, 104), size=(12, 2)):
+        img[y : y + 2, x : x + 3, :3] = rng.uniform(2.0, 20.0, 3)
+    params = dict(threshold=1.0, knee=0.5, intensity=0.6, radius=16)
+    half, _ = run_layers(gpu_call, img, [layer("GLOW", half_resolution=True, **params)])
+    full = glow_reference(img, 1.0, 0.5, 0.6, 16)
+    added_full = full[..., :3] - img[..., :3]
+    added_half = half[..., :3].astype(np.float64) - img[..., :3]
+    assert np.abs(added_half - added_full).max() <= 0.04 * added_full.max()
+    np.testing.assert_allclose(added_half.sum(axis=(0, 1)), added_full.sum(axis=(0, 1)), rtol=0.01)

@@ -83,6 +83,13 @@ def measure(runner, scene, w, h, runs, radii):
             stack.run(ctx, src, layer)
             passes = ctx.stats.post_passes - passes_before
             rows.append((eid, passes, timed(lambda: stack.run(ctx, src, layer))))
+        # GLOW's half-resolution path at the same (default) parameters.
+        half = SimpleNamespace(**{**vars(EFFECTS["GLOW"].defaults()), "half_resolution": True})
+        layer = [("GLOW", True, 1.0, half)]
+        passes_before = ctx.stats.post_passes
+        stack.run(ctx, src, layer)
+        passes = ctx.stats.post_passes - passes_before
+        rows.append(("GLOW, half resolution", passes, timed(lambda: stack.run(ctx, src, layer))))
         everything = [(eid, True, 1.0, cls.defaults()) for eid, cls in EFFECTS.items()]
         rows.append(("whole stack", None, timed(lambda: stack.run(ctx, src, everything))))
 
