@@ -427,9 +427,12 @@ def plan_shadows(
         flat_free = flat_free_of(light)
         memo = {}
         tiles, mode = light_tiles(light, [map_size] * 6, flat_free, memo)
-        if density is not None and receivers is not None and any(t is not None for t in tiles):
-            # A map needs no more texels than the pixels it shadows can show (density): each
-            # map (cascade, cube face) of the light is planned again at the size it needs.
+        # A map needs no more texels than the pixels it shadows can show (density): each map
+        # (cascade, cube face) of the light is planned again at the size it needs. A sun
+        # fitted to the whole scene (no view corners) keeps its size: it must not depend on
+        # the camera, so moving the view never redraws it.
+        camera_bound = light.type != "SUN" or view_corners is not None
+        if density is not None and receivers is not None and camera_bound and any(t is not None for t in tiles):
             soft = light.sampled or pcss
             per_pixel = density.texels_per_pixel * (1.0 if soft else max(1.0, kernel - 1.0))
             sizes = [map_size if t is None else needed_size(t, map_size, receivers, density, per_pixel) for t in tiles]

@@ -155,3 +155,17 @@ def test_packed_maps_never_overlap_and_share_slots(sizes, slots):
         covered.setdefault(index, np.zeros((slot, slot), int))[y : y + n, x : x + n] += 1
     assert all(c.max() == 1 for c in covered.values())  # no texel holds two maps
     assert shadows.pack_tiles([]) == (0, 0, [])
+
+
+def test_a_sun_fitted_to_the_whole_scene_keeps_its_size():
+    """Sun Fit 'SCENE' maps do not depend on the camera (never redrawn when the view moves):
+    no density sizing for them; a view-fitted sun in the same frame is sized."""
+    camera = _camera(8.0)
+    footprint = lightspace.pixel_footprint(camera.projection, False, 160, 90)
+    density = shadows.Density(camera.view, *footprint, 4.0)
+    corners = _corners()
+    receivers = lightspace.visible_receivers(corners, camera.projection @ camera.view)
+    scene_fit = shadows.plan_shadows([_light("SUN")], corners, 4096, None, camera, receivers=receivers, density=density)
+    view_fit = _plan(_light("SUN"), camera, 160, per_pixel=4.0, size=4096)
+    assert [t.size for t in scene_fit.tiles] == [4096]
+    assert view_fit.tiles[0].size < 4096
