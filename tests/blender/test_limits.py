@@ -37,12 +37,12 @@ def test_more_shadow_maps_than_the_atlas_holds_is_reported(penumbra, capfd):
     scenes.box(scene, "Ground", center=(0, 0, -0.5), size=(10.0, 10.0, 1.0))
     scenes.box(scene, center=(0, 0, 0.5))
     scenes.top_camera(scene, height=10.0, ortho_scale=10.0)
-    _grid_of_lights(scene, 16, 20.0, shadow=True)  # 16 point lights, several cube faces each: > 48 tiles
+    _grid_of_lights(scene, 32, 20.0, shadow=True)  # 32 point lights, several cube faces each: > 96 tiles
     scene.penumbra.shadow_map_size = 64
     c = render(scene)["Combined"]
     assert np.all(np.isfinite(c))
     captured = capfd.readouterr()
-    assert "left unshadowed: more than 48 shadow maps" in captured.out + captured.err
+    assert "left unshadowed: more than 96 shadow maps" in captured.out + captured.err
 
 
 def test_material_preview_falls_back_to_eevee_like_cycles(penumbra):

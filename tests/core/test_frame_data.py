@@ -284,3 +284,12 @@ def test_cropped_plans_stay_finite_at_degenerate_and_extreme_inputs(case):
             for a, b in zip(plan.tiles, unit.tiles, strict=True):
                 assert a.fit.texel == pytest.approx(b.fit.texel * scale, rel=0.19)
                 assert a.fit.texel_per_distance == pytest.approx(b.fit.texel_per_distance, rel=0.19)
+
+
+def test_every_uniform_block_fits_what_any_gl_allows():
+    """GL guarantees 16 KiB per uniform block (GL_MAX_UNIFORM_BLOCK_SIZE): the lights table and
+    the shadow-tile table, at their maximum counts, stay within it."""
+    for program in (programs.LIT, programs.SHADOW_DEPTH):
+        for struct, name, count in program.uniform_blocks:
+            assert struct.stride * max(count, 1) <= 16384, (program.name, name)
+    assert programs.MAX_SHADOW_TILES * programs.TILE_STRUCT.stride <= 16384
