@@ -537,10 +537,11 @@ class ShadowAtlas:
     the frame's widest map; narrower maps share a slot (``pack_tiles``). Tiles remember what
     they hold so unchanged maps are reused.
 
-    Memory is what the maps hold and one tile more at most: a FLOAT32 atlas is a depth texture
-    the depth pass writes directly (4 bytes a texel, nothing else); FLOAT16 and RGBA8 maps are
-    drawn in one tile-sized scratch target (colour and depth) and copied into a colour atlas
-    of their own format (2 or 4 bytes a texel)."""
+    Memory is the slots the packed maps take (maps of power-of-two sizes leave no gaps in a
+    slot) and one slot more at most: a FLOAT32 atlas is a depth texture the depth pass writes
+    directly (4 bytes a texel, nothing else); FLOAT16 and RGBA8 maps are drawn in one
+    slot-sized scratch target (colour and depth) and copied into a colour atlas of their own
+    format (2 or 4 bytes a texel)."""
 
     def __init__(self):
         self.size = 0
