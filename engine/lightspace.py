@@ -297,6 +297,13 @@ FLAT = 1e-6  # a box this thin relative to its longest edge is a flat (planar) m
 MAX_FLAT_TESTS = 16  # flat boxes tested for casting nothing (the largest: grounds and walls)
 
 
+def flat_boxes(boxes):
+    """(N,) bool: the boxes (N, 8, 3) one of whose edges is at most FLAT of their longest: the
+    bounds of a planar mesh (a ground, a wall, a card)."""
+    lengths = np.linalg.norm(boxes[:, [1, 2, 4]] - boxes[:, [0]], axis=2)  # the edges from corner 0
+    return lengths.min(axis=1) <= FLAT * lengths.max(axis=1)
+
+
 def flat_casters_without_shadow(boxes, direction=None, position=None):
     """(N,) bool: flat boxes (planar meshes: grounds, walls, cards) that cannot shadow anything
     under a sun shining along ``direction`` (or a light at ``position``), because no other box
@@ -317,7 +324,7 @@ def flat_casters_without_shadow(boxes, direction=None, position=None):
     a, b = edges[rows, (thin + 1) % 3], edges[rows, (thin + 2) % 3]
     normal = np.cross(a, b)
     area = np.linalg.norm(normal, axis=1)
-    flat = (lengths[rows, thin] <= FLAT * longest) & (area > 1e-12 * longest**2) & np.isfinite(area)
+    flat = flat_boxes(boxes) & (area > 1e-12 * longest**2) & np.isfinite(area)
     candidates = np.nonzero(flat)[0]
     candidates = candidates[np.argsort(-area[candidates])][:MAX_FLAT_TESTS]
     light = normalize(direction) if position is None else None

@@ -749,9 +749,7 @@ def _front_to_back(draws, camera):
         position = camera.position
         key = np.linalg.norm(np.maximum(0.0, np.maximum(lo - position, position - hi)), axis=1)
     key = np.where(np.isfinite(key), key, np.inf)
-    extent = np.linalg.norm(corners - corners[:, :1], axis=2)  # edges and diagonals from one corner
-    flat = np.sort(extent, axis=1)[:, 1] <= lightspace.FLAT * extent.max(axis=1)
-    return [draws[i] for i in np.lexsort((key, flat))]
+    return [draws[i] for i in np.lexsort((key, lightspace.flat_boxes(corners)))]
 
 
 def _fixed_kernel(settings):

@@ -351,8 +351,6 @@ def plan_shadows(
             return lightspace.flat_casters_without_shadow(corners, position=light.position)
         return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
 
-    full_size = map_size
-
     def light_tiles(light, sizes, flat_free, memo):
         """The tiles of ``light`` (per cascade or cube face: None where it needs no map) and
         their mode; ``sizes[k]``: texels a side of the k-th one."""
@@ -361,26 +359,23 @@ def plan_shadows(
             # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
             angle = min(max(light.angle, 0.0), math.pi * 0.99)
             spread = math.tan(0.5 * angle) * light.penumbra_scale if soft else 0.0
-            sun_flat_free = flat_free
             if view_corners is None:
                 fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), sizes[0])
                 tiles = [Tile(fit, everything)] if fit is not None else []
             elif slices is None:
                 fitted = lightspace.fit_sun_to_view(
-                    light.direction, corners, view_corners, sizes[0], soft=spread, flat_free=sun_flat_free
+                    light.direction, corners, view_corners, sizes[0], soft=spread, flat_free=flat_free
                 )
                 tiles = [Tile(*fitted)] if fitted is not None else []
             else:
                 fits = [
-                    lightspace.fit_sun_to_view(
-                        light.direction, corners, sc, sizes[k], soft=spread, flat_free=sun_flat_free
-                    )
+                    lightspace.fit_sun_to_view(light.direction, corners, sc, sizes[k], soft=spread, flat_free=flat_free)
                     for k, (sc, _end) in enumerate(slices)
                 ]
                 tiles = [Tile(*f) if f is not None else None for f in fits]
             mode = "CASCADE" if view_corners is not None and slices is not None and len(slices) > 1 else "SINGLE"
         elif light.type == "SPOT":
-            fov = min(light.spot_size * 1.05 + 4.0 / max(full_size, 1), math.radians(170.0))
+            fov = min(light.spot_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
             tile = perspective_tile(
                 light.position,
                 light.direction,

@@ -293,3 +293,21 @@ def test_every_uniform_block_fits_what_any_gl_allows():
         for struct, name, count in program.uniform_blocks:
             assert struct.stride * max(count, 1) <= 16384, (program.name, name)
     assert programs.MAX_SHADOW_TILES * programs.TILE_STRUCT.stride <= 16384
+
+
+def test_flat_meshes_are_drawn_after_what_stands_on_them():
+    """The lit pass draws nearest first so the depth test rejects hidden pixels before they are
+    shaded; a ground's nearest point (under the camera) says nothing of what it hides, so
+    flat boxes come after the others, each group nearest first."""
+    from penumbra.engine.renderer import _front_to_back
+
+    camera = _camera()  # at (0, -6, 3)
+    ground = lightspace.box_corners(np.array([-50.0, -50.0, 0.0]), np.array([50.0, 50.0, 0.0]))
+    wall = lightspace.box_corners(np.array([-5.0, 20.0, 0.0]), np.array([5.0, 20.0, 4.0]))
+    near = lightspace.box_corners(np.array([-0.5, -0.5, 0.0]), np.array([0.5, 0.5, 1.0]))
+    far = lightspace.box_corners(np.array([-0.5, 9.5, 0.0]), np.array([0.5, 10.5, 1.0]))
+    draws = [
+        SimpleNamespace(name=n, corners=c)
+        for n, c in (("ground", ground), ("far", far), ("wall", wall), ("near", near))
+    ]
+    assert [d.name for d in _front_to_back(draws, camera)] == ["near", "far", "ground", "wall"]
