@@ -169,3 +169,16 @@ def test_a_sun_fitted_to_the_whole_scene_keeps_its_size():
     view_fit = _plan(_light("SUN"), camera, 160, per_pixel=4.0, size=4096)
     assert [t.size for t in scene_fit.tiles] == [4096]
     assert view_fit.tiles[0].size < 4096
+
+
+def test_texels_per_pixel_at_its_extremes():
+    """A vanishing density asks for the smallest map; a huge one for the setting's size; both
+    plan the same maps (same lights, same faces) as full-size maps."""
+    camera = _camera(8.0)
+    for light in (_light("SUN"), _light("POINT")):
+        full = _plan(light, camera, 640, per_pixel=None, size=2048)
+        tiny = _plan(light, camera, 640, per_pixel=1e-9, size=2048)
+        huge = _plan(light, camera, 640, per_pixel=1e9, size=2048)
+        assert len(tiny.tiles) == len(huge.tiles) == len(full.tiles) > 0
+        assert {t.size for t in tiny.tiles} == {shadows.MIN_MAP_SIZE}
+        assert {t.size for t in huge.tiles} == {2048}

@@ -162,3 +162,17 @@ def test_half_resolution_glow_is_close_to_the_exact_one_and_keeps_its_energy(pen
     added_half = half[..., :3].astype(np.float64) - img[..., :3]
     assert np.abs(added_half - added_full).max() <= 0.04 * added_full.max()
     np.testing.assert_allclose(added_half.sum(axis=(0, 1)), added_full.sum(axis=(0, 1)), rtol=0.01)
+
+
+@pytest.mark.parametrize("shape", [(1, 300), (300, 1), (3, 5)])
+def test_half_resolution_glow_at_the_widest_radius(penumbra, gpu_call, shape):
+    """Radius 256 (the most) over images far smaller than the kernel, and one-pixel-wide
+    strips: the half-size path still matches its reference."""
+    from penumbra.engine.post.glow import glow_reference
+
+    img = hdr_image(*shape, 11)
+    params = dict(threshold=0.5, knee=1.0, intensity=40.0, radius=256)
+    out, _ = run_layers(gpu_call, img, [layer("GLOW", half_resolution=True, **params)])
+    np.testing.assert_allclose(
+        out, glow_reference(img, 0.5, 1.0, 40.0, 256, half_resolution=True), rtol=1e-5, atol=1e-4
+    )
