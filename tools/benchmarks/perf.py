@@ -9,6 +9,9 @@ so every Penumbra row pays for extraction, shadow maps and allocation, as a batc
 
 Sections (``--sections``, all by default):
   resolution  demo scene without post layers at 480x270, 960x540 and 1920x1080
+  passes      the demo scene at 960x540, F12, timed pass by pass (the GPU waited for with a
+              one-pixel read-back before and after each pass): the depth pass and the lit pass
+              with PCF 5x5, with a single-tap filter (NONE) and with shadows off
   viewport    the viewport path at 960x540 (demo scene with its post layers), one engine
               instance: display only, redraw with nothing changed, camera moving, scene edited
   lights      N shadowed spot lights over a field of boxes (N = 1, 8, 32, 64): F12, and the
@@ -36,7 +39,7 @@ import numpy as np
 from devkit import assets, engines, report, scenes, session
 
 HELP = "frame cost and scaling as ratios to Workbench (AA off, shadows on)"
-SECTIONS = ("resolution", "viewport", "lights", "objects", "instances", "triangles", "materials")
+SECTIONS = ("resolution", "passes", "viewport", "lights", "objects", "instances", "triangles", "materials")
 CSV_FIELDS = ["section", "case", "penumbra_ms", "workbench_ms", "ratio", "note", "runs", "blender"]
 
 
@@ -223,6 +226,75 @@ def section_resolution(plan):
     for w, h in plan["resolutions"]:
         scene = demo(w, h)
         rows.append(_row("resolution", f"{w}x{h}", paired(scene, plan["runs"]), runs=plan["runs"]))
+    return rows
+
+
+def section_passes(plan):
+    """The demo at 960x540 pass by pass: the shadow (depth) pass and the lit pass, each timed
+    to a one-pixel read-back of its targets before and after it (so each pass's GPU work is
+    its own), for PCF 5x5, a single tap (NONE) and shadows off, interleaved."""
+    from penumbra.engine import renderer as renderer_module
+
+    scene = demo(960, 540)
+    lights = [ob for ob in scene.objects if ob.type == "LIGHT"]
+    cases = {"PCF 5x5": ("PCF", True), "one tap (NONE)": ("NONE", True), "shadows off": ("PCF", False)}
+    times = {(case, part): [] for case in cases for part in ("depth pass", "lit pass")}
+    current = {}
+
+    def wait(renderer):
+        """Return once the GPU has finished what was drawn into the frame's targets."""
+        fb = renderer._fb or renderer._fb_color
+        if fb is not None:
+            with fb.bind():
+                fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+        atlas = renderer.shadows._framebuffer
+        if atlas is not None:
+            with atlas.bind():
+                if renderer.shadows.depth_format == "FLOAT32":
+                    atlas.read_depth(0, 0, 1, 1)
+                else:
+                    atlas.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+
+    def timed(method, part):
+        def run(self, *args, **kwargs):
+            wait(self)
+            start = time.perf_counter()
+            out = method(self, *args, **kwargs)
+            wait(self)
+            if "case" in current:
+                times[current["case"], part].append(time.perf_counter() - start)
+            return out
+
+        return run
+
+    def setup(case):
+        _penumbra(scene)
+        scene.penumbra.shadow_filter, shadowed = cases[case]
+        for ob in lights:
+            ob.data.use_shadow = shadowed
+
+    originals = {name: getattr(renderer_module.Renderer, name) for name in ("_shadow_pass", "_lit_pass")}
+    renderer_module.Renderer._shadow_pass = timed(originals["_shadow_pass"], "depth pass")
+    renderer_module.Renderer._lit_pass = timed(originals["_lit_pass"], "lit pass")
+    try:
+        for case in cases:  # warm-up
+            setup(case)
+            _render()
+        for _ in range(plan["runs"]):
+            for case in cases:
+                setup(case)
+                current["case"] = case
+                _render()
+                current.clear()
+    finally:
+        for name, method in originals.items():
+            setattr(renderer_module.Renderer, name, method)
+        for ob in lights:
+            ob.data.use_shadow = True
+    rows = []
+    for (case, part), values in times.items():
+        if values:
+            rows.append(_row("passes", f"{case}: {part}", {"PENUMBRA": statistics.median(values)}, runs=len(values)))
     return rows
 
 
