@@ -132,13 +132,7 @@ class Glow(PostEffect):
         if params.half_resolution:
             return self._half(ctx, src, params, mix)
         ubo = self._weights.get(params.radius)
-        uniforms = {
-            "threshold": params.threshold,
-            "knee": params.threshold * params.knee,  # in colour units
-            "intensity": params.intensity,
-            "square_samples": int(params.square_samples),
-            "radius": params.radius,
-        }
+        uniforms = self._uniforms(params, params.radius)
         tmp = ctx.acquire(src)
         ctx.fullscreen(
             PROGRAM,
@@ -158,18 +152,22 @@ class Glow(PostEffect):
             blocks={"weights": ubo},
         )
 
+    @staticmethod
+    def _uniforms(params, radius):
+        """The shader's parameters of both paths, for a blur of ``radius``."""
+        return {
+            "threshold": params.threshold,
+            "knee": params.threshold * params.knee,  # in colour units
+            "intensity": params.intensity,
+            "square_samples": int(params.square_samples),
+            "radius": radius,
+        }
+
     def _half(self, ctx, src, params, mix):
         """The half-resolution path: down, blur across, blur up, up (four passes)."""
         radius, sigma = half_radius(params.radius)
         ubo = self._weights.get(radius, sigma)
-        uniforms = {
-            "threshold": params.threshold,
-            "knee": params.threshold * params.knee,
-            "intensity": params.intensity,
-            "square_samples": int(params.square_samples),
-            "radius": radius,
-            "mix_factor": 1.0,
-        }
+        uniforms = {**self._uniforms(params, radius), "mix_factor": 1.0}
         half = ((src.width + 1) // 2, (src.height + 1) // 2)
         images = [src]
         for pass_id in ("DOWN", "BLUR_H", "BLUR_V"):
