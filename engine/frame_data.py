@@ -181,6 +181,7 @@ def build_frame_data(
             bins is not None,
             settings.pcf_spacing,
             sampled > 0,
+            (sampled, shadowed, len(lights)),
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

@@ -315,6 +315,11 @@ def depth_defines(depth_format):
     return {"DEPTH_FORMAT": DEPTH_FORMAT.define(depth_format)}
 
 
+# Scenes with at most this many lights (and no light bins) get a lit-pass variant with their
+# light counts compiled in (lit.frag.glsl writes out that many calls).
+UNROLLED_LIGHTS = 4
+
+
 def lit_defines(
     shadow_filter,
     pcf_weights,
@@ -326,6 +331,7 @@ def lit_defines(
     binned=False,
     pcf_spacing=1.0,
     sampled=False,
+    light_counts=None,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -333,8 +339,13 @@ def lit_defines(
     normal (a final render's passes); without them it writes colour only (the viewport).
     ``binned``: each pixel loops over the lights its screen bin lists (``light_bins``).
     PCF with taps one texel apart on a one-channel map reads 2x2 texels per fetch (gather).
-    ``sampled``: some lights move between samples and take the PCSS loop."""
+    ``sampled``: some lights move between samples and take the PCSS loop.
+    ``light_counts``: (sampled, with maps, all) when at most UNROLLED_LIGHTS lights and no
+    bins: the variant calls each light by its constant index, so its data is read at fixed
+    offsets instead of through a loop (about a tenth of the demo's lit pass on llvmpipe)."""
     filt = SHADOW_FILTER[shadow_filter]
+    unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
+    counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
     gather = bool(filt.pcf_taps and pcf_spacing == 1.0 and DEPTH_FORMAT[depth_format].channels == 1)
     weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
     return {
@@ -349,4 +360,8 @@ def lit_defines(
         "AUX_OUTPUTS": bool(aux_outputs),
         "LIGHT_BINS": bool(binned),
         "PCF_GATHER": gather,
+        "UNROLLED_LIGHTS": unrolled,
+        "SAMPLED_COUNT": counts[0],
+        "SHADOWED_COUNT": counts[1],
+        "LIGHT_COUNT": counts[2],
     }

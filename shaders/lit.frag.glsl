@@ -12,7 +12,8 @@
  * (frame.sampled_count, PCSS of their per-sample size), then the other lights with a shadow
  * map (up to frame.shadowed_count, the scene's filter), then lights without a map (no filter
  * code); a scene without lights runs no loop. With several
- * local lights, each pixel loops only over the lights its screen bin lists. */
+ * local lights, each pixel loops only over the lights its screen bin lists; with a few lights
+ * and no bins, the counts are compiled in and each light is called by its constant index. */
 
 struct Surface {
   vec3 P, N, V;
@@ -254,6 +255,26 @@ void main()
       add_light(w * LIGHT_WORD_BITS + b, NO_SHADOW, s, color, arriving, unshadowed);
     }
   }
+#elif UNROLLED_LIGHTS
+  /* The light counts are compiled in (programs.py UNROLLED_LIGHTS): one call per light, each
+   * reading its LightData at a constant offset; the counts fold each call to its filter. */
+#  define LIGHT_FILTER(k) \
+    ((k) < SAMPLED_COUNT ? FILTER_PCSS : (k) < SHADOWED_COUNT ? SHADOW_FILTER : NO_SHADOW)
+#  if LIGHT_COUNT > 0
+  add_light(0, LIGHT_FILTER(0), s, color, arriving, unshadowed);
+#  endif
+#  if LIGHT_COUNT > 1
+  add_light(1, LIGHT_FILTER(1), s, color, arriving, unshadowed);
+#  endif
+#  if LIGHT_COUNT > 2
+  add_light(2, LIGHT_FILTER(2), s, color, arriving, unshadowed);
+#  endif
+#  if LIGHT_COUNT > 3
+  add_light(3, LIGHT_FILTER(3), s, color, arriving, unshadowed);
+#  endif
+#  if LIGHT_COUNT > 4
+#    error "UNROLLED_LIGHTS is larger than the calls written out here"
+#  endif
 #else
 #  if SAMPLED_LIGHTS
   for (int i = 0; i < frame.sampled_count; i++) {

@@ -189,6 +189,38 @@ def test_binned_lighting_gives_the_image_of_every_light_on_every_pixel(penumbra,
     assert binned[..., :3].max() > 0.2  # the spots do light the ground
 
 
+def test_a_few_lights_are_called_by_constant_index_with_the_image_of_the_loop(penumbra, gpu_call, monkeypatch):
+    """Up to UNROLLED_LIGHTS lights (no bins): the lit variant has the light counts compiled in
+    and calls each light by its index. Sun and spot with maps (sampled over their extent in
+    four samples, PCSS), a point light without one: the image of the looping variant."""
+    from penumbra.engine import programs
+    from penumbra.engine.extract import camera_from_scene
+
+    scene = scenes.demo_scene(96, 54)
+    scene.penumbra.layers.clear()
+    point = scenes.light(scene, "Point", "POINT", 300.0, location=(2.0, -2.0, 3.0))
+    point.data.use_shadow = False
+
+    def frames(engine, depsgraph):
+        camera = camera_from_scene(depsgraph, scene, 96, 54)
+        one = engine.render_frame(depsgraph, camera, 96, 54).color_array().copy()
+        four = engine.render_frame(depsgraph, camera, 96, 54, samples=(0, 4), sample_count=4)
+        lit = [dict(defines) for name, defines in engine.renderer.shaders._cache if name.startswith("lit")]
+        return one, four.color_array().copy(), lit
+
+    one, four, lit = gpu_call(frames)
+    counts = {(d["SAMPLED_COUNT"], d["SHADOWED_COUNT"], d["LIGHT_COUNT"]) for d in lit}
+    assert lit and all(d["UNROLLED_LIGHTS"] for d in lit)
+    assert (0, 2, 3) in counts  # one sample: two lights with maps, one without
+    assert any(sampled > 0 for sampled, _mapped, _n in counts)  # four samples: the PCSS calls
+    monkeypatch.setattr(programs, "UNROLLED_LIGHTS", 0)
+    loop_one, loop_four, loop_lit = gpu_call(frames)
+    assert loop_lit and not any(d["UNROLLED_LIGHTS"] for d in loop_lit)
+    np.testing.assert_allclose(one, loop_one, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(four, loop_four, rtol=1e-5, atol=1e-6)
+    assert one[..., :3].max() > 0.2
+
+
 def test_a_light_that_reaches_nothing_visible_gets_no_map(penumbra, gpu_call):
     scene = _spot_scene()
     stats, _image = engine_frame(gpu_call, scene, 160, 90)
