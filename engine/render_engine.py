@@ -6,6 +6,7 @@ import traceback
 import bpy
 import numpy as np
 
+from . import gpu_pool
 from .extract import SceneCache, camera_from_scene, camera_from_view
 from .output import mist_pass, render_views, render_window, unsupported_in_use, view_distance_scale
 
@@ -25,6 +26,7 @@ class PenumbraEngineCore:
         super().__init__(*args, **kwargs)
         self.cache = SceneCache()
         self.renderer = None
+        self.texture_pool = None  # gpu_pool.TexturePool of final renders (set by render())
         self.last_stats = None
         self._reported = None
         self._shown = None  # (view key, FrameOutput) of the frame the viewport shows
@@ -32,6 +34,8 @@ class PenumbraEngineCore:
     def free_gpu(self):
         """Release this instance's GPU resources. Call it while the GPU context is active:
         freeing GPU objects later, from a destructor without a context, aborts Blender 4.5."""
+        if self.renderer is not None:
+            self.renderer.release()  # its textures go to the pool, if it has one
         self.renderer = None
         self._shown = None
         self.cache.clear()
@@ -56,7 +60,7 @@ class PenumbraEngineCore:
         from .renderer import Renderer
 
         if self.renderer is None:
-            self.renderer = Renderer()
+            self.renderer = Renderer(self.texture_pool)
         scene = depsgraph.scene
         snapshot = self.cache.snapshot(depsgraph)
         settings = scene.penumbra.render_settings(
@@ -183,6 +187,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         render. Each result is written whole or cancelled, never left half-written."""
         scene = depsgraph.scene
         layer = depsgraph.view_layer.name
+        self.texture_pool = gpu_pool.FINAL_RENDERS
         if scene.camera is None:
             self.report({"ERROR"}, f"Penumbra: scene '{scene.name}' has no active camera; set one in Scene Properties")
             return
@@ -340,3 +345,4 @@ def register():
 
 def unregister():
     bpy.utils.unregister_class(PenumbraRenderEngine)
+    gpu_pool.FINAL_RENDERS.clear()  # Blender unregisters add-ons on exit, before its GPU module

@@ -10,6 +10,7 @@ import numpy as np
 
 from . import kernels, light_bins, lightspace, sampling
 from .frame_data import build_frame_data, select_lights
+from .gpu_pool import new_texture
 from .materials import CHANNELS, EXTENSION, INTERPOLATION, Material
 from .post import post_stack
 from .post.base import PostContext
@@ -126,11 +127,14 @@ def texture_array(texture, channels):
 class Renderer:
     """GPU state of one engine instance. Create and use only inside a GPU context."""
 
-    def __init__(self):
+    def __init__(self, pool=None):
+        """``pool``: a ``gpu_pool.TexturePool`` the frame's targets and shadow atlas come from
+        (final renders); ``release`` gives them back."""
         from ..shaders.loader import ShaderCache
 
+        self.pool = pool
         self.shaders = ShaderCache()
-        self.shadows = ShadowAtlas()
+        self.shadows = ShadowAtlas(pool)
         self.post = post_stack()
         self._batches = {}  # (geometry key, serial) -> (whole, parts)
         self.textures = TextureCache()
@@ -550,28 +554,54 @@ class Renderer:
 
     # --- resources ------------------------------------------------------------------------
 
+    def release(self):
+        """Give the frame's targets and the shadow atlas back to the pool: at the end of a
+        final render, inside its GPU context. The renderer is not used again."""
+        if self.pool is None:
+            return
+        accum = self._emission_targets[0] if self._emission_targets is not None else None
+        self._fb = self._fb_color = self._fb_emit = self._accum_fb = self._resolve_fb = None
+        self._emission_targets = None
+        self.pool.give(
+            [
+                self._color,
+                self._zbuffer,
+                self._depth,
+                self._shadow,
+                self._normal,
+                self._emission,
+                self._accum_color,
+                self._accum_shadow,
+                accum,
+            ]
+        )
+        self._color = self._zbuffer = self._depth = self._shadow = self._normal = self._emission = None
+        self._accum_color = self._accum_shadow = None
+        self._size = None
+        self.shadows.free()
+
     def _ensure_targets(self, width, height, aux, emission=False):
         """The lit pass's targets at this size; the auxiliary ones (depth, shadow, normal) only
         once a frame asks for them, the Emission pass's likewise."""
         import gpu
 
         if self._size != (width, height):
-            self._color = gpu.types.GPUTexture((width, height), format="RGBA32F")
-            self._zbuffer = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
+            self._color = new_texture(self.pool, (width, height), "RGBA32F")
+            self._zbuffer = new_texture(self.pool, (width, height), "DEPTH_COMPONENT32F")
             self._fb_color = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self._color,))
             self._depth = self._shadow = self._normal = self._fb = None
             self._emission = self._fb_emit = self._emission_targets = None
             self._post_ctx = PostContext(self.shaders, width, height)
             self._size = (width, height)
         if aux and self._fb is None:
-            self._depth = gpu.types.GPUTexture((width, height), format="R32F")
-            self._shadow = gpu.types.GPUTexture((width, height), format="R32F")
-            self._normal = gpu.types.GPUTexture((width, height), format="RGBA16F")
+            self._depth = new_texture(self.pool, (width, height), "R32F")
+            self._shadow = new_texture(self.pool, (width, height), "R32F")
+            self._normal = new_texture(self.pool, (width, height), "RGBA16F")
             self._fb = gpu.types.GPUFrameBuffer(
                 depth_slot=self._zbuffer, color_slots=(self._color, self._depth, self._shadow, self._normal)
             )
         if emission and self._fb_emit is None:
-            self._emission = gpu.types.GPUTexture((width, height), format="RGBA32F")
+            self._emission = new_texture(self.pool, (width, height), "RGBA32F")
             self._fb_emit = gpu.types.GPUFrameBuffer(
                 depth_slot=self._zbuffer,
                 color_slots=(self._color, self._depth, self._shadow, self._normal, self._emission),
@@ -584,7 +614,7 @@ class Renderer:
 
         if self._emission_targets is None:
             width, height = self._size
-            accum = gpu.types.GPUTexture((width, height), format="RGBA32F")
+            accum = new_texture(self.pool, (width, height), "RGBA32F")
             self._emission_targets = (
                 accum,
                 gpu.types.GPUFrameBuffer(color_slots=(accum,)),
@@ -599,11 +629,11 @@ class Renderer:
 
         width, height = self._size
         if self._accum_color is None or (self._accum_color.width, self._accum_color.height) != (width, height):
-            self._accum_color = gpu.types.GPUTexture((width, height), format="RGBA32F")
+            self._accum_color = new_texture(self.pool, (width, height), "RGBA32F")
             self._accum_shadow = None
             self._accum_fb = gpu.types.GPUFrameBuffer(color_slots=(self._accum_color,))
         if aux and self._accum_shadow is None:
-            self._accum_shadow = gpu.types.GPUTexture((width, height), format="R32F")
+            self._accum_shadow = new_texture(self.pool, (width, height), "R32F")
             self._accum_fb = gpu.types.GPUFrameBuffer(color_slots=(self._accum_color, self._accum_shadow))
         self._centre = None
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from . import light_bins, lightspace
 from .enums import DEPTH_FORMAT
+from .gpu_pool import new_texture
 from .programs import (
     MAX_SHADOW_TILES,
     SCALED_COPY,
@@ -538,11 +539,12 @@ class ShadowAtlas:
     slot-sized scratch target (colour and depth) and copied into a colour atlas of their own
     format (2 or 4 bytes a texel)."""
 
-    def __init__(self):
+    def __init__(self, pool=None):
         self.size = 0
         self.count = 0
         self.columns = 1
         self.depth_format = "FLOAT32"
+        self._pool = pool  # a gpu_pool.TexturePool the atlas texture comes from and goes back to
         self.texture = None
         self._framebuffer = None
         self._scratch = None  # (colour, depth, framebuffer) of one tile, non-FLOAT32 formats
@@ -571,8 +573,9 @@ class ShadowAtlas:
         self.size, self.count, self.columns, self.depth_format = size, columns * rows, columns, depth_format
         dims = (columns * size, rows * size)
         fmt = DEPTH_FORMAT[depth_format]
-        # Read with texelFetch only, so the sampler's filter mode never matters.
-        self.texture = gpu.types.GPUTexture(dims, format=fmt.texture)
+        # Read with texelFetch only, so the sampler's filter mode never matters. A pooled
+        # texture holds another render's maps: every map is drawn before it is read.
+        self.texture = new_texture(self._pool, dims, fmt.texture)
         if fmt.depth_only:
             self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.texture)
         else:
@@ -591,9 +594,12 @@ class ShadowAtlas:
         return self.texture.width * self.texture.height * texel + scratch
 
     def free(self):
+        """Drop the GPU objects (inside a GPU context); the atlas texture goes to the pool."""
         self._framebuffer = None
         self._scratch = None
         self._copy_batch = None
+        if self._pool is not None:
+            self._pool.give([self.texture])
         self.texture = None
         self._ubos = []
         self._contents = {}
@@ -626,7 +632,10 @@ class ShadowAtlas:
         depth_only = DEPTH_FORMAT[self.depth_format].depth_only
         shader = shaders.get(shadow_program(self.depth_format), depth_defines(self.depth_format))
         defines = depth_defines(self.depth_format)
-        cutout = {t: shaders.get(shadow_cutout_program(self.depth_format, t), defines) for t in (False, True)}
+
+        def cutout(textured):  # compiled only when a caster has alpha
+            return shaders.get(shadow_cutout_program(self.depth_format, textured), defines)
+
         work = []
         for index, tile in enumerate(plan.tiles):
             casters = [draws[c] for c in tile.casters if draws[c] is not None]
@@ -682,7 +691,7 @@ class ShadowAtlas:
                 gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
                 for caster in casters:
                     for batch, material_ubo, texture in caster.cutouts:
-                        program = cutout[texture is not None]
+                        program = cutout(texture is not None)
                         program.bind()
                         program.uniform_block("tile", tile_ubo)
                         program.uniform_float("alpha_offset", alpha_offset)

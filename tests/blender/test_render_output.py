@@ -8,6 +8,7 @@ import subprocess
 import sys
 import textwrap
 
+import bpy
 import pytest
 
 from devkit.session import ROOT
@@ -275,3 +276,59 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
     for message in ("camera depth of field is not rendered", "motion blur is not rendered",
                     "the Diffuse Color pass is not written"):  # fmt: skip
         assert output.count(f"Penumbra: {message}") == 1, message
+
+
+def test_final_renders_take_their_textures_from_the_pool_and_draw_every_map_again():
+    """A second F12 takes the first one's targets and shadow atlas from the pool
+    (``engine/gpu_pool.py``) and gives the image of a render with an empty pool, though the
+    pooled atlas still holds the first render's maps (the removed ball's shadow among them).
+    Between renders the pool holds no more than its budget."""
+    result, _ = run_child(
+        """
+        from penumbra.engine import gpu_pool
+        pool = gpu_pool.FINAL_RENDERS
+        scene = demo(96, 64)
+        first = combined(scene, "first")
+        held, taken = len(pool), pool.taken
+        bpy.data.objects.remove(bpy.data.objects["Ball"])
+        second = combined(scene, "second")
+        taken = pool.taken - taken
+        pool.clear()
+        fresh = combined(scene, "fresh")
+        pool.budget = 96 * 64 * 16 * 2  # two RGBA32F targets' worth
+        combined(scene, "budget")
+        report(
+            held=held,
+            taken=taken,
+            same=float(np.abs(second - fresh).max()),
+            changed=float(np.abs(first - second).max()),
+            budget_held=pool.held_bytes,
+            budget=pool.budget,
+        )
+        """
+    )
+    assert result["held"] >= 3 and result["taken"] >= 3  # colour, z-buffer and atlas at least
+    assert result["same"] <= 1e-6
+    assert result["changed"] > 0.05  # the ball and its shadow are gone
+    assert 0 < result["budget_held"] <= result["budget"]
+
+
+@pytest.mark.skipif(bpy.app.version < (5, 0, 0), reason="bpy 4.5 as a module can hang in its own exit after GPU work")
+def test_pooled_textures_are_freed_before_blender_exits():
+    """Renders leave textures in the pool, and the interpreter still exits normally (no hard
+    exit): exit status 0, nothing reported unfreed."""
+    script = textwrap.dedent(PRELUDE) + textwrap.dedent(
+        """
+        scene = demo(48, 32)
+        combined(scene, "a")
+        combined(scene, "b")
+        from penumbra.engine import gpu_pool
+        print("POOLED", len(gpu_pool.FINAL_RENDERS))
+        """
+    )
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300, cwd=ROOT)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 0, out[-3000:]
+    pooled = int(next(ln for ln in proc.stdout.splitlines() if ln.startswith("POOLED ")).split()[1])
+    assert pooled >= 3
+    assert "Not freed memory blocks" not in out and "Traceback" not in out, out[-3000:]

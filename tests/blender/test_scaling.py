@@ -221,6 +221,27 @@ def test_a_few_lights_are_called_by_constant_index_with_the_image_of_the_loop(pe
     assert one[..., :3].max() > 0.2
 
 
+def test_a_frame_compiles_only_the_programs_it_draws_with(penumbra, gpu_call):
+    """Opaque casters and no post layer: one depth program and one lit variant, none of the
+    alpha cut-out depth programs; the next frame compiles nothing."""
+    from penumbra.engine.extract import camera_from_scene
+
+    scene = scenes.demo_scene(64, 36)
+    scene.penumbra.layers.clear()
+
+    def job(engine, depsgraph):
+        camera = camera_from_scene(depsgraph, scene, 64, 36)
+        first = engine.render_frame(depsgraph, camera, 64, 36).stats.shaders_compiled
+        names = sorted(name for name, _defines in engine.renderer.shaders._cache)
+        again = engine.render_frame(depsgraph, camera, 64, 36).stats.shaders_compiled
+        return first, names, again
+
+    first, names, again = gpu_call(job)
+    assert first == len(names) and again == 0
+    assert [n for n in names if n.startswith("shadow")] == ["shadow_depth_only"]
+    assert [n for n in names if n.startswith("lit")] == ["lit"]
+
+
 def test_a_light_that_reaches_nothing_visible_gets_no_map(penumbra, gpu_call):
     scene = _spot_scene()
     stats, _image = engine_frame(gpu_call, scene, 160, 90)
