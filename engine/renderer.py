@@ -578,6 +578,9 @@ class Renderer:
         self._color = self._zbuffer = self._depth = self._shadow = self._normal = self._emission = None
         self._accum_color = self._accum_shadow = None
         self._size = None
+        if self._post_ctx is not None:
+            self._post_ctx.release()
+            self._post_ctx = None
         self.shadows.free()
 
     def _ensure_targets(self, width, height, aux, emission=False):
@@ -591,7 +594,9 @@ class Renderer:
             self._fb_color = gpu.types.GPUFrameBuffer(depth_slot=self._zbuffer, color_slots=(self._color,))
             self._depth = self._shadow = self._normal = self._fb = None
             self._emission = self._fb_emit = self._emission_targets = None
-            self._post_ctx = PostContext(self.shaders, width, height)
+            if self._post_ctx is not None:
+                self._post_ctx.release()
+            self._post_ctx = PostContext(self.shaders, width, height, texture_pool=self.pool)
             self._size = (width, height)
         if aux and self._fb is None:
             self._depth = new_texture(self.pool, (width, height), "R32F")

@@ -8,6 +8,7 @@ import numpy as np
 
 from ...shaders.loader import Program, Struct, set_uniforms
 from .. import kernels
+from ..gpu_pool import new_texture
 from ..settings import scale_pixels, values
 
 # One layer of a frame's stack, as the renderer receives it (``params``: a namespace of the
@@ -134,6 +135,7 @@ class PostContext:
     frame: int = 0
     stats: object = None
     pixel_scale: float = 1.0  # sizes in pixels are scaled by this (the resolution %)
+    texture_pool: object = None  # gpu_pool.TexturePool the targets' textures come from (final renders)
     _pool: list = field(default_factory=list)
     _batch: object = None
 
@@ -147,7 +149,7 @@ class PostContext:
         for target in self._pool:
             if id(target.texture) not in busy_ids and (target.texture.width, target.texture.height) == size:
                 return target
-        tex = gpu.types.GPUTexture(size, format="RGBA32F")
+        tex = new_texture(self.texture_pool, size, "RGBA32F")
         target = Target(tex, gpu.types.GPUFrameBuffer(color_slots=(tex,)))
         self._pool.append(target)
         return target
@@ -155,6 +157,13 @@ class PostContext:
     @property
     def memory_bytes(self):
         return sum(t.texture.width * t.texture.height * 16 for t in self._pool)
+
+    def release(self):
+        """Give the targets' textures to ``texture_pool`` (inside the GPU context)."""
+        if self.texture_pool is not None:
+            textures = [t.texture for t in self._pool]
+            self._pool.clear()
+            self.texture_pool.give(textures)
 
     def single_pass(self, program, src, mix, uniforms=None, samplers=None, blocks=None, defines=None):
         """The common one-pass layer: read ``src``, blend by ``mix``, write a fresh target."""
