@@ -1,12 +1,14 @@
-"""Textures kept from one final render to the next.
+"""Textures and compiled programs kept from one final render to the next.
 
 Every F12 render, and every frame of an animation render, is a new engine instance. Without a
 pool each one allocates its targets and its shadow atlas anew, and on llvmpipe a new texture
 costs its zero-fill: about 17 ms for the 32 MiB atlas of the demo at 960x540 (two 2048 maps).
 Blender's own engines keep a texture pool across renders for the same reason.
 
-Only textures are kept. They are shared between GPU contexts, while framebuffers and batches
-belong to the context that made them and are made again by each render. A texture taken from
+Only textures and programs are kept (``final_shaders``: a variant compiles once a session, not
+once a render, about 7 ms a render for the demo). Both are shared between GPU contexts, while
+framebuffers and batches belong to the context that made them and are made again by each
+render. A texture taken from
 the pool holds the last render's pixels; the renderer clears or redraws all of it (its shadow
 maps start empty, so every map is drawn again).
 
@@ -81,4 +83,22 @@ def new_texture(pool, size, fmt):
 
 
 FINAL_RENDERS = TexturePool()  # the pool of F12 and animation renders (never the viewport's)
-atexit.register(FINAL_RENDERS.clear)
+_final_shaders = []  # the ShaderCache final renders share, made on first use
+
+
+def final_shaders():
+    """The ``ShaderCache`` every final render shares."""
+    if not _final_shaders:
+        from ..shaders.loader import ShaderCache
+
+        _final_shaders.append(ShaderCache())
+    return _final_shaders[0]
+
+
+def clear():
+    """Drop every pooled texture and program (on unregister, and at exit)."""
+    FINAL_RENDERS.clear()
+    _final_shaders.clear()
+
+
+atexit.register(clear)

@@ -60,7 +60,8 @@ class PenumbraEngineCore:
         from .renderer import Renderer
 
         if self.renderer is None:
-            self.renderer = Renderer(self.texture_pool)
+            shaders = gpu_pool.final_shaders() if self.texture_pool is not None else None
+            self.renderer = Renderer(self.texture_pool, shaders)
         scene = depsgraph.scene
         snapshot = self.cache.snapshot(depsgraph)
         settings = scene.penumbra.render_settings(
@@ -345,4 +346,4 @@ def register():
 
 def unregister():
     bpy.utils.unregister_class(PenumbraRenderEngine)
-    gpu_pool.FINAL_RENDERS.clear()  # Blender unregisters add-ons on exit, before its GPU module
+    gpu_pool.clear()  # Blender unregisters add-ons on exit, before its GPU module

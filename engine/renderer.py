@@ -127,13 +127,14 @@ def texture_array(texture, channels):
 class Renderer:
     """GPU state of one engine instance. Create and use only inside a GPU context."""
 
-    def __init__(self, pool=None):
+    def __init__(self, pool=None, shaders=None):
         """``pool``: a ``gpu_pool.TexturePool`` the frame's targets and shadow atlas come from
-        (final renders); ``release`` gives them back."""
+        (final renders); ``release`` gives them back. ``shaders``: a ``ShaderCache`` shared
+        with other renderers (final renders), else one of its own."""
         from ..shaders.loader import ShaderCache
 
         self.pool = pool
-        self.shaders = ShaderCache()
+        self.shaders = shaders if shaders is not None else ShaderCache()
         self.shadows = ShadowAtlas(pool)
         self.post = post_stack()
         self._batches = {}  # (geometry key, serial) -> (whole, parts)

@@ -149,7 +149,8 @@ def _format_define(value):
 
 
 class ShaderCache:
-    """Compiled variants, owned by one engine instance (GPU objects never live in globals)."""
+    """Compiled variants: of one engine instance (the viewport), or shared by final renders
+    (``engine/gpu_pool.py``)."""
 
     def __init__(self):
         self._cache = {}

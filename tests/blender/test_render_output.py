@@ -280,7 +280,7 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
 
 def test_final_renders_take_their_textures_from_the_pool_and_draw_every_map_again():
     """A second F12 takes the first one's targets and shadow atlas from the pool
-    (``engine/gpu_pool.py``) and gives the image of a render with an empty pool, though the
+    (``engine/gpu_pool.py``), compiles no program, and gives the image of a render with an empty pool, though the
     pooled atlas still holds the first render's maps (the removed ball's shadow among them).
     Between renders the pool holds no more than its budget."""
     result, _ = run_child(
@@ -290,9 +290,11 @@ def test_final_renders_take_their_textures_from_the_pool_and_draw_every_map_agai
         scene = demo(96, 64)
         first = combined(scene, "first")
         held, taken = len(pool), pool.taken
+        compiled = gpu_pool.final_shaders().compiled
         bpy.data.objects.remove(bpy.data.objects["Ball"])
         second = combined(scene, "second")
         taken = pool.taken - taken
+        compiled_again = gpu_pool.final_shaders().compiled - compiled
         pool.clear()
         fresh = combined(scene, "fresh")
         pool.budget = 96 * 64 * 16 * 2  # two RGBA32F targets' worth
@@ -300,6 +302,8 @@ def test_final_renders_take_their_textures_from_the_pool_and_draw_every_map_agai
         report(
             held=held,
             taken=taken,
+            compiled=compiled,
+            compiled_again=compiled_again,
             same=float(np.abs(second - fresh).max()),
             changed=float(np.abs(first - second).max()),
             budget_held=pool.held_bytes,
@@ -308,6 +312,7 @@ def test_final_renders_take_their_textures_from_the_pool_and_draw_every_map_agai
         """
     )
     assert result["held"] >= 5 and result["taken"] >= 5  # colour, z-buffer, atlas and two post targets at least
+    assert result["compiled"] >= 3 and result["compiled_again"] == 0  # each variant compiles once
     assert result["same"] <= 1e-6
     assert result["changed"] > 0.05  # the ball and its shadow are gone
     assert 0 < result["budget_held"] <= result["budget"]
