@@ -340,12 +340,17 @@ def lit_defines(
     ``binned``: each pixel loops over the lights its screen bin lists (``light_bins``).
     PCF with taps one texel apart on a one-channel map reads 2x2 texels per fetch (gather).
     ``sampled``: some lights move between samples and take the PCSS loop.
-    ``light_counts``: (sampled, with maps, all) when at most UNROLLED_LIGHTS lights and no
-    bins: the variant calls each light by its constant index, so its data is read at fixed
-    offsets instead of through a loop (about a tenth of the demo's lit pass on llvmpipe)."""
+    ``light_counts``: (sampled, with maps, all). With at most UNROLLED_LIGHTS lights and no
+    bins the variant calls each light by its constant index, so its data is read at fixed
+    offsets instead of through a loop (about a tenth of the demo's lit pass on llvmpipe);
+    otherwise a class of lights the frame has none of gets no loop (a loop's body costs one
+    masked pass on llvmpipe even when it runs zero times)."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
+    # Which classes of light the loops must walk (with a map but not sampled, without a map);
+    # unknown counts keep both loops.
+    sampled_n, shadowed_n, total_n = light_counts if light_counts is not None else (0, 1, 2)
     gather = bool(filt.pcf_taps and pcf_spacing == 1.0 and DEPTH_FORMAT[depth_format].channels == 1)
     weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
     return {
@@ -361,6 +366,8 @@ def lit_defines(
         "LIGHT_BINS": bool(binned),
         "PCF_GATHER": gather,
         "UNROLLED_LIGHTS": unrolled,
+        "HAS_SHADOWED": shadowed_n > sampled_n,
+        "HAS_UNSHADOWED": total_n > shadowed_n,
         "SAMPLED_COUNT": counts[0],
         "SHADOWED_COUNT": counts[1],
         "LIGHT_COUNT": counts[2],

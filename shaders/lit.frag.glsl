@@ -227,34 +227,35 @@ void main()
   float arriving = 0.0, unshadowed = 0.0;
 #if LIGHT_BINS
   /* Only the lights this pixel's screen bin lists (engine/light_bins.py): word w of the bin
-   * holds lights w * LIGHT_WORD_BITS + bit, as exact small integers in a float channel. */
-  vec4 words = texelFetch(light_bins, ivec2(gl_FragCoord.xy) / LIGHT_BIN_SIZE, 0);
-#  if SAMPLED_LIGHTS
-  for (int w = 0; w < LIGHT_WORDS; w++) {
-    uint bits = uint(words[w]) & uint(frame.sampled_mask[w]);
-    while (bits != 0u) {
-      int b = findLSB(bits);
-      bits &= bits - 1u;
-      add_light(w * LIGHT_WORD_BITS + b, FILTER_PCSS, s, color, arriving, unshadowed);
-    }
-  }
+   * holds lights w * LIGHT_WORD_BITS + bit, as exact small integers in a float channel.
+   * One loop per class of light (sampled, with a map, without) walks the set bits of all four
+   * words in order. On llvmpipe a loop's body runs at least once (masked) even when no pixel
+   * has work in it, so classes no light of the frame is in are not compiled (HAS_*), and the
+   * words share one loop rather than one loop each. */
+#  if LIGHT_WORDS != 4
+#    error "the bin loops below read four words"
 #  endif
-  for (int w = 0; w < LIGHT_WORDS; w++) {
-    uint bits = uint(words[w]) & uint(frame.shadowed_mask[w]) & ~uint(frame.sampled_mask[w]);
-    while (bits != 0u) {
-      int b = findLSB(bits);
-      bits &= bits - 1u;
-      add_light(w * LIGHT_WORD_BITS + b, SHADOW_FILTER, s, color, arriving, unshadowed);
+  uvec4 words = uvec4(texelFetch(light_bins, ivec2(gl_FragCoord.xy) / LIGHT_BIN_SIZE, 0));
+  uvec4 sampled_mask = uvec4(frame.sampled_mask), shadowed_mask = uvec4(frame.shadowed_mask);
+#  define BIN_LOOP(BITS, FILTER) \
+    { \
+      uvec4 bits = (BITS); \
+      while (any(notEqual(bits, uvec4(0u)))) { \
+        int w = (bits.x != 0u) ? 0 : (bits.y != 0u) ? 1 : (bits.z != 0u) ? 2 : 3; \
+        uint word = bits[w]; \
+        bits[w] = word & (word - 1u); \
+        add_light(w * LIGHT_WORD_BITS + findLSB(word), FILTER, s, color, arriving, unshadowed); \
+      } \
     }
-  }
-  for (int w = 0; w < LIGHT_WORDS; w++) {
-    uint bits = uint(words[w]) & ~uint(frame.shadowed_mask[w]);
-    while (bits != 0u) {
-      int b = findLSB(bits);
-      bits &= bits - 1u;
-      add_light(w * LIGHT_WORD_BITS + b, NO_SHADOW, s, color, arriving, unshadowed);
-    }
-  }
+#  if SAMPLED_LIGHTS
+  BIN_LOOP(words & sampled_mask, FILTER_PCSS)
+#  endif
+#  if HAS_SHADOWED
+  BIN_LOOP(words & shadowed_mask & ~sampled_mask, SHADOW_FILTER)
+#  endif
+#  if HAS_UNSHADOWED
+  BIN_LOOP(words & ~shadowed_mask, NO_SHADOW)
+#  endif
 #elif UNROLLED_LIGHTS
   /* The light counts are compiled in (programs.py UNROLLED_LIGHTS): one call per light, each
    * reading its LightData at a constant offset; the counts fold each call to its filter. */
@@ -281,12 +282,16 @@ void main()
     add_light(i, FILTER_PCSS, s, color, arriving, unshadowed);
   }
 #  endif
+#  if HAS_SHADOWED
   for (int i = frame.sampled_count; i < frame.shadowed_count; i++) {
     add_light(i, SHADOW_FILTER, s, color, arriving, unshadowed);
   }
+#  endif
+#  if HAS_UNSHADOWED
   for (int i = frame.shadowed_count; i < frame.light_count; i++) {
     add_light(i, NO_SHADOW, s, color, arriving, unshadowed);
   }
+#  endif
 #endif
   color += emission;
 #if HOLDOUT

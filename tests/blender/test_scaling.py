@@ -242,6 +242,40 @@ def test_a_frame_compiles_only_the_programs_it_draws_with(penumbra, gpu_call):
     assert [n for n in names if n.startswith("lit")] == ["lit"]
 
 
+def test_binned_light_classes_each_get_their_loop(penumbra, gpu_call, monkeypatch):
+    """Bins with all three classes of light: soft spots sampled over their extent (four
+    samples, PCSS), spots with maps, spots without: the image of every light on every pixel.
+    Each class is compiled only when the frame has a light in it."""
+    from penumbra.engine import frame_data
+    from penumbra.engine.extract import camera_from_scene
+
+    scene = _spot_scene()
+    bpy.data.lights["Spot0"].shadow_soft_size = 0.5
+    bpy.data.lights["Spot1"].shadow_soft_size = 0.5
+    bpy.data.lights["Spot3"].use_shadow = False
+
+    def frames(engine, depsgraph):
+        camera = camera_from_scene(depsgraph, scene, 160, 90)
+        out = engine.render_frame(depsgraph, camera, 160, 90, samples=(0, 4), sample_count=4)
+        lit = [dict(d) for name, d in engine.renderer.shaders._cache if name.startswith("lit")]
+        return out.stats, out.color_array().copy(), lit
+
+    stats, binned, lit = gpu_call(frames)
+    assert stats.binned and stats.lights_sampled >= 1
+    assert any(d["LIGHT_BINS"] and d["SAMPLED_LIGHTS"] and d["HAS_SHADOWED"] and d["HAS_UNSHADOWED"] for d in lit)
+    monkeypatch.setattr(frame_data, "BIN_MIN_LOCAL_LIGHTS", 10**6)
+    full_stats, full, _lit = gpu_call(frames)
+    assert not full_stats.binned
+    np.testing.assert_allclose(binned, full, rtol=1e-5, atol=1e-6)
+    assert binned[..., :3].max() > 0.2
+
+    # Every spot with a map: the variant has no loop for lights without one.
+    bpy.data.lights["Spot3"].use_shadow = True
+    monkeypatch.setattr(frame_data, "BIN_MIN_LOCAL_LIGHTS", 2)
+    _stats, _image, lit = gpu_call(frames)
+    assert any(d["LIGHT_BINS"] and not d["HAS_UNSHADOWED"] for d in lit)
+
+
 def test_a_light_that_reaches_nothing_visible_gets_no_map(penumbra, gpu_call):
     scene = _spot_scene()
     stats, _image = engine_frame(gpu_call, scene, 160, 90)
