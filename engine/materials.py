@@ -53,6 +53,8 @@ class Material:
     textures: dict = field(default_factory=dict)  # channel -> TextureRef
     color_attribute: str | None = None  # base colour from this colour attribute ("" = active)
     blend: str = "OPAQUE"  # OPAQUE, HASHED (dithered alpha) or BLEND (sorted, blended)
+    cull_camera: bool = False  # Settings › Backface Culling › Camera: back faces not drawn
+    cull_shadow: bool = False  # Settings › Backface Culling › Shadow: back faces cast no shadow
     messages: tuple = ()  # what could not be read, for the render report and the panel
 
     @property
@@ -220,7 +222,15 @@ def _blend_mode(mat):
 
 def material_from_blender(mat):
     """A Blender material as Penumbra draws it (``Material``), with a message for every part
-    it could not read."""
+    it could not read, and its back-face culling settings (as EEVEE reads them)."""
+    out = _material_surface(mat)
+    if mat is not None:
+        out.cull_camera = bool(getattr(mat, "use_backface_culling", False))
+        out.cull_shadow = bool(getattr(mat, "use_backface_culling_shadow", False))
+    return out
+
+
+def _material_surface(mat):
     if mat is None:
         return Material()
     notes = []

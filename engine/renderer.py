@@ -391,8 +391,9 @@ class Renderer:
         if not d.instance.shadow:
             return None
         mats = [(index, batch, d.material(index)) for index, batch in d.parts]
+        cull = bool(mats) and all(m.cull_shadow for _i, _b, m in mats)
         if not any(m.uses_alpha for _i, _b, m in mats):
-            return Caster([d.whole], d.model, d.det, d.identity)
+            return Caster([d.whole], d.model, d.det, d.identity, cull_back=cull)
         solid, cutouts = [], []
         for _index, batch, mat in mats:
             if not mat.uses_alpha:
@@ -402,7 +403,7 @@ class Renderer:
             elif mat.alpha > 0.0:
                 cutouts.append((batch, self._material_ubo(mat), None))
         identity = (*d.identity, tuple(id(m) for _i, _b, m in mats))
-        return Caster(solid, d.model, d.det, identity, cutouts)
+        return Caster(solid, d.model, d.det, identity, cutouts, cull_back=cull)
 
     def _material_ubo(self, mat):
         """The MaterialData block of ``mat``, built once per Material read."""
@@ -493,6 +494,13 @@ class Renderer:
         def draw(entries, with_aux):
             last = None
             for features, _rank, d, batch, mat in entries:
+                # Material › Backface Culling › Camera: faces turned away are not drawn (the
+                # winding flips under a mirroring model matrix).
+                culling = (mat.cull_camera, mat.cull_camera and d.det < 0.0)
+                if bound.get("culling") != culling:
+                    gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
+                    gpu.state.front_facing_set(culling[1])
+                    bound["culling"] = culling
                 shader = bind(features, with_aux)
                 if last is not d or bound.get("model_shader") is not shader:
                     shader.uniform_float("model", d.model)
@@ -519,6 +527,8 @@ class Renderer:
                 gpu.state.blend_set("ALPHA_PREMULT")
                 draw(blended, False)
                 gpu.state.blend_set("NONE")
+        gpu.state.face_culling_set("NONE")
+        gpu.state.front_facing_set(False)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
         stats.passes += 1

@@ -303,6 +303,7 @@ class Caster:
     det: float  # sign of the model matrix (winding under negative scale)
     identity: tuple  # what a tile's content depends on
     cutouts: list = field(default_factory=list)  # (batch, material UBO, alpha texture): alpha >= 0.5 casts
+    cull_back: bool = False  # every material asks for shadow back-face culling: faces away from the light cast nothing
 
 
 def plan_shadows(
@@ -646,7 +647,7 @@ class ShadowAtlas:
                 tile.size,
                 tile.origin,
                 cull_front,
-                tuple(c.identity for c in casters),
+                tuple((c.identity, c.cull_back) for c in casters),
                 # Alpha casters cover other texels in each sample: such a map is redrawn per sample.
                 alpha_offset if any(c.cutouts for c in casters) else None,
             )
@@ -681,9 +682,11 @@ class ShadowAtlas:
                 shader.bind()
                 shader.uniform_block("tile", tile_ubo)
                 for caster in casters:
-                    if cull_front:
-                        gpu.state.face_culling_set("FRONT")
+                    if cull_front or caster.cull_back:
+                        gpu.state.face_culling_set("FRONT" if cull_front else "BACK")
                         gpu.state.front_facing_set(caster.det < 0.0)
+                    else:
+                        gpu.state.face_culling_set("NONE")
                     shader.uniform_float("model", caster.model)
                     for batch in caster.batches:
                         batch.draw(shader)

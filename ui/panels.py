@@ -125,6 +125,11 @@ class PENUMBRA_PT_material(PenumbraPanel, bpy.types.Panel):
         col = self.layout.column(align=True)
         for icon, text in summary(material_from_blender(context.material)):
             col.label(text=text, icon=icon)
+        # Blender's own settings, as EEVEE reads them (saved in the .blend, undoable).
+        col = self.layout.column(heading="Backface Culling")
+        col.prop(context.material, "use_backface_culling", text="Camera")
+        if hasattr(context.material, "use_backface_culling_shadow"):
+            col.prop(context.material, "use_backface_culling_shadow", text="Shadow")
 
 
 class PENUMBRA_UL_layers(bpy.types.UIList):
