@@ -126,6 +126,12 @@ class Fit:
     def view_proj(self):
         return self.proj @ self.view
 
+    @property
+    def orthographic(self):
+        """True when clip w is 1 everywhere: window depth is then linear in view distance, and
+        ``proj`` maps [near, far] to it exactly."""
+        return bool(np.array_equal(self.proj[3], (0.0, 0.0, 0.0, 1.0)))
+
 
 def fit_sun_ortho(direction, points, map_size, padding_texels=2.0):
     """Fit an orthographic light frustum for a sun shining along ``direction`` around ``points``.

@@ -237,13 +237,23 @@ SHADOW_DEPTH = Program(
     push_constants=(("MAT4", "model"),),
     uniform_blocks=((TILE_STRUCT, "tile", 0),),
     outputs=(("VEC4", "out_depth"),),
-    defines=tuple({**DEPTH_FORMAT.defines(), "ALPHA_CUTOUT": False, "HAS_UV": False}.items()),
+    defines=tuple({**DEPTH_FORMAT.defines(), "ALPHA_CUTOUT": False, "HAS_UV": False, "RASTER_DEPTH": False}.items()),
 )
 
 
 # FLOAT32 maps are the depth buffer itself: the linear depth goes to gl_FragDepth, so a tile
 # needs no colour target and no second buffer.
 SHADOW_DEPTH_ONLY = replace(SHADOW_DEPTH, name="shadow_depth_only", outputs=(), depth_write="ANY")
+# An orthographic tile (a sun's) already rasterises that linear depth: its projection maps the
+# tile's [near, far] to window depth [0, 1], and pancaking clamps below 0 as the fragment stage
+# would. It writes no gl_FragDepth, which keeps the rasteriser's early depth test (no fragment
+# work for covered texels).
+SHADOW_DEPTH_RASTER = replace(
+    SHADOW_DEPTH_ONLY,
+    name="shadow_depth_raster",
+    depth_write="",
+    defines=tuple({**dict(SHADOW_DEPTH.defines), "RASTER_DEPTH": True}.items()),
+)
 
 
 # out = scale * src at (pixel - origin): a shadow tile from the scratch target into its place in
@@ -271,8 +281,8 @@ SCALED_COPY_SHADOW = replace(
 
 # Shadow casters with alpha (leaves, fences, glass panes drawn with alpha): a texel is
 # covered in a fraction alpha of the samples (``textured``: the alpha comes from a texture).
-def shadow_cutout_program(depth_format, textured):
-    base = shadow_program(depth_format)
+def shadow_cutout_program(depth_format, textured, raster_depth=False):
+    base = shadow_program(depth_format, raster_depth)
     program = replace(
         base,
         libs=base.libs + ("lib/material.glsl",),
@@ -306,9 +316,12 @@ BACKGROUND = Program(
 )
 
 
-def shadow_program(depth_format):
-    """The depth pass of a map stored as ``depth_format``."""
-    return SHADOW_DEPTH_ONLY if DEPTH_FORMAT[depth_format].depth_only else SHADOW_DEPTH
+def shadow_program(depth_format, raster_depth=False):
+    """The depth pass of a map stored as ``depth_format``; ``raster_depth``: the tile is
+    orthographic, so a depth-buffer map takes the rasterised depth as it is."""
+    if not DEPTH_FORMAT[depth_format].depth_only:
+        return SHADOW_DEPTH
+    return SHADOW_DEPTH_RASTER if raster_depth else SHADOW_DEPTH_ONLY
 
 
 def depth_defines(depth_format):

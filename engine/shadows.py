@@ -631,11 +631,13 @@ class ShadowAtlas:
         import gpu
 
         depth_only = DEPTH_FORMAT[self.depth_format].depth_only
-        shader = shaders.get(shadow_program(self.depth_format), depth_defines(self.depth_format))
         defines = depth_defines(self.depth_format)
 
-        def cutout(textured):  # compiled only when a caster has alpha
-            return shaders.get(shadow_cutout_program(self.depth_format, textured), defines)
+        def program(raster):  # raster: an orthographic tile of a depth-buffer map
+            return shaders.get(shadow_program(self.depth_format, raster), defines)
+
+        def cutout(textured, raster):  # compiled only when a caster has alpha
+            return shaders.get(shadow_cutout_program(self.depth_format, textured, raster), defines)
 
         work = []
         for index, tile in enumerate(plan.tiles):
@@ -679,6 +681,8 @@ class ShadowAtlas:
                 gpu.state.depth_test_set("LESS")
                 gpu.state.depth_mask_set(True)
                 tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record()]))
+                raster = depth_only and tile.fit.orthographic
+                shader = program(raster)
                 shader.bind()
                 shader.uniform_block("tile", tile_ubo)
                 for caster in casters:
@@ -694,15 +698,15 @@ class ShadowAtlas:
                 gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
                 for caster in casters:
                     for batch, material_ubo, texture in caster.cutouts:
-                        program = cutout(texture is not None)
-                        program.bind()
-                        program.uniform_block("tile", tile_ubo)
-                        program.uniform_float("alpha_offset", alpha_offset)
-                        program.uniform_float("model", caster.model)
-                        program.uniform_block("material", material_ubo)
+                        cut = cutout(texture is not None, raster)
+                        cut.bind()
+                        cut.uniform_block("tile", tile_ubo)
+                        cut.uniform_float("alpha_offset", alpha_offset)
+                        cut.uniform_float("model", caster.model)
+                        cut.uniform_block("material", material_ubo)
                         if texture is not None:
-                            program.uniform_sampler("tex_alpha", texture)
-                        batch.draw(program)
+                            cut.uniform_sampler("tex_alpha", texture)
+                        batch.draw(cut)
                         stats.draws += 1
                 gpu.state.face_culling_set("NONE")
                 gpu.state.front_facing_set(False)

@@ -15,10 +15,12 @@ void main()
     discard;
   }
 #endif
-  float d = clamp((v_distance - tile.near) / (tile.far - tile.near), 0.0, 1.0);
 #if DEPTH_FORMAT == DEPTH_FLOAT32
-  gl_FragDepth = d;
+#  if !RASTER_DEPTH /* orthographic tiles rasterise this depth already (programs.py) */
+  gl_FragDepth = clamp((v_distance - tile.near) / (tile.far - tile.near), 0.0, 1.0);
+#  endif
 #else
+  float d = clamp((v_distance - tile.near) / (tile.far - tile.near), 0.0, 1.0);
   out_depth = encode_depth(d);
 #endif
 }

@@ -238,8 +238,47 @@ def test_a_frame_compiles_only_the_programs_it_draws_with(penumbra, gpu_call):
 
     first, names, again = gpu_call(job)
     assert first == len(names) and again == 0
-    assert [n for n in names if n.startswith("shadow")] == ["shadow_depth_only"]
+    # The sun's tile is orthographic (rasterised depth), the spot's perspective (gl_FragDepth).
+    assert [n for n in names if n.startswith("shadow")] == ["shadow_depth_only", "shadow_depth_raster"]
     assert [n for n in names if n.startswith("lit")] == ["lit"]
+
+
+def test_orthographic_tiles_rasterise_the_depth_the_fragment_stage_would_write(penumbra, gpu_call, monkeypatch):
+    """A sun's map drawn without gl_FragDepth (its projection is linear in view distance) holds
+    the depth the gl_FragDepth program writes, to float precision, and gives the same image;
+    an alpha cut-out caster (the cut-out program's raster variant) included."""
+    from penumbra.engine import lightspace
+    from penumbra.engine.extract import camera_from_scene
+
+    scene = scenes.demo_scene(96, 54)
+    scene.penumbra.layers.clear()
+    mat = scenes.material("Cut", (0.6, 0.6, 0.6))
+    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Alpha"].default_value = 0.5
+    scenes.plane(scene, "Card", size=1.2, z=1.4, mat=mat).location = (0.8, -0.6, 0.0)
+
+    def job(engine, depsgraph):
+        camera = camera_from_scene(depsgraph, scene, 96, 54)
+        image = engine.render_frame(depsgraph, camera, 96, 54).color_array().copy()
+        atlas = engine.renderer.shadows
+        with atlas._framebuffer.bind():
+            depth = np.asarray(atlas._framebuffer.read_depth(0, 0, atlas.texture.width, atlas.texture.height))
+        names = {name for name, _defines in engine.renderer.shaders._cache}
+        return image, depth.astype(np.float32).copy(), names
+
+    image, depth, names = gpu_call(job)
+    assert {"shadow_depth_raster", "shadow_depth_raster_alpha"} <= names
+    monkeypatch.setattr(lightspace.Fit, "orthographic", property(lambda self: False))
+    ref_image, ref_depth, ref_names = gpu_call(job)
+    assert not any("raster" in n for n in ref_names)
+    covered = ref_depth < 1.0
+    assert covered.mean() > 0.05  # the maps hold casters and receivers
+    # Both float32: the rasteriser evaluates the depth plane at the texel, the fragment stage
+    # divides the interpolated distance; they differ by a few ulps of the plane (8e-6 measured,
+    # a fraction of a millimetre over this tile's range, far below the depth bias).
+    np.testing.assert_allclose(depth, ref_depth, rtol=0, atol=2e-5)
+    assert np.mean(np.abs(depth - ref_depth) > 1e-6) < 1e-3
+    np.testing.assert_allclose(image, ref_image, rtol=1e-5, atol=1e-5)
 
 
 def test_binned_light_classes_each_get_their_loop(penumbra, gpu_call, monkeypatch):
