@@ -32,6 +32,7 @@ class Geometry:
     uvs: np.ndarray | None = None  # (vertices, 2) float32: the UV map a material's textures read
     colors: np.ndarray | None = None  # (vertices, 4) float32 linear: a colour attribute
     tangents: np.ndarray | None = None  # (vertices, 4) float32 MikkTSpace tangent and sign; w 0: none
+    closed: bool = False  # the triangles bound solids with outward normals (``closed_outward``)
     messages: tuple = ()
     deps: frozenset = frozenset()
     serial: int = 0  # distinguishes rebuilt geometry of the same key (GPU batches key on it)
@@ -235,6 +236,7 @@ def geometry_from_mesh(mesh, needs=None):
         positions = co
         normals = _read(mesh.vertex_normals, "vector", nv, np.float32, 3)
         tris = corner_vert[corners]
+        tris_are_vertices = True
     else:  # flat or mixed: one vertex per face corner
         positions = co[corner_vert]
         if mesh.normals_domain == "POINT":
@@ -242,6 +244,7 @@ def geometry_from_mesh(mesh, needs=None):
         else:
             normals = _read(mesh.corner_normals, "vector", nc, np.float32, 3)
         tris = corners
+        tris_are_vertices = False
     uvs = colors = tangents = None
     messages = []
     if extras:
@@ -278,6 +281,8 @@ def geometry_from_mesh(mesh, needs=None):
         used[tris.ravel()] = True
         drawn = positions[used]
     bounds = np.array([drawn.min(axis=0), drawn.max(axis=0)]) if len(drawn) else np.full((2, 3), np.nan)
+    # Closedness is a property of the surface: test it on mesh vertices, not face corners.
+    closed = not dropped and _closed_cached(tris if tris_are_vertices else corner_vert[tris], co)
     return Geometry(
         np.ascontiguousarray(positions, np.float32),
         np.ascontiguousarray(normals, np.float32),
@@ -287,8 +292,90 @@ def geometry_from_mesh(mesh, needs=None):
         uvs=uvs,
         colors=colors,
         tangents=tangents,
+        closed=closed,
         messages=tuple(messages),
     )
+
+
+_CLOSED = {}  # content digest of (triangles, positions) -> closed_outward: final renders extract anew
+
+
+def _closed_cached(tris, co):
+    """``closed_outward``, remembered by content: its test costs about an extraction's time on
+    a large closed mesh, while hashing the arrays costs a few percent of it."""
+    import hashlib
+
+    digest = hashlib.blake2b(digest_size=16)
+    digest.update(np.ascontiguousarray(tris, np.int32).data)
+    digest.update(np.ascontiguousarray(co, np.float32).data)
+    key = digest.digest()
+    closed = _CLOSED.get(key)
+    if closed is None:
+        if len(_CLOSED) >= 1024:
+            _CLOSED.clear()
+        closed = _CLOSED[key] = closed_outward(tris, co)
+    return closed
+
+
+def closed_outward(tris, co):
+    """Whether triangles ``tris`` (indices into positions ``co``) bound solids seen from outside:
+    the directed edges are exactly their own reverses, as a multiset (a closed, consistently
+    oriented surface; an edge may join more than two faces if they pair up), and each connected
+    piece encloses a positive volume (its normals point outward).
+
+    Seen from a point outside the surface's bounds, every back face of such a surface lies
+    behind one of its front faces (a ray from outside meets a face it leaves through only
+    after one it enters through), so back faces can be skipped without changing the image.
+    Open meshes, unwelded seams, flipped or inconsistent normals and inward pieces (cavities
+    modelled as inner shells) all give False: they are drawn whole."""
+    if len(tris) < 4:
+        return False
+    t = np.asarray(tris, np.int64)
+    count = int(t.max()) + 1
+    a, b, c = t[:, 0], t[:, 1], t[:, 2]
+    # Multiset equality of the directed edges and their reverses, by two random per-vertex
+    # hashes: sum H(from) G(to) over the edges equals the sum over the reversed edges (exact
+    # wrapping integer arithmetic; unequal multisets agree with probability about 2^-64).
+    rng = np.random.default_rng(0x5EED)
+    h, g = rng.integers(0, 2**64 - 1, size=(2, count), dtype=np.uint64, endpoint=True)
+    with np.errstate(over="ignore"):
+        ha, hb, hc, ga, gb, gc = h[a], h[b], h[c], g[a], g[b], g[c]
+        forward = np.sum(ha * gb + hb * gc + hc * ga, dtype=np.uint64)
+        backward = np.sum(hb * ga + hc * gb + ha * gc, dtype=np.uint64)
+    if forward != backward:
+        return False
+    labels = _components(np.concatenate([a, b]), np.concatenate([b, c]), count)
+    if labels is None:
+        return False
+    p = np.asarray(co, np.float64)[:count]
+    p = p - (p.min(axis=0) + p.max(axis=0)) / 2.0  # near the origin: the volume sum keeps its digits
+    pa, pb, pc = p[a], p[b], p[c]
+    volume = np.einsum("ij,ij->i", pa, np.cross(pb, pc))
+    piece = labels[a]
+    total = np.bincount(piece, weights=volume, minlength=count)
+    size = np.bincount(piece, weights=np.abs(volume), minlength=count)
+    used = size > 0.0
+    return bool(used.any() and np.all(total[used] > 1e-6 * size[used]))
+
+
+def _components(u, v, count, rounds=64):
+    """Connected-component label (its smallest vertex) of every vertex of the graph with edges
+    (u, v): hooking roots onto smaller roots, then pointer jumping. None if it has not settled
+    after ``rounds`` hooking rounds (the caller then assumes nothing)."""
+    parent = np.arange(count)
+    for _ in range(rounds):
+        pu, pv = parent[u], parent[v]
+        lo, hi = np.minimum(pu, pv), np.maximum(pu, pv)
+        moved = lo < hi
+        if not moved.any():
+            return parent
+        np.minimum.at(parent, hi[moved], lo[moved])
+        while True:
+            jumped = parent[parent]
+            if np.array_equal(jumped, parent):
+                break
+            parent = jumped
+    return None
 
 
 def _corner_uvs(mesh, needs, nc, messages):

@@ -30,6 +30,10 @@ from .textures import TextureCache
 
 _UNSET = object()
 DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
+# Closed meshes (``extract.closed_outward``) seen from outside their bounds are drawn without
+# their back faces, in the lit pass and in shadow maps: those faces are hidden by the mesh's
+# own front faces, so the image is the same and the rasteriser sets up half the triangles.
+CULL_CLOSED = True
 _CORNER_BITS = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=bool)  # box corners
 
 
@@ -51,6 +55,7 @@ class FrameStats:
     lights_sampled: int = 0  # lights that moved between samples (the others kept one map)
     cancelled: bool = False  # on_sample asked to stop before the last sample
     lights_out_of_view: int = 0  # lights that reach no visible surface: no map, no shading
+    closed_culled: int = 0  # closed instances drawn without back faces (lit pass and each map)
     binned: bool = False  # the lit pass looped over each screen bin's lights only
     messages: list = field(default_factory=list)  # what the user must be told about this frame
 
@@ -103,6 +108,7 @@ class Draw:
     det: float  # sign of the model matrix: flips the winding under negative scale
     identity: tuple  # what a shadow tile's content depends on
     corners: np.ndarray  # (8, 3) world corners of the instance's bounds
+    closed: bool = False  # a closed opaque surface: back faces hidden from outside its bounds
 
     def material(self, index):
         materials = self.instance.materials
@@ -304,7 +310,9 @@ class Renderer:
                 whole, parts = self._batches_for(inst.key, geo)
                 identity = (inst.key, inst.matrix.tobytes(), geo.serial)
                 model = Matrix(inst.matrix.tolist())
-                draws.append(Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i]))
+                draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
+                draw.closed = CULL_CLOSED and geo.closed and not any(draw.material(m).uses_alpha for m, _b in parts)
+                draws.append(draw)
                 stats.triangles += geo.triangle_count
         live = {(key, geo.serial) for key, geo in snapshot.geometry.items()}
         for stale in [k for k in self._batches if k not in live]:
@@ -393,7 +401,7 @@ class Renderer:
         mats = [(index, batch, d.material(index)) for index, batch in d.parts]
         cull = bool(mats) and all(m.cull_shadow for _i, _b, m in mats)
         if not any(m.uses_alpha for _i, _b, m in mats):
-            return Caster([d.whole], d.model, d.det, d.identity, cull_back=cull)
+            return Caster([d.whole], d.model, d.det, d.identity, cull_back=cull, closed=d.closed, corners=d.corners)
         solid, cutouts = [], []
         for _index, batch, mat in mats:
             if not mat.uses_alpha:
@@ -460,6 +468,15 @@ class Renderer:
             self._normal.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
         if world is not None and world.image is not None and not settings.film_transparent:
             self._background(world, camera)
+        # Closed instances wholly beyond the near plane: from there no back face shows.
+        outside = set()
+        closed = [d for d in draws if d.closed]
+        if closed:
+            vp = camera.projection @ camera.view
+            near = vp[2] + vp[3]  # clip z + w: positive beyond the near plane
+            beyond = np.all(np.stack([d.corners for d in closed]) @ near[:3] + near[3] > 0.0, axis=1)
+            outside = {id(d) for d, ok in zip(closed, beyond, strict=True) if ok}
+            stats.closed_culled += len(outside)
         opaque, blended = [], []
         for rank, d in enumerate(_front_to_back(draws, camera)):
             for mat_index, batch in d.parts:
@@ -496,7 +513,8 @@ class Renderer:
             for features, _rank, d, batch, mat in entries:
                 # Material › Backface Culling › Camera: faces turned away are not drawn (the
                 # winding flips under a mirroring model matrix).
-                culling = (mat.cull_camera, mat.cull_camera and d.det < 0.0)
+                cull = mat.cull_camera or id(d) in outside
+                culling = (cull, cull and d.det < 0.0)
                 if bound.get("culling") != culling:
                     gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
                     gpu.state.front_facing_set(culling[1])

@@ -304,6 +304,8 @@ class Caster:
     identity: tuple  # what a tile's content depends on
     cutouts: list = field(default_factory=list)  # (batch, material UBO, alpha texture): alpha >= 0.5 casts
     cull_back: bool = False  # every material asks for shadow back-face culling: faces away from the light cast nothing
+    closed: bool = False  # a closed opaque surface (renderer.CULL_CLOSED): its back faces are hidden from outside
+    corners: object = None  # (8, 3) world corners of its bounds, with ``closed``
 
 
 def plan_shadows(
@@ -685,8 +687,15 @@ class ShadowAtlas:
                 shader = program(raster)
                 shader.bind()
                 shader.uniform_block("tile", tile_ubo)
+                w_row = tile.fit.view_proj[3]
                 for caster in casters:
-                    if cull_front or caster.cull_back:
+                    # A closed caster wholly in front of the light (w > 0 at every corner: no
+                    # clipping, and the light outside it) casts with its faces toward the light.
+                    closed = (
+                        not cull_front and caster.closed and bool(np.all(caster.corners @ w_row[:3] + w_row[3] > 0.0))
+                    )
+                    stats.closed_culled += closed
+                    if cull_front or caster.cull_back or closed:
                         gpu.state.face_culling_set("FRONT" if cull_front else "BACK")
                         gpu.state.front_facing_set(caster.det < 0.0)
                     else:

@@ -72,3 +72,53 @@ def test_bounds_ignore_loose_vertices_and_broken_triangles_are_dropped(penumbra)
     assert 0 < geo.triangle_count < tris_before
     assert np.isfinite(geo.positions[geo.indices]).all()
     bpy.data.meshes.remove(me)
+
+
+def test_closed_outward_surfaces_are_told_apart(penumbra):
+    """``Geometry.closed``: closed and consistently outward only; an open mesh, a flipped or
+    partly flipped one and a cavity (an inward inner shell) are drawn whole."""
+    import bmesh
+
+    from devkit import assets
+    from penumbra.engine.extract import geometry_from_mesh
+
+    scene = scenes.empty_scene(32, 32)
+
+    def mesh(build):
+        me = bpy.data.meshes.new("M")
+        bm = bmesh.new()
+        build(bm)
+        bm.to_mesh(me)
+        bm.free()
+        return me
+
+    def cube(bm, size=1.0, offset=(0.0, 0.0, 0.0)):
+        verts = bmesh.ops.create_cube(bm, size=size)["verts"]
+        bmesh.ops.translate(bm, verts=verts, vec=offset)
+        return list({f for v in verts for f in v.link_faces})
+
+    def flipped(bm):
+        bmesh.ops.reverse_faces(bm, faces=cube(bm))
+
+    def one_flipped(bm):
+        bmesh.ops.reverse_faces(bm, faces=cube(bm)[:1])
+
+    def cavity(bm):
+        cube(bm, 2.0)
+        bmesh.ops.reverse_faces(bm, faces=cube(bm, 1.0))
+
+    def two(bm):
+        cube(bm)
+        cube(bm, offset=(3.0, 0.0, 0.0))
+
+    def far(bm):
+        cube(bm, offset=(1e5, 1e5, 0.0))
+
+    def grid(bm):
+        bmesh.ops.create_grid(bm, x_segments=3, y_segments=3, size=1.0)
+
+    expect = {cube: True, two: True, far: True, flipped: False, one_flipped: False, cavity: False, grid: False}
+    for build, closed in expect.items():
+        assert geometry_from_mesh(mesh(build)).closed is closed, build.__name__
+    assert geometry_from_mesh(assets.import_mesh(scene, assets.SPOT).data).closed
+    assert not geometry_from_mesh(assets.import_mesh(scene, assets.BUNNY).data).closed  # holes underneath
