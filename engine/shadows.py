@@ -687,15 +687,17 @@ class ShadowAtlas:
                 shader = program(raster)
                 shader.bind()
                 shader.uniform_block("tile", tile_ubo)
-                w_row = tile.fit.view_proj[3]
+                # Closed casters wholly in front of the light (w > 0 at every corner: no
+                # clipping, and the light outside them) cast with their faces toward the light.
+                front = set()
+                closed = [c for c in casters if c.closed] if not cull_front else []
+                if closed:
+                    w_row = tile.fit.view_proj[3]
+                    ok = np.all(np.stack([c.corners for c in closed]) @ w_row[:3] + w_row[3] > 0.0, axis=1)
+                    front = {id(c) for c, inside in zip(closed, ok, strict=True) if inside}
+                    stats.closed_culled += len(front)
                 for caster in casters:
-                    # A closed caster wholly in front of the light (w > 0 at every corner: no
-                    # clipping, and the light outside it) casts with its faces toward the light.
-                    closed = (
-                        not cull_front and caster.closed and bool(np.all(caster.corners @ w_row[:3] + w_row[3] > 0.0))
-                    )
-                    stats.closed_culled += closed
-                    if cull_front or caster.cull_back or closed:
+                    if cull_front or caster.cull_back or id(caster) in front:
                         gpu.state.face_culling_set("FRONT" if cull_front else "BACK")
                         gpu.state.front_facing_set(caster.det < 0.0)
                     else:
