@@ -46,6 +46,7 @@ class FrameStats:
     shadow_texels: int = 0  # texels of the maps drawn (each its size squared: the depth pass's fill)
     passes: int = 0
     post_passes: int = 0
+    post_layers: int = 0  # post layers drawn (consecutive point layers share one pass)
     draws: int = 0
     triangles: int = 0
     texture_bytes: int = 0

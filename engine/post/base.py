@@ -62,6 +62,61 @@ class PostEffect:
         return SimpleNamespace(**values(cls.params, source))
 
 
+# Per-pixel layers (``PointEffect``): a run of consecutive ones shares one full-screen pass.
+# Each layer has POINT_SLOTS vec4s of a uniform block; the last one's w is the layer's mix.
+FUSE_POINT_LAYERS = True  # False: one pass per layer (tests and the benchmark compare the two)
+MAX_POINT_LAYERS = 8  # layers one pass takes; a longer run is split
+POINT_SLOTS = 4
+POINT_DATA = Struct("PointData", (("VEC4", "v"),))
+POINT_PROGRAM = post_program(
+    "post_point",
+    "post/point.frag.glsl",
+    uniform_blocks=((POINT_DATA, "point", MAX_POINT_LAYERS * POINT_SLOTS),),
+)  # its libraries (every point effect's function) are added by ``point_program``
+
+
+def point_program(effects):
+    """POINT_PROGRAM with the GLSL libraries of ``effects`` (PointEffect subclasses)."""
+    from dataclasses import replace
+
+    libs = tuple(dict.fromkeys(cls.point_glsl for cls in effects))
+    return replace(POINT_PROGRAM, libs=POINT_PROGRAM.libs + libs)
+
+
+def point_words(*values):
+    """A layer's data: up to POINT_SLOTS * 4 - 1 words (the last is its mix), float32 or, for
+    a Python int (not a bool), the int32 bit pattern the shader reads with floatBitsToInt."""
+    if len(values) > POINT_SLOTS * 4 - 1:
+        raise ValueError(f"{len(values)} words: a point layer has {POINT_SLOTS * 4 - 1}")
+    data = np.zeros(POINT_SLOTS * 4, np.float32)
+    ints = data.view(np.int32)
+    for i, v in enumerate(values):
+        if isinstance(v, int | np.integer) and not isinstance(v, bool | np.bool_):
+            ints[i] = int(v)
+        else:
+            data[i] = float(v)
+    return data
+
+
+class PointEffect(PostEffect):
+    """A layer whose output at a pixel depends only on its input there (and the pixel's
+    position, the frame's size and number): consecutive ones run in one pass.
+
+    ``point_glsl`` declares ``vec4 <point_function>(vec4 c, int o)``: the effect of the layer
+    on the sanitised colour ``c``, its data at ``point[o] ... point[o + POINT_SLOTS - 1]``
+    (written by ``point_data``, which returns ``point_words(...)``). The mix is applied around
+    it exactly as ``post_mix`` does."""
+
+    point_glsl = ""
+    point_function = ""
+
+    def point_data(self, ctx, params):
+        raise NotImplementedError
+
+    def execute(self, ctx, src, params, mix):
+        return ctx.point_pass(src, [(self, params, mix)])
+
+
 # Normalised 1-D Gaussian weights as a uniform block, shared by the blurring effects.
 GAUSSIAN_MAX_RADIUS = 256
 GAUSSIAN_WEIGHTS = Struct("GaussianWeights", (("VEC4", "w"),))
@@ -138,6 +193,8 @@ class PostContext:
     texture_pool: object = None  # gpu_pool.TexturePool the targets' textures come from (final renders)
     _pool: list = field(default_factory=list)
     _batch: object = None
+    _point_ubos: list = field(default_factory=list)  # one per point pass of a frame
+    _point_next: int = 0
 
     def acquire(self, *busy, size=None):
         """A float target of the frame's size (or ``size``, (width, height)) whose texture is
@@ -174,6 +231,33 @@ class PostContext:
             samplers={"source_tex": src, **(samplers or {})},
             uniforms={"mix_factor": mix, **(uniforms or {})},
             blocks=blocks,
+        )
+
+    def point_pass(self, src, layers):
+        """One pass of consecutive point layers ``layers`` ([(PointEffect, params, mix)], at
+        most MAX_POINT_LAYERS) over ``src``; returns the new texture."""
+        import gpu
+
+        data = np.zeros((MAX_POINT_LAYERS * POINT_SLOTS, 4), np.float32)
+        defines = {"POINT_COUNT": len(layers)}
+        for i, (effect, params, mix) in enumerate(layers):
+            words = effect.point_data(self, params)
+            words[-1] = min(float(mix), 1.0)
+            data[i * POINT_SLOTS : (i + 1) * POINT_SLOTS] = words.reshape(POINT_SLOTS, 4)
+            defines[f"POINT_FN_{i}"] = effect.point_function
+        index = self._point_next
+        self._point_next += 1
+        if index < len(self._point_ubos):
+            self._point_ubos[index].update(data.tobytes())
+        else:
+            self._point_ubos.append(gpu.types.GPUUniformBuf(data.tobytes()))
+        program = point_program(type(e) for e, _p, _m in layers)
+        return self.fullscreen(
+            program,
+            self.acquire(src),
+            defines=defines,
+            samplers={"source_tex": src},
+            blocks={"point": self._point_ubos[index]},
         )
 
     def fullscreen(self, program, target, defines=None, samplers=None, uniforms=None, blocks=None):
@@ -223,7 +307,10 @@ class PostStack:
         return eff
 
     def run(self, ctx, src, layers):
-        """``layers``: [Layer] (or equal tuples) in stack order."""
+        """``layers``: [Layer] (or equal tuples) in stack order. Consecutive point layers
+        share a pass (``FUSE_POINT_LAYERS``)."""
+        ctx._point_next = 0
+        run = []  # consecutive point layers not drawn yet
         for slot, (effect_id, enabled, mix, params) in enumerate(layers):
             if not enabled or mix <= 0.0:
                 continue
@@ -231,5 +318,19 @@ class PostStack:
             params = scale_pixels(eff.params, eff.values(params), ctx.pixel_scale)
             if eff.is_identity(params):
                 continue
-            src = eff.execute(ctx, src, params, min(float(mix), 1.0))
+            mix = min(float(mix), 1.0)
+            if ctx.stats is not None:
+                ctx.stats.post_layers += 1
+            if FUSE_POINT_LAYERS and isinstance(eff, PointEffect):
+                run.append((eff, params, mix))
+                if len(run) == MAX_POINT_LAYERS:
+                    src = ctx.point_pass(src, run)
+                    run = []
+                continue
+            if run:
+                src = ctx.point_pass(src, run)
+                run = []
+            src = eff.execute(ctx, src, params, mix)
+        if run:
+            src = ctx.point_pass(src, run)
         return src

@@ -6,23 +6,12 @@ the colour becomes ``c + amount * g``: additive, zero-mean grain of the same str
 shadows and highlights. The result is not clamped, so dark pixels may go slightly negative
 and the image mean is preserved. ``monochrome`` uses channel 0's value for R, G and B. Alpha
 is untouched. The hash is PCG (O'Neill's permuted congruential output function) chained over
-the inputs; ``grain_reference`` is its numpy twin.
+the inputs; ``grain_reference`` is its numpy twin. A point layer: it shares a pass with its
+neighbours.
 """
 
 from ..settings import Param
-from .base import PostEffect, post_program
-
-PROGRAM = post_program(
-    "post_noise",
-    "post/noise.frag.glsl",
-    push_constants=(
-        ("FLOAT", "amount"),
-        ("INT", "grain_size"),
-        ("INT", "frame"),
-        ("INT", "seed"),
-        ("INT", "monochrome"),
-    ),
-)
+from .base import PointEffect, point_words
 
 
 def _pcg(v):
@@ -53,11 +42,13 @@ def grain_reference(width, height, frame, size=1, seed=0, monochrome=False):
     return out
 
 
-class Noise(PostEffect):
+class Noise(PointEffect):
     id = "NOISE"
     label = "Noise"
     icon = "MOD_NOISE"
     description = "Animated film grain (the same frame always gives the same grain)"
+    point_glsl = "post/noise.frag.glsl"
+    point_function = "noise_point"
     params = (
         Param(
             "amount",
@@ -76,16 +67,5 @@ class Noise(PostEffect):
     def is_identity(self, params):
         return params.amount <= 0.0
 
-    def execute(self, ctx, src, params, mix):
-        return ctx.single_pass(
-            PROGRAM,
-            src,
-            mix,
-            uniforms={
-                "amount": params.amount,
-                "grain_size": params.size,
-                "frame": int(ctx.frame),
-                "seed": params.seed,
-                "monochrome": int(params.monochrome),
-            },
-        )
+    def point_data(self, ctx, params):
+        return point_words(params.amount, int(params.size), int(ctx.frame), int(params.seed), int(params.monochrome))

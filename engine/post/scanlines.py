@@ -5,25 +5,11 @@ dark band, which multiplies the colour by ``1 - intensity``. Periods start at th
 of the image on frame 0 and move up by ``scroll_speed`` periods per frame (down if negative);
 the offset depends only on ``ctx.frame``. With ``antialias`` a pixel is darkened by the
 fraction of its own height covered by dark bands (an exact box filter), otherwise by whether
-its centre is inside one.
+its centre is inside one. A point layer: it shares a pass with its neighbours.
 """
 
 from ..settings import Param
-from .base import PostEffect, post_program
-
-PROGRAM = post_program(
-    "post_scanlines",
-    "post/scanlines.frag.glsl",
-    # scan = (periods per pixel, thickness, intensity, offset in periods in [0, 1))
-    push_constants=(
-        ("FLOAT", "periods_per_pixel"),
-        ("FLOAT", "thickness"),
-        ("FLOAT", "intensity"),
-        ("FLOAT", "scroll"),  # offset in periods
-        ("INT", "line_count"),
-        ("INT", "antialias"),
-    ),
-)
+from .base import PointEffect, point_words
 
 
 def scroll_offset(frame, speed):
@@ -54,11 +40,13 @@ def scanline_darkness(rows, height, count, thickness, offset, antialias=True):
     return (dark_measure(f0 + w) - dark_measure(f0)) / w
 
 
-class Scanlines(PostEffect):
+class Scanlines(PointEffect):
     id = "SCANLINES"
     label = "Scanlines"
     icon = "ALIGN_JUSTIFY"
     description = "Darken horizontal bands like the lines of a CRT screen"
+    point_glsl = "post/scanlines.frag.glsl"
+    point_function = "scanlines_point"
     params = (
         Param("count", "INT", 240, "Number of lines over the image height", min=1, soft_max=1080),
         Param(
@@ -74,19 +62,14 @@ class Scanlines(PostEffect):
     def is_identity(self, params):
         return params.intensity <= 0.0 or params.thickness <= 0.0
 
-    def execute(self, ctx, src, params, mix):
-        return ctx.single_pass(
-            PROGRAM,
-            src,
-            mix,
-            uniforms={
-                "periods_per_pixel": params.count / ctx.height,
-                "thickness": params.thickness,
-                "intensity": params.intensity,
-                "scroll": scroll_offset(ctx.frame, params.scroll_speed),
-                "line_count": params.count,
-                "antialias": int(params.antialias),
-            },
+    def point_data(self, ctx, params):
+        return point_words(
+            params.count / ctx.height,  # periods per pixel
+            params.thickness,
+            params.intensity,
+            scroll_offset(ctx.frame, params.scroll_speed),  # offset in periods, in [0, 1)
+            int(params.count),
+            int(params.antialias),
         )
 
 

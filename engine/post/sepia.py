@@ -1,12 +1,12 @@
 """SEPIA: the classic sepia-tone matrix, blended with the input by ``amount``.
 
-The matrix lives here as data and reaches the shader as push constants, so the shader and
-any reference share one set of constants. Values are not clamped (the stack is HDR): white
-maps to (1.351, 1.203, 0.937).
+The matrix lives here as data and reaches the shader as layer data, so the shader and any
+reference share one set of constants. Values are not clamped (the stack is HDR): white maps
+to (1.351, 1.203, 0.937). A point layer: it shares a pass with its neighbours.
 """
 
 from ..settings import Param
-from .base import PostEffect, post_program
+from .base import PointEffect, point_words
 
 # Rows give R', G', B' from (R, G, B).
 SEPIA_MATRIX = (
@@ -15,18 +15,14 @@ SEPIA_MATRIX = (
     (0.272, 0.534, 0.131),
 )
 
-PROGRAM = post_program(
-    "post_sepia",
-    "post/sepia.frag.glsl",
-    push_constants=(("VEC4", "sepia_r"), ("VEC4", "sepia_g"), ("VEC4", "sepia_b"), ("FLOAT", "amount")),
-)
 
-
-class Sepia(PostEffect):
+class Sepia(PointEffect):
     id = "SEPIA"
     label = "Sepia"
     icon = "COLOR"
     description = "Old-photograph brown tone (standard sepia matrix)"
+    point_glsl = "post/sepia.frag.glsl"
+    point_function = "sepia_point"
     params = (
         Param(
             "amount",
@@ -42,9 +38,9 @@ class Sepia(PostEffect):
     def is_identity(self, params):
         return params.amount <= 0.0
 
-    def execute(self, ctx, src, params, mix):
-        rows = {f"sepia_{ch}": (*row, 0.0) for ch, row in zip("rgb", SEPIA_MATRIX)}
-        return ctx.single_pass(PROGRAM, src, mix, uniforms={"amount": params.amount, **rows})
+    def point_data(self, ctx, params):
+        (r, g, b) = SEPIA_MATRIX
+        return point_words(*r, params.amount, *g, 0.0, *b)
 
 
 def sepia_reference(rgb, amount):

@@ -1,13 +1,8 @@
-"""VIGNETTE: darkens (or tints) the image towards its edges."""
+"""VIGNETTE: darkens (or tints) the image towards its edges. A point layer: it shares a pass
+with its neighbours."""
 
 from ..settings import Param
-from .base import PostEffect, post_program
-
-PROGRAM = post_program(
-    "post_vignette",
-    "post/vignette.frag.glsl",
-    push_constants=(("VEC4", "vignette_color"), ("FLOAT", "radius"), ("FLOAT", "softness"), ("FLOAT", "roundness")),
-)
+from .base import PointEffect, point_words
 
 
 def vignette_factor(x, y, width, height, radius, softness, roundness):
@@ -30,11 +25,13 @@ def vignette_factor(x, y, width, height, radius, softness, roundness):
     return t * t * (3.0 - 2.0 * t)
 
 
-class Vignette(PostEffect):
+class Vignette(PointEffect):
     id = "VIGNETTE"
     label = "Vignette"
     icon = "CLIPUV_DEHLT"
     description = "Darken or tint the image towards its edges"
+    point_glsl = "post/vignette.frag.glsl"
+    point_function = "vignette_point"
     params = (
         Param(
             "radius",
@@ -57,15 +54,5 @@ class Vignette(PostEffect):
         Param("color", "COLOR", (0.0, 0.0, 0.0), "Colour at the edges"),
     )
 
-    def execute(self, ctx, src, params, mix):
-        return ctx.single_pass(
-            PROGRAM,
-            src,
-            mix,
-            uniforms={
-                "vignette_color": (*params.color[:3], 1.0),
-                "radius": params.radius,
-                "softness": params.softness,
-                "roundness": params.roundness,
-            },
-        )
+    def point_data(self, ctx, params):
+        return point_words(*params.color[:3], params.radius, params.softness, params.roundness)

@@ -1,9 +1,10 @@
-/* line_count periods over the image height (periods_per_pixel per pixel), a dark band of
- * thickness periods in each, scrolled by scroll periods. Mirrors scanlines.py's
- * scanline_darkness; rows count from the bottom. */
+/* SCANLINES as a point layer. line_count periods over the image height (periods_per_pixel per
+ * pixel), a dark band of thickness periods in each, scrolled by scroll periods. Mirrors
+ * scanlines.py's scanline_darkness; rows count from the bottom. point[o]: periods per pixel,
+ * thickness, intensity, scroll; point[o + 1]: line count, antialias (int bits). */
 
 /* Dark length, in periods, inside [0, f] (f >= 0): whole periods plus the partial one. */
-float dark_measure(float f)
+float scanlines_dark_measure(float f, float thickness)
 {
   float n = floor(f);
   return n * thickness + min(f - n, thickness);
@@ -12,28 +13,33 @@ float dark_measure(float f)
 /* fract(num / den * line_count - scroll) for integer num, den: the integer part of the
  * position is dropped exactly in integers (num * (count mod den) mod den), so the phase keeps
  * float32 precision however many lines lie below the pixel. Exact for den < 65536. */
-float phase(uint num, uint den)
+float scanlines_phase(uint num, uint den, int line_count, float scroll)
 {
   uint r = (num * (uint(line_count) % den)) % den;
   float u = float(r) / float(den) - scroll;
   return u - floor(u);
 }
 
-void main()
+vec4 scanlines_point(vec4 c, int o)
 {
-  vec4 c = post_source();
+  float periods_per_pixel = point[o].v.x;
+  float thickness = point[o].v.y;
+  float intensity = point[o].v.z;
+  float scroll = point[o].v.w;
+  int line_count = floatBitsToInt(point[o + 1].v.x);
+  bool antialias = floatBitsToInt(point[o + 1].v.y) != 0;
   uint row = uint(gl_FragCoord.y);
   uint height = uint(target_size.y);
   float dark;
-  if (antialias != 0) {
+  if (antialias) {
     /* Box filter over the pixel's height: the covered fraction of [row, row + 1]. */
     float w = periods_per_pixel;
-    float f0 = phase(row, height);
-    dark = (dark_measure(f0 + w) - dark_measure(f0)) / w;
+    float f0 = scanlines_phase(row, height, line_count, scroll);
+    dark = (scanlines_dark_measure(f0 + w, thickness) - scanlines_dark_measure(f0, thickness)) / w;
   }
   else {
     /* The pixel centre, row + 1/2 = (2 row + 1) / 2. */
-    dark = (phase(2u * row + 1u, 2u * height) < thickness) ? 1.0 : 0.0;
+    dark = (scanlines_phase(2u * row + 1u, 2u * height, line_count, scroll) < thickness) ? 1.0 : 0.0;
   }
-  out_color = post_mix(vec4(c.rgb * (1.0 - intensity * dark), c.a));
+  return vec4(c.rgb * (1.0 - intensity * dark), c.a);
 }

@@ -1,7 +1,7 @@
-/* sepia_r/g/b = rows of sepia.py's SEPIA_MATRIX (w unused); amount blends it in. */
-void main()
+/* SEPIA as a point layer (see sepia.py). point[o], point[o + 1], point[o + 2]: the rows of
+ * SEPIA_MATRIX in xyz; point[o].w: amount. */
+vec4 sepia_point(vec4 c, int o)
 {
-  vec4 c = post_source();
-  vec3 s = vec3(dot(sepia_r.rgb, c.rgb), dot(sepia_g.rgb, c.rgb), dot(sepia_b.rgb, c.rgb));
-  out_color = post_mix(vec4(mix(c.rgb, s, amount), c.a));
+  vec3 s = vec3(dot(point[o].v.xyz, c.rgb), dot(point[o + 1].v.xyz, c.rgb), dot(point[o + 2].v.xyz, c.rgb));
+  return vec4(mix(c.rgb, s, point[o].v.w), c.a);
 }

@@ -1,7 +1,11 @@
-/* See vignette.py's vignette_factor. */
-void main()
+/* VIGNETTE as a point layer; see vignette.py's vignette_factor. point[o]: colour (xyz),
+ * radius (w); point[o + 1]: softness, roundness. */
+vec4 vignette_point(vec4 c, int o)
 {
-  vec4 c = post_source();
+  vec3 color = point[o].v.xyz;
+  float radius = point[o].v.w;
+  float softness = point[o + 1].v.x;
+  float roundness = point[o + 1].v.y;
   float aspect = target_size.x / target_size.y;
   vec2 p = (gl_FragCoord.xy / target_size - 0.5) * 2.0;
   p.x *= 1.0 + (aspect - 1.0) * roundness;
@@ -14,5 +18,5 @@ void main()
     float t = saturate((d - radius) / softness);
     f = t * t * (3.0 - 2.0 * t);
   }
-  out_color = post_mix(vec4(mix(c.rgb, vignette_color.rgb, f), c.a));
+  return vec4(mix(c.rgb, color, f), c.a);
 }

@@ -88,7 +88,8 @@ def test_new_effects_as_scene_layers(penumbra, gpu_call):
         return gpu_call(job)
 
     (stats, a), (_, b), (_, c) = render_frame(5), render_frame(5), render_frame(6)
-    assert stats.post_passes == 2 + 1 + 1 + 3 + 1  # defaults: glow 2, pixelate AVERAGE 3
+    assert stats.post_layers == len(effect_ids)
+    assert stats.post_passes == 2 + 1 + 3 + 1  # defaults: glow 2, scanlines + sepia 1, pixelate AVERAGE 3
     assert np.all(np.isfinite(a))
     np.testing.assert_array_equal(a, b)  # the scene's frame seeds the grain: reproducible
     assert not np.array_equal(a, c)

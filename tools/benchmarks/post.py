@@ -54,7 +54,7 @@ def measure(runner, scene, w, h, runs, radii):
         import gpu
 
         from penumbra.engine.extract import camera_from_scene
-        from penumbra.engine.post import EFFECTS, PostContext, PostStack
+        from penumbra.engine.post import EFFECTS, PostContext, PostStack, base
         from penumbra.engine.post.base import GAUSSIAN_VEC4S, GAUSSIAN_WEIGHTS, GaussianWeights, post_program
         from penumbra.engine.renderer import FrameStats
 
@@ -91,6 +91,18 @@ def measure(runner, scene, w, h, runs, radii):
         passes = ctx.stats.post_passes - passes_before
         rows.append(("GLOW, half resolution", passes, timed(lambda: stack.run(ctx, src, layer))))
         everything = [(eid, True, 1.0, cls.defaults()) for eid, cls in EFFECTS.items()]
+        # The point layers stacked: one shared pass (as the stack runs them), then one pass each.
+        points = [layer for layer in everything if issubclass(EFFECTS[layer[0]], base.PointEffect)]
+        for fuse, how in ((True, "in one pass"), (False, "one pass each")):
+            base.FUSE_POINT_LAYERS = fuse
+            try:
+                passes_before = ctx.stats.post_passes
+                stack.run(ctx, src, points)
+                passes = ctx.stats.post_passes - passes_before
+                name = f"{' + '.join(layer[0] for layer in points)}, {how}"
+                rows.append((name, passes, timed(lambda: stack.run(ctx, src, points))))
+            finally:
+                base.FUSE_POINT_LAYERS = True
         rows.append(("whole stack", None, timed(lambda: stack.run(ctx, src, everything))))
 
         naive = post_program(
