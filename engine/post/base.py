@@ -216,7 +216,9 @@ class PostContext:
         return sum(t.texture.width * t.texture.height * 16 for t in self._pool)
 
     def release(self):
-        """Give the targets' textures to ``texture_pool`` (inside the GPU context)."""
+        """Give the targets' textures to ``texture_pool`` and free the point passes' uniform
+        buffers (inside the GPU context)."""
+        self._point_ubos.clear()
         if self.texture_pool is not None:
             textures = [t.texture for t in self._pool]
             self._pool.clear()
