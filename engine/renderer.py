@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels, light_bins, lightspace, sampling
+from . import kernels, light_bins, lightspace, sampling, simplify
 from .frame_data import build_frame_data, select_lights
 from .gpu_pool import new_texture
 from .materials import CHANNELS, EXTENSION, INTERPOLATION, Material
@@ -57,6 +57,7 @@ class FrameStats:
     cancelled: bool = False  # on_sample asked to stop before the last sample
     lights_out_of_view: int = 0  # lights that reach no visible surface: no map, no shading
     closed_culled: int = 0  # closed instances drawn without back faces (lit pass and each map)
+    simplified: int = 0  # instances drawn at a level of detail (``simplify``; ``triangles`` counts its)
     binned: bool = False  # the lit pass looped over each screen bin's lights only
     messages: list = field(default_factory=list)  # what the user must be told about this frame
 
@@ -145,6 +146,7 @@ class Renderer:
         self.shadows = ShadowAtlas(pool)
         self.post = post_stack()
         self._batches = {}  # (geometry key, serial) -> (whole, parts)
+        self._lod_batches = {}  # (geometry key, serial, level) -> (whole, parts) of ``simplify.simplified``
         self.textures = TextureCache()
         self._material_ubos = {}  # id(Material) -> (Material, GPUUniformBuf)
         self._jitter_tex = None
@@ -194,7 +196,7 @@ class Renderer:
         emission = bool(emission and aux)
         self._emission_on = emission
         self._ensure_targets(width, height, aux, emission)
-        draws = self._draw_list(snapshot, stats)
+        draws = self._draw_list(snapshot, stats, camera, settings, (width, height))
         stats.messages.extend(getattr(snapshot, "messages", ()))
         self.textures.forget(getattr(snapshot, "images_changed", ()))
         lights = select_lights(snapshot.lights, camera.position, MAX_LIGHTS)
@@ -293,10 +295,10 @@ class Renderer:
 
     # --- stages ---------------------------------------------------------------------------
 
-    def _draw_list(self, snapshot, stats):
+    def _draw_list(self, snapshot, stats, camera=None, settings=None, size=None):
         """The frame's instances with their batches; batches of geometry no longer in the
-        snapshot are released. Per-instance numbers (sign of the matrix, world bounds) are
-        computed for all instances at once."""
+        snapshot are released. Per-instance numbers (sign of the matrix, world bounds, level
+        of detail) are computed for all instances at once."""
         from mathutils import Matrix
 
         kept = [(inst, snapshot.geometry[inst.key]) for inst in snapshot.instances if inst.key in snapshot.geometry]
@@ -307,18 +309,54 @@ class Renderer:
             dets = np.linalg.det(matrices[:, :3, :3])
             local = np.where(_CORNER_BITS[None], bounds[:, None, 1], bounds[:, None, 0])  # (n, 8, 3)
             corners = np.einsum("nij,nkj->nki", matrices[:, :3, :3], local) + matrices[:, None, :3, 3]
+            levels = self._levels(kept, matrices, bounds, corners, camera, settings, size)
             for i, (inst, geo) in enumerate(kept):
-                whole, parts = self._batches_for(inst.key, geo)
-                identity = (inst.key, inst.matrix.tobytes(), geo.serial)
+                lod = simplify.simplified(geo, levels[i]) if levels[i] is not None else None
+                if lod is not None:
+                    whole, parts = self._batches_for((inst.key, geo.serial, levels[i]), lod, self._lod_batches)
+                    identity = (inst.key, inst.matrix.tobytes(), geo.serial, levels[i])
+                    stats.simplified += 1
+                else:
+                    whole, parts = self._batches_for(inst.key, geo)
+                    identity = (inst.key, inst.matrix.tobytes(), geo.serial)
                 model = Matrix(inst.matrix.tolist())
                 draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
-                draw.closed = CULL_CLOSED and geo.closed and not any(draw.material(m).uses_alpha for m, _b in parts)
+                closed = CULL_CLOSED and geo.closed and lod is None  # a level is not tested for closedness
+                draw.closed = closed and not any(draw.material(m).uses_alpha for m, _b in parts)
                 draws.append(draw)
-                stats.triangles += geo.triangle_count
+                stats.triangles += (lod or geo).triangle_count
         live = {(key, geo.serial) for key, geo in snapshot.geometry.items()}
         for stale in [k for k in self._batches if k not in live]:
             del self._batches[stale]
+        for stale in [k for k in self._lod_batches if k[:2] not in live]:
+            del self._lod_batches[stale]
         return draws
+
+    def _levels(self, kept, matrices, bounds, corners, camera, settings, size):
+        """Each instance's level of detail (``simplify.level_for``) or None (drawn whole):
+        Render › Simplify › Merge Below in pixels of the full-resolution frame, at the
+        instance's nearest point to the camera."""
+        levels = [None] * len(kept)
+        pixels = float(getattr(settings, "simplify_pixels", 0.0)) * float(getattr(settings, "pixel_scale", 1.0))
+        if not pixels > 0.0 or camera is None or size is None:
+            return levels
+        footprint = lightspace.pixel_footprint(camera.projection, camera.is_ortho, *size)
+        view = np.asarray(camera.view, dtype=np.float64)
+        vp = np.asarray(camera.projection, dtype=np.float64) @ view
+        near = vp[2] + vp[3]  # clip z + w: positive beyond the near plane
+        beyond = np.all(corners @ near[:3] + near[3] > 0.0, axis=1)
+        nearest = np.min(-(corners @ view[2, :3] + view[2, 3]), axis=1)
+        stretch = np.linalg.svd(matrices[:, :3, :3], compute_uv=False)[:, 0]
+        extent = np.max(bounds[:, 1] - bounds[:, 0], axis=1)
+        for i, (inst, geo) in enumerate(kept):
+            if not beyond[i] or geo.triangle_count < simplify.MIN_TRIANGLES:
+                continue
+            if geo.uvs is not None or geo.colors is not None or geo.tangents is not None:
+                continue  # its materials read more than positions and normals
+            if any(m is not None and m.uses_alpha for m in inst.materials):
+                continue
+            levels[i] = simplify.level_for(float(extent[i]), float(stretch[i]), float(nearest[i]), footprint, pixels)
+        return levels
 
     def _lights_in_view(self, lights, draws, camera, width, height, stats):
         """The lights that can light a visible surface, with the screen rectangle each can
@@ -731,12 +769,14 @@ class Renderer:
             ubo[0].update(raw)
         return self._ubos[name][0]
 
-    def _batches_for(self, key, geo):
-        """(all-triangles batch, [(material index, batch)]) of a Geometry, built once."""
+    def _batches_for(self, key, geo, cache=None):
+        """(all-triangles batch, [(material index, batch)]) of a Geometry, built once: kept in
+        ``cache`` under ``key`` when given, else under (key, serial) with the meshes' own."""
         import gpu
 
-        cache_key = (key, geo.serial)
-        cached = self._batches.get(cache_key)
+        cache_key = key if cache is not None else (key, geo.serial)
+        cache = self._batches if cache is None else cache
+        cached = cache.get(cache_key)
         if cached is not None:
             return cached
         fmt = gpu.types.GPUVertFormat()
@@ -755,8 +795,8 @@ class Renderer:
                 continue
             ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices[first : first + count])
             parts.append((mat_index, gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)))
-        self._batches[cache_key] = (whole, parts)
-        return self._batches[cache_key]
+        cache[cache_key] = (whole, parts)
+        return cache[cache_key]
 
     def _jitter(self, samples):
         """The jittered-disk texture: (JITTER_SIZE, JITTER_SIZE, samples / 2) RGBA, two 2-D

@@ -123,6 +123,7 @@ SAMPLING = "sampling"
 SHADOWS = "shadows"
 LIGHTING = "lighting"
 VIEWPORT = "viewport"
+SIMPLIFY = "simplify"
 
 SCENE_PARAMS = (
     Param(
@@ -325,6 +326,21 @@ SCENE_PARAMS = (
         label="Navigation Scale",
         section=VIEWPORT,
         subtype="FACTOR",
+    ),
+    Param(
+        "simplify_pixels",
+        "FLOAT",
+        0.0,
+        "Merge each mesh's triangles into cells this many pixels wide, judged at the instance's "
+        "point nearest the camera (in pixels of the full-resolution frame): fewer triangles to "
+        "draw where the frame cannot show them apart. A surface moves by a small part of a cell, "
+        "never more than its diagonal. Meshes whose materials read UVs, colour attributes or "
+        "tangents, or use alpha, are drawn whole. 0: every triangle is drawn",
+        min=0.0,
+        soft_max=8.0,
+        label="Merge Below",
+        section=SIMPLIFY,
+        unit="PIXELS",
     ),
 )
 

@@ -66,6 +66,12 @@ class PENUMBRA_PT_viewport(_SettingsPanel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
 
+class PENUMBRA_PT_simplify(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Simplify"
+    section = settings.SIMPLIFY
+    bl_options = {"DEFAULT_CLOSED"}
+
+
 class PENUMBRA_PT_film(PenumbraPanel, bpy.types.Panel):
     bl_label = "Film"
     bl_context = "render"
@@ -203,6 +209,7 @@ classes = (
     PENUMBRA_PT_light,
     PENUMBRA_PT_lighting,
     PENUMBRA_PT_viewport,
+    PENUMBRA_PT_simplify,
     PENUMBRA_UL_layers,
     PENUMBRA_MT_layer_add,
     PENUMBRA_PT_sidebar_layers,
