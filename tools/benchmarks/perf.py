@@ -17,7 +17,9 @@ Sections (``--sections``, all by default):
   lights      N shadowed spot lights over a field of boxes (N = 1, 8, 32, 64): F12, and the
               viewport path with every map reused
   objects     N separate objects (each its own mesh) and N instances of one mesh
-  instances   1 and 16 collection instances of the Stanford bunny (69k triangles): F12
+  instances   1 and 16 collection instances of the Stanford bunny (69k triangles): F12; the
+              same with Render > Simplify > Merge Below at 2 and 4 px (and the image's error
+              against every triangle drawn); closed cows
   triangles   one grid mesh of 70k ... 2M triangles: F12, and extraction against a bare copy
               of the same data with ``foreach_get`` (the limit for reading a mesh from Python)
   materials   16 UV spheres on a ground at 960x540 with constant materials, a 1024² image
@@ -459,6 +461,26 @@ def section_instances(plan):
         t = paired(scene, plan["runs"])
         first = first or t["PENUMBRA"]
         rows.append(_row("instances", f"{n} bunny instances", t, f"{t['PENUMBRA'] / first:.2f}x one", plan["runs"]))
+    # Render > Simplify > Merge Below: the same bunnies at a level of detail, each count against
+    # one bunny at the same setting; the error is against the full-detail frame.
+    from devkit.render import render
+
+    for pixels in (2.0, 4.0):
+        first = None
+        for n in (1, 16):
+            scene = bunny_field(n)
+            _penumbra(scene)
+            full = render(scene)["Combined"][..., :3]
+            scene.penumbra.simplify_pixels = pixels
+            simplified = render(scene)["Combined"][..., :3]
+            diff = np.abs(simplified - full).max(axis=-1)
+            t = paired(scene, plan["runs"])
+            first = first or t["PENUMBRA"]
+            note = (
+                f"{t['PENUMBRA'] / first:.2f}x one at {pixels:g} px; against every triangle: mean error "
+                f"{diff.mean():.4f}, {100 * np.mean(diff > 0.05):.1f} % of pixels over 0.05"
+            )
+            rows.append(_row("instances", f"{n} bunny instances, Merge Below {pixels:g} px", t, note, plan["runs"]))
     first = None
     for n in (1, 16):
         scene = bunny_field(n, assets.SPOT, subdivisions=2)
