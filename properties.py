@@ -138,7 +138,7 @@ PENUMBRA_PG_layer = group_class(
 )
 
 
-def _render_settings(self, frame, film_transparent=False, pixel_scale=1.0):
+def _render_settings(self, frame, film_transparent=False, pixel_scale=1.0, use_simplify=False):
     """The plain settings a frame needs (the renderer never reads Blender properties)."""
     soloing = any(layer.solo for layer in self.layers)
     layers = []
@@ -151,7 +151,12 @@ def _render_settings(self, frame, film_transparent=False, pixel_scale=1.0):
             params = SimpleNamespace(**{p.name: getattr(group, p.name) for p in EFFECTS[layer.effect].params})
         layers.append(Layer(layer.effect, enabled, layer.mix, params))
     return settings.render_settings(
-        self, frame=frame, film_transparent=film_transparent, pixel_scale=pixel_scale, layers=layers
+        self,
+        frame=frame,
+        film_transparent=film_transparent,
+        pixel_scale=pixel_scale,
+        use_simplify=use_simplify,
+        layers=layers,
     )
 
 

@@ -65,7 +65,10 @@ class PenumbraEngineCore:
         scene = depsgraph.scene
         snapshot = self.cache.snapshot(depsgraph)
         settings = scene.penumbra.render_settings(
-            frame=scene.frame_current, film_transparent=scene.render.film_transparent, pixel_scale=pixel_scale
+            frame=scene.frame_current,
+            film_transparent=scene.render.film_transparent,
+            pixel_scale=pixel_scale,
+            use_simplify=scene.render.use_simplify,
         )
         out = self.renderer.render(
             snapshot,

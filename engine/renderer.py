@@ -334,10 +334,12 @@ class Renderer:
 
     def _levels(self, kept, matrices, bounds, corners, camera, settings, size):
         """Each instance's level of detail (``simplify.level_for``) or None (drawn whole):
-        Render › Simplify › Merge Below in pixels of the full-resolution frame, at the
-        instance's nearest point to the camera."""
+        with Render › Simplify on, its Penumbra › Merge Below in pixels of the full-resolution
+        frame, at the instance's nearest point to the camera."""
         levels = [None] * len(kept)
-        pixels = float(getattr(settings, "simplify_pixels", 0.0)) * float(getattr(settings, "pixel_scale", 1.0))
+        if not getattr(settings, "use_simplify", False):
+            return levels
+        pixels = float(settings.simplify_pixels) * float(settings.pixel_scale)
         if not pixels > 0.0 or camera is None or size is None:
             return levels
         footprint = lightspace.pixel_footprint(camera.projection, camera.is_ortho, *size)

@@ -331,7 +331,7 @@ SCENE_PARAMS = (
         "simplify_pixels",
         "FLOAT",
         0.0,
-        "Merge each mesh's triangles into cells this many pixels wide, judged at the instance's "
+        "With Simplify on: merge each mesh's triangles into cells this many pixels wide, judged at the instance's "
         "point nearest the camera (in pixels of the full-resolution frame): fewer triangles to "
         "draw where the frame cannot show them apart. A surface moves by a small part of a cell, "
         "never more than its diagonal. Meshes whose materials read UVs, colour attributes or "
@@ -389,6 +389,7 @@ RenderSettings = dataclasses.make_dataclass(
     [(p.name, object, dataclasses.field(default=p.default)) for p in SCENE_PARAMS]
     + [
         ("film_transparent", bool, dataclasses.field(default=False)),
+        ("use_simplify", bool, dataclasses.field(default=False)),  # Render › Simplify's switch
         ("pixel_scale", float, dataclasses.field(default=1.0)),  # resolution % / 100 of a final render
         ("frame", int, dataclasses.field(default=1)),
         ("layers", list, dataclasses.field(default_factory=list)),  # [post.Layer] in stack order

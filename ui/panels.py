@@ -67,9 +67,15 @@ class PENUMBRA_PT_viewport(_SettingsPanel, bpy.types.Panel):
 
 
 class PENUMBRA_PT_simplify(_SettingsPanel, bpy.types.Panel):
-    bl_label = "Simplify"
+    """Penumbra's part of Blender's Simplify panel, switched by its header checkbox."""
+
+    bl_label = "Penumbra"
+    bl_parent_id = "RENDER_PT_simplify"
     section = settings.SIMPLIFY
-    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        self.layout.active = context.scene.render.use_simplify
+        super().draw(context)
 
 
 class PENUMBRA_PT_film(PenumbraPanel, bpy.types.Panel):

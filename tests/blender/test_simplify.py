@@ -1,4 +1,4 @@
-"""Render › Simplify › Merge Below (``engine/simplify.py``): levels of detail by clustering.
+"""Render › Simplify › Penumbra › Merge Below (``engine/simplify.py``): levels of detail by clustering.
 Checked on geometry with a known surface (spheres: every vertex's distance to the sphere), on
 the level a cell size in pixels asks for, and on frames: fewer triangles, nearly the same image,
 and nothing simplified that needs more than positions and normals."""
@@ -145,6 +145,10 @@ def test_frames_draw_fewer_triangles_and_look_the_same(penumbra, gpu_call):
     whole_stats, whole = engine_frame(gpu_call, scene, 160, 90)
     assert whole_stats.simplified == 0  # off by default
     scene.penumbra.simplify_pixels = 2.0
+    off_stats, off = engine_frame(gpu_call, scene, 160, 90)  # Blender's Simplify switch is off
+    assert off_stats.simplified == 0 and off_stats.triangles == whole_stats.triangles
+    np.testing.assert_array_equal(off, whole)
+    scene.render.use_simplify = True
     stats, simplified = engine_frame(gpu_call, scene, 160, 90)
     assert stats.simplified == 9  # every ball; the two-triangle ground is too small to simplify
     assert stats.triangles < 0.15 * whole_stats.triangles  # measured 0.094
@@ -163,6 +167,7 @@ def test_what_needs_more_than_normals_is_drawn_whole(penumbra, gpu_call):
     from mathutils import Vector
 
     scene = _sphere_field(count=3)
+    scene.render.use_simplify = True
     scene.penumbra.simplify_pixels = 4.0
     balls = [ob for ob in scene.objects if ob.name.startswith("Ball")]
     textured = scenes.material("Textured", (0.8, 0.8, 0.8))

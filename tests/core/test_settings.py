@@ -77,7 +77,8 @@ def test_render_settings_come_from_the_declarations_and_reject_unknown_ids():
     source.pcf_kernel_size = 99  # above its max of 15
     rs = settings.render_settings(source, frame=7)
     assert rs.pcf_kernel_size == 15 and rs.frame == 7
-    fields = [f for f in vars(rs) if f not in {"frame", "layers", "film_transparent", "pixel_scale"}]
+    extra = {"frame", "layers", "film_transparent", "pixel_scale", "use_simplify"}
+    fields = [f for f in vars(rs) if f not in extra]
     assert fields == [p.name for p in settings.SCENE_PARAMS]
     source.shadow_filter = "SOFT"
     with pytest.raises(ValueError, match="unknown shadow filter"):

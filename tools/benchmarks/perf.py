@@ -471,6 +471,7 @@ def section_instances(plan):
             scene = bunny_field(n)
             _penumbra(scene)
             full = render(scene)["Combined"][..., :3]
+            scene.render.use_simplify = True
             scene.penumbra.simplify_pixels = pixels
             simplified = render(scene)["Combined"][..., :3]
             diff = np.abs(simplified - full).max(axis=-1)
