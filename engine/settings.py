@@ -330,12 +330,12 @@ SCENE_PARAMS = (
     Param(
         "simplify_pixels",
         "FLOAT",
-        0.0,
-        "With Simplify on: merge each mesh's triangles into cells this many pixels wide, judged at the instance's "
-        "point nearest the camera (in pixels of the full-resolution frame): fewer triangles to "
-        "draw where the frame cannot show them apart. A surface moves by a small part of a cell, "
-        "never more than its diagonal. Meshes whose materials read UVs, colour attributes or "
-        "tangents, or use alpha, are drawn whole. 0: every triangle is drawn",
+        2.0,
+        "While Simplify is on, merge each mesh's triangles into cells this many pixels wide, "
+        "judged at the instance's point nearest the camera (pixels of the full-resolution frame): "
+        "fewer triangles where the frame cannot show them apart. A surface moves by a small part "
+        "of a cell, never more than its diagonal. Meshes whose materials read UVs, colour "
+        "attributes or tangents, or use alpha, are drawn whole. 0: every triangle is drawn",
         min=0.0,
         soft_max=8.0,
         label="Merge Below",

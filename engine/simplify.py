@@ -1,6 +1,7 @@
 """Levels of detail: a mesh's triangles merged where the frame cannot show them apart.
 
-Render › Simplify › Merge Below (``simplify_pixels``, 0 = off) sets a cell size in pixels. Each
+With Blender's Render › Simplify switched on, its Penumbra › Merge Below (``simplify_pixels``,
+2 px by default; 0 draws every triangle) sets a cell size in pixels. Each
 instance gets the coarsest level whose cells, at the instance's nearest point to the camera,
 are at most that many pixels across. A level clusters the mesh on a grid of ``2**level`` cells
 along its longest side and puts each cluster's vertex where the planes of its triangles meet

@@ -142,13 +142,15 @@ def _sphere_field(count=9, segments=160, rings=80):
 
 def test_frames_draw_fewer_triangles_and_look_the_same(penumbra, gpu_call):
     scene = _sphere_field()
+    assert scene.penumbra.simplify_pixels == 2.0 and not scene.render.use_simplify  # the defaults
     whole_stats, whole = engine_frame(gpu_call, scene, 160, 90)
-    assert whole_stats.simplified == 0  # off by default
-    scene.penumbra.simplify_pixels = 2.0
-    off_stats, off = engine_frame(gpu_call, scene, 160, 90)  # Blender's Simplify switch is off
+    assert whole_stats.simplified == 0
+    scene.penumbra.simplify_pixels = 0.0
+    scene.render.use_simplify = True
+    off_stats, off = engine_frame(gpu_call, scene, 160, 90)  # Simplify on, Merge Below 0
     assert off_stats.simplified == 0 and off_stats.triangles == whole_stats.triangles
     np.testing.assert_array_equal(off, whole)
-    scene.render.use_simplify = True
+    scene.penumbra.simplify_pixels = 2.0
     stats, simplified = engine_frame(gpu_call, scene, 160, 90)
     assert stats.simplified == 9  # every ball; the two-triangle ground is too small to simplify
     assert stats.triangles < 0.15 * whole_stats.triangles  # measured 0.094
