@@ -89,7 +89,7 @@ def cluster(geo, level):
     count = len(cell_index)
     corner = cluster_of[tris]  # (t, 3) clusters of each triangle's corners
     kept = (corner[:, 0] != corner[:, 1]) & (corner[:, 1] != corner[:, 2]) & (corner[:, 0] != corner[:, 2])
-    if not kept.any():
+    if not kept.any() or kept.sum() > WORTH * len(tris):  # nothing, or too much, would be left
         return None
 
     # Plane quadrics of the triangles (weighted by area), summed per cluster of each corner.
@@ -100,9 +100,11 @@ def cluster(geo, level):
     plane = np.concatenate([unit, -np.einsum("ij,ij->i", unit, a)[:, None]], axis=1)
     plane *= np.sqrt(0.5 * length)[:, None]
     rows, cols = np.triu_indices(4)
-    q = plane[:, rows] * plane[:, cols]  # (t, 10): the upper triangle of each 4x4 quadric
-    target = corner.ravel()
-    quadric = np.stack([np.bincount(target, np.repeat(q[:, k], 3), count) for k in range(10)], axis=1)
+    quadric = np.zeros((count, 10))  # the upper triangle of each cluster's 4x4 quadric
+    for k, (r, c) in enumerate(zip(rows, cols, strict=True)):
+        q = plane[:, r] * plane[:, c]
+        for j in range(3):
+            quadric[:, k] += np.bincount(corner[:, j], q, count)
     full = np.zeros((count, 4, 4))
     full[:, rows, cols] = quadric
     full[:, cols, rows] = quadric
@@ -166,11 +168,17 @@ def cluster(geo, level):
 
 
 def _positions(p):
-    """(index of each row of ``p`` among its distinct rows, how many distinct rows)."""
-    rows = np.ascontiguousarray(p).view(np.dtype((np.void, p.dtype.itemsize * 3)))[:, 0]
-    _u, inverse = np.unique(rows, return_inverse=True)
-    inverse = inverse.ravel()
-    return inverse, int(inverse.max()) + 1 if len(inverse) else 0
+    """(index of each row of ``p`` among its distinct rows, how many distinct rows): the rows
+    sorted by their float32 bits (equal floats, equal bits; -0 and 0 apart, which only splits
+    a position in two)."""
+    bits = np.ascontiguousarray(p, np.float32).view(np.uint32).astype(np.uint64)
+    order = np.lexsort((bits[:, 2], (bits[:, 0] << np.uint64(32)) | bits[:, 1]))
+    ordered = bits[order]
+    new = np.ones(len(p), bool)
+    new[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+    index = np.empty(len(p), np.int64)
+    index[order] = np.cumsum(new) - 1
+    return index, int(new.sum())
 
 
 def _compact(keys):
