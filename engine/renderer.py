@@ -303,6 +303,7 @@ class Renderer:
 
         kept = [(inst, snapshot.geometry[inst.key]) for inst in snapshot.instances if inst.key in snapshot.geometry]
         draws = []
+        used_levels = set()
         if kept:
             matrices = np.stack([inst.matrix for inst, _geo in kept])
             bounds = np.stack([geo.bounds for _inst, geo in kept])
@@ -313,6 +314,7 @@ class Renderer:
             for i, (inst, geo) in enumerate(kept):
                 lod = simplify.simplified(geo, levels[i]) if levels[i] is not None else None
                 if lod is not None:
+                    used_levels.add((inst.key, geo.serial, levels[i]))
                     whole, parts = self._batches_for((inst.key, geo.serial, levels[i]), lod, self._lod_batches)
                     identity = (inst.key, inst.matrix.tobytes(), geo.serial, levels[i])
                     stats.simplified += 1
@@ -328,7 +330,7 @@ class Renderer:
         live = {(key, geo.serial) for key, geo in snapshot.geometry.items()}
         for stale in [k for k in self._batches if k not in live]:
             del self._batches[stale]
-        for stale in [k for k in self._lod_batches if k[:2] not in live]:
+        for stale in [k for k in self._lod_batches if k not in used_levels]:  # levels this frame did not draw
             del self._lod_batches[stale]
         return draws
 

@@ -26,7 +26,7 @@ MAX_LEVEL = 12  # 4096 cells: finer ones keep nearly every triangle of real mesh
 MIN_TRIANGLES = 2048  # smaller meshes are drawn whole (their draw costs more than their triangles)
 WORTH = 0.7  # a level keeping more than this fraction of the triangles is not used
 _CACHE = {}  # (content digest, level) -> Geometry or None: final renders extract anew
-_CACHE_LIMIT = 256
+_CACHE_TRIANGLES = 8_000_000  # the levels kept hold at most about this many triangles
 
 
 def level_for(extent, stretch, nearest_depth, footprint, pixels):
@@ -56,9 +56,11 @@ def simplified(geo, level):
         digest = geo._simplify_digest = h.digest()
     key = (digest, level)
     if key not in _CACHE:
-        if len(_CACHE) >= _CACHE_LIMIT:
+        lod = cluster(geo, level)
+        held = sum(g.triangle_count for g in _CACHE.values() if g is not None)
+        if held + (lod.triangle_count if lod is not None else 0) > _CACHE_TRIANGLES or len(_CACHE) >= 4096:
             _CACHE.clear()
-        _CACHE[key] = cluster(geo, level)
+        _CACHE[key] = lod
     return _CACHE[key]
 
 

@@ -190,3 +190,35 @@ def test_what_needs_more_than_normals_is_drawn_whole(penumbra, gpu_call):
     bpy.context.view_layer.update()
     stats, _image = engine_frame(gpu_call, scene, 160, 90)
     assert stats.simplified == 0
+
+
+def test_a_farther_view_draws_coarser_levels_and_keeps_only_its_own(penumbra, gpu_call):
+    """One renderer, two frames: the camera pulled back three times as far draws coarser
+    levels (fewer triangles), and the GPU batches of levels the new frame does not draw are
+    released (a moving viewport does not pile up levels)."""
+    import dataclasses
+
+    from mathutils import Vector
+
+    from penumbra.engine.extract import camera_from_scene
+
+    scene = _sphere_field()
+    scene.render.use_simplify = True
+    scene.penumbra.simplify_pixels = 2.0
+    distance = float((scene.camera.location - Vector((0.0, 0.0, 0.5))).length)
+
+    def job(engine, depsgraph):
+        near = camera_from_scene(depsgraph, scene, 160, 90)
+        back = np.eye(4)
+        back[2, 3] = -2.0 * distance  # the world 2 distances further along the view axis
+        far = dataclasses.replace(near, view=back @ near.view)
+        first = engine.render_frame(depsgraph, near, 160, 90).stats
+        near_levels = set(engine.renderer._lod_batches)
+        second = engine.render_frame(depsgraph, far, 160, 90).stats
+        return first, near_levels, second, set(engine.renderer._lod_batches)
+
+    first, near_levels, second, far_levels = gpu_call(job)
+    assert first.simplified == second.simplified == 9
+    assert second.triangles < 0.5 * first.triangles
+    assert {k[2] for k in far_levels}.isdisjoint({k[2] for k in near_levels})  # coarser levels
+    assert 1 <= len(far_levels) <= 9 and far_levels.isdisjoint(near_levels)
