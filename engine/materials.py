@@ -503,15 +503,17 @@ def equirect_sh(rgb):
     return np.einsum("hwk,hwc,hw->kc", basis, rgb.astype(np.float64), solid_angle)
 
 
-def image_pixels(image):
+def image_pixels(image, data=None):
     """An image's pixels as float32 (h, w, 4), row 0 at the bottom, scene-linear colour with
-    straight alpha (as the Image Texture node outputs them), or None when it has none."""
+    straight alpha (as the Image Texture node outputs them), or None when it has none.
+    ``data``: ``image.pixels`` already read (``textures.raw_pixels``)."""
     w, h = image.size
     channels = image.channels
     if w == 0 or h == 0 or channels == 0:
         return None
-    data = np.empty(w * h * channels, np.float32)
-    image.pixels.foreach_get(data)
+    if data is None:
+        data = np.empty(w * h * channels, np.float32)
+        image.pixels.foreach_get(data)
     data = data.reshape(h, w, channels)
     out = np.ones((h, w, 4), np.float32)
     if channels >= 3:

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels, light_bins, lightspace, sampling, simplify
+from . import gpu_pool, kernels, light_bins, lightspace, sampling, simplify
 from .frame_data import build_frame_data, select_lights
 from .gpu_pool import new_texture
 from .materials import CHANNELS, EXTENSION, INTERPOLATION, Material
@@ -147,7 +147,7 @@ class Renderer:
         self.post = post_stack()
         self._batches = {}  # (geometry key, serial) -> (whole, parts)
         self._lod_batches = {}  # (geometry key, serial, level) -> (whole, parts) of ``simplify.simplified``
-        self.textures = TextureCache()
+        self.textures = TextureCache(gpu_pool.FINAL_IMAGES if pool is not None else None)
         self._material_ubos = {}  # id(Material) -> (Material, GPUUniformBuf)
         self._jitter_tex = None
         self._jitter_dummy = None

@@ -397,3 +397,34 @@ def test_emission_pass_is_what_surfaces_emit(penumbra, samples, eevee_emission):
     if samples > 1:  # anti-aliased like Combined: edge pixels are partial
         partial = (emit[..., 0] > 0.05) & (emit[..., 0] < 1.95)
         assert partial.sum() > 10
+
+
+def test_final_renders_share_an_image_until_its_pixels_change(penumbra):
+    """Final renders (a new engine each) convert and upload an image once and take it from
+    ``gpu_pool.FINAL_IMAGES`` after that, by the hash of its pixels: the same frame. Pixels
+    edited in memory make a new texture at once, saved or not."""
+    from penumbra.engine import gpu_pool
+
+    scene = _builder("texture_base_color")
+    image = bpy.data.images["Checker"]
+    gpu_pool.FINAL_IMAGES.clear()
+    hits = gpu_pool.FINAL_IMAGES.hits
+    first = _penumbra(scene, samples=1)
+    second = _penumbra(scene, samples=1)
+    assert (gpu_pool.FINAL_IMAGES.hits, len(gpu_pool.FINAL_IMAGES)) == (hits + 1, 1)
+    np.testing.assert_array_equal(first, second)
+
+    pixels = np.empty(len(image.pixels), np.float32)
+    image.pixels.foreach_get(pixels)
+    pixels.reshape(-1, 4)[7, :3] = (0.9, 0.1, 0.1)  # one texel red
+    image.pixels.foreach_set(pixels)
+    edited = _penumbra(scene, samples=1)
+    assert (gpu_pool.FINAL_IMAGES.hits, len(gpu_pool.FINAL_IMAGES)) == (hits + 1, 2)  # a new texture
+    assert not np.array_equal(edited, first)
+    again = _penumbra(scene, samples=1)
+    assert gpu_pool.FINAL_IMAGES.hits == hits + 2
+    np.testing.assert_array_equal(again, edited)
+    image.colorspace_settings.name = "Non-Color"  # the same pixels read another way
+    other = _penumbra(scene, samples=1)
+    assert (gpu_pool.FINAL_IMAGES.hits, len(gpu_pool.FINAL_IMAGES)) == (hits + 2, 3)
+    assert not np.array_equal(other, edited)
