@@ -4,12 +4,13 @@ Every F12 render, and every frame of an animation render, is a new engine instan
 pool each one allocates its targets and its shadow atlas anew, and on llvmpipe a new texture
 costs its zero-fill: about 17 ms for the 32 MiB atlas of the demo at 960x540 (two 2048 maps).
 
-Image textures are kept too (``FINAL_IMAGES``), by their pixels' hash. Only textures
-and programs are kept (``final_shaders``: a variant compiles once a session, not
-once a render, about 7 ms a render for the demo). Both are shared between GPU contexts, while
-framebuffers and batches belong to the context that made them and are made again by each
-render. A texture taken from the pool holds the last render's pixels; the renderer clears or
-redraws all of it (its shadow maps start empty, so every map is drawn again).
+Only textures and programs are kept: render targets (``FINAL_RENDERS``), image textures by the
+hash of their pixels (``FINAL_IMAGES``, at most twice the targets' budget) and compiled programs
+(``final_shaders``: a variant compiles once a session, not once a render, about 7 ms a render
+for the demo). Textures and programs are shared between GPU contexts, while framebuffers and
+batches belong to the context that made them and are made again by each render. A texture
+taken from the pool holds the last render's pixels; the renderer clears or redraws all of it
+(its shadow maps start empty, so every map is drawn again).
 
 The pool holds at most ``budget`` bytes between renders, oldest textures dropped first. It is
 emptied when the extension is unregistered (Blender disables add-ons on exit before it shuts
@@ -89,7 +90,7 @@ class ImageTextures:
 
     def __init__(self, budget=BUDGET * 2):
         self.budget = budget
-        self._held = OrderedDict()  # fingerprint -> texture
+        self._held = OrderedDict()  # content key -> texture, least recently used first
         self.hits = 0
 
     def __len__(self):

@@ -5,8 +5,8 @@ alpha, as the Image Texture node outputs them) and uploaded as RGBA16F; a textur
 a depsgraph update says its image changed (``SceneCache.images_changed``) or it is no longer
 used. Final renders (a new engine each) also share textures between renders through
 ``gpu_pool.FINAL_IMAGES``, by ``content_key``: an animation render converts and uploads each
-image once. A missing or unreadable image draws as magenta,
-Blender's own colour for a missing texture, with a message.
+image once. A missing or unreadable image draws as magenta, Blender's own colour for a missing
+texture, with a message.
 """
 
 import hashlib
