@@ -148,6 +148,34 @@ class GaussianWeights:
         return self._ubo
 
 
+def half_size_mean(img):
+    """Reference of a half-size pass, numpy-ready: each pixel of the ((h + 1) // 2,
+    (w + 1) // 2) image is the mean of the 2x2 pixels of ``img`` (h, w, c) it covers that
+    exist (one or two at odd edges), in float64."""
+    img = np.asarray(img, np.float64)
+    h, w, c = img.shape
+    hh, hw = (h + 1) // 2, (w + 1) // 2
+    sums = np.zeros((2 * hh, 2 * hw, c))
+    counts = np.zeros((2 * hh, 2 * hw, 1))
+    sums[:h, :w], counts[:h, :w] = img, 1.0
+    return sums.reshape(hh, 2, hw, 2, c).sum(axis=(1, 3)) / counts.reshape(hh, 2, hw, 2, 1).sum(axis=(1, 3))
+
+
+def bilinear_up(small, h, w):
+    """Reference of reading a half-size image back at full size, numpy-ready: ``small``
+    bilinearly at each of the (h, w) pixel centres, clamped to its edge texels, in float64."""
+    small = np.asarray(small, np.float64)
+    hh, hw = small.shape[:2]
+    ty = np.clip((np.arange(h) + 0.5) * 0.5 - 0.5, 0.0, hh - 1)
+    tx = np.clip((np.arange(w) + 0.5) * 0.5 - 0.5, 0.0, hw - 1)
+    y0, x0 = np.floor(ty).astype(int), np.floor(tx).astype(int)
+    y1, x1 = np.minimum(y0 + 1, hh - 1), np.minimum(x0 + 1, hw - 1)
+    fy, fx = (ty - y0)[:, None, None], (tx - x0)[None, :, None]
+    rows0 = small[y0][:, x0] * (1 - fx) + small[y0][:, x1] * fx
+    rows1 = small[y1][:, x0] * (1 - fx) + small[y1][:, x1] * fx
+    return rows0 * (1 - fy) + rows1 * fy
+
+
 def table_texture(rgb):
     """An RGBA32F texture of a built-in table: ``rgb`` is (height, width, 3), or (width, 3) for
     one row; alpha is 1."""

@@ -16,7 +16,16 @@ import numpy as np
 
 from ..enums import Enum
 from ..settings import Param
-from .base import GAUSSIAN_MAX_RADIUS, GAUSSIAN_VEC4S, GAUSSIAN_WEIGHTS, GaussianWeights, PostEffect, post_program
+from .base import (
+    GAUSSIAN_MAX_RADIUS,
+    GAUSSIAN_VEC4S,
+    GAUSSIAN_WEIGHTS,
+    GaussianWeights,
+    PostEffect,
+    bilinear_up,
+    half_size_mean,
+    post_program,
+)
 
 # The shader's passes, selected by the GLOW_PASS define (see glow.frag.glsl).
 PASS = Enum(
@@ -217,19 +226,7 @@ def glow_reference(img, threshold, knee, intensity, radius, square_samples=False
         out[..., :3] += intensity * gaussian_reference(padded, radius)[..., :3]
         return out
     h, w = bright.shape[:2]
-    hh, hw = (h + 1) // 2, (w + 1) // 2
-    sums = np.zeros((2 * hh, 2 * hw, 3))
-    counts = np.zeros((2 * hh, 2 * hw, 1))
-    sums[:h, :w], counts[:h, :w] = bright, 1.0
-    small = sums.reshape(hh, 2, hw, 2, 3).sum(axis=(1, 3)) / counts.reshape(hh, 2, hw, 2, 1).sum(axis=(1, 3))
     r, sigma = half_radius(radius)
-    blurred = gaussian_reference(small, r, sigma)
-    ty = np.clip((np.arange(h) + 0.5) * 0.5 - 0.5, 0.0, hh - 1)
-    tx = np.clip((np.arange(w) + 0.5) * 0.5 - 0.5, 0.0, hw - 1)
-    y0, x0 = np.floor(ty).astype(int), np.floor(tx).astype(int)
-    y1, x1 = np.minimum(y0 + 1, hh - 1), np.minimum(x0 + 1, hw - 1)
-    fy, fx = (ty - y0)[:, None, None], (tx - x0)[None, :, None]
-    rows0 = blurred[y0][:, x0] * (1 - fx) + blurred[y0][:, x1] * fx
-    rows1 = blurred[y1][:, x0] * (1 - fx) + blurred[y1][:, x1] * fx
-    out[..., :3] += intensity * (rows0 * (1 - fy) + rows1 * fy)
+    blurred = gaussian_reference(half_size_mean(bright), r, sigma)
+    out[..., :3] += intensity * bilinear_up(blurred, h, w)
     return out
