@@ -114,7 +114,8 @@ class Colorizer(PostEffect):
     def execute(self, ctx, src, params, mix):
         luma = src
         if params.blur_radius > 0:
-            luma = self._blur.execute(ctx, src, SimpleNamespace(radius=params.blur_radius, sigma=0.0), 1.0)
+            blur = SimpleNamespace(radius=params.blur_radius, sigma=0.0, half_resolution=False)
+            luma = self._blur.execute(ctx, src, blur, 1.0)
         dst = ctx.acquire(src, luma)
         return ctx.fullscreen(
             PROGRAM,

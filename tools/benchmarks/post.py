@@ -83,13 +83,22 @@ def measure(runner, scene, w, h, runs, radii):
             stack.run(ctx, src, layer)
             passes = ctx.stats.post_passes - passes_before
             rows.append((eid, passes, timed(lambda: stack.run(ctx, src, layer))))
-        # GLOW's half-resolution path at the same (default) parameters.
-        half = SimpleNamespace(**{**vars(EFFECTS["GLOW"].defaults()), "half_resolution": True})
-        layer = [("GLOW", True, 1.0, half)]
-        passes_before = ctx.stats.post_passes
-        stack.run(ctx, src, layer)
-        passes = ctx.stats.post_passes - passes_before
-        rows.append(("GLOW, half resolution", passes, timed(lambda: stack.run(ctx, src, layer))))
+        # The half-resolution paths of GLOW and BLUR at the same (default) parameters, and BLUR
+        # at radius 16 both ways.
+        wide = {"radius": 16}
+        for eid, extra, name in (
+            ("GLOW", {}, "GLOW, half resolution"),
+            ("BLUR", {}, "BLUR, half resolution"),
+            ("BLUR", wide, "BLUR (radius 16)"),
+            ("BLUR", wide, "BLUR (radius 16), half resolution"),
+        ):
+            half = "half" in name
+            params = SimpleNamespace(**{**vars(EFFECTS[eid].defaults()), **extra, "half_resolution": half})
+            layer = [(eid, True, 1.0, params)]
+            passes_before = ctx.stats.post_passes
+            stack.run(ctx, src, layer)
+            passes = ctx.stats.post_passes - passes_before
+            rows.append((name, passes, timed(lambda layer=layer: stack.run(ctx, src, layer))))
         everything = [(eid, True, 1.0, cls.defaults()) for eid, cls in EFFECTS.items()]
         # The point layers stacked: one shared pass (as the stack runs them), then one pass each.
         points = [layer for layer in everything if issubclass(EFFECTS[layer[0]], base.PointEffect)]
@@ -115,7 +124,7 @@ def measure(runner, scene, w, h, runs, radii):
         blur_rows = []
         for r in radii:
             ubo = weights.get(r)
-            layer = [("BLUR", True, 1.0, SimpleNamespace(radius=r, sigma=0.0))]
+            layer = [("BLUR", True, 1.0, SimpleNamespace(**{**vars(EFFECTS["BLUR"].defaults()), "radius": r}))]
             sep = timed(lambda: stack.run(ctx, src, layer))
             direct = timed(
                 lambda: ctx.fullscreen(
