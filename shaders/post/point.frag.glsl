@@ -9,39 +9,35 @@ vec4 point_step(vec4 c, vec4 effected, int layer)
   return (m >= 1.0) ? effected : mix(c, effected, m);
 }
 
+/* Layer i of the pass: its input cleaned of NaN/Inf, its effect, its mix. */
+#define POINT_LAYER(i, fn) c = sanitize(c); c = point_step(c, fn(c, 4 * (i)), i)
+
 void main()
 {
   vec4 c = post_source();
 #if POINT_COUNT > 0
-  c = point_step(c, POINT_FN_0(c, 0), 0);
+  POINT_LAYER(0, POINT_FN_0);
 #endif
 #if POINT_COUNT > 1
-  c = sanitize(c);
-  c = point_step(c, POINT_FN_1(c, 4), 1);
+  POINT_LAYER(1, POINT_FN_1);
 #endif
 #if POINT_COUNT > 2
-  c = sanitize(c);
-  c = point_step(c, POINT_FN_2(c, 8), 2);
+  POINT_LAYER(2, POINT_FN_2);
 #endif
 #if POINT_COUNT > 3
-  c = sanitize(c);
-  c = point_step(c, POINT_FN_3(c, 12), 3);
+  POINT_LAYER(3, POINT_FN_3);
 #endif
 #if POINT_COUNT > 4
-  c = sanitize(c);
-  c = point_step(c, POINT_FN_4(c, 16), 4);
+  POINT_LAYER(4, POINT_FN_4);
 #endif
 #if POINT_COUNT > 5
-  c = sanitize(c);
-  c = point_step(c, POINT_FN_5(c, 20), 5);
+  POINT_LAYER(5, POINT_FN_5);
 #endif
 #if POINT_COUNT > 6
-  c = sanitize(c);
-  c = point_step(c, POINT_FN_6(c, 24), 6);
+  POINT_LAYER(6, POINT_FN_6);
 #endif
 #if POINT_COUNT > 7
-  c = sanitize(c);
-  c = point_step(c, POINT_FN_7(c, 28), 7);
+  POINT_LAYER(7, POINT_FN_7);
 #endif
   out_color = c;
 }
