@@ -103,8 +103,8 @@ def cluster(geo, level):
     plane *= np.sqrt(0.5 * length)[:, None]
     rows, cols = np.triu_indices(4)
     quadric = np.zeros((count, 10))  # the upper triangle of each cluster's 4x4 quadric
-    for k, (r, c) in enumerate(zip(rows, cols, strict=True)):
-        q = plane[:, r] * plane[:, c]
+    for k, (row, col) in enumerate(zip(rows, cols, strict=True)):
+        q = plane[:, row] * plane[:, col]
         for j in range(3):
             quadric[:, k] += np.bincount(corner[:, j], q, count)
     full = np.zeros((count, 4, 4))
