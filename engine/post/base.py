@@ -290,6 +290,33 @@ class PostContext:
             blocks={"point": self._point_ubos[index]},
         )
 
+    def half_size(self, program, src, mix, steps, up, blocks=None):
+        """A layer drawn at half size: each of ``steps`` ([(defines, uniforms)]) a pass into a
+        half-size target reading the one before (``input_tex``; the first reads ``src``),
+        then ``up`` (defines, uniforms) back at full size, blended by ``mix``. Every pass also
+        sees ``src`` as ``source_tex``."""
+        half = ((src.width + 1) // 2, (src.height + 1) // 2)
+        image = src
+        for defines, uniforms in steps:
+            target = self.acquire(image, size=half)  # two half-size targets in turn
+            image = self.fullscreen(
+                program,
+                target,
+                defines=defines,
+                samplers={"source_tex": src, "input_tex": image},
+                uniforms={**uniforms, "mix_factor": 1.0},
+                blocks=blocks,
+            )
+        defines, uniforms = up
+        return self.fullscreen(
+            program,
+            self.acquire(src),
+            defines=defines,
+            samplers={"source_tex": src, "input_tex": image},
+            uniforms={**uniforms, "mix_factor": mix},
+            blocks=blocks,
+        )
+
     def fullscreen(self, program, target, defines=None, samplers=None, uniforms=None, blocks=None):
         """Draw one full-screen pass of ``program`` into ``target`` (over all of it, whatever
         its size)."""

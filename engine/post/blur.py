@@ -114,29 +114,12 @@ class Blur(PostEffect):
         """The half-resolution path: down, blur across, blur up, up (four passes)."""
         radius, sigma = half_kernel(params.radius, self.sigma(params))
         ubo = self._weights.get(radius, sigma)
-        half = ((src.width + 1) // 2, (src.height + 1) // 2)
-        steps = (("DOWN", (0.0, 0.0)), ("AXIS", (1.0, 0.0)), ("AXIS", (0.0, 1.0)))
-        images = [src]
-        for pass_id, direction in steps:
-            target = ctx.acquire(images[-1], size=half)  # two half-size targets in turn
-            images.append(
-                ctx.fullscreen(
-                    PROGRAM,
-                    target,
-                    defines={"BLUR_PASS": PASS.define(pass_id)},
-                    samplers={"source_tex": src, "input_tex": images[-1]},
-                    uniforms={"direction": direction, "radius": radius, "mix_factor": 1.0},
-                    blocks={"weights": ubo},
-                )
-            )
-        return ctx.fullscreen(
-            PROGRAM,
-            ctx.acquire(src),
-            defines={"BLUR_PASS": PASS.define("UP")},
-            samplers={"source_tex": src, "input_tex": images[-1]},
-            uniforms={"direction": (0.0, 0.0), "radius": radius, "mix_factor": mix},
-            blocks={"weights": ubo},
-        )
+
+        def step(pass_id, direction):
+            return {"BLUR_PASS": PASS.define(pass_id)}, {"direction": direction, "radius": radius}
+
+        steps = [step("DOWN", (0.0, 0.0)), step("AXIS", (1.0, 0.0)), step("AXIS", (0.0, 1.0))]
+        return ctx.half_size(PROGRAM, src, mix, steps, step("UP", (0.0, 0.0)), {"weights": ubo})
 
 
 def half_kernel(radius, sigma=None):

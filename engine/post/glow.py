@@ -26,6 +26,7 @@ from .base import (
     half_size_mean,
     post_program,
 )
+from .blur import gaussian_reference, half_kernel
 
 # The shader's passes, selected by the GLOW_PASS define (see glow.frag.glsl).
 PASS = Enum(
@@ -174,36 +175,12 @@ class Glow(PostEffect):
 
     def _half(self, ctx, src, params, mix):
         """The half-resolution path: down, blur across, blur up, up (four passes)."""
-        radius, sigma = half_radius(params.radius)
+        radius, sigma = half_kernel(params.radius)
         ubo = self._weights.get(radius, sigma)
-        uniforms = {**self._uniforms(params, radius), "mix_factor": 1.0}
-        half = ((src.width + 1) // 2, (src.height + 1) // 2)
-        images = [src]
-        for pass_id in ("DOWN", "BLUR_H", "BLUR_V"):
-            target = ctx.acquire(images[-1], size=half)  # two half-size targets in turn
-            images.append(
-                ctx.fullscreen(
-                    PROGRAM,
-                    target,
-                    defines={"GLOW_PASS": PASS.define(pass_id)},
-                    samplers={"source_tex": src, "input_tex": images[-1]},
-                    uniforms=uniforms,
-                    blocks={"weights": ubo},
-                )
-            )
-        return ctx.fullscreen(
-            PROGRAM,
-            ctx.acquire(src),
-            defines={"GLOW_PASS": PASS.define("UP")},
-            samplers={"source_tex": src, "input_tex": images[-1]},
-            uniforms={**uniforms, "mix_factor": mix},
-            blocks={"weights": ubo},
-        )
-
-
-def half_radius(radius):
-    """(radius, sigma) of the half-resolution blur: half the full one's, in half-size pixels."""
-    return (int(radius) + 1) // 2, int(radius) / 4.0
+        uniforms = self._uniforms(params, radius)
+        steps = [({"GLOW_PASS": PASS.define(p)}, uniforms) for p in ("DOWN", "BLUR_H", "BLUR_V")]
+        up = ({"GLOW_PASS": PASS.define("UP")}, uniforms)
+        return ctx.half_size(PROGRAM, src, mix, steps, up, {"weights": ubo})
 
 
 def glow_reference(img, threshold, knee, intensity, radius, square_samples=False, half_resolution=False):
@@ -211,10 +188,8 @@ def glow_reference(img, threshold, knee, intensity, radius, square_samples=False
     Gaussian(bright-pass), alpha kept, in float64. ``knee`` is the parameter (a fraction of
     ``threshold``); non-finite input components read as 0. ``half_resolution``: the
     half-size path (2x2 means of the bright-pass over the pixels that exist, the blur of
-    ``half_radius``, a bilinear read at each pixel's centre, clamped to the edge)."""
+    ``blur.half_kernel``, a bilinear read at each pixel's centre, clamped to the edge)."""
     import numpy as np
-
-    from .blur import gaussian_reference
 
     clean = np.where(np.isfinite(img), img, 0.0).astype(np.float64)
     bright = bright_pass(clean[..., :3], threshold, threshold * knee)
@@ -226,7 +201,7 @@ def glow_reference(img, threshold, knee, intensity, radius, square_samples=False
         out[..., :3] += intensity * gaussian_reference(padded, radius)[..., :3]
         return out
     h, w = bright.shape[:2]
-    r, sigma = half_radius(radius)
+    r, sigma = half_kernel(radius)
     blurred = gaussian_reference(half_size_mean(bright), r, sigma)
     out[..., :3] += intensity * bilinear_up(blurred, h, w)
     return out
