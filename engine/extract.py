@@ -548,6 +548,17 @@ class SceneCache:
                 own[key] = data.as_pointer() if data is not None else 0
             return own[key]
 
+        held = {}
+
+        def holdout(orig, inst):
+            """Object > Visibility > Holdout, or a collection set to Holdout in this view layer
+            (an instance takes its instancer's, as Blender's engines do)."""
+            base = inst.parent.original if inst.is_instance and inst.parent is not None else orig
+            key = base.name_full
+            if key not in held:
+                held[key] = bool(base.holdout_get(view_layer=depsgraph.view_layer))
+            return held[key] or bool(getattr(orig, "is_holdout", False))
+
         messages = []
         for inst in depsgraph.object_instances:
             ob = inst.object
@@ -598,7 +609,7 @@ class SceneCache:
                     materials=materials,
                     shadow=shadow,
                     camera=camera,
-                    holdout=bool(getattr(orig, "is_holdout", False)),
+                    holdout=holdout(orig, inst),
                 )
             )
         # Forget geometry no longer in the scene so its GPU buffers are freed.

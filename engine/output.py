@@ -57,10 +57,11 @@ def render_views(render):
 
 
 # Blender settings a scene can switch on that Penumbra does not render: (where, attribute,
-# what the user is told). Checked on every final render; each one in use is named once in
-# the render report.
+# what the user is told[, the value that is not rendered: True unless given]). Checked on every
+# final render; each one in use is named once in the render report.
 _UNSUPPORTED = (
     ("camera", "dof.use_dof", "camera depth of field is not rendered"),
+    ("camera", "type", "panoramic cameras are not rendered (drawn as a perspective camera)", "PANO"),
     ("render", "use_motion_blur", "motion blur is not rendered"),
     ("render", "use_freestyle", "Freestyle lines are not rendered"),
     ("view_layer", "use_pass_diffuse_color", "the Diffuse Color pass is not written"),
@@ -82,8 +83,8 @@ def unsupported_in_use(camera_data, render, view_layer):
     """Messages for the settings of ``_UNSUPPORTED`` that are switched on, each once."""
     owners = {"camera": camera_data, "render": render, "view_layer": view_layer}
     out = []
-    for where, path, message in _UNSUPPORTED:
-        if _lookup(owners[where], path) is True:
+    for where, path, message, *value in _UNSUPPORTED:
+        if _lookup(owners[where], path) == (value[0] if value else True):
             text = f"Penumbra: {message}"
             if text not in out:
                 out.append(text)

@@ -288,6 +288,42 @@ def test_object_visibility_matches_eevee(penumbra):
     assert (ours[..., 3] < 0.01).sum() > 30  # the holdout's hole is there
 
 
+def test_a_collection_held_out_in_the_view_layer_is_a_holdout(penumbra):
+    """Outliner > Holdout on a collection masks its objects in that view layer, and an
+    instance of a collection takes its instancer's: the same image (RGB and alpha) as the
+    object's own Holdout switch, on both."""
+    size = 48
+
+    def held_out(how):
+        scene = material_scenes.visibility(size, size)
+        sphere = scene.objects["Holdout"]
+        if how == "object":
+            return _penumbra(scene, samples=1)
+        sphere.is_holdout = False
+        layers = scene.view_layers[0].layer_collection
+        masked = bpy.data.collections.new("Masked")
+        scene.collection.children.link(masked)
+        if how == "collection":
+            scene.collection.objects.unlink(sphere)
+            masked.objects.link(sphere)
+        else:  # the sphere drawn only through an instance of its (excluded) collection
+            source = bpy.data.collections.new("Source")
+            scene.collection.children.link(source)
+            scene.collection.objects.unlink(sphere)
+            source.objects.link(sphere)
+            layers.children["Source"].exclude = True
+            empty = bpy.data.objects.new("SphereInstance", None)
+            empty.instance_type, empty.instance_collection = "COLLECTION", source
+            masked.objects.link(empty)
+        layers.children["Masked"].holdout = True
+        return _penumbra(scene, samples=1)
+
+    own = held_out("object")
+    assert (own[..., 3] < 0.01).sum() > 30  # the hole is there
+    for how in ("collection", "instance"):
+        np.testing.assert_allclose(held_out(how), own, atol=1e-5, err_msg=how)
+
+
 # --- model only what a scene requires -----------------------------------------------------
 
 

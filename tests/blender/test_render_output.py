@@ -266,6 +266,7 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         """
         scene = demo(32, 24)
         scene.camera.data.dof.use_dof = True
+        scene.camera.data.type = "PANO"
         scene.render.use_motion_blur = True
         scene.view_layers[0].use_pass_diffuse_color = True
         bpy.ops.render.render()
@@ -274,7 +275,8 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
     )
     assert result["done"]
     for message in ("camera depth of field is not rendered", "motion blur is not rendered",
-                    "the Diffuse Color pass is not written"):  # fmt: skip
+                    "the Diffuse Color pass is not written",
+                    "panoramic cameras are not rendered (drawn as a perspective camera)"):  # fmt: skip
         assert output.count(f"Penumbra: {message}") == 1, message
 
 
