@@ -64,10 +64,6 @@ _UNSUPPORTED = (
     ("camera", "type", "panoramic cameras are not rendered (drawn as a perspective camera)", "PANO"),
     ("render", "use_motion_blur", "motion blur is not rendered"),
     ("render", "use_freestyle", "Freestyle lines are not rendered"),
-    ("view_layer", "use_pass_diffuse_color", "the Diffuse Color pass is not written"),
-    ("view_layer", "use_pass_ambient_occlusion", "the Ambient Occlusion pass is not written"),
-    ("view_layer", "use_pass_cryptomatte_object", "Cryptomatte passes are not written"),
-    ("view_layer", "use_pass_cryptomatte_material", "Cryptomatte passes are not written"),
 )
 
 
@@ -79,16 +75,31 @@ def _lookup(owner, path):
     return owner
 
 
+# The view layer passes Penumbra writes (its own Shadow and Lit passes live in ``penumbra``).
+WRITTEN_PASSES = {"use_pass_combined", "use_pass_z", "use_pass_normal", "use_pass_mist", "use_pass_emit"}
+
+
 def unsupported_in_use(camera_data, render, view_layer):
-    """Messages for the settings of ``_UNSUPPORTED`` that are switched on, each once."""
+    """Messages for the settings of ``_UNSUPPORTED`` that are switched on, and for every pass of
+    the view layer that is switched on but not written (a file set up for another engine keeps
+    its passes switched on), AOVs and light groups included; each once."""
     owners = {"camera": camera_data, "render": render, "view_layer": view_layer}
     out = []
     for where, path, message, *value in _UNSUPPORTED:
         if _lookup(owners[where], path) == (value[0] if value else True):
-            text = f"Penumbra: {message}"
-            if text not in out:
-                out.append(text)
-    return out
+            out.append(f"Penumbra: {message}")
+    if view_layer is not None:
+        for prop in view_layer.bl_rna.properties:
+            name = prop.identifier
+            if name.startswith("use_pass_") and name not in WRITTEN_PASSES and name != "use_pass_cryptomatte_accurate":
+                if getattr(view_layer, name, False) is True:
+                    own = " (switch on Penumbra's own in View Layer > Passes)" if name == "use_pass_shadow" else ""
+                    out.append(f"Penumbra: Blender's {prop.name} pass is not written{own}")
+        if len(getattr(view_layer, "aovs", ())):
+            out.append("Penumbra: shader AOV passes are not written")
+        if len(getattr(view_layer, "lightgroups", ())):
+            out.append("Penumbra: light group passes are not written")
+    return list(dict.fromkeys(out))
 
 
 def view_distance_scale(projection, is_ortho, width, height):

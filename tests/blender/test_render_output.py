@@ -268,16 +268,27 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         scene.camera.data.dof.use_dof = True
         scene.camera.data.type = "PANO"
         scene.render.use_motion_blur = True
-        scene.view_layers[0].use_pass_diffuse_color = True
+        layer = scene.view_layers[0]
+        layer.use_pass_diffuse_color = layer.use_pass_vector = layer.use_pass_cryptomatte_object = True
+        layer.use_pass_shadow = layer.use_pass_z = layer.use_pass_normal = True  # Depth and Normal are written
+        layer.aovs.add()
         bpy.ops.render.render()
         report(done=True)
         """
     )
     assert result["done"]
-    for message in ("camera depth of field is not rendered", "motion blur is not rendered",
-                    "the Diffuse Color pass is not written",
-                    "panoramic cameras are not rendered (drawn as a perspective camera)"):  # fmt: skip
+    for message in (
+        "camera depth of field is not rendered",
+        "motion blur is not rendered",
+        "panoramic cameras are not rendered (drawn as a perspective camera)",
+        "Blender's Diffuse Color pass is not written",
+        "Blender's Vector pass is not written",
+        "Blender's Cryptomatte Object pass is not written",
+        "shader AOV passes are not written",
+        "Blender's Shadow pass is not written (switch on Penumbra's own in View Layer > Passes)",
+    ):
         assert output.count(f"Penumbra: {message}") == 1, message
+    assert "Depth pass is not" not in output and "Normal pass is not" not in output and "Z pass" not in output
 
 
 def test_final_renders_take_their_textures_from_the_pool_and_draw_every_map_again():
