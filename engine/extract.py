@@ -563,6 +563,12 @@ class SceneCache:
         for inst in depsgraph.object_instances:
             ob = inst.object
             if ob.type == "LIGHT":
+                linking = getattr(ob, "light_linking", None)
+                if linking is not None and (linking.receiver_collection or linking.blocker_collection):
+                    messages.append(
+                        f"light '{ob.name}': light and shadow linking are not rendered (it lights, and is "
+                        "blocked by, every object)"
+                    )
                 light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
                 if light is not None:
                     lights.append(light)

@@ -272,8 +272,12 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         layer.use_pass_diffuse_color = layer.use_pass_vector = layer.use_pass_cryptomatte_object = True
         layer.use_pass_shadow = layer.use_pass_z = layer.use_pass_normal = True  # Depth and Normal are written
         layer.aovs.add()
+        linked = bpy.data.collections.new("Linked")
+        linked.objects.link(bpy.data.objects["Ball"])
+        sun = next(ob for ob in scene.objects if ob.type == "LIGHT")
+        sun.light_linking.blocker_collection = linked
         bpy.ops.render.render()
-        report(done=True)
+        report(done=True, sun=sun.name)
         """
     )
     assert result["done"]
@@ -285,6 +289,8 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         "Blender's Vector pass is not written",
         "Blender's Cryptomatte Object pass is not written",
         "shader AOV passes are not written",
+        f"light '{result['sun']}': light and shadow linking are not rendered (it lights, and is blocked by, "
+        "every object)",
         "Blender's Shadow pass is not written (switch on Penumbra's own in View Layer > Passes)",
     ):
         assert output.count(f"Penumbra: {message}") == 1, message
