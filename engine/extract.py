@@ -158,6 +158,7 @@ def camera_from_scene(depsgraph, scene, width, height, matrix_world=None, shift_
     aspect_x, aspect_y = scene.render.pixel_aspect_x, scene.render.pixel_aspect_y
     proj = matrix_np(cam_ob.calc_matrix_camera(depsgraph, x=width, y=height, scale_x=aspect_x, scale_y=aspect_y))
     ortho = cam_ob.data.type == "ORTHO"
+    exact_depth_rows(proj, cam_ob.data.clip_start, cam_ob.data.clip_end, ortho)
     if shift_x is not None and shift_x != cam_ob.data.shift_x:
         delta = (shift_x - cam_ob.data.shift_x) * shift_scale(
             cam_ob.data.sensor_fit, width * aspect_x, height * aspect_y
@@ -166,9 +167,30 @@ def camera_from_scene(depsgraph, scene, width, height, matrix_world=None, shift_
             proj[0, 3] -= delta
         else:
             proj[0, 2] += delta
+    # Blender's engines ignore the camera object's scale (a scaled rig must not scale the view,
+    # the clip distances or the Depth pass): its axes are normalised, as Blender does.
     world = cam_ob.matrix_world if matrix_world is None else matrix_world
+    if any(abs(world.col[i].xyz.length - 1.0) > 1e-6 for i in range(3)):  # unscaled: as it is, to the bit
+        world = world.normalized()
     view = matrix_np(world.inverted_safe())
     return Camera(view=view, projection=proj, is_ortho=ortho)
+
+
+def exact_depth_rows(proj, near, far, ortho):
+    """Put back the depth terms of ``proj`` (Blender's float32 camera matrix) in float64 from
+    the clip distances, when they are the same numbers rounded: at a near/far ratio beyond
+    about 1e7 float32 rounds a perspective matrix's -(f + n) / (f - n) to -1 and the far plane
+    is lost, though the GPU still draws with it. Changes ``proj`` in place."""
+    near, far = float(near), float(far)
+    if not (far > near and (ortho or near > 0.0)):
+        return
+    if ortho:
+        exact = (-2.0 / (far - near), -(far + near) / (far - near))
+    else:
+        exact = (-(far + near) / (far - near), -2.0 * far * near / (far - near))
+    given = (proj[2, 2], proj[2, 3])
+    if all(abs(np.float32(e) - np.float32(g)) <= 2.0 * abs(np.spacing(np.float32(e))) for e, g in zip(exact, given)):
+        proj[2, 2], proj[2, 3] = exact
 
 
 def shift_scale(sensor_fit, width, height):

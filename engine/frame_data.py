@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernels, light_bins
+from . import kernels, light_bins, lightspace
 from .enums import LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
 from .kernels import RING
 from .programs import (
@@ -24,6 +24,8 @@ from .programs import (
     lit_defines,
     max_filter_radius,
 )
+
+_ZERO = np.zeros(3)  # the default frame origin: world space as it is
 
 
 @dataclass
@@ -62,15 +64,16 @@ def select_lights(lights, camera_position, limit):
     return [lights[i] for i in keep]
 
 
-def light_row(light, shadow=None):
-    """One LIGHT_STRUCT row. ``shadow``: the light's ``shadows.LightShadow`` or None."""
+def light_row(light, shadow=None, origin=_ZERO):
+    """One LIGHT_STRUCT row. ``shadow``: the light's ``shadows.LightShadow`` or None;
+    ``origin``: the frame origin, which positions are given relative to."""
     half = 0.5 * min(max(light.spot_size, 0.0), math.pi)
     cos_half = math.cos(half)
     tiles = (list(shadow.tiles) if shadow else []) + [-1] * 6
     return {
         "color": light.color,
         "type": LIGHT_TYPE.value(light.type),
-        "position": light.position,
+        "position": np.asarray(light.position, np.float64) - origin,
         "radius": light.radius,
         "direction": light.direction,
         "spot_cos_half": cos_half if light.type == "SPOT" else -2.0,
@@ -86,11 +89,12 @@ def light_row(light, shadow=None):
     }
 
 
-def frame_row(camera, world_color, light_count, settings, tile_size, atlas_columns):
+def frame_row(camera, world_color, light_count, settings, tile_size, atlas_columns, origin=_ZERO):
+    view = camera.view @ lightspace.from_origin(origin)  # takes positions relative to ``origin``
     return {
-        "view_proj": camera.projection @ camera.view,
-        "view": camera.view,
-        "camera_position": camera.position,
+        "view_proj": camera.projection @ view,
+        "view": view,
+        "camera_position": camera.position - origin,
         "is_ortho": int(camera.is_ortho),
         "camera_forward": camera.forward,
         "light_count": light_count,
@@ -138,6 +142,7 @@ def build_frame_data(
     rects=None,
     size=None,
     alpha_offset=0.5,
+    origin=_ZERO,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -146,14 +151,21 @@ def build_frame_data(
     light, the screen rectangle it can light (``light_bins.screen_rects``) on a frame of
     ``size`` (width, height) pixels, which bins the lights when several are local.
     ``world_color``: a ``materials.World`` (its SH light) or a constant colour;
-    ``alpha_offset``: this sample's shift of the alpha-hash threshold ((s + 0.5) / N)."""
+    ``alpha_offset``: this sample's shift of the alpha-hash threshold ((s + 0.5) / N);
+    ``origin``: the frame origin: every position the GPU gets is relative to it."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings)
     order, sampled, shadowed = shading_order(lights, plan)
     sh = getattr(world_color, "sh", None)  # a materials.World, or a constant colour
     frame = frame_row(
-        camera, world_color.mean if sh is not None else world_color, len(lights), settings, tile_size, atlas_columns
+        camera,
+        world_color.mean if sh is not None else world_color,
+        len(lights),
+        settings,
+        tile_size,
+        atlas_columns,
+        origin,
     )
     if sh is not None:
         for k in range(1, 9):
@@ -168,8 +180,8 @@ def build_frame_data(
         bins = light_bins.bin_masks([rects[i] for i in order], size[0], size[1], LIGHT_WORDS)
     return FrameData(
         frame=FRAME_STRUCT.pack([frame]),
-        lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i)) for i in order], MAX_LIGHTS),
-        tiles=TILE_STRUCT.pack([t.record() for t in plan.tiles], MAX_SHADOW_TILES),
+        lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i), origin) for i in order], MAX_LIGHTS),
+        tiles=TILE_STRUCT.pack([t.record(origin) for t in plan.tiles], MAX_SHADOW_TILES),
         defines=lit_defines(
             settings.shadow_filter if shadowed > sampled else "NONE",  # no map: no filter code at all
             kernels.pcf_weights(settings.pcf_kernel_size),

@@ -11,7 +11,16 @@ import numpy as np
 
 from . import light_bins
 
+
 # Maps clip-space xyz in [-1, 1] to texture space [0, 1] (seed 004's "bias matrix").
+def from_origin(origin):
+    """The 4x4 translation by ``origin``: a world -> X matrix times it takes positions relative
+    to ``origin`` (the frame origin the GPU works around; see ``Renderer.render``)."""
+    t = np.eye(4)
+    t[:3, 3] = origin
+    return t
+
+
 BIAS_MATRIX = np.array(
     [
         [0.5, 0.0, 0.0, 0.5],
@@ -508,7 +517,7 @@ def view_depth_range(projection, view, corners, is_ortho):
 
 def clip_range(projection, is_ortho):
     """The (near, far) clip distances of an OpenGL projection matrix."""
-    p22, p23 = float(projection[2, 2]), float(projection[2, 3])
+    p22, p23 = np.float64(projection[2, 2]), np.float64(projection[2, 3])  # numpy: a zero divisor gives inf
     with np.errstate(divide="ignore", invalid="ignore"):
         if is_ortho:
             near, far = (p23 + 1.0) / p22, (p23 - 1.0) / p22
@@ -517,6 +526,36 @@ def clip_range(projection, is_ortho):
     if not (np.isfinite(near) and np.isfinite(far) and far > near):
         return None
     return near, far
+
+
+DEPTH_FIT_MARGIN = 1e-3  # relative widening of the visible depth range the lit pass rasterises
+
+
+def depth_fitted(projection, is_ortho, depth_range):
+    """``projection`` with its depth row mapping the visible geometry's depth range
+    (``view_depth_range``, widened by DEPTH_FIT_MARGIN) instead of the whole clip range: x and
+    y are unchanged, and nothing lies between the two near planes or the two far planes, so
+    what is clipped is unchanged too, while the depth buffer's precision goes to what is
+    there (a clip range of 1e-6 .. 100 leaves float32 depth two values for a 10 m scene).
+    The projection as it is when the range is unknown or the matrix is not a plain one."""
+    p = np.asarray(projection, np.float64)
+    clip = clip_range(p, is_ortho)
+    if depth_range is None or clip is None or p[2, 0] != 0.0 or p[2, 1] != 0.0:
+        return projection
+    near, far = float(depth_range[0]), float(depth_range[1])
+    if is_ortho:
+        pad = DEPTH_FIT_MARGIN * max(far - near, abs(near), abs(far), 1e-30)
+        near, far = max(clip[0], near - pad), min(clip[1], far + pad)
+    else:
+        near, far = max(clip[0], near * (1.0 - DEPTH_FIT_MARGIN)), min(clip[1], far * (1.0 + DEPTH_FIT_MARGIN))
+    if not (far > near and (is_ortho or near > 0.0)) or (near, far) == clip:
+        return projection
+    out = p.copy()
+    if is_ortho:
+        out[2, 2], out[2, 3] = -2.0 / (far - near), -(far + near) / (far - near)
+    else:
+        out[2, 2], out[2, 3] = -(far + near) / (far - near), -2.0 * far * near / (far - near)
+    return out
 
 
 def cascade_count(near, far, requested=0):

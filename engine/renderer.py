@@ -165,6 +165,7 @@ class Renderer:
         self._emission = self._fb_emit = self._emission_targets = None
         self._emission_on = False
         self._depth_range = _UNSET  # the frame's visible depth range, once computed
+        self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
         self._receivers = None  # and what the camera sees (lightspace.visible_receivers)
 
     # --- the frame ------------------------------------------------------------------------
@@ -196,6 +197,12 @@ class Renderer:
         emission = bool(emission and aux)
         self._emission_on = emission
         self._ensure_targets(width, height, aux, emission)
+        # The frame origin: the GPU gets every position relative to the camera (model matrices,
+        # lights, the camera's and each map's view), computed here in float64, so a scene far
+        # from the world origin keeps float32's precision where it is seen. Maps do not depend
+        # on it (each is drawn and read through the same shift) and stay reusable when it moves.
+        origin = camera.position
+        self._origin = origin if np.all(np.isfinite(origin)) else np.zeros(3)
         draws = self._draw_list(snapshot, stats, camera, settings, (width, height))
         stats.messages.extend(getattr(snapshot, "messages", ()))
         self.textures.forget(getattr(snapshot, "images_changed", ()))
@@ -274,9 +281,17 @@ class Renderer:
         width, height = self._size
         lights, rects = self._lights_in_view(lights, draws, view_camera, width, height, stats)
         plan = self._shadow_pass(draws, lights, camera, settings, stats, alpha_offset)
+        if self._depth_range is _UNSET:
+            corners = np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
+            self._depth_range = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
+        # The lit pass rasterises with the depth buffer spread over what the camera sees.
+        fitted = lightspace.depth_fitted(view_camera.projection, view_camera.is_ortho, self._depth_range)
+        raster_camera = (
+            view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
+        )
         data = build_frame_data(
             lights,
-            view_camera,
+            raster_camera,
             snapshot.world if snapshot.world is not None else snapshot.world_color,
             settings,
             plan,
@@ -287,6 +302,7 @@ class Renderer:
             rects=rects,
             size=(width, height),
             alpha_offset=alpha_offset,
+            origin=self._origin,
         )
         stats.binned = data.bins is not None
         seen = [d for d in draws if d.instance.camera]
@@ -321,7 +337,9 @@ class Renderer:
                 else:
                     whole, parts = self._batches_for(inst.key, geo)
                     identity = (inst.key, inst.matrix.tobytes(), geo.serial)
-                model = Matrix(inst.matrix.tolist())
+                model = inst.matrix.copy()
+                model[:3, 3] -= self._origin
+                model = Matrix(model.tolist())
                 draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
                 closed = CULL_CLOSED and geo.closed and lod is None  # a level is not tested for closedness
                 draw.closed = closed and not any(draw.material(m).uses_alpha for m, _b in parts)
@@ -430,7 +448,9 @@ class Renderer:
             )
         self.shadows.place(plan, settings.shadow_depth_format)
         shadow_draws = [self._caster(d) for d in draws]
-        self.shadows.render(plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats, alpha_offset)
+        self.shadows.render(
+            plan, shadow_draws, self.shaders, settings.shadow_cull_front, stats, alpha_offset, self._origin
+        )
         return plan
 
     def _caster(self, d):
@@ -600,7 +620,7 @@ class Renderer:
 
         width, height = self._size
         try:
-            inverse = np.linalg.inv(camera.projection @ camera.view)
+            inverse = np.linalg.inv(camera.projection @ camera.view @ lightspace.from_origin(self._origin))
         except np.linalg.LinAlgError:
             return
         if not np.all(np.isfinite(inverse)):

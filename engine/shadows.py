@@ -38,10 +38,12 @@ class Tile:
     origin: tuple = (0, 0)  # its lower-left texel in the atlas (ShadowAtlas.place)
     held: object = None  # points of the visible receivers inside it, when planning found them
 
-    def record(self):
+    def record(self, origin=None):
+        """The tile's TILE_STRUCT row; ``origin``: the frame origin its view takes positions
+        relative to (the map's content does not depend on it)."""
         f = self.fit
         return {
-            "view": f.view,
+            "view": f.view if origin is None else f.view @ lightspace.from_origin(origin),
             "proj_tex": lightspace.BIAS_MATRIX @ f.proj,
             "near": f.near,
             "far": f.far,
@@ -626,10 +628,10 @@ class ShadowAtlas:
         self._ubos[index].update(raw)
         return self._ubos[index]
 
-    def render(self, plan, draws, shaders, cull_front, stats, alpha_offset=0.5):
+    def render(self, plan, draws, shaders, cull_front, stats, alpha_offset=0.5, origin=None):
         """Draw every tile of ``plan`` whose content changed. ``draws``: per instance a
         ``Caster``, or None for an instance that casts no shadow; a tile's key is its fit and
-        its casters."""
+        its casters. ``origin``: the frame origin the casters' model matrices are relative to."""
         import gpu
 
         depth_only = DEPTH_FORMAT[self.depth_format].depth_only
@@ -682,7 +684,7 @@ class ShadowAtlas:
                     target.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
                 gpu.state.depth_test_set("LESS")
                 gpu.state.depth_mask_set(True)
-                tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record()]))
+                tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(origin)]))
                 raster = depth_only and tile.fit.orthographic
                 shader = program(raster)
                 shader.bind()

@@ -137,3 +137,61 @@ def test_huge_filter_radius_stays_bounded(shadow_scene):
     scene.penumbra.shadow_samples = 64
     c = render(scene)["Combined"][..., 0]
     assert np.all(np.isfinite(c)) and c.max() <= ALBEDO / math.pi * 3.0 * 1.001
+
+
+# --- far from the origin, scaled cameras, extreme clip ratios ------------------------------
+
+
+def _moved(scene, offset):
+    for ob in scene.objects:
+        if ob.parent is None:
+            ob.location = tuple(c + o for c, o in zip(ob.location, offset, strict=True))
+
+
+@pytest.mark.parametrize("scene_name", ["default cube", "box over plane"])
+def test_a_scene_far_from_the_world_origin_renders_as_at_it(shadow_scene, scene_name):
+    """The same scene moved 100 km along each axis (camera, light and all): positions reach
+    the GPU relative to the camera, so float32 keeps its precision there. Blender itself
+    stores the moved positions in float32 (8 mm apart at 1e5), so silhouettes may move by a
+    tenth of a pixel; lit surfaces must not get acne or broken face normals. Before the frame
+    origin, Blender's default cube scene moved so: mean 0.020, 3.6 % of pixels over 0.05."""
+    if scene_name == "default cube":  # Blender's startup scene: 2 m cube, 1000 W point light
+        scene = scenes.empty_scene(96, 64)
+        scenes.box(scene, "Cube", center=(0, 0, 0), size=(2, 2, 2), mat=scenes.material("Grey", (0.8, 0.8, 0.8)))
+        scenes.light(scene, "L", "POINT", 1000.0, location=(4.08, 1.0, 5.9), shadow_soft_size=0.1)
+        scenes.camera(scene, (7.36, -6.93, 4.96), (math.radians(63.6), 0.0, math.radians(46.7)), lens=50.0)
+    else:
+        scene = shadow_scene("POINT", "PCF", size=96)
+        scenes.look_at(scene, (2.0, -9.0, 7.0), (0.0, 0.0, 1.0))
+    near = render(scene)["Combined"][..., :3]
+    _moved(scene, (1.0e5, 1.0e5, 1.0e5))
+    far = render(scene)["Combined"][..., :3]
+    diff = np.abs(far - near).max(axis=-1)
+    assert diff.mean() < 3e-3, diff.mean()  # measured 7e-4 on both
+    assert np.mean(diff > 0.05) < 0.01, np.mean(diff > 0.05)  # measured 0.1 %
+
+
+def test_a_scaled_camera_object_renders_as_unscaled(shadow_scene):
+    """Blender's engines ignore the camera object's scale: the image and the Depth pass are
+    those of the unscaled camera (a scaled camera used to scale the view, and so the clip
+    distances and the Depth pass)."""
+    scene = shadow_scene("SUN", "PCF", size=64)
+    scenes.look_at(scene, (2.0, -9.0, 7.0), (0.0, 0.0, 1.0))
+    plain = render(scene, passes=("Combined", "Depth"))
+    scene.camera.scale = (3.0, 3.0, 3.0)
+    scaled = render(scene, passes=("Combined", "Depth"))
+    np.testing.assert_allclose(scaled["Combined"], plain["Combined"], atol=1e-5)
+    np.testing.assert_allclose(scaled["Depth"], plain["Depth"], rtol=1e-5)
+
+
+def test_camera_near_far_ratio_1e8_perspective(shadow_scene, analytic_shadow):
+    """Clip Start 1e-6 with Clip End 100: Blender's float32 camera matrix rounds the far
+    plane away (-(f + n) / (f - n) becomes -1); the depth terms are taken again in float64
+    from the clip distances, so the frame renders (it used to fail with a division by zero)
+    and the shadow is exact."""
+    scene = shadow_scene("SUN", "PCF", size=96)
+    scenes.look_at(scene, (2.0, -9.0, 7.0), (0.0, 0.0, 1.0))
+    scene.camera.data.clip_start, scene.camera.data.clip_end = 1e-6, 100.0
+    _lum, visibility, on_plane, shadowed = analytic_shadow(scene, scene.objects["L"])
+    assert on_plane.sum() > 2000
+    assert iou((visibility < 0.5)[on_plane], shadowed[on_plane]) > 0.95
