@@ -55,6 +55,7 @@ class Material:
     blend: str = "OPAQUE"  # OPAQUE, HASHED (dithered alpha) or BLEND (sorted, blended)
     cull_camera: bool = False  # Settings › Backface Culling › Camera: back faces not drawn
     cull_shadow: bool = False  # Settings › Backface Culling › Shadow: back faces cast no shadow
+    holdout: bool = False  # a Holdout shader: a hole in the film where it shows (it still casts)
     messages: tuple = ()  # what could not be read, for the render report and the panel
 
     @property
@@ -74,6 +75,8 @@ class Material:
             out.add("VCOL")
         if self.uses_alpha:
             out.add(f"ALPHA_{self.blend}")
+        if self.holdout:
+            out.add("HOLDOUT")
         return frozenset(out)
 
 
@@ -276,6 +279,10 @@ def _shader(mat, node, notes, depth=0):
         out = _black()
         out.alpha = 0.0
         return out
+    if idname == "ShaderNodeHoldout":
+        out = _black()
+        out.holdout = True
+        return out
     if idname == "ShaderNodeMixShader" and depth < 8:
         return _mix_shader(mat, node, notes, depth)
     notes.append(f"'{node.bl_label or idname}' shader")
@@ -300,6 +307,9 @@ def _mix_shader(mat, node, notes, depth):
     a, b = sides
     if fac in (0.0, 1.0):
         return b if fac == 1.0 else a
+    if a.holdout or b.holdout:
+        notes.append("a Holdout shader mixed with another (the side with the larger factor is drawn)")
+        return b if fac >= 0.5 else a
     if a.textures or b.textures or a.color_attribute is not None or b.color_attribute is not None:
         notes.append("a Mix Shader of textured shaders (the side with the larger factor is drawn)")
         return b if fac >= 0.5 else a
@@ -430,6 +440,8 @@ def summary(read):
     if read.color_attribute is not None:
         lines.append(("GROUP_VCOL", f"Colour attribute: {read.color_attribute or 'the active one'}"))
     alpha = {"OPAQUE": "opaque", "HASHED": "dithered (hashed over samples)", "BLEND": "blended"}[read.blend]
+    if read.holdout:
+        alpha = "holdout (a hole in the film)"
     lines.append(("IMAGE_ALPHA", f"Alpha: {alpha}"))
     lines += [("ERROR", m.split(": ", 1)[-1]) for m in read.messages]
     return lines

@@ -288,10 +288,10 @@ def test_object_visibility_matches_eevee(penumbra):
     assert (ours[..., 3] < 0.01).sum() > 30  # the holdout's hole is there
 
 
-def test_a_collection_held_out_in_the_view_layer_is_a_holdout(penumbra):
-    """Outliner > Holdout on a collection masks its objects in that view layer, and an
-    instance of a collection takes its instancer's: the same image (RGB and alpha) as the
-    object's own Holdout switch, on both."""
+def test_holdouts_from_the_view_layer_and_the_holdout_shader(penumbra):
+    """Outliner > Holdout on a collection masks its objects in that view layer, an instance
+    of a collection takes its instancer's, and a material whose surface is a Holdout shader
+    is one: each gives the same image (RGB and alpha) as the object's own Holdout switch."""
     size = 48
 
     def held_out(how):
@@ -300,6 +300,15 @@ def test_a_collection_held_out_in_the_view_layer_is_a_holdout(penumbra):
         if how == "object":
             return _penumbra(scene, samples=1)
         sphere.is_holdout = False
+        if how == "shader":
+            mat = bpy.data.materials.new("Hole")
+            mat.use_nodes = True
+            nodes = mat.node_tree.nodes
+            hole = nodes.new("ShaderNodeHoldout")
+            output = next(n for n in nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+            mat.node_tree.links.new(hole.outputs[0], output.inputs["Surface"])
+            sphere.material_slots[0].material = mat
+            return _penumbra(scene, samples=1)
         layers = scene.view_layers[0].layer_collection
         masked = bpy.data.collections.new("Masked")
         scene.collection.children.link(masked)
@@ -320,7 +329,7 @@ def test_a_collection_held_out_in_the_view_layer_is_a_holdout(penumbra):
 
     own = held_out("object")
     assert (own[..., 3] < 0.01).sum() > 30  # the hole is there
-    for how in ("collection", "instance"):
+    for how in ("collection", "instance", "shader"):
         np.testing.assert_allclose(held_out(how), own, atol=1e-5, err_msg=how)
 
 
