@@ -99,6 +99,27 @@ class Light:
     sampled: bool = False  # moves between samples: its shadow is PCSS of its per-sample size
 
     @property
+    def spot_axes(self):
+        """(right, up, (scale_x, scale_y)): the light's unit X and Y axes and how much its
+        object scale stretches a spot's cone along them (X and Y scale over Z scale, as in
+        Blender's engines: a non-uniformly scaled spot lights an ellipse)."""
+        m = np.asarray(self.matrix, np.float64)[:3, :3]
+        lengths = np.linalg.norm(m, axis=0)
+        if not (np.all(np.isfinite(lengths)) and lengths.min() > 1e-12 * max(lengths.max(), 1e-300)):
+            return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]), (1.0, 1.0)
+        scale = (float(lengths[0] / lengths[2]), float(lengths[1] / lengths[2]))
+        return m[:, 0] / lengths[0], m[:, 1] / lengths[1], scale
+
+    @property
+    def cone_size(self):
+        """The full angle of the round cone around a spot's (possibly elliptical) cone."""
+        half = 0.5 * min(max(self.spot_size, 0.0), math.pi)
+        if half >= 0.5 * math.pi - 1e-9:
+            return 2.0 * half
+        widest = max(self.spot_axes[2])
+        return min(2.0 * math.atan(math.tan(half) * widest), math.pi)
+
+    @property
     def shadow_radius(self):
         """Radius of the emitter for soft shadows: Blender's shadow_soft_size, or half an area
         light's size."""
@@ -590,6 +611,10 @@ class SceneCache:
                     messages.append(
                         f"light '{ob.name}': light and shadow linking are not rendered (it lights, and is "
                         "blocked by, every object)"
+                    )
+                if ob.data.type == "AREA" and float(getattr(ob.data, "spread", math.pi)) < math.pi - 1e-6:
+                    messages.append(
+                        f"area light '{ob.name}': Spread is not rendered (it emits over the whole half-space)"
                     )
                 light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
                 if light is not None:

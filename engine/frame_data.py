@@ -70,6 +70,7 @@ def light_row(light, shadow=None, origin=_ZERO):
     half = 0.5 * min(max(light.spot_size, 0.0), math.pi)
     cos_half = math.cos(half)
     tiles = (list(shadow.tiles) if shadow else []) + [-1] * 6
+    right, up, (scale_x, scale_y) = light.spot_axes if light.type == "SPOT" else ((1, 0, 0), (0, 1, 0), (1, 1))
     return {
         "color": light.color,
         "type": LIGHT_TYPE.value(light.type),
@@ -78,6 +79,10 @@ def light_row(light, shadow=None, origin=_ZERO):
         "direction": light.direction,
         "spot_cos_half": cos_half if light.type == "SPOT" else -2.0,
         "spot_blend_width": (1.0 - cos_half) * max(light.spot_blend, 0.0),
+        "spot_right": right,
+        "spot_scale_x": scale_x,
+        "spot_up": up,
+        "spot_scale_y": scale_y,
         "shadow_mode": SHADOW_MODE.value(shadow.mode if shadow else "NONE"),
         "shadow_radius": light.shadow_radius * light.penumbra_scale,
         "sun_tan_half_angle": math.tan(0.5 * min(max(light.angle, 0.0), math.pi * 0.99)) * light.penumbra_scale,

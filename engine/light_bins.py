@@ -61,7 +61,7 @@ def influence_planes(light):
     p, a = light.position, light.direction
     if kind == "AREA":
         return _unit_planes([(*(-a), -(a @ p))])  # emits forward only: (x - p) . a >= 0
-    half = 0.5 * min(max(light.spot_size, 0.0), math.pi)
+    half = 0.5 * light.cone_size
     if half > WIDE_SPOT:
         return _unit_planes([(*(-a), -(a @ p))])
     helper = np.eye(3)[int(np.argmin(np.abs(a)))]

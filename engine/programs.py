@@ -36,6 +36,10 @@ LIGHT_STRUCT = Struct(
         ("VEC3", "direction"),  # where the light points
         ("FLOAT", "spot_cos_half"),  # cos(spot_size / 2); spots only
         ("FLOAT", "spot_blend_width"),  # (1 - cos(spot_size / 2)) * spot_blend
+        ("VEC3", "spot_right"),  # the light's unit X axis
+        ("FLOAT", "spot_scale_x"),  # how much the object's X scale (over Z) widens the cone along it
+        ("VEC3", "spot_up"),  # the light's unit Y axis
+        ("FLOAT", "spot_scale_y"),
         ("INT", "shadow_mode"),  # SHADOW_MODE_*
         ("FLOAT", "shadow_radius"),  # emitter radius for soft shadows (world units)
         ("FLOAT", "sun_tan_half_angle"),  # tan(sun angle / 2)

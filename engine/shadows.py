@@ -381,7 +381,7 @@ def plan_shadows(
                 tiles = [Tile(*f) if f is not None else None for f in fits]
             mode = "CASCADE" if view_corners is not None and slices is not None and len(slices) > 1 else "SINGLE"
         elif light.type == "SPOT":
-            fov = min(light.spot_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
+            fov = min(light.cone_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
             tile = perspective_tile(
                 light.position,
                 light.direction,

@@ -4,7 +4,8 @@
 /* Blender's light conventions, measured against Cycles:
  *   sun   irradiance  E = strength * cos
  *   point/spot        E = P / (4 pi) * cos / (d^2 + r^2)   (soft falloff)
- *   spot  mask        smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) * blend))
+ *   spot  mask        smoothstep((cos a - cos(size/2)) / ((1 - cos(size/2)) * blend)), a measured
+ *                     with the light's X/Y scale (over Z) undone: a scaled spot lights an ellipse
  *   area  (far field) E = P / pi * cos * cos_emitter / d^2
  * Outgoing diffuse radiance is albedo / pi * E; LightData.color already holds
  * colour * energy * 2^exposure. */
@@ -28,7 +29,12 @@ void light_incident(LightData L, vec3 P, out vec3 to_light, out float irradiance
   }
   irradiance = 1.0 / (4.0 * M_PI * max(dist2 + r * r, 1e-30));
   if (L.type == LIGHT_SPOT) {
-    float cos_a = dot(-to_light, L.direction);
+    /* The angle from the axis after undoing the object's X/Y scale (an elliptical cone, as in
+     * Blender's engines); with uniform scale it is the plain angle. */
+    vec3 l = -to_light;
+    float z = dot(l, L.direction);
+    vec2 xy = vec2(dot(l, L.spot_right) / L.spot_scale_x, dot(l, L.spot_up) / L.spot_scale_y);
+    float cos_a = (z > 0.0) ? z * inversesqrt(z * z + dot(xy, xy)) : -1.0;
     float t = cos_a - L.spot_cos_half;
     if (t <= 0.0) {
       irradiance = 0.0;

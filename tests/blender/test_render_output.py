@@ -276,6 +276,9 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         linked.objects.link(bpy.data.objects["Ball"])
         sun = next(ob for ob in scene.objects if ob.type == "LIGHT")
         sun.light_linking.blocker_collection = linked
+        area = bpy.data.lights.new("Panel", "AREA")
+        area.spread = 0.5
+        scene.collection.objects.link(bpy.data.objects.new("Panel", area))
         bpy.ops.render.render()
         report(done=True, sun=sun.name)
         """
@@ -289,6 +292,7 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         "Blender's Vector pass is not written",
         "Blender's Cryptomatte Object pass is not written",
         "shader AOV passes are not written",
+        "area light 'Panel': Spread is not rendered (it emits over the whole half-space)",
         f"light '{result['sun']}': light and shadow linking are not rendered (it lights, and is blocked by, "
         "every object)",
         "Blender's Shadow pass is not written (switch on Penumbra's own in View Layer > Passes)",

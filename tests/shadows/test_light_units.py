@@ -43,3 +43,36 @@ def test_world_colour_is_ambient(penumbra):
     scenes.top_camera(scene, height=10.0, ortho_scale=1.0)
     c = render(scene)["Combined"]
     np.testing.assert_allclose(c[16, 16, :3], ALBEDO * np.array([0.2, 0.3, 0.4]), rtol=1e-4)
+
+
+def test_a_non_uniformly_scaled_spot_lights_an_ellipse(penumbra):
+    """A spot's object scale stretches its cone along its X and Y (relative to Z), as in
+    Blender's engines: straight down from 2 m with a 60 degree cone scaled (2, 0.5, 1), the
+    lit footprint is the ellipse of semi-axes 2 tan 30 deg * (2, 0.5); a uniform scale leaves
+    the cone round. Its shadow map covers the wider cone: a box in the stretched part, 47
+    degrees off the axis, shadows the ground behind it."""
+    size, view = 128, 6.0
+    half = math.tan(math.radians(30.0)) * 2.0
+
+    def render_spot(scale, box=False):
+        scene = scenes.empty_scene(size, size)
+        scenes.plane(scene, size=40.0, mat=scenes.white())
+        if box:
+            scenes.box(scene, "Box", center=(1.6, 0.0, 0.5), size=(0.4, 0.4, 0.4), mat=scenes.white())
+        spot = scenes.light(scene, "L", "SPOT", 100.0, location=(0, 0, 2.0), spot_size=math.radians(60), spot_blend=0.0)
+        spot.data.shadow_soft_size = 0.0
+        spot.scale = scale
+        scenes.top_camera(scene, height=10.0, ortho_scale=view)
+        return render(scene)["Combined"][..., 0]
+
+    centres = ((np.arange(size) + 0.5) / size - 0.5) * view
+    x, y = np.meshgrid(centres, centres)
+    pixel = view / size
+    for scale, (ax, ay) in (((2.0, 0.5, 1.0), (2.0, 0.5)), ((3.0, 3.0, 3.0), (1.0, 1.0))):
+        lit = render_spot(scale) > 1e-4
+        r = np.hypot(x / (half * ax), y / (half * ay))
+        edge = np.abs(r - 1.0) < 1.5 * pixel / (half * min(ax, ay))
+        assert np.array_equal(lit[~edge], (r < 1.0)[~edge]), scale
+    lum = render_spot((2.0, 0.5, 1.0), box=True)
+    row, behind, mirror = size // 2, int((2.1 / view + 0.5) * size), int((-2.1 / view + 0.5) * size)
+    assert lum[row, mirror] > 1e-3 and lum[row, behind] < 0.1 * lum[row, mirror]
