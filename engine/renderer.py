@@ -281,11 +281,12 @@ class Renderer:
         width, height = self._size
         lights, rects = self._lights_in_view(lights, draws, view_camera, width, height, stats)
         plan = self._shadow_pass(draws, lights, camera, settings, stats, alpha_offset)
-        if self._depth_range is _UNSET:
+        depth_range = self._depth_range
+        if depth_range is _UNSET:  # no shadow plan this frame: the quick, wider bound
             corners = np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
-            self._depth_range = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
+            depth_range = lightspace.box_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
         # The lit pass rasterises with the depth buffer spread over what the camera sees.
-        fitted = lightspace.depth_fitted(view_camera.projection, view_camera.is_ortho, self._depth_range)
+        fitted = lightspace.depth_fitted(view_camera.projection, view_camera.is_ortho, depth_range)
         raster_camera = (
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
         )

@@ -195,3 +195,8 @@ def test_camera_near_far_ratio_1e8_perspective(shadow_scene, analytic_shadow):
     _lum, visibility, on_plane, shadowed = analytic_shadow(scene, scene.objects["L"])
     assert on_plane.sum() > 2000
     assert iou((visibility < 0.5)[on_plane], shadowed[on_plane]) > 0.95
+    # Without a map (no shadow plan): the same image as with an ordinary clip range.
+    scene.objects["L"].data.use_shadow = False
+    extreme = render(scene)["Combined"]
+    scene.camera.data.clip_start = 0.1
+    np.testing.assert_allclose(extreme, render(scene)["Combined"], atol=1e-4)
