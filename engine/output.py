@@ -41,6 +41,36 @@ def render_window(width, height, use_border=False, border=(0.0, 0.0, 1.0, 1.0)):
     return Window(x0, y0, x1, y1)
 
 
+def viewport_window(width, height, use_border, border, frame=None):
+    """The pixels of a ``width`` x ``height`` viewport region a render region leaves visible
+    (a ``Window``; the whole region without one; None when it is empty). ``border`` = (min x,
+    min y, max x, max y) as fractions of ``frame``, the camera frame's (x0, y0, x1, y1) in
+    region pixels in camera view (the scene's Render Region), else of the region itself (the
+    viewport's own Render Region, Ctrl+B)."""
+    if not use_border:
+        return Window(0, 0, width, height)
+    fx0, fy0, fx1, fy1 = frame if frame is not None else (0.0, 0.0, float(width), float(height))
+    xmin, ymin, xmax, ymax = border
+    x0 = max(0, min(width, round(fx0 + xmin * (fx1 - fx0))))
+    x1 = max(0, min(width, round(fx0 + xmax * (fx1 - fx0))))
+    y0 = max(0, min(height, round(fy0 + ymin * (fy1 - fy0))))
+    y1 = max(0, min(height, round(fy0 + ymax * (fy1 - fy0))))
+    return Window(x0, y0, x1, y1) if x1 > x0 and y1 > y0 else None
+
+
+def frame_in_region(corners, perspective_matrix, width, height):
+    """The region-pixel rectangle (x0, y0, x1, y1) around world points ``corners`` (the
+    camera frame's) seen through a viewport's ``perspective_matrix``; None when one is behind
+    the view."""
+    pts = np.asarray(corners, np.float64)
+    clip = np.c_[pts, np.ones(len(pts))] @ np.asarray(perspective_matrix, np.float64).T
+    if not np.all(clip[:, 3] > 0.0):
+        return None
+    x = (clip[:, 0] / clip[:, 3] * 0.5 + 0.5) * width
+    y = (clip[:, 1] / clip[:, 3] * 0.5 + 0.5) * height
+    return float(x.min()), float(y.min()), float(x.max()), float(y.max())
+
+
 def scaled_size(resolution_x, resolution_y, percentage):
     """Blender's integer resolution rule: ``resolution * percentage / 100``, truncated."""
     return max(1, resolution_x * percentage // 100), max(1, resolution_y * percentage // 100)

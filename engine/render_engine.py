@@ -8,7 +8,15 @@ import numpy as np
 
 from . import gpu_pool
 from .extract import SceneCache, camera_from_scene, camera_from_view
-from .output import mist_pass, render_views, render_window, unsupported_in_use, view_distance_scale
+from .output import (
+    frame_in_region,
+    mist_pass,
+    render_views,
+    render_window,
+    unsupported_in_use,
+    view_distance_scale,
+    viewport_window,
+)
 
 ENDLESS_SAMPLES = 64  # how finely soft lights are split when the viewport refines without end
 
@@ -147,17 +155,42 @@ class PenumbraEngineCore:
         """Something in the scene changed: the next viewport redraw renders afresh."""
         self._shown = None
 
-    def draw_display(self, scene, texture, width, height):
+    def draw_display(self, scene, texture, width, height, window=None):
         """Draw a scene-linear texture through Blender's colour management (view transform,
-        look, exposure, gamma): the viewport shows what the final render saves."""
+        look, exposure, gamma): the viewport shows what the final render saves. ``window``
+        (an ``output.Window``): only those pixels show (a render region)."""
         import gpu
         from gpu_extras.presets import draw_texture_2d
 
         gpu.state.blend_set("ALPHA_PREMULT")
+        if window is not None:
+            gpu.state.scissor_set(window.x0, window.y0, window.width, window.height)
+            gpu.state.scissor_test_set(True)
         self.bind_display_space_shader(scene)
         draw_texture_2d(texture, (0, 0), width, height)
         self.unbind_display_space_shader()
+        if window is not None:
+            gpu.state.scissor_test_set(False)
         gpu.state.blend_set("NONE")
+
+    def viewport_region(self, context, depsgraph, width, height):
+        """The part of the viewport a render region leaves visible (``output.viewport_window``):
+        the scene's Render Region in camera view, the viewport's own elsewhere."""
+        rv3d, space, scene = context.region_data, context.space_data, depsgraph.scene
+        if rv3d.view_perspective == "CAMERA" and scene.camera is not None:
+            r = scene.render
+            cam = scene.camera.evaluated_get(depsgraph)
+            corners = [cam.matrix_world @ v for v in cam.data.view_frame(scene=scene)]
+            frame = frame_in_region(corners, rv3d.perspective_matrix, width, height)
+            border = (r.border_min_x, r.border_min_y, r.border_max_x, r.border_max_y)
+            return viewport_window(width, height, r.use_border and frame is not None, border, frame)
+        border = (
+            space.render_border_min_x,
+            space.render_border_min_y,
+            space.render_border_max_x,
+            space.render_border_max_y,
+        )
+        return viewport_window(width, height, space.use_render_border, border)
 
 
 class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
@@ -332,7 +365,9 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         # What the final render would put in its report (lights left out, clamped maps) shows
         # in the viewport's text overlay, as Blender's engines show their status there.
         self.update_stats("", " | ".join([self.viewport_status(), *out.stats.messages]).strip(" |"))
-        self.draw_display(depsgraph.scene, out.color, width, height)
+        window = self.viewport_region(context, depsgraph, width, height)
+        if window is not None:  # an empty render region shows nothing
+            self.draw_display(depsgraph.scene, out.color, width, height, window)
         if self.refining():
             self.tag_redraw()  # the next redraw refines: full resolution, or one more sample
 
