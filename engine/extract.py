@@ -78,6 +78,40 @@ class MeshInstance:
     shadow: bool = True  # casts shadows (Object > Visibility > Ray Visibility > Shadow)
     camera: bool = True  # seen by the camera (Ray Visibility > Camera)
     holdout: bool = False  # Object > Visibility > Holdout: alpha 0 where it covers
+    names: tuple = ()  # the object's name and its instancer's: what light linking matches
+
+
+@dataclass(frozen=True)
+class LinkSet:
+    """A light's receiver or blocker collection, as Blender's light linking reads it: objects
+    set to Include and to Exclude (a child collection's state holds for everything in it).
+    With any Include, only those are linked; otherwise all but the excluded."""
+
+    include: frozenset = frozenset()
+    exclude: frozenset = frozenset()
+
+    def links(self, names):
+        if any(n in self.exclude for n in names):
+            return False
+        return not self.include or any(n in self.include for n in names)
+
+
+def link_set(collection):
+    """The ``LinkSet`` of a light linking collection (None: no collection, so everything)."""
+    if collection is None:
+        return None
+    include, exclude = set(), set()
+
+    def walk(coll, state, depth):
+        for entry, ob in zip(coll.collection_objects, coll.objects, strict=False):
+            own = state or entry.light_linking.link_state
+            (include if own == "INCLUDE" else exclude).add(ob.name_full)
+        if depth < 64:
+            for entry, child in zip(coll.collection_children, coll.children, strict=False):
+                walk(child, state or entry.light_linking.link_state, depth + 1)
+
+    walk(collection, None, 0)
+    return LinkSet(frozenset(include), frozenset(exclude))
 
 
 @dataclass
@@ -97,6 +131,8 @@ class Light:
     shape: str = "SQUARE"  # area lights: SQUARE, RECTANGLE, DISK or ELLIPSE
     penumbra_scale: float = 1.0  # the light size PCSS sees, relative (1/sqrt(samples) when sampled)
     sampled: bool = False  # moves between samples: its shadow is PCSS of its per-sample size
+    receivers: LinkSet | None = None  # light linking: what it lights (None: everything)
+    blockers: LinkSet | None = None  # shadow linking: what casts its shadow (None: everything)
 
     @property
     def spot_axes(self):
@@ -592,6 +628,16 @@ class SceneCache:
             return own[key]
 
         held = {}
+        sets = {}
+
+        def linked(collection):
+            """A light linking collection's ``LinkSet``, read once per snapshot."""
+            if collection is None:
+                return None
+            key = collection.original.name_full if collection.original is not None else collection.name_full
+            if key not in sets:
+                sets[key] = link_set(collection.original or collection)
+            return sets[key]
 
         def holdout(orig, inst):
             """Object > Visibility > Holdout, or a collection set to Holdout in this view layer
@@ -606,18 +652,16 @@ class SceneCache:
         for inst in depsgraph.object_instances:
             ob = inst.object
             if ob.type == "LIGHT":
-                linking = getattr(ob, "light_linking", None)
-                if linking is not None and (linking.receiver_collection or linking.blocker_collection):
-                    messages.append(
-                        f"light '{ob.name}': light and shadow linking are not rendered (it lights, and is "
-                        "blocked by, every object)"
-                    )
                 if ob.data.type == "AREA" and float(getattr(ob.data, "spread", math.pi)) < math.pi - 1e-6:
                     messages.append(
                         f"area light '{ob.name}': Spread is not rendered (it emits over the whole half-space)"
                     )
                 light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
                 if light is not None:
+                    linking = getattr(ob, "light_linking", None)
+                    if linking is not None:
+                        light.receivers = linked(linking.receiver_collection)
+                        light.blockers = linked(linking.blocker_collection)
                     lights.append(light)
                 continue
             if ob.type == "CURVES":
@@ -663,6 +707,9 @@ class SceneCache:
                     shadow=shadow,
                     camera=camera,
                     holdout=holdout(orig, inst),
+                    names=(orig.name_full, inst.parent.original.name_full)
+                    if inst.is_instance and inst.parent is not None
+                    else (orig.name_full,),
                 )
             )
         # Forget geometry no longer in the scene so its GPU buffers are freed.

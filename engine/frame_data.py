@@ -199,6 +199,7 @@ def build_frame_data(
             settings.pcf_spacing,
             sampled > 0,
             (sampled, shadowed, len(lights)),
+            any(light.receivers is not None for light in lights),
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

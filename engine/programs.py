@@ -162,7 +162,8 @@ LIT = Program(
         "lib/shadow_filters.glsl",
         "lib/material.glsl",
     ),
-    push_constants=(("MAT4", "model"),),
+    # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
+    push_constants=(("MAT4", "model"), ("IVEC4", "light_mask")),
     samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex"), ("FLOAT_2D", "light_bins")),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
@@ -349,6 +350,7 @@ def lit_defines(
     pcf_spacing=1.0,
     sampled=False,
     light_counts=None,
+    light_linking=False,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -361,7 +363,8 @@ def lit_defines(
     bins the variant calls each light by its constant index, so its data is read at fixed
     offsets instead of through a loop (about a tenth of the demo's lit pass on llvmpipe);
     otherwise a class of lights the frame has none of gets no loop (a loop's body costs one
-    masked pass on llvmpipe even when it runs zero times)."""
+    masked pass on llvmpipe even when it runs zero times). ``light_linking``: some light
+    lights only some objects; each object's ``light_mask`` says which."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -388,4 +391,5 @@ def lit_defines(
         "SAMPLED_COUNT": counts[0],
         "SHADOWED_COUNT": counts[1],
         "LIGHT_COUNT": counts[2],
+        "LIGHT_LINKING": bool(light_linking),
     }

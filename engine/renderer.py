@@ -307,8 +307,23 @@ class Renderer:
         )
         stats.binned = data.bins is not None
         seen = [d for d in draws if d.instance.camera]
-        self._lit_pass(seen, view_camera, data, plan, snapshot.world_color, settings, aux, stats, snapshot.world)
+        masks = self._light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
+        self._lit_pass(seen, view_camera, data, plan, snapshot.world_color, settings, aux, stats, snapshot.world, masks)
         return plan
+
+    @staticmethod
+    def _light_masks(draws, lights, order):
+        """Light linking: per draw (by id), the lit pass's ``light_mask``: bit j of word j // 32
+        set when light ``order[j]`` (the j-th light as the lit pass walks them) reaches it."""
+        out = {}
+        for d in draws:
+            words = [0, 0, 0, 0]
+            for j, i in enumerate(order):
+                receivers = lights[i].receivers
+                if receivers is None or receivers.links(d.instance.names):
+                    words[j >> 5] |= 1 << (j & 31)
+            out[id(d)] = tuple(w - (1 << 32) if w >= 1 << 31 else w for w in words)  # as signed ints
+        return out
 
     # --- stages ---------------------------------------------------------------------------
 
@@ -447,6 +462,15 @@ class Renderer:
             stats.messages.append(
                 f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
             )
+        for i, entry in plan.lights.items():  # shadow linking: only the light's blockers cast
+            blockers = lights[i].blockers
+            if blockers is not None:
+                for t in entry.tiles:
+                    if t >= 0:
+                        tile = plan.tiles[t]
+                        tile.casters = np.array(
+                            [c for c in tile.casters if blockers.links(draws[c].instance.names)], dtype=np.int64
+                        )
         self.shadows.place(plan, settings.shadow_depth_format)
         shadow_draws = [self._caster(d) for d in draws]
         self.shadows.render(
@@ -513,7 +537,7 @@ class Renderer:
         self._material_ubos[id(mat)] = (mat, ubo)
         return ubo
 
-    def _lit_pass(self, draws, camera, data, plan, world_color, settings, aux, stats, world=None):
+    def _lit_pass(self, draws, camera, data, plan, world_color, settings, aux, stats, world=None, masks=None):
         """Every visible part, grouped by material variant: opaque and alpha-hashed parts
         nearest first, then alpha-blended parts farthest first, blended over them (their
         depth, normal and shadow stay those of what is behind; EEVEE too keeps blended
@@ -586,6 +610,8 @@ class Renderer:
                 shader = bind(features, with_aux)
                 if last is not d or bound.get("model_shader") is not shader:
                     shader.uniform_float("model", d.model)
+                    if masks is not None:
+                        shader.uniform_int("light_mask", masks[id(d)])
                     last, bound["model_shader"] = d, shader
                 shader.uniform_block("material", self._material_ubo(mat))
                 for channel, ref in mat.textures.items():

@@ -31,6 +31,12 @@ struct Surface {
 void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout float arriving,
                inout float unshadowed)
 {
+#if LIGHT_LINKING
+  /* Light linking: this object's bit of light i (engine/renderer.py, Renderer._light_masks). */
+  if (((uint(light_mask[i >> 5]) >> uint(i & 31)) & 1u) == 0u) {
+    return;
+  }
+#endif
   LightData L = lights[i];
   vec3 to_light;
   float irradiance;
