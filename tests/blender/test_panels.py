@@ -13,6 +13,7 @@ SHOWN = [
     "RENDER_PT_format", "RENDER_PT_output", "RENDER_PT_color_management", "RENDER_PT_stereoscopy",
     "DATA_PT_EEVEE_light", "DATA_PT_camera", "DATA_PT_lens", "DATA_PT_context_mesh", "DATA_PT_vertex_colors",
     "EEVEE_MATERIAL_PT_surface", "EEVEE_WORLD_PT_surface", "OBJECT_PT_visibility", "OBJECT_PT_custom_props",
+    "OBJECT_PT_shading",  # holds Light Linking and Shadow Linking
     "PHYSICS_PT_add", "PARTICLE_PT_context_particles", "PENUMBRA_PT_film", "PENUMBRA_PT_passes",
 ]  # fmt: skip
 HIDDEN = [
