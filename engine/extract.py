@@ -14,6 +14,13 @@ import numpy as np
 from .materials import material_from_blender, world_from_blender
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
+# Object types Blender's own engines render that Penumbra does not: named in the report.
+_NOT_DRAWN = {
+    "POINTCLOUD": "point cloud object",
+    "VOLUME": "volume object",
+    "GREASEPENCIL": "Grease Pencil object",
+    "GPENCIL": "Grease Pencil object",
+}
 
 
 @dataclass
@@ -666,6 +673,9 @@ class SceneCache:
                 continue
             if ob.type == "CURVES":
                 messages.append(f"hair curves object '{ob.name}' is not drawn (hair is not supported)")
+                continue
+            if ob.type in _NOT_DRAWN:
+                messages.append(f"{_NOT_DRAWN[ob.type]} '{ob.name}' is not drawn")
                 continue
             if ob.type not in GEOMETRY_TYPES:
                 continue

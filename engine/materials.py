@@ -250,6 +250,9 @@ def _material_surface(mat):
         out = _display(mat, notes, "its surface shader is drawn with the viewport display colour")
     elif "alpha" in out.textures or out.alpha < 1.0:
         out.blend = _blend_mode(mat)
+    for socket in ("Volume", "Displacement"):
+        if _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", socket, {"ALL", "EEVEE"}):
+            notes.append(f"its {socket} output is not drawn")
     out.messages = tuple(f"material '{mat.name}': {n}" for n in dict.fromkeys(notes))
     return out
 
@@ -556,7 +559,29 @@ def srgb_to_linear(c):
 _SRGB_TABLE = srgb_to_linear(np.arange(256) / 255.0)  # byte code -> linear
 
 
+def _linked_outputs(tree, idname, socket, targets=None):
+    """Whether the active output node(s) of type ``idname`` in ``tree`` have ``socket`` linked."""
+    outputs = [n for n in tree.nodes if n.bl_idname == idname]
+    active = [n for n in outputs if n.is_active_output and (targets is None or n.target in targets)] or outputs
+    return any(socket in out.inputs and _source(out.inputs[socket])[0] is not None for out in active)
+
+
 def world_from_blender(scene):
+    """The scene world's light (``World``, see ``_world_surface``); a Volume shader on the
+    world's output is named (not drawn)."""
+    out = _world_surface(scene)
+    world = scene.world
+    tree = getattr(world, "node_tree", None) if world is not None else None
+    if (
+        tree is not None
+        and getattr(world, "use_nodes", True)
+        and _linked_outputs(tree, "ShaderNodeOutputWorld", "Volume")
+    ):
+        out.messages = (*out.messages, f"world '{world.name}': its Volume shader is not drawn")
+    return out
+
+
+def _world_surface(scene):
     """The scene world's light (``World``): a Background shader's colour x strength, or an
     Environment Texture image's radiance as SH; anything else its colour with a message."""
     world = scene.world

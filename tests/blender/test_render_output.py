@@ -272,6 +272,14 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         layer.use_pass_diffuse_color = layer.use_pass_vector = layer.use_pass_cryptomatte_object = True
         layer.use_pass_shadow = layer.use_pass_z = layer.use_pass_normal = True  # Depth and Normal are written
         layer.aovs.add()
+        for kind in ("pointclouds", "volumes"):  # object types Penumbra does not draw
+            data = getattr(bpy.data, kind).new(kind)
+            scene.collection.objects.link(bpy.data.objects.new(kind.title(), data))
+        for tree, output in ((bpy.data.materials["Ball"].node_tree, "ShaderNodeOutputMaterial"),
+                             (scene.world.node_tree, "ShaderNodeOutputWorld")):  # fmt: skip
+            volume = tree.nodes.new("ShaderNodeVolumePrincipled")
+            out = next(n for n in tree.nodes if n.bl_idname == output)
+            tree.links.new(volume.outputs[0], out.inputs["Volume"])
         area = bpy.data.lights.new("Panel", "AREA")
         area.spread = 0.5
         scene.collection.objects.link(bpy.data.objects.new("Panel", area))
@@ -289,6 +297,10 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         "Blender's Cryptomatte Object pass is not written",
         "shader AOV passes are not written",
         "area light 'Panel': Spread is not rendered (it emits over the whole half-space)",
+        "point cloud object 'Pointclouds' is not drawn",
+        "volume object 'Volumes' is not drawn",
+        "material 'Ball': its Volume output is not drawn",
+        "world 'World': its Volume shader is not drawn",
         "Blender's Shadow pass is not written (switch on Penumbra's own in View Layer > Passes)",
     ):
         assert output.count(f"Penumbra: {message}") == 1, message
