@@ -315,14 +315,18 @@ class Renderer:
     def _light_masks(draws, lights, order):
         """Light linking: per draw (by id), the lit pass's ``light_mask``: bit j of word j // 32
         set when light ``order[j]`` (the j-th light as the lit pass walks them) reaches it."""
+        by_names = {}  # instances of one object share its mask
         out = {}
         for d in draws:
-            words = [0, 0, 0, 0]
-            for j, i in enumerate(order):
-                receivers = lights[i].receivers
-                if receivers is None or receivers.links(d.instance.names):
-                    words[j >> 5] |= 1 << (j & 31)
-            out[id(d)] = tuple(w - (1 << 32) if w >= 1 << 31 else w for w in words)  # as signed ints
+            names = d.instance.names
+            if names not in by_names:
+                words = [0, 0, 0, 0]
+                for j, i in enumerate(order):
+                    receivers = lights[i].receivers
+                    if receivers is None or receivers.links(names):
+                        words[j >> 5] |= 1 << (j & 31)
+                by_names[names] = tuple(w - (1 << 32) if w >= 1 << 31 else w for w in words)  # as signed ints
+            out[id(d)] = by_names[names]
         return out
 
     # --- stages ---------------------------------------------------------------------------
