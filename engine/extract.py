@@ -753,8 +753,27 @@ def _note_hair(ob, inst, messages):
             )
 
 
+def emitter_area(data, matrix):
+    """The emitter's area as Blender's *Normalize* switch counts it (measured against Cycles):
+    an area light's (with its object's X/Y scale; a disk or ellipse pi/4 of its box), a point
+    or spot's sphere 4 pi r^2, a sun's pi sin^2(angle / 2); 1 for a point-like emitter."""
+    kind = data.type
+    if kind == "AREA":
+        sx, sy = np.linalg.norm(np.asarray(matrix, np.float64)[:3, :2], axis=0)
+        size_x = float(data.size)
+        size_y = float(data.size_y) if data.shape in {"RECTANGLE", "ELLIPSE"} else size_x
+        area = size_x * sx * size_y * sy * (math.pi / 4.0 if data.shape in {"DISK", "ELLIPSE"} else 1.0)
+    elif kind == "SUN":
+        area = math.pi * math.sin(0.5 * min(max(float(data.angle), 0.0), math.pi)) ** 2
+    else:
+        area = 4.0 * math.pi * float(getattr(data, "shadow_soft_size", 0.0)) ** 2
+    return area if area > 0.0 and math.isfinite(area) else 1.0
+
+
 def light_from_blender(data, matrix):
     color = np.array(data.color[:3], dtype=np.float64) * float(data.energy)
+    if not getattr(data, "normalize", True):  # power per unit of emitter area: it grows with size
+        color *= emitter_area(data, matrix)
     if getattr(data, "use_temperature", False):
         color *= np.array(data.temperature_color[:3], dtype=np.float64)  # Blender's blackbody colour
     color *= 2.0 ** float(getattr(data, "exposure", 0.0))

@@ -4,6 +4,7 @@ constants measured in Cycles (see the README's light-unit table)."""
 import math
 
 import numpy as np
+import pytest
 
 from devkit import scenes
 from devkit.render import render
@@ -43,6 +44,28 @@ def test_world_colour_is_ambient(penumbra):
     scenes.top_camera(scene, height=10.0, ortho_scale=1.0)
     c = render(scene)["Combined"]
     np.testing.assert_allclose(c[16, 16, :3], ALBEDO * np.array([0.2, 0.3, 0.4]), rtol=1e-4)
+
+
+@pytest.mark.parametrize(
+    "kind, props, ratio",
+    [
+        ("AREA", {"size": 2.0}, 4.0),
+        ("AREA", {"size": 0.5}, 0.25),
+        ("AREA", {"shape": "DISK", "size": 2.0}, math.pi),
+        ("AREA", {"shape": "RECTANGLE", "size": 2.0, "size_y": 0.5}, 1.0),
+        ("POINT", {"shadow_soft_size": 1.0}, 4.0 * math.pi),
+        ("SPOT", {"shadow_soft_size": 0.25, "spot_size": math.radians(120)}, math.pi / 4.0),
+        ("SUN", {"angle": math.radians(40)}, math.pi * math.sin(math.radians(20)) ** 2),
+        ("POINT", {"shadow_soft_size": 0.0}, 1.0),
+    ],
+)
+def test_normalize_off_scales_power_by_the_emitter_area(penumbra, kind, props, ratio):
+    """Light › Normalize off: the power is per unit of emitter area. Cycles' ratios (unnormalised
+    over normalised, measured at the centre of this set-up): 4, 0.25, pi, 1, 4 pi, pi / 4 and
+    pi sin^2(20 deg) = 0.3675; a point of radius 0 is unchanged."""
+    on = _single_light_plane(kind, 1.0 if kind == "SUN" else 100.0, **props).mean()
+    off = _single_light_plane(kind, 1.0 if kind == "SUN" else 100.0, normalize=False, **props).mean()
+    np.testing.assert_allclose(off / on, ratio, rtol=1e-4)
 
 
 def test_a_non_uniformly_scaled_spot_lights_an_ellipse(penumbra):
