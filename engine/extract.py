@@ -138,6 +138,8 @@ class Light:
     shape: str = "SQUARE"  # area lights: SQUARE, RECTANGLE, DISK or ELLIPSE
     penumbra_scale: float = 1.0  # the light size PCSS sees, relative (1/sqrt(samples) when sampled)
     sampled: bool = False  # moves between samples: its shadow is PCSS of its per-sample size
+    diffuse_factor: float = 1.0  # Light > Influence: how much it adds to diffuse and specular
+    specular_factor: float = 1.0
     receivers: LinkSet | None = None  # light linking: what it lights (None: everything)
     blockers: LinkSet | None = None  # shadow linking: what casts its shadow (None: everything)
 
@@ -783,6 +785,8 @@ def light_from_blender(data, matrix):
     if not getattr(data, "use_soft_falloff", True):
         radius = 0.0
     light = Light(type=data.type, color=color, matrix=matrix, radius=radius, use_shadow=bool(data.use_shadow))
+    light.diffuse_factor = float(getattr(data, "diffuse_factor", 1.0))
+    light.specular_factor = float(getattr(data, "specular_factor", 1.0))
     if data.type == "SPOT":
         light.spot_size = float(data.spot_size)
         light.spot_blend = float(data.spot_blend)

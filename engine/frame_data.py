@@ -89,6 +89,8 @@ def light_row(light, shadow=None, origin=_ZERO):
         "tiles": tiles[:4],
         "tiles_45": tiles[4:6],
         "bias_scale": light.bias_scale,
+        "diffuse_factor": light.diffuse_factor,
+        "specular_factor": light.specular_factor,
         "cascade_splits": (list(shadow.splits) + [3.0e38] * 4)[:4] if shadow and shadow.splits else (3.0e38,) * 4,
         "cascade_blend": (list(shadow.blend) + [0.0] * 4)[:4] if shadow and shadow.blend else (0.0,) * 4,
     }

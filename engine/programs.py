@@ -46,6 +46,8 @@ LIGHT_STRUCT = Struct(
         ("IVEC4", "tiles"),  # atlas tile of cube faces 0..3 (x: the single map); -1: none
         ("IVEC2", "tiles_45"),  # atlas tiles of cube faces 4, 5
         ("FLOAT", "bias_scale"),  # light.penumbra.bias_scale
+        ("FLOAT", "diffuse_factor"),  # Light > Influence > Diffuse (EEVEE's), on the diffuse term
+        ("FLOAT", "specular_factor"),  # Light > Influence > Specular, on the specular term
         ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
         ("VEC4", "cascade_blend"),  # CASCADE: depth before each end over which the next one fades in
     ),

@@ -71,7 +71,7 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   float f90 = clamp(50.0 * dot(s.f0, vec3(0.3333)), 0.0, 1.0);
   vec3 spec = (s.f0 + (f90 - s.f0) * fw) * (D * Vis);
   vec3 E = L.color * (irradiance * NdotL * visibility);
-  color += E * (s.albedo / M_PI + spec);
+  color += E * (s.albedo / M_PI * L.diffuse_factor + spec * L.specular_factor);
 #else
 #  if SPECULAR_MODEL == SPECULAR_BLINN
   vec3 H = normalize(to_light + s.V);
@@ -81,7 +81,7 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   float spec = (s.shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, s.V), 0.0), s.shininess);
 #  endif
   vec3 E = L.color * (irradiance * NdotL * visibility);
-  color += E * (s.albedo / M_PI + s.f0 * spec);
+  color += E * (s.albedo / M_PI * L.diffuse_factor + s.f0 * spec * L.specular_factor);
 #endif
 }
 

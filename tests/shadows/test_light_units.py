@@ -99,3 +99,28 @@ def test_a_non_uniformly_scaled_spot_lights_an_ellipse(penumbra):
     lum = render_spot((2.0, 0.5, 1.0), box=True)
     row, behind, mirror = size // 2, int((2.1 / view + 0.5) * size), int((-2.1 / view + 0.5) * size)
     assert lum[row, mirror] > 1e-3 and lum[row, behind] < 0.1 * lum[row, mirror]
+
+
+@pytest.mark.parametrize("metallic", [0.0, 1.0])
+def test_light_influence_factors_scale_diffuse_and_specular(penumbra, metallic):
+    """Light › Influence › Diffuse and Specular (EEVEE's): a plane without specular (Specular
+    IOR Level 0) under Diffuse 0.37 is 0.37 as bright and ignores Specular; a rough metal
+    (no diffuse) under Specular 0.25 is 0.25 as bright and ignores Diffuse."""
+
+    def lum(diffuse=1.0, specular=1.0):
+        scene = scenes.empty_scene(32, 32)
+        mat = scenes.material("M", (0.8, 0.8, 0.8), roughness=0.6, specular=0.0, metallic=metallic)
+        scenes.plane(scene, size=200.0, mat=mat)
+        light = scenes.light(scene, "L", "POINT", 100.0, location=(0.3, 0.0, 2.0), shadow_soft_size=0.1)
+        light.data.diffuse_factor, light.data.specular_factor = diffuse, specular
+        scenes.camera(scene, (0.0, 0.0, 6.0), (0.0, 0.0, 0.0), ortho_scale=0.4, clip=(0.1, 20.0))
+        return render(scene)["Combined"][..., 0].mean()
+
+    base = lum()
+    assert base > 1e-3
+    if metallic:
+        np.testing.assert_allclose(lum(specular=0.25) / base, 0.25, rtol=1e-4)
+        np.testing.assert_allclose(lum(diffuse=0.0) / base, 1.0, rtol=1e-4)
+    else:
+        np.testing.assert_allclose(lum(diffuse=0.37) / base, 0.37, rtol=1e-4)
+        np.testing.assert_allclose(lum(specular=0.0) / base, 1.0, rtol=1e-4)
