@@ -114,6 +114,9 @@ class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
 
     def draw(self, context):
         layout = self.split_layout()
+        influence = layout.column(align=True, heading="Influence")
+        influence.prop(context.light, "diffuse_factor", text="Diffuse")
+        influence.prop(context.light, "specular_factor", text="Specular")
         layout.prop(context.light, "use_shadow")
         col = layout.column()
         col.active = context.light.use_shadow
