@@ -337,7 +337,52 @@ def _mix_shader(mat, node, notes, depth):
     return out
 
 
+def _multiplied(socket):
+    """A Mix (Color) node set to Multiply with a constant factor, one side fed by something
+    and the other a constant colour: (the socket that feeds, per-channel tint) such that the
+    node gives that input x tint (mix(A, A B, f) = A (1 - f + f B)); else None."""
+    node, out = _source(socket)
+    if node is None:
+        return None
+    if node.bl_idname == "ShaderNodeMix" and node.data_type == "RGBA" and out.identifier == "Result_Color":
+        sockets = {s.identifier: s for s in node.inputs}
+        fac, a, b, clamp = sockets["Factor_Float"], sockets["A_Color"], sockets["B_Color"], node.clamp_result
+    elif node.bl_idname == "ShaderNodeMixRGB":
+        fac, a, b, clamp = node.inputs[0], node.inputs["Color1"], node.inputs["Color2"], node.use_clamp
+    else:
+        return None
+    if node.blend_type != "MULTIPLY" or fac.is_linked:
+        return None
+    f = min(max(float(fac.default_value), 0.0), 1.0)
+    for fed, constant in ((a, b), (b, a)):
+        src, src_out = _source(constant)
+        if src is None:
+            color = constant.default_value
+        elif src.bl_idname == "ShaderNodeRGB":
+            color = src_out.default_value
+        else:
+            continue
+        tint = tuple(1.0 - f + f * float(c) for c in color[:3])
+        if _source(fed)[0] is None or (clamp and max(tint) > 1.0):
+            return None
+        return fed, (*tint, 1.0)
+    return None
+
+
 def _color_channel(socket, notes, label, out, channel, fallback):
+    multiplied = _multiplied(socket)
+    if multiplied is not None:  # an input x a constant tint: the input, tinted
+        fed, tint = multiplied
+        kind, value = _input(fed, "color", notes, label)
+        if kind == "texture":
+            out.textures[channel] = value
+            return tint
+        if kind == "attribute":
+            out.color_attribute = value
+            return tint
+        if kind == "value":
+            return tuple(float(v) * t for v, t in zip(value, tint, strict=False))
+        return fallback
     kind, value = _input(socket, "color", notes, label)
     if kind == "texture":
         out.textures[channel] = value

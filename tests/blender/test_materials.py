@@ -12,7 +12,7 @@ import bpy
 import numpy as np
 import pytest
 
-from devkit import engines, material_scenes
+from devkit import engines, material_scenes, scenes
 from devkit.render import render
 
 SIZE = 48
@@ -473,3 +473,53 @@ def test_final_renders_share_an_image_until_its_pixels_change(penumbra):
     other = _penumbra(scene, samples=1)
     assert (gpu_pool.FINAL_IMAGES.hits, len(gpu_pool.FINAL_IMAGES)) == (hits + 2, 3)
     assert not np.array_equal(other, edited)
+
+
+@pytest.mark.parametrize("node", ["ShaderNodeMix", "ShaderNodeMixRGB"])
+def test_a_texture_multiplied_by_a_colour_is_drawn_tinted(penumbra, node):
+    """Image Texture x a constant colour through a Mix (Color) node set to Multiply, factor
+    0.75: per channel the image's render times 1 - f + f B, on a surface without specular
+    (diffuse light is linear in the albedo), and nothing named as unsupported."""
+    from penumbra.engine.materials import material_from_blender
+
+    tint = (0.5, 0.8, 1.0)
+
+    def render_plane(tinted):
+        scene = scenes.empty_scene(32, 32)
+        image = bpy.data.images.new("Checks", 8, 8)
+        cells = np.indices((8, 8)).sum(axis=0) % 2
+        pixels = np.ones((8, 8, 4), np.float32)
+        pixels[..., :3] = np.where(cells[..., None], 0.9, 0.2)
+        image.pixels.foreach_set(pixels.ravel())
+        mat = scenes.material("Tex", (0.8, 0.8, 0.8), roughness=1.0, specular=0.0)
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+        tex = nodes.new("ShaderNodeTexImage")
+        tex.image, tex.interpolation = image, "Closest"
+        if tinted:
+            mix = nodes.new(node)
+            mix.blend_type = "MULTIPLY"
+            if node == "ShaderNodeMix":
+                mix.data_type = "RGBA"
+                sockets = {s.identifier: s for s in mix.inputs}
+                fac, a, b, result = sockets["Factor_Float"], sockets["A_Color"], sockets["B_Color"], mix.outputs[2]
+            else:
+                fac, a, b, result = mix.inputs[0], mix.inputs["Color1"], mix.inputs["Color2"], mix.outputs[0]
+            fac.default_value = 0.75
+            b.default_value = (*tint, 1.0)
+            links.new(tex.outputs["Color"], a)
+            links.new(result, bsdf.inputs["Base Color"])
+        else:
+            links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+        material_scenes.uv_plane(scene, size=2.0, mat=mat)
+        scenes.light(scene, "Sun", "SUN", 3.0)
+        scenes.top_camera(scene, height=5.0, ortho_scale=1.8)
+        read = material_from_blender(mat)
+        return _penumbra(scene, samples=1), read
+
+    plain, _ = render_plane(False)
+    tinted, read = render_plane(True)
+    assert "base_color" in read.textures and not read.messages
+    expected = plain[..., :3] * (1.0 - 0.75 + 0.75 * np.array(tint))
+    assert plain[..., :3].max() > 0.3
+    np.testing.assert_allclose(tinted[..., :3], expected, rtol=1e-4, atol=1e-5)
