@@ -39,6 +39,7 @@ class TextureRef:
     interpolation: str = "Linear"
     extension: str = "REPEAT"
     transform: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))  # uv' = M @ (u, v, 1) (Mapping node)
+    component: int = 0  # a value channel: 0 the colour's luminance (or alpha), 1-3 R, G, B (Separate Color)
 
 
 @dataclass
@@ -177,6 +178,14 @@ def _input(socket, kind, notes, label):
             return "texture", ref
         notes.append(f"{label}: an Image Texture node without an image")
         return "value", ((0.0, 0.0, 0.0, 1.0) if kind == "color" else 0.0)
+    if idname in {"ShaderNodeSeparateColor", "ShaderNodeSeparateRGB"} and kind == "value":
+        # One component of an image (glTF's packed occlusion/roughness/metallic maps).
+        src, src_out = _source(node.inputs[0])
+        rgb = getattr(node, "mode", "RGB") == "RGB"
+        if rgb and src is not None and src.bl_idname == "ShaderNodeTexImage" and src_out.name == "Color":
+            ref = _image_ref(src, "Color", notes)
+            if ref is not None:
+                return "texture", TextureRef(**{**ref.__dict__, "component": 1 + list(node.outputs).index(out)})
     if idname == "ShaderNodeVertexColor" and kind == "color":
         return "attribute", node.layer_name
     if idname == "ShaderNodeAttribute" and kind == "color" and node.attribute_type == "GEOMETRY":

@@ -108,7 +108,8 @@ MESH_VERTEX_IN = (("VEC3", "pos"), ("VEC3", "nor"))
 
 # One material's values and, per texture channel (materials.CHANNELS), the rows of its UV
 # transform (uv' = (dot(row_u, uv1), dot(row_v, uv1))) and its mode (interpolation,
-# extension, 1 = the image's alpha output, 0).
+# extension, 1 = the image's alpha output, the component a value channel reads: 0 = luminance
+# or alpha, 1-3 = R, G, B through a Separate Color node).
 MATERIAL_STRUCT = Struct(
     "MaterialData",
     (

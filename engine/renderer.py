@@ -532,7 +532,7 @@ class Renderer:
                     INTERPOLATION.get(ref.interpolation, 1),
                     EXTENSION.get(ref.extension, 0),
                     int(ref.output == "Alpha"),
-                    0,
+                    int(ref.component),
                 )
             row[f"{channel}_mode"] = mode
         ubo = gpu.types.GPUUniformBuf(MATERIAL_STRUCT.pack([row]).tobytes())

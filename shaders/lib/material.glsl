@@ -70,10 +70,13 @@ vec2 texture_uv(vec2 uv, vec4 row_u, vec4 row_v)
                texture_uv(uv, material.channel##_uv_u, material.channel##_uv_v), \
                material.channel##_mode)
 
-/* A value channel: the alpha output, or the colour converted to a value as Blender does
- * (Rec.709 luminance). */
+/* A value channel: one component through a Separate Color node (mode.w 1-3: R, G, B), the
+ * alpha output, or the colour converted to a value as Blender does (Rec.709 luminance). */
 float sample_value(vec4 texel, ivec4 mode)
 {
+  if (mode.w != 0) {
+    return texel[mode.w - 1];
+  }
   return (mode.z != 0) ? texel.a : dot(texel.rgb, vec3(0.2126, 0.7152, 0.0722));
 }
 

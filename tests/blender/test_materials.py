@@ -523,3 +523,38 @@ def test_a_texture_multiplied_by_a_colour_is_drawn_tinted(penumbra, node):
     expected = plain[..., :3] * (1.0 - 0.75 + 0.75 * np.array(tint))
     assert plain[..., :3].max() > 0.3
     np.testing.assert_allclose(tinted[..., :3], expected, rtol=1e-4, atol=1e-5)
+
+
+@pytest.mark.parametrize("node", ["ShaderNodeSeparateColor", "ShaderNodeSeparateRGB"])
+def test_separate_color_reads_one_component_of_an_image(penumbra, node):
+    """A packed (glTF-style) map: an image's G into Roughness and B into Metallic through a
+    Separate Color node gives the render of those constants (0.75 and 0.25), not of the
+    image's luminance."""
+    if not hasattr(bpy.types, node):
+        pytest.skip(f"{node} does not exist in Blender {bpy.app.version_string}")
+    from penumbra.engine.materials import material_from_blender
+
+    def render_plane(packed):
+        scene = scenes.empty_scene(32, 32)
+        mat = scenes.material("M", (0.8, 0.5, 0.3), roughness=0.75, specular=0.5, metallic=0.25)
+        if packed:
+            image = bpy.data.images.new("Packed", 4, 4, float_buffer=True)
+            image.colorspace_settings.is_data = True
+            image.pixels.foreach_set(np.tile([0.5, 0.75, 0.25, 1.0], 16).astype(np.float32))
+            nodes, links = mat.node_tree.nodes, mat.node_tree.links
+            bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+            tex, split = nodes.new("ShaderNodeTexImage"), nodes.new(node)
+            tex.image = image
+            links.new(tex.outputs["Color"], split.inputs[0])
+            links.new(split.outputs[1], bsdf.inputs["Roughness"])
+            links.new(split.outputs[2], bsdf.inputs["Metallic"])
+        material_scenes.uv_plane(scene, size=2.0, mat=mat)
+        scenes.light(scene, "Lamp", "POINT", 30.0, location=(0.4, -0.3, 1.5))
+        scenes.camera(scene, (0.0, -2.0, 3.0), (math.radians(34), 0.0, 0.0), ortho_scale=2.0, clip=(0.1, 10.0))
+        return _penumbra(scene, samples=1), material_from_blender(mat)
+
+    constant, _ = render_plane(False)
+    packed, read = render_plane(True)
+    assert {"roughness", "metallic"} <= set(read.textures) and not read.messages
+    assert constant[..., :3].max() > 0.1
+    np.testing.assert_allclose(packed, constant, rtol=1e-4, atol=1e-5)
