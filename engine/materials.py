@@ -404,7 +404,39 @@ def _color_channel(socket, notes, label, out, channel, fallback):
     return tuple(value)
 
 
+def _scaled(socket):
+    """A Math node set to Multiply with one input a constant (its own value or a Value node)
+    and the other fed: (the fed socket, the constant); else None. Clamped products are read
+    only while the constant is at most 1 (then nothing in [0, 1] reaches the clamp)."""
+    node, _out = _source(socket)
+    if node is None or node.bl_idname != "ShaderNodeMath" or node.operation != "MULTIPLY":
+        return None
+    a, b = node.inputs[0], node.inputs[1]
+    for fed, constant in ((a, b), (b, a)):
+        src, src_out = _source(constant)
+        if src is None:
+            factor = float(constant.default_value)
+        elif src.bl_idname == "ShaderNodeValue":
+            factor = float(src_out.default_value)
+        else:
+            continue
+        if _source(fed)[0] is None or (node.use_clamp and not 0.0 <= factor <= 1.0):
+            return None
+        return fed, factor
+    return None
+
+
 def _value_channel(socket, notes, label, out, channel, fallback):
+    scaled = _scaled(socket)
+    if scaled is not None and channel is not None:  # an input x a constant: the input, scaled
+        fed, factor = scaled
+        kind, value = _input(fed, "value", notes, label)
+        if kind == "texture":
+            out.textures[channel] = value
+            return factor
+        if kind == "value":
+            return float(value) * factor
+        return fallback
     kind, value = _input(socket, "value", notes, label)
     if kind == "texture" and channel is None:
         notes.append(f"a texture into {label} (its value is used)")

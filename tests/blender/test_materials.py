@@ -525,18 +525,23 @@ def test_a_texture_multiplied_by_a_colour_is_drawn_tinted(penumbra, node):
     np.testing.assert_allclose(tinted[..., :3], expected, rtol=1e-4, atol=1e-5)
 
 
-@pytest.mark.parametrize("node", ["ShaderNodeSeparateColor", "ShaderNodeSeparateRGB"])
-def test_separate_color_reads_one_component_of_an_image(penumbra, node):
+@pytest.mark.parametrize(
+    "node, factor",
+    [("ShaderNodeSeparateColor", None), ("ShaderNodeSeparateRGB", None), ("ShaderNodeSeparateColor", 0.5)],
+)
+def test_separate_color_reads_one_component_of_an_image(penumbra, node, factor):
     """A packed (glTF-style) map: an image's G into Roughness and B into Metallic through a
     Separate Color node gives the render of those constants (0.75 and 0.25), not of the
-    image's luminance."""
+    image's luminance; with a Math Multiply by 0.5 between G and Roughness (the glTF
+    importer's roughness factor), that of roughness 0.375."""
     if not hasattr(bpy.types, node):
         pytest.skip(f"{node} does not exist in Blender {bpy.app.version_string}")
     from penumbra.engine.materials import material_from_blender
 
     def render_plane(packed):
         scene = scenes.empty_scene(32, 32)
-        mat = scenes.material("M", (0.8, 0.5, 0.3), roughness=0.75, specular=0.5, metallic=0.25)
+        roughness = 0.75 * (factor or 1.0)
+        mat = scenes.material("M", (0.8, 0.5, 0.3), roughness=roughness, specular=0.5, metallic=0.25)
         if packed:
             image = bpy.data.images.new("Packed", 4, 4, float_buffer=True)
             image.colorspace_settings.is_data = True
@@ -546,7 +551,14 @@ def test_separate_color_reads_one_component_of_an_image(penumbra, node):
             tex, split = nodes.new("ShaderNodeTexImage"), nodes.new(node)
             tex.image = image
             links.new(tex.outputs["Color"], split.inputs[0])
-            links.new(split.outputs[1], bsdf.inputs["Roughness"])
+            if factor is None:
+                links.new(split.outputs[1], bsdf.inputs["Roughness"])
+            else:
+                scale = nodes.new("ShaderNodeMath")
+                scale.operation = "MULTIPLY"
+                scale.inputs[1].default_value = factor
+                links.new(split.outputs[1], scale.inputs[0])
+                links.new(scale.outputs[0], bsdf.inputs["Roughness"])
             links.new(split.outputs[2], bsdf.inputs["Metallic"])
         material_scenes.uv_plane(scene, size=2.0, mat=mat)
         scenes.light(scene, "Lamp", "POINT", 30.0, location=(0.4, -0.3, 1.5))
