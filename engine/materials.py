@@ -346,6 +346,21 @@ def _mix_shader(mat, node, notes, depth):
     return out
 
 
+def _fed_and_constant(a, b, constant_node):
+    """Of two inputs, (the one a node feeds, the other's constant value: its own, or that of a
+    ``constant_node`` (RGB / Value) feeding it); None unless exactly that."""
+    for fed, constant in ((a, b), (b, a)):
+        src, src_out = _source(constant)
+        if src is None:
+            value = constant.default_value
+        elif src.bl_idname == constant_node:
+            value = src_out.default_value
+        else:
+            continue
+        return (fed, value) if _source(fed)[0] is not None else None
+    return None
+
+
 def _multiplied(socket):
     """A Mix (Color) node set to Multiply with a constant factor, one side fed by something
     and the other a constant colour: (the socket that feeds, per-channel tint) such that the
@@ -362,46 +377,29 @@ def _multiplied(socket):
         return None
     if node.blend_type != "MULTIPLY" or fac.is_linked:
         return None
+    found = _fed_and_constant(a, b, "ShaderNodeRGB")
+    if found is None:
+        return None
     f = min(max(float(fac.default_value), 0.0), 1.0)
-    for fed, constant in ((a, b), (b, a)):
-        src, src_out = _source(constant)
-        if src is None:
-            color = constant.default_value
-        elif src.bl_idname == "ShaderNodeRGB":
-            color = src_out.default_value
-        else:
-            continue
-        tint = tuple(1.0 - f + f * float(c) for c in color[:3])
-        if _source(fed)[0] is None or (clamp and max(tint) > 1.0):
-            return None
-        return fed, (*tint, 1.0)
-    return None
+    tint = tuple(1.0 - f + f * float(c) for c in found[1][:3])
+    return None if clamp and max(tint) > 1.0 else (found[0], (*tint, 1.0))
 
 
 def _color_channel(socket, notes, label, out, channel, fallback):
+    """A colour input: its value, or a texture / colour attribute (then the multiplier the
+    shader applies to it: 1, or a Multiply node's constant tint)."""
     multiplied = _multiplied(socket)
-    if multiplied is not None:  # an input x a constant tint: the input, tinted
-        fed, tint = multiplied
-        kind, value = _input(fed, "color", notes, label)
-        if kind == "texture":
-            out.textures[channel] = value
-            return tint
-        if kind == "attribute":
-            out.color_attribute = value
-            return tint
-        if kind == "value":
-            return tuple(float(v) * t for v, t in zip(value, tint, strict=False))
-        return fallback
-    kind, value = _input(socket, "color", notes, label)
+    source, tint = multiplied if multiplied is not None else (socket, (1.0, 1.0, 1.0, 1.0))
+    kind, value = _input(source, "color", notes, label)
     if kind == "texture":
         out.textures[channel] = value
-        return (1.0, 1.0, 1.0, 1.0)
+        return tint
     if kind == "attribute":
         out.color_attribute = value
-        return (1.0, 1.0, 1.0, 1.0)
+        return tint
     if kind == "unsupported":
         return fallback
-    return tuple(value)
+    return tuple(float(v) * t for v, t in zip(value, tint, strict=False))
 
 
 def _scaled(socket):
@@ -411,42 +409,27 @@ def _scaled(socket):
     node, _out = _source(socket)
     if node is None or node.bl_idname != "ShaderNodeMath" or node.operation != "MULTIPLY":
         return None
-    a, b = node.inputs[0], node.inputs[1]
-    for fed, constant in ((a, b), (b, a)):
-        src, src_out = _source(constant)
-        if src is None:
-            factor = float(constant.default_value)
-        elif src.bl_idname == "ShaderNodeValue":
-            factor = float(src_out.default_value)
-        else:
-            continue
-        if _source(fed)[0] is None or (node.use_clamp and not 0.0 <= factor <= 1.0):
-            return None
-        return fed, factor
-    return None
+    found = _fed_and_constant(node.inputs[0], node.inputs[1], "ShaderNodeValue")
+    if found is None or (node.use_clamp and not 0.0 <= float(found[1]) <= 1.0):
+        return None
+    return found[0], float(found[1])
 
 
 def _value_channel(socket, notes, label, out, channel, fallback):
-    scaled = _scaled(socket)
-    if scaled is not None and channel is not None:  # an input x a constant: the input, scaled
-        fed, factor = scaled
-        kind, value = _input(fed, "value", notes, label)
-        if kind == "texture":
-            out.textures[channel] = value
-            return factor
-        if kind == "value":
-            return float(value) * factor
-        return fallback
-    kind, value = _input(socket, "value", notes, label)
+    """A value input: its value, or a texture (then the multiplier the shader applies to it: 1,
+    or a Math Multiply node's constant)."""
+    scaled = _scaled(socket) if channel is not None else None
+    source, factor = scaled if scaled is not None else (socket, 1.0)
+    kind, value = _input(source, "value", notes, label)
     if kind == "texture" and channel is None:
         notes.append(f"a texture into {label} (its value is used)")
         return float(socket.default_value)
     if kind == "texture":
         out.textures[channel] = value
-        return 1.0
+        return factor
     if kind in {"unsupported", "attribute"}:
         return fallback
-    return float(value)
+    return float(value) * factor
 
 
 def _principled(mat, node, notes):
