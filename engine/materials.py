@@ -57,6 +57,7 @@ class Material:
     cull_camera: bool = False  # Settings › Backface Culling › Camera: back faces not drawn
     cull_shadow: bool = False  # Settings › Backface Culling › Shadow: back faces cast no shadow
     holdout: bool = False  # a Holdout shader: a hole in the film where it shows (it still casts)
+    transparent_shadow: bool = True  # Settings > Transparent Shadows: off, alpha casts as opaque
     messages: tuple = ()  # what could not be read, for the render report and the panel
 
     @property
@@ -239,6 +240,7 @@ def material_from_blender(mat):
     if mat is not None:
         out.cull_camera = bool(getattr(mat, "use_backface_culling", False))
         out.cull_shadow = bool(getattr(mat, "use_backface_culling_shadow", False))
+        out.transparent_shadow = bool(getattr(mat, "use_transparent_shadow", True))
     return out
 
 

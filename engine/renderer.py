@@ -492,11 +492,12 @@ class Renderer:
             return None
         mats = [(index, batch, d.material(index)) for index, batch in d.parts]
         cull = bool(mats) and all(m.cull_shadow for _i, _b, m in mats)
-        if not any(m.uses_alpha for _i, _b, m in mats):
+        # Material > Settings > Transparent Shadows off: its alpha casts as an opaque surface.
+        if not any(m.uses_alpha and m.transparent_shadow for _i, _b, m in mats):
             return Caster([d.whole], d.model, d.det, d.identity, cull_back=cull, closed=d.closed, corners=d.corners)
         solid, cutouts = [], []
         for _index, batch, mat in mats:
-            if not mat.uses_alpha:
+            if not (mat.uses_alpha and mat.transparent_shadow):
                 solid.append(batch)
             elif "alpha" in mat.textures:
                 cutouts.append((batch, self._material_ubo(mat), self.textures.get(mat.textures["alpha"].image)))

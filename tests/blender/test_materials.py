@@ -248,11 +248,15 @@ def test_alpha_covers_a_quarter_and_its_shadow_lets_three_quarters_through(penum
     assert ours.std(axis=(0, 1)).max() < 0.06, ours.std(axis=(0, 1))
 
 
-def test_alpha_textured_plane_casts_the_analytic_checker_shadow(penumbra):
+@pytest.mark.parametrize("transparent", [True, False])
+def test_alpha_textured_plane_casts_the_analytic_checker_shadow(penumbra, transparent):
     """The ground seen from between it and the checker plane: shadowed exactly under opaque
-    cells. Pixels more than one pixel from a cell edge must agree with the analytic pattern."""
+    cells. Pixels more than one pixel from a cell edge must agree with the analytic pattern.
+    With the material's Transparent Shadows off (EEVEE's switch), the whole plane casts, as
+    an opaque one."""
     size = 64
     scene = _builder("alpha_checker_shadow", size)
+    scene.objects["Checker"].material_slots[0].material.use_transparent_shadow = transparent
     image = _penumbra(scene, samples=1)[..., :3].mean(axis=-1)
     view, cells, side = scene["view_size"], scene["checker_cells"], scene["checker_size"]
     centres = ((np.arange(size) + 0.5) / size - 0.5) * view
@@ -260,16 +264,17 @@ def test_alpha_textured_plane_casts_the_analytic_checker_shadow(penumbra):
     inside = (np.abs(gx) < side / 2) & (np.abs(gy) < side / 2)
     i = np.floor((gx + side / 2) / (side / cells)).astype(int)
     j = np.floor((gy + side / 2) / (side / cells)).astype(int)
-    shadowed = inside & ((i + j) % 2 == scene["checker_opaque_parity"])
+    shadowed = inside & ((i + j) % 2 == scene["checker_opaque_parity"]) if transparent else inside
     cell = side / cells
     pixel = view / size
     fx, fy = np.mod(gx + side / 2, cell), np.mod(gy + side / 2, cell)
     near_edge = (np.minimum(fx, cell - fx) < 1.5 * pixel) | (np.minimum(fy, cell - fy) < 1.5 * pixel)
+    near_edge &= transparent  # opaque: only the plane's own border is an edge
     near_edge |= np.abs(np.abs(gx) - side / 2) < 1.5 * pixel
     near_edge |= np.abs(np.abs(gy) - side / 2) < 1.5 * pixel
     lit_level = image[~shadowed & ~near_edge].mean()
     dark = image < 0.5 * lit_level
-    assert shadowed.sum() > 200
+    assert shadowed.sum() > 200 and (~shadowed & ~near_edge).sum() > 200
     assert np.array_equal(dark[~near_edge], shadowed[~near_edge])
 
 
