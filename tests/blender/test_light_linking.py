@@ -26,6 +26,10 @@ def _scene():
 def _link(scene, kind, entries):
     """Give light L a ``kind`` ('receiver' or 'blocker') collection of ``entries``: (object
     name, state), or (child collection of those object names, state)."""
+    _link_light(scene, scene.objects["L"], entries, kind)
+
+
+def _link_light(scene, light, entries, kind="receiver"):
     import bpy
 
     top = bpy.data.collections.new(f"{kind}s")
@@ -39,7 +43,7 @@ def _link(scene, kind, entries):
         else:
             top.objects.link(scene.objects[what])
             top.collection_objects[-1].light_linking.link_state = state
-    setattr(scene.objects["L"].light_linking, f"{kind}_collection", top)
+    setattr(light.light_linking, f"{kind}_collection", top)
 
 
 def _covers(name):
@@ -113,3 +117,56 @@ def test_an_instance_is_linked_through_its_instancer(penumbra):
     a = _covers("A")
     assert np.abs(plain[a] - excluded[a]).max() > 0.1  # the instance is no longer lit
     np.testing.assert_allclose(excluded[~a], plain[~a], atol=1e-5)
+
+
+def test_masks_carry_lights_past_the_first_word(penumbra):
+    """``Renderer._light_masks``: bit j of word j // 32 for the j-th light in shading order;
+    bit 31 is stored as a negative int (the shader reads the words as signed)."""
+    from types import SimpleNamespace
+
+    from penumbra.engine.extract import Light, LinkSet
+    from penumbra.engine.renderer import Renderer
+
+    def light(excluded=()):
+        out = Light(type="POINT", color=np.ones(3), matrix=np.eye(4), radius=0.0)
+        out.receivers = LinkSet(exclude=frozenset(excluded)) if excluded else None
+        return out
+
+    lights = [light() for _ in range(40)]
+    lights[5], lights[33] = light({"A"}), light({"B"})
+    order = list(range(40))[::-1]  # shading order: light 39 first
+    draws = [SimpleNamespace(instance=SimpleNamespace(names=(n,))) for n in ("A", "B", "C")]
+    masks = Renderer._light_masks(draws, lights, order)
+    as_bits = {
+        n: [((w & 0xFFFFFFFF) >> b) & 1 for w in masks[id(d)][:2] for b in range(32)] for n, d in zip("ABC", draws)
+    }
+    for name, off in (("A", 5), ("B", 33)):
+        bits = as_bits[name]
+        assert bits[order.index(off)] == 0 and sum(bits[:40]) == 39 and sum(bits[40:]) == 0
+    assert sum(as_bits["C"]) == 40 and masks[id(draws[2])][0] == -1  # all 32 bits: -1 as a signed int
+
+
+def test_linking_reaches_lights_past_the_first_mask_word(penumbra):
+    """40 lights (no maps), the 36th (index 35) excluded from A: A's pixels equal the render
+    with that light switched off, the rest equal the render with it on."""
+    import bpy
+
+    def scene_with(energy_35, exclude):
+        scene = _scene()
+        bpy.data.objects.remove(scene.objects["L"])
+        for k in range(40):
+            light = scenes.light(scene, f"L{k:02d}", "POINT", 2.0, location=(k * 0.1 - 2.0, -2.0, 4.0))
+            light.data.use_shadow = False
+            if k == 35:
+                light.data.energy = energy_35
+                if exclude:
+                    _link_light(scene, light, [("A", "EXCLUDE")])
+        return scene
+
+    on = render(scene_with(800.0, False))["Combined"]
+    off = render(scene_with(0.0, False))["Combined"]
+    linked = render(scene_with(800.0, True))["Combined"]
+    a = _covers("A")
+    assert np.abs(on[a] - off[a]).max() > 0.1
+    np.testing.assert_allclose(linked[a], off[a], atol=1e-5)
+    np.testing.assert_allclose(linked[~a], on[~a], atol=1e-5)
