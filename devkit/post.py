@@ -108,8 +108,9 @@ def run_many(gpu_call, runs, make_runs=None):
     def job(engine, depsgraph):
         import gpu
 
-        from penumbra.engine.post import PostContext, PostStack
-        from penumbra.engine.renderer import FrameStats, texture_array
+        from penumbra.engine.frame.film import texture_array
+        from penumbra.engine.frame.stats import FrameStats
+        from penumbra.engine.post import PostContext, post_stack
         from penumbra.shaders.loader import ShaderCache
 
         shaders = ShaderCache()
@@ -124,7 +125,7 @@ def run_many(gpu_call, runs, make_runs=None):
                 src = uploaded[id(image)] = gpu.types.GPUTexture((w, h), format="RGBA32F", data=buf)
             stats = FrameStats()
             ctx = PostContext(shaders, w, h, frame=frame, stats=stats)
-            out = PostStack().run(ctx, src, layers)
+            out = post_stack().run(ctx, src, layers)
             results.append((texture_array(out, 4).copy(), stats))
         return results
 
@@ -158,8 +159,9 @@ def run_flat(gpu_call, width, height, color, stacks, step=60):
     def job(engine, depsgraph):
         import gpu
 
-        from penumbra.engine.post import PostContext, PostStack
-        from penumbra.engine.renderer import FrameStats, buffer_array
+        from penumbra.engine.frame.film import buffer_array
+        from penumbra.engine.frame.stats import FrameStats
+        from penumbra.engine.post import PostContext, post_stack
         from penumbra.shaders.loader import ShaderCache
 
         src = gpu.types.GPUTexture((width, height), format="RGBA32F")
@@ -168,7 +170,7 @@ def run_flat(gpu_call, width, height, color, stacks, step=60):
         results = []
         for layers in stacks:
             stats = ctx.stats = FrameStats()
-            out = PostStack().run(ctx, src, layers)
+            out = post_stack().run(ctx, src, layers)
             fb = gpu.types.GPUFrameBuffer(color_slots=(out,))
             rows = []
             with fb.bind():

@@ -37,7 +37,7 @@ def render(scene=None, passes=("Combined",)):
 def engine_frame(runner, scene, width, height):
     """One frame of ``scene``'s camera through the engine core (``devkit.session.GpuRunner``
     ``runner``): (FrameStats, scene-linear RGBA array (height, width, 4), row 0 at the bottom)."""
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     def job(engine, depsgraph):
         out = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, width, height), width, height)

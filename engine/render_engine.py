@@ -7,8 +7,7 @@ import bpy
 import numpy as np
 
 from . import gpu_pool
-from .extract import SceneCache, camera_from_scene, camera_from_view
-from .output import (
+from .frame.output import (
     frame_in_region,
     mist_pass,
     render_views,
@@ -17,6 +16,7 @@ from .output import (
     view_distance_scale,
     viewport_window,
 )
+from .scene.extract import SceneCache, camera_from_scene, camera_from_view
 
 ENDLESS_SAMPLES = 64  # how finely soft lights are split when the viewport refines without end
 
@@ -65,7 +65,7 @@ class PenumbraEngineCore:
         (``Renderer.render``); returns the renderer's FrameOutput. ``pixel_scale`` scales the
         post layers' sizes in pixels (a final render's resolution %); ``aux``: also produce the
         depth, shadow and normal targets (passes), not only colour."""
-        from .renderer import Renderer
+        from .frame.renderer import Renderer
 
         if self.renderer is None:
             shaders = gpu_pool.final_shaders() if self.texture_pool is not None else None

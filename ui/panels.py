@@ -135,7 +135,7 @@ class PENUMBRA_PT_material(PenumbraPanel, bpy.types.Panel):
         return super().poll(context) and getattr(context, "material", None) is not None
 
     def draw(self, context):
-        from ..engine.materials import material_from_blender, summary
+        from ..engine.scene.materials import material_from_blender, summary
 
         col = self.layout.column(align=True)
         for icon, text in summary(material_from_blender(context.material)):

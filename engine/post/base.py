@@ -7,9 +7,9 @@ from types import SimpleNamespace
 import numpy as np
 
 from ...shaders.loader import Program, Struct, set_uniforms
-from .. import kernels
 from ..gpu_pool import new_texture
 from ..settings import scale_pixels, values
+from ..shadows import kernels
 
 # One layer of a frame's stack, as the renderer receives it (``params``: a namespace of the
 # effect's parameter values, or None for a disabled layer).
@@ -347,10 +347,8 @@ class PostContext:
 class PostStack:
     """Runs the enabled layers top to bottom; owns one effect instance per layer slot."""
 
-    def __init__(self, effects=None):
-        if effects is None:
-            from . import EFFECTS as effects
-        self._classes = effects  # id -> PostEffect subclass
+    def __init__(self, effects):
+        self._classes = effects  # id -> PostEffect subclass (``post.EFFECTS``; ``post.post_stack()``)
         self._effects = {}
 
     def effect(self, slot, effect_id):

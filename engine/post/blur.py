@@ -6,9 +6,9 @@ quarter of the pixels and half the taps, for a blur a little softer than the exa
 (``blur_reference`` states both, exactly).
 """
 
-from .. import kernels
 from ..enums import Enum
 from ..settings import Param
+from ..shadows import kernels
 from .base import (
     GAUSSIAN_MAX_RADIUS,
     GAUSSIAN_VEC4S,
@@ -148,7 +148,7 @@ def gaussian_reference(img, radius, sigma=None):
     ``kernels.gaussian_1d(radius, sigma)`` with clamp-to-edge, in float64 (``img``: (h, w, C))."""
     import numpy as np
 
-    from .. import kernels
+    from ..shadows import kernels
 
     w = kernels.gaussian_1d(radius, sigma)
     out = np.asarray(img).astype(np.float64)

@@ -110,13 +110,13 @@ def test_closed_meshes_seen_from_outside_draw_no_back_faces_and_look_the_same(pe
     """A closed, outward-facing mesh wholly beyond the camera's near plane (and in front of a
     light) hides its back faces behind its own front faces: drawing it without them changes
     nothing, in the image or in the shadows, mirrored or not."""
-    from penumbra.engine import renderer
+    from penumbra.engine.frame import draw_list
 
     scene = _closed_scene()
     stats, culled = engine_frame(gpu_call, scene, 96, 64)
     # Lit pass: cow, box, mirrored box; the sun's map and the spot's map: each caster it holds.
     assert stats.closed_culled >= 3 + 3 + 1
-    monkeypatch.setattr(renderer, "CULL_CLOSED", False)
+    monkeypatch.setattr(draw_list, "CULL_CLOSED", False)
     whole_stats, whole = engine_frame(gpu_call, scene, 96, 64)
     assert whole_stats.closed_culled == 0
     np.testing.assert_allclose(culled, whole, rtol=0, atol=1e-5)
@@ -126,7 +126,7 @@ def test_closed_meshes_seen_from_outside_draw_no_back_faces_and_look_the_same(pe
 def test_a_camera_inside_a_closed_mesh_sees_its_back_faces(penumbra, gpu_call, monkeypatch):
     """A room modelled as an outward-facing box, seen from inside: its walls are back faces,
     and the camera's view is not culled."""
-    from penumbra.engine import renderer
+    from penumbra.engine.frame import draw_list
 
     scene = scenes.empty_scene(64, 48)
     scenes.set_world(scene, WORLD)
@@ -136,6 +136,6 @@ def test_a_camera_inside_a_closed_mesh_sees_its_back_faces(penumbra, gpu_call, m
     scenes.look_at(scene, (0.0, -2.0, 1.5), (0.0, 2.0, 1.2))
     _stats, inside = engine_frame(gpu_call, scene, 64, 48)
     assert np.abs(_centre(inside) - WORLD).max() > 0.1  # the wall, not the world
-    monkeypatch.setattr(renderer, "CULL_CLOSED", False)
+    monkeypatch.setattr(draw_list, "CULL_CLOSED", False)
     _stats, whole = engine_frame(gpu_call, scene, 64, 48)
     np.testing.assert_allclose(inside, whole, rtol=0, atol=1e-6)

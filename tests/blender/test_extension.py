@@ -136,7 +136,13 @@ def test_zip_contents(extension_zip):
     with zipfile.ZipFile(extension_zip) as archive:
         names = set(archive.namelist())
 
-    assert {"__init__.py", "blender_manifest.toml", "LICENSE", "engine/renderer.py", "shaders/lit.frag.glsl"} <= names
+    assert {
+        "__init__.py",
+        "blender_manifest.toml",
+        "LICENSE",
+        "engine/frame/renderer.py",
+        "shaders/lit.frag.glsl",
+    } <= names
     shaders = {p.relative_to(ROOT).as_posix() for p in (ROOT / "shaders").rglob("*.glsl")}
     assert shaders and shaders <= names, f"shaders missing from the zip: {sorted(shaders - names)}"
 

@@ -1,4 +1,4 @@
-"""Mesh extraction (engine/extract.py ``geometry_from_mesh``): the indexed buffers read through
+"""Mesh extraction (engine/scene/extract.py ``geometry_from_mesh``): the indexed buffers read through
 the attribute API hold exactly the triangles, corner normals and material slots Blender's own
 per-triangle data gives."""
 
@@ -43,7 +43,7 @@ def _sphere(smooth):
 
 
 def test_extraction_matches_blenders_triangles_normals_and_slots(penumbra):
-    from penumbra.engine.extract import geometry_from_mesh
+    from penumbra.engine.scene.extract import geometry_from_mesh
 
     for smooth in (True, False, "mixed"):
         me = _sphere(smooth)
@@ -58,7 +58,7 @@ def test_extraction_matches_blenders_triangles_normals_and_slots(penumbra):
 
 
 def test_bounds_ignore_loose_vertices_and_broken_triangles_are_dropped(penumbra):
-    from penumbra.engine.extract import geometry_from_mesh
+    from penumbra.engine.scene.extract import geometry_from_mesh
 
     me = _sphere(True)
     me.vertices.add(1)
@@ -80,7 +80,7 @@ def test_closed_outward_surfaces_are_told_apart(penumbra):
     import bmesh
 
     from devkit import assets
-    from penumbra.engine.extract import geometry_from_mesh
+    from penumbra.engine.scene.extract import geometry_from_mesh
 
     scene = scenes.empty_scene(32, 32)
 

@@ -111,7 +111,7 @@ def test_geometry_cache_rebuilds_only_changed_meshes(penumbra, gpu_call):
     scene = scenes.demo_scene(64, 36)
 
     def job(engine, depsgraph):
-        from penumbra.engine.extract import camera_from_scene
+        from penumbra.engine.scene.extract import camera_from_scene
 
         cam = camera_from_scene(depsgraph, scene, 64, 36)
         engine.render_frame(depsgraph, cam, 64, 36)

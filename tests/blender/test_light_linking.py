@@ -120,12 +120,12 @@ def test_an_instance_is_linked_through_its_instancer(penumbra):
 
 
 def test_masks_carry_lights_past_the_first_word(penumbra):
-    """``Renderer._light_masks``: bit j of word j // 32 for the j-th light in shading order;
+    """``draw_list.light_masks``: bit j of word j // 32 for the j-th light in shading order;
     bit 31 is stored as a negative int (the shader reads the words as signed)."""
     from types import SimpleNamespace
 
-    from penumbra.engine.extract import Light, LinkSet
-    from penumbra.engine.renderer import Renderer
+    from penumbra.engine.frame.draw_list import light_masks
+    from penumbra.engine.scene.extract import Light, LinkSet
 
     def light(excluded=()):
         out = Light(type="POINT", color=np.ones(3), matrix=np.eye(4), radius=0.0)
@@ -136,7 +136,7 @@ def test_masks_carry_lights_past_the_first_word(penumbra):
     lights[5], lights[33] = light({"A"}), light({"B"})
     order = list(range(40))[::-1]  # shading order: light 39 first
     draws = [SimpleNamespace(instance=SimpleNamespace(names=(n,))) for n in ("A", "B", "C")]
-    masks = Renderer._light_masks(draws, lights, order)
+    masks = light_masks(draws, lights, order)
     as_bits = {
         n: [((w & 0xFFFFFFFF) >> b) & 1 for w in masks[id(d)][:2] for b in range(32)] for n, d in zip("ABC", draws)
     }

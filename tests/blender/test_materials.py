@@ -110,7 +110,7 @@ def test_shader_set_ups_match_eevee(penumbra, name, bound):
 
 
 def test_unsupported_input_falls_back_to_the_viewport_colour_and_says_so(penumbra):
-    from penumbra.engine.materials import material_from_blender
+    from penumbra.engine.scene.materials import material_from_blender
 
     mat, bsdf, _output = material_scenes.node_material("Noisy")
     mat.diffuse_color = (0.1, 0.7, 0.2, 1.0)
@@ -129,7 +129,7 @@ def test_unsupported_input_falls_back_to_the_viewport_colour_and_says_so(penumbr
 
 
 def test_material_panel_lists_what_is_drawn_and_what_is_not(penumbra):
-    from penumbra.engine.materials import material_from_blender, summary
+    from penumbra.engine.scene.materials import material_from_blender, summary
     from penumbra.ui.panels import PENUMBRA_PT_material
 
     assert PENUMBRA_PT_material.bl_context == "material" and "PENUMBRA" in PENUMBRA_PT_material.COMPAT_ENGINES
@@ -342,8 +342,8 @@ def test_holdouts_from_the_view_layer_and_the_holdout_shader(penumbra):
 
 
 def test_textured_variants_exist_only_for_textured_materials(penumbra):
-    from penumbra.engine.materials import material_from_blender
-    from penumbra.engine.programs import lit_program
+    from penumbra.engine.frame.programs import lit_program
+    from penumbra.engine.scene.materials import material_from_blender
 
     scene = _builder("texture_base_color")
     plane = next(ob for ob in scene.objects if ob.type == "MESH")
@@ -363,7 +363,7 @@ def test_images_upload_once_and_reupload_after_an_update(penumbra, gpu_call):
     image = bpy.data.images[0]
 
     def job(engine, depsgraph):
-        from penumbra.engine.extract import camera_from_scene
+        from penumbra.engine.scene.extract import camera_from_scene
 
         camera = camera_from_scene(depsgraph, scene, SIZE, SIZE)
         for _ in range(2):
@@ -375,7 +375,7 @@ def test_images_upload_once_and_reupload_after_an_update(penumbra, gpu_call):
 
     assert gpu_call(job) == [1, 1, 2]
 
-    from penumbra.engine.extract import SceneCache
+    from penumbra.engine.scene.extract import SceneCache
 
     cache = SceneCache()
     cache.snapshot(bpy.context.evaluated_depsgraph_get())
@@ -485,7 +485,7 @@ def test_a_texture_multiplied_by_a_colour_is_drawn_tinted(penumbra, node):
     """Image Texture x a constant colour through a Mix (Color) node set to Multiply, factor
     0.75: per channel the image's render times 1 - f + f B, on a surface without specular
     (diffuse light is linear in the albedo), and nothing named as unsupported."""
-    from penumbra.engine.materials import material_from_blender
+    from penumbra.engine.scene.materials import material_from_blender
 
     tint = (0.5, 0.8, 1.0)
 
@@ -541,7 +541,7 @@ def test_separate_color_reads_one_component_of_an_image(penumbra, node, factor):
     importer's roughness factor), that of roughness 0.375."""
     if not hasattr(bpy.types, node):
         pytest.skip(f"{node} does not exist in Blender {bpy.app.version_string}")
-    from penumbra.engine.materials import material_from_blender
+    from penumbra.engine.scene.materials import material_from_blender
 
     def render_plane(packed):
         scene = scenes.empty_scene(32, 32)

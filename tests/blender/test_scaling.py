@@ -38,7 +38,7 @@ def test_collection_instances_share_one_extracted_geometry(penumbra, gpu_call):
     scene = _instanced_scene(16)
 
     def job(engine, depsgraph):
-        from penumbra.engine.extract import camera_from_scene
+        from penumbra.engine.scene.extract import camera_from_scene
 
         out = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 96, 54), 96, 54)
         keys = {inst.key for inst in engine.cache.snapshot(depsgraph).instances}
@@ -57,7 +57,7 @@ def test_instances_of_a_modified_object_share_its_evaluated_geometry(penumbra, g
     ball.modifiers.new("Bevel", "BEVEL")  # an evaluated mesh of its own, shared by the instances
 
     def job(engine, depsgraph):
-        from penumbra.engine.extract import camera_from_scene
+        from penumbra.engine.scene.extract import camera_from_scene
 
         engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 96, 54), 96, 54)
         return engine.cache.built
@@ -177,7 +177,7 @@ def _spot_scene():
 
 
 def test_binned_lighting_gives_the_image_of_every_light_on_every_pixel(penumbra, gpu_call, monkeypatch):
-    from penumbra.engine import frame_data
+    from penumbra.engine.frame import frame_data
 
     scene = _spot_scene()
     binned_stats, binned = engine_frame(gpu_call, scene, 160, 90)
@@ -193,8 +193,8 @@ def test_a_few_lights_are_called_by_constant_index_with_the_image_of_the_loop(pe
     """Up to UNROLLED_LIGHTS lights (no bins): the lit variant has the light counts compiled in
     and calls each light by its index. Sun and spot with maps (sampled over their extent in
     four samples, PCSS), a point light without one: the image of the looping variant."""
-    from penumbra.engine import programs
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.frame import programs
+    from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.demo_scene(96, 54)
     scene.penumbra.layers.clear()
@@ -224,7 +224,7 @@ def test_a_few_lights_are_called_by_constant_index_with_the_image_of_the_loop(pe
 def test_a_frame_compiles_only_the_programs_it_draws_with(penumbra, gpu_call):
     """Opaque casters and no post layer: one depth program and one lit variant, none of the
     alpha cut-out depth programs; the next frame compiles nothing."""
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.demo_scene(64, 36)
     scene.penumbra.layers.clear()
@@ -247,8 +247,8 @@ def test_orthographic_tiles_rasterise_the_depth_the_fragment_stage_would_write(p
     """A sun's map drawn without gl_FragDepth (its projection is linear in view distance) holds
     the depth the gl_FragDepth program writes, to float precision, and gives the same image;
     an alpha cut-out caster (the cut-out program's raster variant) included."""
-    from penumbra.engine import lightspace
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
+    from penumbra.engine.shadows import lightspace
 
     scene = scenes.demo_scene(96, 54)
     scene.penumbra.layers.clear()
@@ -285,8 +285,8 @@ def test_binned_light_classes_each_get_their_loop(penumbra, gpu_call, monkeypatc
     """Bins with all three classes of light: soft spots sampled over their extent (four
     samples, PCSS), spots with maps, spots without: the image of every light on every pixel.
     Each class is compiled only when the frame has a light in it."""
-    from penumbra.engine import frame_data
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.frame import frame_data
+    from penumbra.engine.scene.extract import camera_from_scene
 
     scene = _spot_scene()
     bpy.data.lights["Spot0"].shadow_soft_size = 0.5
@@ -350,7 +350,7 @@ def test_materials_are_read_once_and_again_only_after_they_change(penumbra):
     """Fifty objects share two materials: two reads, not fifty. Editing one material's node
     value re-reads that material only (the depsgraph update invalidates it), and the next
     snapshot carries the new value."""
-    from penumbra.engine.extract import SceneCache
+    from penumbra.engine.scene.extract import SceneCache
 
     scene = scenes.empty_scene(32, 32)
     red, blue = scenes.material("Red", (0.8, 0.1, 0.1)), scenes.material("Blue", (0.1, 0.1, 0.8))

@@ -1,4 +1,4 @@
-"""Render › Simplify › Penumbra › Merge Below (``engine/simplify.py``): levels of detail by clustering.
+"""Render › Simplify › Penumbra › Merge Below (``engine/scene/simplify.py``): levels of detail by clustering.
 Checked on geometry with a known surface (spheres: every vertex's distance to the sphere), on
 the level a cell size in pixels asks for, and on frames: fewer triangles, nearly the same image,
 and nothing simplified that needs more than positions and normals."""
@@ -17,7 +17,7 @@ WORLD = (0.2, 0.3, 0.4)
 def _sphere_geometry(scene, radius=1.0, segments=256, rings=128, flat=False, offset=(0.0, 0.0, 0.0), materials=1):
     from mathutils import Matrix
 
-    from penumbra.engine.extract import geometry_from_mesh
+    from penumbra.engine.scene.extract import geometry_from_mesh
 
     ob = scenes.uv_sphere(scene, "Sphere", radius=radius, segments=segments, rings=rings)
     me = ob.data
@@ -31,7 +31,7 @@ def _sphere_geometry(scene, radius=1.0, segments=256, rings=128, flat=False, off
 
 
 def test_level_for_is_the_coarsest_cell_within_the_pixels(penumbra):
-    from penumbra.engine import simplify
+    from penumbra.engine.scene import simplify
 
     # A 1 m mesh scaled 2x, 10 m away, pixels 1 cm wide there: 2 px cells are at most 2 cm,
     # so at least 2 m / 2 cm = 100 cells: 2^7.
@@ -48,7 +48,7 @@ def test_level_for_is_the_coarsest_cell_within_the_pixels(penumbra):
 
 @pytest.mark.parametrize("flat", [False, True], ids=["smooth", "flat"])
 def test_levels_keep_the_sphere_and_its_materials(penumbra, flat):
-    from penumbra.engine import simplify
+    from penumbra.engine.scene import simplify
 
     scene = scenes.empty_scene(32, 32)
     geo = _sphere_geometry(scene, flat=flat, materials=2)
@@ -84,7 +84,7 @@ def test_levels_keep_the_sphere_and_its_materials(penumbra, flat):
 
 
 def test_far_from_the_origin_and_tiny(penumbra):
-    from penumbra.engine import simplify
+    from penumbra.engine.scene import simplify
 
     scene = scenes.empty_scene(32, 32)
     for radius, offset in ((1.0, (1e5, -2e5, 3e4)), (1e-4, (0.0, 0.0, 0.0))):
@@ -104,8 +104,8 @@ def test_thin_parts_keep_both_sides(penumbra):
     import bmesh
     import bpy
 
-    from penumbra.engine import simplify
-    from penumbra.engine.extract import geometry_from_mesh
+    from penumbra.engine.scene import simplify
+    from penumbra.engine.scene.extract import geometry_from_mesh
 
     me = bpy.data.meshes.new("Plate")
     bm = bmesh.new()
@@ -200,7 +200,7 @@ def test_a_farther_view_draws_coarser_levels_and_keeps_only_its_own(penumbra, gp
 
     from mathutils import Vector
 
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     scene = _sphere_field()
     scene.render.use_simplify = True
@@ -213,9 +213,9 @@ def test_a_farther_view_draws_coarser_levels_and_keeps_only_its_own(penumbra, gp
         back[2, 3] = -2.0 * distance  # the world 2 distances further along the view axis
         far = dataclasses.replace(near, view=back @ near.view)
         first = engine.render_frame(depsgraph, near, 160, 90).stats
-        near_levels = set(engine.renderer._lod_batches)
+        near_levels = set(engine.renderer.batches.levels)
         second = engine.render_frame(depsgraph, far, 160, 90).stats
-        return first, near_levels, second, set(engine.renderer._lod_batches)
+        return first, near_levels, second, set(engine.renderer.batches.levels)
 
     first, near_levels, second, far_levels = gpu_call(job)
     assert first.simplified == second.simplified == 9

@@ -46,7 +46,7 @@ def _viewport_frame(gpu_call, scene, window=None, frame=None):
                 proj = Matrix(((2 / w, 0, 0, -1), (0, 2 / h, 0, -1), (0, 0, -1, 0), (0, 0, 0, 1)))
                 gpu.matrix.load_projection_matrix(proj)
                 engine.draw_display(scene, out.color, w, h, window)
-            from penumbra.engine.renderer import buffer_array
+            from penumbra.engine.frame.film import buffer_array
 
             display = buffer_array(fb.read_color(0, 0, w, h, 4, 0, "FLOAT")).reshape(h, w, 4).copy()
         offscreen.free()
@@ -92,8 +92,8 @@ def test_viewport_camera_from_region_matrices(penumbra):
     """``camera_from_view`` detects orthographic views and inverts the view matrix correctly."""
     from mathutils import Matrix
 
-    from penumbra.engine.extract import camera_from_view
-    from penumbra.engine.lightspace import orthographic, perspective
+    from penumbra.engine.scene.extract import camera_from_view
+    from penumbra.engine.shadows.lightspace import orthographic, perspective
 
     view = Matrix.Translation((1.0, -2.0, -10.0))
     persp = camera_from_view(view, Matrix(perspective(math.radians(50), 1.5, 0.1, 100).tolist()))
@@ -122,7 +122,7 @@ def test_a_render_region_shows_only_its_window_in_the_viewport(penumbra, gpu_cal
 
 
 def test_viewport_window_rules():
-    from penumbra.engine.output import viewport_window
+    from penumbra.engine.frame.output import viewport_window
 
     assert viewport_window(100, 50, False, (0.2, 0.2, 0.4, 0.4)) == viewport_window(100, 50, True, (0, 0, 1, 1))
     # The viewport's own region: fractions of the region.

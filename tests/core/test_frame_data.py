@@ -11,10 +11,13 @@ import pytest
 from devkit.session import ROOT, load_penumbra
 
 load_penumbra()
-from penumbra.engine import kernels, lightspace, programs, settings, shadows  # noqa: E402
+from penumbra.engine import settings  # noqa: E402
 from penumbra.engine.enums import LIGHT_TYPE, SHADOW_MODE  # noqa: E402
-from penumbra.engine.extract import Camera, Light  # noqa: E402
-from penumbra.engine.frame_data import build_frame_data  # noqa: E402
+from penumbra.engine.frame import programs  # noqa: E402
+from penumbra.engine.frame.frame_data import build_frame_data  # noqa: E402
+from penumbra.engine.scene.extract import Camera, Light  # noqa: E402
+from penumbra.engine.shadows import kernels, lightspace  # noqa: E402
+from penumbra.engine.shadows import planning as shadows  # noqa: E402
 from penumbra.shaders.loader import Struct  # noqa: E402
 
 
@@ -299,7 +302,7 @@ def test_flat_meshes_are_drawn_after_what_stands_on_them():
     """The lit pass draws nearest first so the depth test rejects hidden pixels before they are
     shaded; a ground's nearest point (under the camera) says nothing of what it hides, so
     flat boxes come after the others, each group nearest first."""
-    from penumbra.engine.renderer import _front_to_back
+    from penumbra.engine.frame.draw_list import front_to_back
 
     camera = _camera()  # at (0, -6, 3)
     ground = lightspace.box_corners(np.array([-50.0, -50.0, 0.0]), np.array([50.0, 50.0, 0.0]))
@@ -310,4 +313,4 @@ def test_flat_meshes_are_drawn_after_what_stands_on_them():
         SimpleNamespace(name=n, corners=c)
         for n, c in (("ground", ground), ("far", far), ("wall", wall), ("near", near))
     ]
-    assert [d.name for d in _front_to_back(draws, camera)] == ["near", "far", "ground", "wall"]
+    assert [d.name for d in front_to_back(draws, camera)] == ["near", "far", "ground", "wall"]

@@ -6,7 +6,7 @@ import pytest
 from devkit.session import load_penumbra
 
 load_penumbra()
-from penumbra.engine import kernels  # noqa: E402
+from penumbra.engine.shadows import kernels  # noqa: E402
 
 
 @pytest.mark.parametrize("radius", [0, 1, 3, 10, 64])

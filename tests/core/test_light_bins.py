@@ -1,4 +1,4 @@
-"""Light binning (engine/light_bins.py): a light's screen rectangle contains every visible
+"""Light binning (engine/shadows/light_bins.py): a light's screen rectangle contains every visible
 point it can light (checked by sampling), and lights that reach nothing visible get none."""
 
 import math
@@ -9,8 +9,8 @@ import pytest
 from devkit.session import load_penumbra
 
 load_penumbra()
-from penumbra.engine import light_bins, lightspace  # noqa: E402
-from penumbra.engine.extract import Light  # noqa: E402
+from penumbra.engine.scene.extract import Light  # noqa: E402
+from penumbra.engine.shadows import light_bins, lightspace  # noqa: E402
 
 W, H = 320, 180
 

@@ -6,7 +6,7 @@ import pytest
 from devkit.session import load_penumbra
 
 load_penumbra()
-from penumbra.engine import lightspace  # noqa: E402
+from penumbra.engine.shadows import lightspace  # noqa: E402
 
 
 @pytest.mark.parametrize(
@@ -111,7 +111,7 @@ def test_sun_fit_empty_and_nonfinite():
 def test_perspective_tile_covers_the_casters_in_front_only():
     """The fit spot and cube-face maps use: near/far bracket every caster in the cone, all their
     corners project inside the map, and a light with every caster behind it gets no tile."""
-    from penumbra.engine.shadows import perspective_tile
+    from penumbra.engine.shadows.planning import perspective_tile
 
     boxes = [((-0.5, -0.5, -2.5), (0.5, 0.5, -2.0)), ((0.0, 0.0, -6.5), (1.0, 1.0, -6.0)), ((0, 0, 4), (1, 1, 5))]
     corners = np.stack([lightspace.box_corners(np.array(lo, float), np.array(hi, float)) for lo, hi in boxes])
@@ -252,7 +252,7 @@ def test_off_center_perspective_maps_its_window_to_the_unit_square():
 def test_local_light_maps_crop_to_what_the_camera_sees_and_the_casters_can_shadow():
     """A point light 5 m over a 2 km flat ground with a 20 cm box: the ground casts nothing, so
     the downward face covers the box's window (and its shadow in view), not the whole face."""
-    from penumbra.engine.shadows import perspective_tile
+    from penumbra.engine.shadows.planning import perspective_tile
 
     ground = _flat((-1000, -1000, 0), (1000, 1000, 0))
     box = lightspace.box_corners((0.4, -0.1, 0.0), (0.6, 0.1, 0.2))

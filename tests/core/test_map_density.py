@@ -10,8 +10,9 @@ import pytest
 from devkit.session import load_penumbra
 
 load_penumbra()
-from penumbra.engine import lightspace, shadows  # noqa: E402
-from penumbra.engine.extract import Camera, Light  # noqa: E402
+from penumbra.engine.scene.extract import Camera, Light  # noqa: E402
+from penumbra.engine.shadows import lightspace  # noqa: E402
+from penumbra.engine.shadows import planning as shadows  # noqa: E402
 
 FOV = math.radians(50)
 

@@ -1,4 +1,4 @@
-"""Sample sequences (engine/sampling.py): pixel offsets cover the filter and are weighted by
+"""Sample sequences (engine/frame/sampling.py): pixel offsets cover the filter and are weighted by
 it, soft lights move over their own extent, and one sample is the single-sample frame."""
 
 import math
@@ -9,8 +9,8 @@ import pytest
 from devkit.session import load_penumbra
 
 load_penumbra()
-from penumbra.engine import sampling  # noqa: E402
-from penumbra.engine.extract import Light  # noqa: E402
+from penumbra.engine.frame import sampling  # noqa: E402
+from penumbra.engine.scene.extract import Light  # noqa: E402
 
 
 def _light(kind, **kw):
@@ -90,7 +90,8 @@ def test_sequences_are_deterministic_and_differ_between_lights():
 
 
 def test_only_lights_whose_penumbra_reaches_a_texel_move_between_samples():
-    from penumbra.engine import lightspace, shadows
+    from penumbra.engine.shadows import lightspace
+    from penumbra.engine.shadows import planning as shadows
 
     def plan_for(fits):
         plan = shadows.ShadowPlan()

@@ -61,8 +61,8 @@ def test_8k_frame_through_cheap_and_separable_layers(penumbra, gpu_call):
 
 def test_new_effects_as_scene_layers(penumbra, gpu_call):
     """The generated properties drive the effects: defaults through the real frame path."""
-    from penumbra.engine.extract import camera_from_scene
     from penumbra.engine.post import EFFECTS
+    from penumbra.engine.scene.extract import camera_from_scene
 
     effect_ids = ["GLOW", "SCANLINES", "SEPIA", "PIXELATE", "NOISE"]
     scene = scenes.demo_scene(48, 32)

@@ -94,8 +94,8 @@ def test_cascade_planning(penumbra):
     automatic count grows with the depth ratio (1 up to 20, then one more per factor 20)."""
     import bpy
 
-    from penumbra.engine import lightspace
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
+    from penumbra.engine.shadows import lightspace
 
     scene = small_box_scene(horizon=False)
     depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -192,7 +192,7 @@ def test_visible_depth_range_is_computed_once_per_frame(penumbra, gpu_call, monk
     """It and the visible receivers depend only on the unjittered camera and the instances'
     bounds: a frame of 4 samples (a soft sun, refitted every sample) computes them once, not
     per sample."""
-    from penumbra.engine import lightspace
+    from penumbra.engine.shadows import lightspace
 
     calls, seen = [], []
     real = lightspace.view_depth_range
@@ -203,7 +203,7 @@ def test_visible_depth_range_is_computed_once_per_frame(penumbra, gpu_call, monk
     scene.objects["Sun"].data.angle = math.radians(5.0)
 
     def job(engine, depsgraph):
-        from penumbra.engine.extract import camera_from_scene
+        from penumbra.engine.scene.extract import camera_from_scene
 
         camera = camera_from_scene(depsgraph, scene, 160, 90)
         out = engine.render_frame(depsgraph, camera, 160, 90, samples=(0, 4), sample_count=4)
@@ -217,7 +217,8 @@ def test_visible_depth_range_is_computed_once_per_frame(penumbra, gpu_call, monk
 def test_cascade_seams_blend_inside_the_overlap_both_maps_cover(penumbra):
     """Before each split the next cascade fades in over half the depth both maps cover (each
     slice is widened by CASCADE_OVERLAP of its depth), so a filter there reads inside both."""
-    from penumbra.engine import lightspace, shadows
+    from penumbra.engine.shadows import lightspace
+    from penumbra.engine.shadows import planning as shadows
 
     splits = lightspace.cascade_splits(0.5, 500.0, 3)
     blend = shadows.cascade_blend(splits[1:], (0.5, 500.0))

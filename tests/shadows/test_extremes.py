@@ -47,7 +47,7 @@ def test_grazing_sun_no_acne_and_bounded_peter_panning(penumbra, analytic_shadow
     assert acne < 0.005, f"acne on {acne:.2%} of the lit plane"
     # Peter-panning: along the centre column behind the box, the shadow must start within a
     # few light-space texels of the box's base (y = 0.5).
-    from penumbra.engine import lightspace
+    from penumbra.engine.shadows import lightspace
 
     view, proj, w, h = camera_matrices(scene)
     p, _ = plane_hits(view, proj, w, h)

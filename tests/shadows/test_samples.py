@@ -39,7 +39,7 @@ def _expected_coverage(verts, size, ortho_scale, filter_size, grid=48):
     ``filter_size`` pixels: a dense grid of offsets over the filter, each weighted by it."""
     from matplotlib.path import Path
 
-    from penumbra.engine.sampling import blackman_harris
+    from penumbra.engine.frame.sampling import blackman_harris
 
     px = ortho_scale / size
     offs = (np.arange(grid) + 0.5) / grid * filter_size - filter_size / 2
@@ -230,7 +230,7 @@ def test_a_new_process_renders_the_same_bits(penumbra):
 
 
 def test_hard_lights_keep_one_map_and_soft_lights_move_theirs(penumbra, gpu_call):
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.empty_scene(48, 48)
     scenes.box_over_plane(scene)
@@ -254,7 +254,7 @@ def test_hard_lights_keep_one_map_and_soft_lights_move_theirs(penumbra, gpu_call
 def test_one_sample_is_the_single_sample_frame(penumbra, gpu_call):
     """samples = 1 accumulates nothing: the same passes, the same pixels as the frame of a
     renderer that knows no samples (sample 0 is centred and lights sit at their centres)."""
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.demo_scene(64, 36)
     scene.objects["Spot"].data.shadow_soft_size = 0.5
@@ -298,7 +298,7 @@ def test_viewport_after_n_redraws_shows_the_final_render_of_n_samples(penumbra, 
 
 
 def test_cancelling_keeps_the_samples_done_and_raises_nothing(penumbra, gpu_call):
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.demo_scene(48, 27)
 
@@ -330,7 +330,7 @@ def test_filter_size_zero_and_ten_and_hard_lights_at_many_samples(penumbra, gpu_
     """filter_size 0 jitters nothing: with only hard lights every sample is the same, so any
     sample count gives the one-sample image. filter_size 10 (its maximum) stays finite and
     keeps the mean brightness (the filter is normalised)."""
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.demo_scene(48, 27)
     scene.penumbra.layers.clear()

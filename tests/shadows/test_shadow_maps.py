@@ -25,7 +25,7 @@ def test_light_without_shadow_gets_no_shadow_map(penumbra, gpu_call):
 def test_point_light_skips_cube_faces_without_casters(shadow_scene, gpu_call):
     """A face gets a map only when a caster it can see may shadow something: the flat plane
     shadows nothing (nothing lies below it), so only the faces that see the box draw one."""
-    from penumbra.engine import lightspace
+    from penumbra.engine.shadows import lightspace
 
     scene = shadow_scene("POINT", "PCF")
     stats, _ = engine_frame(gpu_call, scene, 64, 36)
@@ -76,7 +76,7 @@ def test_no_caster_no_shadow_map(penumbra, gpu_call):
 
 
 def _two_frames(gpu_call, scene, move):
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     def job(engine, depsgraph):
         first = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, 64, 64), 64, 64).stats

@@ -244,7 +244,9 @@ def section_passes(plan):
     """The demo at 960x540 pass by pass: the shadow (depth) pass and the lit pass, each timed
     to a one-pixel read-back of its targets before and after it (so each pass's GPU work is
     its own), for PCF 5x5, a single tap (NONE) and shadows off, interleaved."""
-    from penumbra.engine import renderer as renderer_module
+    from penumbra.engine.frame.lit_pass import LitPass
+    from penumbra.engine.frame.renderer import Renderer
+    from penumbra.engine.frame.shadow_pass import ShadowPass
 
     scene = demo(960, 540)
     lights = [ob for ob in scene.objects if ob.type == "LIGHT"]
@@ -254,7 +256,7 @@ def section_passes(plan):
 
     def wait(renderer):
         """Return once the GPU has finished what was drawn into the frame's targets."""
-        fb = renderer._fb or renderer._fb_color
+        fb = renderer.film.fb or renderer.film.fb_color
         if fb is not None:
             with fb.bind():
                 fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
@@ -268,10 +270,10 @@ def section_passes(plan):
 
     def timed(method, part):
         def run(self, *args, **kwargs):
-            wait(self)
+            wait(current["renderer"])
             start = time.perf_counter()
             out = method(self, *args, **kwargs)
-            wait(self)
+            wait(current["renderer"])
             if "case" in current:
                 times[current["case"], part].append(time.perf_counter() - start)
             return out
@@ -284,9 +286,21 @@ def section_passes(plan):
         for ob in lights:
             ob.data.use_shadow = shadowed
 
-    originals = {name: getattr(renderer_module.Renderer, name) for name in ("_shadow_pass", "_lit_pass")}
-    renderer_module.Renderer._shadow_pass = timed(originals["_shadow_pass"], "depth pass")
-    renderer_module.Renderer._lit_pass = timed(originals["_lit_pass"], "lit pass")
+    def recorded(method):
+        def run(self, *args, **kwargs):
+            current["renderer"] = self  # the renderer whose targets ``wait`` reads
+            return method(self, *args, **kwargs)
+
+        return run
+
+    originals = {
+        (ShadowPass, "draw"): ShadowPass.draw,
+        (LitPass, "draw"): LitPass.draw,
+        (Renderer, "render"): Renderer.render,
+    }
+    ShadowPass.draw = timed(ShadowPass.draw, "depth pass")
+    LitPass.draw = timed(LitPass.draw, "lit pass")
+    Renderer.render = recorded(Renderer.render)
     try:
         for case in cases:  # warm-up
             setup(case)
@@ -296,10 +310,10 @@ def section_passes(plan):
                 setup(case)
                 current["case"] = case
                 _render()
-                current.clear()
+                current.pop("case")
     finally:
-        for name, method in originals.items():
-            setattr(renderer_module.Renderer, name, method)
+        for (owner, name), method in originals.items():
+            setattr(owner, name, method)
         for ob in lights:
             ob.data.use_shadow = True
     rows = []
@@ -404,7 +418,7 @@ def _pixel_projection(w, h):
 def _viewport_reused(scene, runs):
     """Median seconds of the engine core's frame with every shadow map reused (one engine
     instance, colour only, as the viewport renders after an edit elsewhere)."""
-    from penumbra.engine.extract import camera_from_scene
+    from penumbra.engine.scene.extract import camera_from_scene
 
     runner = session.GpuRunner()
     runner.register()
@@ -493,7 +507,7 @@ def section_instances(plan):
 
 
 def section_triangles(plan):
-    from penumbra.engine.extract import geometry_from_mesh
+    from penumbra.engine.scene.extract import geometry_from_mesh
 
     rows = []
     for n in plan["grids"]:

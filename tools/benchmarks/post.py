@@ -53,14 +53,14 @@ def measure(runner, scene, w, h, runs, radii):
     def job(engine, depsgraph):
         import gpu
 
-        from penumbra.engine.extract import camera_from_scene
-        from penumbra.engine.post import EFFECTS, PostContext, PostStack, base
+        from penumbra.engine.frame.stats import FrameStats
+        from penumbra.engine.post import EFFECTS, PostContext, base, post_stack
         from penumbra.engine.post.base import GAUSSIAN_VEC4S, GAUSSIAN_WEIGHTS, GaussianWeights, post_program
-        from penumbra.engine.renderer import FrameStats
+        from penumbra.engine.scene.extract import camera_from_scene
 
         frame = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, w, h), w, h)
         src = frame.color
-        stack = PostStack()
+        stack = post_stack()
         ctx = PostContext(engine.renderer.shaders, w, h, frame=1, stats=FrameStats())
 
         def timed(draw):

@@ -405,7 +405,7 @@ def plot_scaling(rows, plan, path):
 
 def moved(camera, offset):
     """``camera`` translated by ``offset`` in world space (the view looks the same way)."""
-    from penumbra.engine.extract import Camera
+    from penumbra.engine.scene.extract import Camera
 
     shift = np.eye(4)
     shift[:3, 3] = -np.asarray(offset, float)
@@ -417,7 +417,7 @@ def frames(runner, scene, width, height, offsets=((0, 0, 0),)):
     camera moved by each of ``offsets`` in turn."""
 
     def job(engine, depsgraph):
-        from penumbra.engine.extract import camera_from_scene
+        from penumbra.engine.scene.extract import camera_from_scene
 
         camera = camera_from_scene(depsgraph, scene, width, height)
         return [engine.render_frame(depsgraph, moved(camera, o), width, height).stats for o in offsets]
@@ -505,11 +505,11 @@ DETAILED_FILTERS = ("PCF", "PCSS")
 def texels_per_metre(runner, scene):
     """Shadow-map texels per metre at the detailed caster (the largest mesh that is not the
     ground or a wall): the finest map of the light, at the caster's distance for local lights.
-    Read from the frame's own shadow plan (``Renderer._plan``)."""
-    from penumbra.engine import renderer as renderer_module
+    Read from the frame's own shadow plan (``ShadowPass.plan``)."""
+    from penumbra.engine.frame import shadow_pass
 
     plans = []
-    original = renderer_module.Renderer._plan
+    original = shadow_pass.ShadowPass.plan
 
     def recording(self, *args, **kwargs):
         plans.append(original(self, *args, **kwargs))
@@ -522,16 +522,16 @@ def texels_per_metre(runner, scene):
     distance = float(np.linalg.norm(centre - np.array(light.matrix_world.translation)))
 
     def job(engine, depsgraph):
-        from penumbra.engine.extract import camera_from_scene
+        from penumbra.engine.scene.extract import camera_from_scene
 
         w, h = scene.render.resolution_x, scene.render.resolution_y
         engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, w, h), w, h)
 
-    renderer_module.Renderer._plan = recording
+    shadow_pass.ShadowPass.plan = recording
     try:
         runner(job)
     finally:
-        renderer_module.Renderer._plan = original
+        shadow_pass.ShadowPass.plan = original
     sizes = [t.fit.texel + t.fit.texel_per_distance * distance for p in plans for t in p.tiles]
     return 1.0 / min(sizes) if sizes else float("nan")
 

@@ -8,16 +8,14 @@ comment.
 
 from dataclasses import replace
 
-from ..shaders.loader import Program, Struct
-from . import light_bins, lightspace
-from .enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
-from .materials import CHANNELS
+from ...shaders.loader import Program, Struct
+from ..enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
+from ..scene.materials import CHANNELS
+from ..shadows import light_bins, lightspace
+from ..shadows.planning import MAX_SHADOW_TILES
 
 MAX_LIGHTS = 64
 LIGHT_WORDS = MAX_LIGHTS // light_bins.WORD_BITS  # channels of a light-bin texel
-# Maps a frame can hold: the lit pass's ShadowTile block (160 bytes each) stays within the 16 KiB every
-# GL implementation allows a uniform block. Maps share the atlas by size, so the texels are what they hold.
-MAX_SHADOW_TILES = 96
 JITTER_SIZE = 32  # the jitter texture repeats every 32x32 pixels
 MAX_DISK_SAMPLES = 64
 # The widest JITTER/PCSS kernel, in texels: a fixed fraction of the map's side.

@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernels, light_bins, lightspace
-from .enums import LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
-from .kernels import RING
+from ..enums import LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
+from ..shadows import kernels, light_bins, lightspace
+from ..shadows.kernels import RING
 from .programs import (
     FRAME_STRUCT,
     LIGHT_STRUCT,

@@ -1,0 +1,161 @@
+"""The draw list: the frame's mesh instances with their GPU batches, world bounds and level of
+detail; the order the lit pass draws them in; which lights reach what the camera sees; and
+each instance's light-linking mask."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..scene import simplify
+from ..scene.materials import Material
+from ..shadows import light_bins, lightspace
+
+DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
+# Closed meshes (``extract.closed_outward``) seen from outside their bounds are drawn without
+# their back faces, in the lit pass and in shadow maps: those faces are hidden by the mesh's
+# own front faces, so the image is the same and the rasteriser sets up half the triangles.
+CULL_CLOSED = True
+_CORNER_BITS = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=bool)  # box corners
+
+
+@dataclass
+class Draw:
+    """One mesh instance of the frame with its GPU batches."""
+
+    instance: object  # extract.MeshInstance
+    whole: object  # GPUBatch of every triangle (shadow passes)
+    parts: list  # [(material index, GPUBatch)] (lit pass)
+    model: object  # mathutils.Matrix
+    det: float  # sign of the model matrix: flips the winding under negative scale
+    identity: tuple  # what a shadow tile's content depends on
+    corners: np.ndarray  # (8, 3) world corners of the instance's bounds
+    closed: bool = False  # a closed opaque surface: back faces hidden from outside its bounds
+
+    def material(self, index):
+        materials = self.instance.materials
+        mat = materials[index] if 0 <= index < len(materials) else None
+        return mat or DEFAULT_MATERIAL
+
+
+def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size=None):
+    """The frame's instances with their batches (``batches.Batches``); batches of geometry no
+    longer in the snapshot are released. Per-instance numbers (sign of the matrix, world
+    bounds, level of detail) are computed for all instances at once. Model matrices reach the
+    GPU relative to ``origin`` (the frame origin)."""
+    from mathutils import Matrix
+
+    kept = [(inst, snapshot.geometry[inst.key]) for inst in snapshot.instances if inst.key in snapshot.geometry]
+    draws = []
+    used_levels = set()
+    if kept:
+        matrices = np.stack([inst.matrix for inst, _geo in kept])
+        bounds = np.stack([geo.bounds for _inst, geo in kept])
+        dets = np.linalg.det(matrices[:, :3, :3])
+        local = np.where(_CORNER_BITS[None], bounds[:, None, 1], bounds[:, None, 0])  # (n, 8, 3)
+        corners = np.einsum("nij,nkj->nki", matrices[:, :3, :3], local) + matrices[:, None, :3, 3]
+        levels = _levels(kept, matrices, bounds, corners, camera, settings, size)
+        for i, (inst, geo) in enumerate(kept):
+            lod = simplify.simplified(geo, levels[i]) if levels[i] is not None else None
+            if lod is not None:
+                key = (inst.key, geo.serial, levels[i])
+                used_levels.add(key)
+                whole, parts = batches.level(key, lod)
+                identity = (inst.key, inst.matrix.tobytes(), geo.serial, levels[i])
+                stats.simplified += 1
+            else:
+                whole, parts = batches.get(inst.key, geo)
+                identity = (inst.key, inst.matrix.tobytes(), geo.serial)
+            model = inst.matrix.copy()
+            model[:3, 3] -= origin
+            model = Matrix(model.tolist())
+            draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
+            closed = CULL_CLOSED and geo.closed and lod is None  # a level is not tested for closedness
+            draw.closed = closed and not any(draw.material(m).uses_alpha for m, _b in parts)
+            draws.append(draw)
+            stats.triangles += (lod or geo).triangle_count
+    batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()}, used_levels)
+    return draws
+
+
+def _levels(kept, matrices, bounds, corners, camera, settings, size):
+    """Each instance's level of detail (``simplify.level_for``) or None (drawn whole):
+    with Render › Simplify on, its Penumbra › Merge Below in pixels of the full-resolution
+    frame, at the instance's nearest point to the camera."""
+    levels = [None] * len(kept)
+    if not getattr(settings, "use_simplify", False):
+        return levels
+    pixels = float(settings.simplify_pixels) * float(settings.pixel_scale)
+    if not pixels > 0.0 or camera is None or size is None:
+        return levels
+    footprint = lightspace.pixel_footprint(camera.projection, camera.is_ortho, *size)
+    view = np.asarray(camera.view, dtype=np.float64)
+    vp = np.asarray(camera.projection, dtype=np.float64) @ view
+    near = vp[2] + vp[3]  # clip z + w: positive beyond the near plane
+    beyond = np.all(corners @ near[:3] + near[3] > 0.0, axis=1)
+    nearest = np.min(-(corners @ view[2, :3] + view[2, 3]), axis=1)
+    stretch = np.linalg.svd(matrices[:, :3, :3], compute_uv=False)[:, 0]
+    extent = np.max(bounds[:, 1] - bounds[:, 0], axis=1)
+    for i, (inst, geo) in enumerate(kept):
+        if not beyond[i] or geo.triangle_count < simplify.MIN_TRIANGLES:
+            continue
+        if geo.uvs is not None or geo.colors is not None or geo.tangents is not None:
+            continue  # its materials read more than positions and normals
+        if any(m is not None and m.uses_alpha for m in inst.materials):
+            continue
+        levels[i] = simplify.level_for(float(extent[i]), float(stretch[i]), float(nearest[i]), footprint, pixels)
+    return levels
+
+
+def corners_of(draws):
+    """(n, 8, 3) world corners of the draws' bounds."""
+    return np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
+
+
+def lights_in_view(lights, draws, camera, width, height, stats):
+    """The lights that can light a visible surface, with the screen rectangle each can reach
+    (``light_bins.screen_rects``); a light that reaches nothing the camera sees gets no shadow
+    map and no shading."""
+    if not draws or not lights:
+        return lights, None
+    corners = np.concatenate([d.corners for d in draws])
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    rects = light_bins.screen_rects(lights, camera.projection @ camera.view, lo, hi, width, height)
+    keep = [i for i, r in enumerate(rects) if r is not None]
+    stats.lights_out_of_view = len(lights) - len(keep)
+    return [lights[i] for i in keep], [rects[i] for i in keep]
+
+
+def light_masks(draws, lights, order):
+    """Light linking: per draw (by id), the lit pass's ``light_mask``: bit j of word j // 32
+    set when light ``order[j]`` (the j-th light as the lit pass walks them) reaches it."""
+    by_names = {}  # instances of one object share its mask
+    out = {}
+    for d in draws:
+        names = d.instance.names
+        if names not in by_names:
+            words = [0, 0, 0, 0]
+            for j, i in enumerate(order):
+                receivers = lights[i].receivers
+                if receivers is None or receivers.links(names):
+                    words[j >> 5] |= 1 << (j & 31)
+            by_names[names] = tuple(w - (1 << 32) if w >= 1 << 31 else w for w in words)  # as signed ints
+        out[id(d)] = by_names[names]
+    return out
+
+
+def front_to_back(draws, camera):
+    """The draws nearest the camera first (by the nearest point of their bounds), so the
+    depth test rejects hidden pixels before they are shaded; flat meshes (grounds, walls)
+    after the others: their nearest point is no measure of what they hide, and what stands
+    on them is usually in front of them."""
+    if len(draws) < 2:
+        return draws
+    corners = np.stack([d.corners for d in draws])
+    lo, hi = corners.min(axis=1), corners.max(axis=1)
+    if camera.is_ortho:
+        key = np.min(corners @ camera.forward, axis=1)
+    else:
+        position = camera.position
+        key = np.linalg.norm(np.maximum(0.0, np.maximum(lo - position, position - hi)), axis=1)
+    key = np.where(np.isfinite(key), key, np.inf)
+    return [draws[i] for i in np.lexsort((key, lightspace.flat_boxes(corners)))]

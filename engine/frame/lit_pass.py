@@ -1,0 +1,196 @@
+"""The lit pass: every visible part shaded by its material variant (``programs.lit_program``)
+with the frame's lights and shadow atlas, into the film's targets; and the world's
+Environment Texture behind it."""
+
+import numpy as np
+
+from ..shadows import kernels, lightspace
+from .draw_list import front_to_back
+from .programs import BACKGROUND, JITTER_SIZE, SHADOW_SAMPLER, lit_program
+
+
+class LitPass:
+    """The lit pass's GPU state of one renderer: its uniform blocks, the jittered-disk and
+    light-bin textures. ``materials``: the renderer's ``MaterialBlocks``; ``textures``: its
+    ``TextureCache``."""
+
+    def __init__(self, shaders, materials, textures):
+        self.shaders = shaders
+        self.materials = materials
+        self.textures = textures
+        self._ubos = {}
+        self._jitter_tex = None
+        self._jitter_dummy = None
+        self._bins_tex = None
+        self._dummy_shadow = None
+
+    def draw(self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None):
+        """Every visible part of ``draws``, grouped by material variant: opaque and
+        alpha-hashed parts nearest first, then alpha-blended parts farthest first, blended over
+        them (their depth, normal and shadow stay those of what is behind; EEVEE too keeps
+        blended surfaces out of its depth). ``atlas``: the shadow atlas, or None when no map
+        was planned; ``world``: the snapshot's World (or None) and ``world_color``."""
+        import gpu
+
+        world_data, world_color = world
+        shadow_tex = atlas.texture if atlas is not None else self._shadow_dummy()
+        # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
+        bg = (0.0, 0.0, 0.0, 0.0) if settings.film_transparent else (*map(float, world_color[:3]), 1.0)
+        emission = aux and emission
+        film.clear(bg, aux, emission)
+        if world_data is not None and world_data.image is not None and not settings.film_transparent:
+            self._background(film, world_data, camera, origin)
+        # Closed instances wholly beyond the near plane: from there no back face shows.
+        outside = set()
+        closed = [d for d in draws if d.closed]
+        if closed:
+            vp = camera.projection @ camera.view
+            near = vp[2] + vp[3]  # clip z + w: positive beyond the near plane
+            beyond = np.all(np.stack([d.corners for d in closed]) @ near[:3] + near[3] > 0.0, axis=1)
+            outside = {id(d) for d, ok in zip(closed, beyond, strict=True) if ok}
+            stats.closed_culled += len(outside)
+        opaque, blended = [], []
+        for rank, d in enumerate(front_to_back(draws, camera)):
+            for mat_index, batch in d.parts:
+                mat = d.material(mat_index)
+                features = mat.features | ({"HOLDOUT"} if d.instance.holdout else set())
+                entry = (features, rank, d, batch, mat)
+                (blended if "ALPHA_BLEND" in features and not d.instance.holdout else opaque).append(entry)
+        opaque.sort(key=lambda e: (sorted(e[0]), e[1]))
+        blended.sort(key=lambda e: -e[1])
+        width, height = film.size
+        bound = {"shader": None}
+
+        def bind(features, with_aux):
+            program = lit_program(frozenset(features), with_aux, emission and with_aux)
+            shader = self.shaders.get(program, data.defines)
+            if bound["shader"] is shader:
+                return shader
+            shader.bind()
+            shader.uniform_block("frame", self._ubo("frame", data.frame))
+            shader.uniform_block("lights", self._ubo("lights", data.lights))
+            shader.uniform_block("shadow_tiles", self._ubo("tiles", data.tiles))
+            shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
+            shader.uniform_sampler("jitter_tex", self._jitter(data.disk_samples))
+            shader.uniform_sampler("light_bins", self._bins_texture(data.bins))
+            bound["shader"] = shader
+            return shader
+
+        def draw(entries, with_aux):
+            last = None
+            for features, _rank, d, batch, mat in entries:
+                # Material › Backface Culling › Camera: faces turned away are not drawn (the
+                # winding flips under a mirroring model matrix).
+                cull = mat.cull_camera or id(d) in outside
+                culling = (cull, cull and d.det < 0.0)
+                if bound.get("culling") != culling:
+                    gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
+                    gpu.state.front_facing_set(culling[1])
+                    bound["culling"] = culling
+                shader = bind(features, with_aux)
+                if last is not d or bound.get("model_shader") is not shader:
+                    shader.uniform_float("model", d.model)
+                    if masks is not None:
+                        shader.uniform_int("light_mask", masks[id(d)])
+                    last, bound["model_shader"] = d, shader
+                shader.uniform_block("material", self.materials.get(mat))
+                for channel, ref in mat.textures.items():
+                    shader.uniform_sampler(f"tex_{channel}", self.textures.get(ref.image))
+                batch.draw(shader)
+                stats.draws += 1
+
+        fb = film.fb_emit if emission else (film.fb if aux else film.fb_color)
+        with fb.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            fb.clear(depth=1.0)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            draw(opaque, aux)
+        if blended:
+            bound["shader"] = None
+            with film.fb_color.bind():
+                gpu.state.viewport_set(0, 0, width, height)
+                gpu.state.depth_test_set("LESS_EQUAL")
+                gpu.state.depth_mask_set(False)
+                gpu.state.blend_set("ALPHA_PREMULT")
+                draw(blended, False)
+                gpu.state.blend_set("NONE")
+        gpu.state.face_culling_set("NONE")
+        gpu.state.front_facing_set(False)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+        stats.passes += 1
+
+    def _background(self, film, world, camera, origin):
+        """The world's Environment Texture behind the scene (``programs.BACKGROUND``)."""
+        from mathutils import Matrix
+
+        width, height = film.size
+        try:
+            inverse = np.linalg.inv(camera.projection @ camera.view @ lightspace.from_origin(origin))
+        except np.linalg.LinAlgError:
+            return
+        if not np.all(np.isfinite(inverse)):
+            return
+        film.fullscreen(
+            BACKGROUND,
+            film.fb_color,
+            {"env": self.textures.get(world.image)},
+            {
+                "inverse_view_proj": Matrix(inverse.tolist()),
+                "viewport_origin": (0.0, 0.0),
+                "viewport_size": (float(width), float(height)),
+                "strength": float(world.strength),
+            },
+        )
+
+    def _ubo(self, name, data):
+        import gpu
+
+        raw = data.tobytes()
+        ubo = self._ubos.get(name)
+        if ubo is None or ubo[1] != len(raw):
+            self._ubos[name] = (gpu.types.GPUUniformBuf(raw), len(raw))
+        else:
+            ubo[0].update(raw)
+        return self._ubos[name][0]
+
+    def _jitter(self, samples):
+        """The jittered-disk texture: (JITTER_SIZE, JITTER_SIZE, samples / 2) RGBA, two 2-D
+        offsets per texel, outer ring first (kernels.jitter_disk); a 1x1x1 texture when the
+        variant reads no disk (``samples`` 0)."""
+        import gpu
+
+        if samples == 0:
+            if self._jitter_dummy is None:
+                buf = gpu.types.Buffer("FLOAT", 4, [0.0] * 4)
+                self._jitter_dummy = gpu.types.GPUTexture((1, 1, 1), format="RGBA32F", data=buf)
+            return self._jitter_dummy
+        if self._jitter_tex is None or self._jitter_tex[0] != samples:
+            disk = kernels.jitter_disk(JITTER_SIZE, samples).astype(np.float32)
+            # (y, x, sample, 2) -> 3-D texture (x, y, sample pair) of RGBA: z slowest in memory.
+            data = disk.reshape(JITTER_SIZE, JITTER_SIZE, samples // 2, 4).transpose(2, 0, 1, 3)
+            buf = gpu.types.Buffer("FLOAT", data.size, data.ravel().tolist())
+            tex = gpu.types.GPUTexture((JITTER_SIZE, JITTER_SIZE, samples // 2), format="RGBA32F", data=buf)
+            self._jitter_tex = (samples, tex)
+        return self._jitter_tex[1]
+
+    def _bins_texture(self, bins):
+        """The light-bin masks as an RGBA32F texture (a 1x1 zero texture when not binned)."""
+        import gpu
+
+        if bins is None:
+            bins = np.zeros((1, 1, 4), np.float32)
+        rows, cols = bins.shape[:2]
+        buf = gpu.types.Buffer("FLOAT", bins.size, np.ascontiguousarray(bins, np.float32).ravel())
+        # Kept until the next frame: the draw that samples it runs after this call returns.
+        self._bins_tex = gpu.types.GPUTexture((cols, rows), format="RGBA32F", data=buf)
+        return self._bins_tex
+
+    def _shadow_dummy(self):
+        import gpu
+
+        if self._dummy_shadow is None:
+            self._dummy_shadow = gpu.types.GPUTexture((1, 1), format="R32F")
+            self._dummy_shadow.clear(format="FLOAT", value=(1.0,))
+        return self._dummy_shadow

@@ -1,0 +1,51 @@
+"""Each material's uniform block (``programs.MATERIAL_STRUCT``), built once per Material read:
+the lit pass and the shadow pass's alpha cutouts bind the same block."""
+
+from ..scene.materials import CHANNELS, EXTENSION, INTERPOLATION
+from .programs import MATERIAL_STRUCT
+
+MAX_BLOCKS = 4096  # blocks kept before the cache starts afresh (materials of past snapshots)
+
+
+class MaterialBlocks:
+    def __init__(self):
+        self._blocks = {}  # id(Material) -> (Material, GPUUniformBuf)
+
+    def __len__(self):
+        return len(self._blocks)
+
+    def get(self, mat):
+        """The MaterialData block of ``mat``."""
+        import gpu
+
+        cached = self._blocks.get(id(mat))
+        if cached is not None and cached[0] is mat:
+            return cached[1]
+        row = {
+            "base_color": tuple(mat.base_color)[:4],
+            "emission": tuple(mat.emission)[:3],
+            "roughness": float(mat.roughness),
+            "metallic": float(mat.metallic),
+            "specular": float(mat.specular),
+            "alpha": float(mat.alpha),
+            "normal_strength": float(mat.normal_strength),
+        }
+        for channel in CHANNELS:
+            ref = mat.textures.get(channel)
+            rows = ref.transform if ref is not None else ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+            row[f"{channel}_uv_u"] = (*rows[0], 0.0)
+            row[f"{channel}_uv_v"] = (*rows[1], 0.0)
+            mode = (0, 0, 0, 0)
+            if ref is not None:
+                mode = (
+                    INTERPOLATION.get(ref.interpolation, 1),
+                    EXTENSION.get(ref.extension, 0),
+                    int(ref.output == "Alpha"),
+                    int(ref.component),
+                )
+            row[f"{channel}_mode"] = mode
+        ubo = gpu.types.GPUUniformBuf(MATERIAL_STRUCT.pack([row]).tobytes())
+        if len(self._blocks) > MAX_BLOCKS:
+            self._blocks.clear()
+        self._blocks[id(mat)] = (mat, ubo)
+        return ubo

@@ -1,0 +1,209 @@
+"""One frame as its stages: extract (done by the caller) -> shadows -> lit -> post -> output.
+The same code serves the viewport and final renders; only where the camera comes from and
+where the result goes differ.
+
+The renderer only sequences the frame; each stage keeps its own state: the draw list and its
+GPU batches (``draw_list``, ``batches``), the shadow pass (``shadow_pass``), the lit pass
+(``lit_pass``) and the film's targets, accumulation and resolve (``film``).
+"""
+
+import dataclasses
+
+import numpy as np
+
+from ..gpu_pool import FINAL_IMAGES
+from ..post import post_stack
+from ..scene.textures import TextureCache
+from ..shadows import lightspace
+from . import sampling
+from .batches import Batches
+from .draw_list import corners_of, draw_list, light_masks, lights_in_view
+from .film import Film, FrameOutput
+from .frame_data import build_frame_data, select_lights
+from .lit_pass import LitPass
+from .material_blocks import MaterialBlocks
+from .programs import MAX_LIGHTS
+from .shadow_pass import UNSET, ShadowPass
+from .stats import FrameStats
+
+
+class Renderer:
+    """GPU state of one engine instance. Create and use only inside a GPU context."""
+
+    def __init__(self, pool=None, shaders=None):
+        """``pool``: a ``gpu_pool.TexturePool`` the frame's targets and shadow atlas come from
+        (final renders); ``release`` gives them back. ``shaders``: a ``ShaderCache`` shared
+        with other renderers (final renders), else one of its own."""
+        from ...shaders.loader import ShaderCache
+
+        self.pool = pool
+        self.shaders = shaders if shaders is not None else ShaderCache()
+        self.textures = TextureCache(FINAL_IMAGES if pool is not None else None)
+        self.materials = MaterialBlocks()
+        self.batches = Batches()
+        self.film = Film(self.shaders, pool)
+        self.shadow_pass = ShadowPass(pool)
+        self.lit_pass = LitPass(self.shaders, self.materials, self.textures)
+        self.post = post_stack()
+        self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
+
+    @property
+    def shadows(self):
+        """The shadow atlas (``shadow_maps.ShadowAtlas``)."""
+        return self.shadow_pass.atlas
+
+    def render(
+        self,
+        snapshot,
+        camera,
+        settings,
+        width,
+        height,
+        aux=True,
+        samples=(0, 1),
+        sample_count=1,
+        on_sample=None,
+        emission=False,
+    ):
+        """Samples ``samples[0] .. samples[1] - 1`` of a frame of ``sample_count`` samples
+        (``frame/sampling.py``), added to the samples this renderer already accumulated for
+        it (a start of 0 begins the frame afresh), then the post stack on their filtered
+        average. One sample of one is exactly the single-sample frame, with no accumulation.
+        ``aux``: also write the depth, shadow and normal targets (a final render's passes;
+        depth and normal are the centred sample's, shadow is averaged like colour).
+        ``on_sample(done)`` after each sample; returning False stops the frame there (cancel).
+        ``emission`` (with ``aux``): also write the Emission pass's target, averaged like colour."""
+        stats = FrameStats()
+        compiled_before = self.shaders.compiled
+        self.shadow_pass.begin_frame()
+        emission = bool(emission and aux)
+        film = self.film
+        film.ensure(width, height, aux, emission)
+        # The frame origin: the GPU gets every position relative to the camera (model matrices,
+        # lights, the camera's and each map's view), computed here in float64, so a scene far
+        # from the world origin keeps float32's precision where it is seen. Maps do not depend
+        # on it (each is drawn and read through the same shift) and stay reusable when it moves.
+        origin = camera.position
+        self._origin = origin if np.all(np.isfinite(origin)) else np.zeros(3)
+        draws = draw_list(snapshot, self.batches, stats, self._origin, camera, settings, (width, height))
+        stats.messages.extend(getattr(snapshot, "messages", ()))
+        self.textures.forget(getattr(snapshot, "images_changed", ()))
+        lights = select_lights(snapshot.lights, camera.position, MAX_LIGHTS)
+        if len(lights) < len(snapshot.lights):
+            stats.messages.append(
+                f"Penumbra: {len(snapshot.lights)} lights; only the {MAX_LIGHTS} that contribute most to the view "
+                "are lit"
+            )
+        start, stop = samples
+        accumulate = sample_count > 1
+        if accumulate:
+            film.begin(aux, emission, fresh=start == 0)
+        plan = None
+        moving = set()
+        if accumulate:
+            moving = sampling.sampled_lights(lights, self.shadow_pass.plan(draws, lights, camera, settings, film.size))
+        stats.lights_sampled = len(moving)
+        for s in range(start, stop):
+            dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
+            view_camera = camera
+            if dx or dy:
+                jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
+                view_camera = dataclasses.replace(camera, projection=jittered)
+            sample_lights = [
+                sampling.light_at_sample(lt, i, s, sample_count) if i in moving else lt for i, lt in enumerate(lights)
+            ]
+            alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
+            plan = self._sample(
+                draws, sample_lights, camera, view_camera, snapshot, settings, aux, emission, stats, alpha_offset
+            )
+            if accumulate:
+                film.accumulate(weight, aux, emission)
+            if aux and accumulate and s == 0:  # the centred sample's depth and normal
+                film.keep_centre()
+            stats.samples += 1
+            if on_sample is not None and on_sample(s + 1) is False:
+                stats.cancelled = True
+                break
+        if accumulate and stats.samples:
+            film.resolve(aux, emission)
+        color = self._post_pass(settings, stats)
+        stats.shadow_bytes = self.shadows.memory_bytes if plan is not None and plan.tiles else 0
+        stats.texture_bytes = (
+            film.target_bytes(aux, accumulate) + stats.shadow_bytes + film.post_ctx.memory_bytes + self.textures.bytes
+        )
+        stats.shaders_compiled = self.shaders.compiled - compiled_before
+        if not aux:
+            return FrameOutput(color, None, None, stats, width, height, lit=film.color)
+        out = FrameOutput(color, film.depth, film.shadow, stats, width, height, lit=film.color, normal=film.normal)
+        out.emission = film.emission if emission else None
+        if accumulate and film.centre is not None:
+            out.depth_data, out.normal_data = film.centre
+        return out
+
+    def _sample(self, draws, lights, camera, view_camera, snapshot, settings, aux, emission, stats, alpha_offset=0.5):
+        """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
+        does not move between samples keeps its map), then the lit pass seen through
+        ``view_camera``. Returns the shadow plan."""
+        film = self.film
+        width, height = film.size
+        lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats)
+        plan = self.shadow_pass.draw(
+            draws,
+            lights,
+            camera,
+            settings,
+            film.size,
+            stats,
+            self.shaders,
+            self.materials,
+            self.textures,
+            self._origin,
+            alpha_offset,
+        )
+        depth_range = self.shadow_pass.depth_range
+        if depth_range is UNSET:  # no shadow plan this frame: the quick, wider bound
+            depth_range = lightspace.box_depth_range(camera.projection, camera.view, corners_of(draws), camera.is_ortho)
+        # The lit pass rasterises with the depth buffer spread over what the camera sees.
+        fitted = lightspace.depth_fitted(view_camera.projection, view_camera.is_ortho, depth_range)
+        raster_camera = (
+            view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
+        )
+        atlas = self.shadows if plan.tiles else None
+        data = build_frame_data(
+            lights,
+            raster_camera,
+            snapshot.world if snapshot.world is not None else snapshot.world_color,
+            settings,
+            plan,
+            tile_size=atlas.size if atlas else 1,
+            atlas_columns=atlas.columns if atlas else 1,
+            depth_format=atlas.depth_format if atlas else "FLOAT32",
+            aux_outputs=aux,
+            rects=rects,
+            size=(width, height),
+            alpha_offset=alpha_offset,
+            origin=self._origin,
+        )
+        stats.binned = data.bins is not None
+        seen = [d for d in draws if d.instance.camera]
+        masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
+        world = (snapshot.world, snapshot.world_color)
+        self.lit_pass.draw(
+            film, seen, view_camera, data, atlas, world, settings, aux, emission, stats, self._origin, masks
+        )
+        return plan
+
+    def _post_pass(self, settings, stats):
+        ctx = self.film.post_ctx
+        ctx.frame = settings.frame
+        ctx.pixel_scale = settings.pixel_scale
+        ctx.stats = stats
+        return self.post.run(ctx, self.film.color, settings.layers)
+
+    def release(self):
+        """Give the frame's targets and the shadow atlas back to the pool: at the end of a
+        final render, inside its GPU context. The renderer is not used again."""
+        if self.pool is None:
+            return
+        self.film.release()
+        self.shadows.free()

@@ -1,0 +1,249 @@
+"""The depth pass: the shadow atlas of one engine instance and what each instance draws into
+it (``Caster``). Which maps a frame needs, and how each is fitted, is decided beforehand
+without a GPU (``shadows.planning.plan_shadows``)."""
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..enums import DEPTH_FORMAT
+from ..gpu_pool import new_texture
+from ..shadows.planning import pack_tiles
+from .programs import (
+    SCALED_COPY,
+    TILE_STRUCT,
+    depth_defines,
+    shadow_cutout_program,
+    shadow_program,
+)
+
+
+@dataclass
+class Caster:
+    """One instance as it draws into shadow maps."""
+
+    batches: list  # GPUBatches drawn whole (opaque material parts)
+    model: object  # mathutils.Matrix
+    det: float  # sign of the model matrix (winding under negative scale)
+    identity: tuple  # what a tile's content depends on
+    cutouts: list = field(default_factory=list)  # (batch, material UBO, alpha texture): alpha >= 0.5 casts
+    cull_back: bool = False  # every material asks for shadow back-face culling: faces away from the light cast nothing
+    closed: bool = False  # a closed opaque surface (renderer.CULL_CLOSED): its back faces are hidden from outside
+    corners: object = None  # (8, 3) world corners of its bounds, with ``closed``
+
+
+class ShadowAtlas:
+    """The atlas of one engine instance: square slots in a grid ``columns`` wide, as wide as
+    the frame's widest map; narrower maps share a slot (``pack_tiles``). Tiles remember what
+    they hold so unchanged maps are reused.
+
+    Memory is the slots the packed maps take (maps of power-of-two sizes leave no gaps in a
+    slot) and one slot more at most: a FLOAT32 atlas is a depth texture the depth pass writes
+    directly (4 bytes a texel, nothing else); FLOAT16 and RGBA8 maps are drawn in one
+    slot-sized scratch target (colour and depth) and copied into a colour atlas of their own
+    format (2 or 4 bytes a texel)."""
+
+    def __init__(self, pool=None):
+        self.size = 0
+        self.count = 0
+        self.columns = 1
+        self.depth_format = "FLOAT32"
+        self._pool = pool  # a gpu_pool.TexturePool the atlas texture comes from and goes back to
+        self.texture = None
+        self._framebuffer = None
+        self._scratch = None  # (colour, depth, framebuffer) of one tile, non-FLOAT32 formats
+        self._copy_batch = None
+        self._ubos = []
+        self._contents = {}  # tile index -> what its map holds
+
+    @staticmethod
+    def grid(count):
+        columns = max(1, math.ceil(math.sqrt(count)))
+        rows = max(1, math.ceil(count / columns))
+        return columns, rows
+
+    def ensure(self, size, count, depth_format):
+        import gpu
+
+        count = max(1, count)
+        columns, rows = self.grid(count)
+        if (
+            self.texture is not None
+            and (self.size, self.columns, self.depth_format) == (size, columns, depth_format)
+            and self.count >= count
+        ):
+            return
+        self.free()
+        self.size, self.count, self.columns, self.depth_format = size, columns * rows, columns, depth_format
+        dims = (columns * size, rows * size)
+        fmt = DEPTH_FORMAT[depth_format]
+        # Read with texelFetch only, so the sampler's filter mode never matters. A pooled
+        # texture holds another render's maps: every map is drawn before it is read.
+        self.texture = new_texture(self._pool, dims, fmt.texture)
+        if fmt.depth_only:
+            self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.texture)
+        else:
+            self._framebuffer = gpu.types.GPUFrameBuffer(color_slots=(self.texture,))
+            color = gpu.types.GPUTexture((size, size), format=fmt.texture)
+            depth = gpu.types.GPUTexture((size, size), format="DEPTH_COMPONENT32F")
+            self._scratch = (color, depth, gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=(color,)))
+        self._contents = {}
+
+    @property
+    def memory_bytes(self):
+        if self.texture is None:
+            return 0
+        texel = DEPTH_FORMAT[self.depth_format].bytes
+        scratch = 0 if self._scratch is None else self.size * self.size * (texel + 4)
+        return self.texture.width * self.texture.height * texel + scratch
+
+    def free(self):
+        """Drop the GPU objects (inside a GPU context); the atlas texture goes to the pool."""
+        self._framebuffer = None
+        self._scratch = None
+        self._copy_batch = None
+        if self._pool is not None:
+            self._pool.give([self.texture])
+        self.texture = None
+        self._ubos = []
+        self._contents = {}
+        self.size = self.count = 0
+        self.columns = 1
+
+    def place(self, plan, depth_format):
+        """Pack the plan's maps (``pack_tiles``), make the atlas hold them and set each tile's
+        ``origin``."""
+        slot, count, where = pack_tiles([t.size for t in plan.tiles])
+        self.ensure(slot, count, depth_format)
+        for tile, (index, x, y) in zip(plan.tiles, where, strict=True):
+            tile.origin = ((index % self.columns) * self.size + x, (index // self.columns) * self.size + y)
+
+    def _tile_ubo(self, index, data):
+        import gpu
+
+        raw = data.tobytes()
+        while len(self._ubos) <= index:
+            self._ubos.append(gpu.types.GPUUniformBuf(raw))
+        self._ubos[index].update(raw)
+        return self._ubos[index]
+
+    def render(self, plan, draws, shaders, cull_front, stats, alpha_offset=0.5, origin=None):
+        """Draw every tile of ``plan`` whose content changed. ``draws``: per instance a
+        ``Caster``, or None for an instance that casts no shadow; a tile's key is its fit and
+        its casters. ``origin``: the frame origin the casters' model matrices are relative to."""
+        import gpu
+
+        depth_only = DEPTH_FORMAT[self.depth_format].depth_only
+        defines = depth_defines(self.depth_format)
+
+        def program(raster):  # raster: an orthographic tile of a depth-buffer map
+            return shaders.get(shadow_program(self.depth_format, raster), defines)
+
+        def cutout(textured, raster):  # compiled only when a caster has alpha
+            return shaders.get(shadow_cutout_program(self.depth_format, textured, raster), defines)
+
+        work = []
+        for index, tile in enumerate(plan.tiles):
+            casters = [draws[c] for c in tile.casters if draws[c] is not None]
+            key = (
+                tile.fit.view_proj.tobytes(),
+                tile.fit.near,
+                tile.fit.far,
+                tile.size,
+                tile.origin,
+                cull_front,
+                tuple((c.identity, c.cull_back) for c in casters),
+                # Alpha casters cover other texels in each sample: such a map is redrawn per sample.
+                alpha_offset if any(c.cutouts for c in casters) else None,
+            )
+            if self._contents.get(index) == key:
+                stats.shadow_maps_reused += 1
+                continue
+            work.append((index, tile, casters, key))
+        # Every map redrawn (a final render's frame) and filling most of the atlas: one clear of
+        # the whole atlas, not one scissored clear per map (which GL may draw as a quad).
+        used = sum(t.size**2 for _i, t, _c, _k in work)
+        cleared = depth_only and len(work) == len(plan.tiles) and 2 * used >= self.count * self.size**2
+        if cleared:
+            with self._framebuffer.bind():
+                self._framebuffer.clear(depth=1.0)
+        for index, tile, casters, key in work:
+            (x0, y0), n = tile.origin, tile.size
+            target = self._framebuffer if depth_only else self._scratch[2]
+            with target.bind():
+                if depth_only:
+                    gpu.state.viewport_set(x0, y0, n, n)
+                    if not cleared:
+                        gpu.state.scissor_set(x0, y0, n, n)
+                        gpu.state.scissor_test_set(True)
+                        target.clear(depth=1.0)
+                        gpu.state.scissor_test_set(False)
+                else:
+                    gpu.state.viewport_set(0, 0, n, n)
+                    target.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
+                gpu.state.depth_test_set("LESS")
+                gpu.state.depth_mask_set(True)
+                tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(origin)]))
+                raster = depth_only and tile.fit.orthographic
+                shader = program(raster)
+                shader.bind()
+                shader.uniform_block("tile", tile_ubo)
+                # Closed casters wholly in front of the light (w > 0 at every corner: no
+                # clipping, and the light outside them) cast with their faces toward the light.
+                front = set()
+                closed = [c for c in casters if c.closed] if not cull_front else []
+                if closed:
+                    w_row = tile.fit.view_proj[3]
+                    ok = np.all(np.stack([c.corners for c in closed]) @ w_row[:3] + w_row[3] > 0.0, axis=1)
+                    front = {id(c) for c, inside in zip(closed, ok, strict=True) if inside}
+                    stats.closed_culled += len(front)
+                for caster in casters:
+                    if cull_front or caster.cull_back or id(caster) in front:
+                        gpu.state.face_culling_set("FRONT" if cull_front else "BACK")
+                        gpu.state.front_facing_set(caster.det < 0.0)
+                    else:
+                        gpu.state.face_culling_set("NONE")
+                    shader.uniform_float("model", caster.model)
+                    for batch in caster.batches:
+                        batch.draw(shader)
+                        stats.draws += 1
+                gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
+                for caster in casters:
+                    for batch, material_ubo, texture in caster.cutouts:
+                        cut = cutout(texture is not None, raster)
+                        cut.bind()
+                        cut.uniform_block("tile", tile_ubo)
+                        cut.uniform_float("alpha_offset", alpha_offset)
+                        cut.uniform_float("model", caster.model)
+                        cut.uniform_block("material", material_ubo)
+                        if texture is not None:
+                            cut.uniform_sampler("tex_alpha", texture)
+                        batch.draw(cut)
+                        stats.draws += 1
+                gpu.state.face_culling_set("NONE")
+                gpu.state.front_facing_set(False)
+                gpu.state.depth_test_set("NONE")
+                gpu.state.depth_mask_set(False)
+            if not depth_only:
+                self._copy_scratch(x0, y0, n, shaders)
+                stats.passes += 1
+            self._contents[index] = key
+            stats.passes += 1
+            stats.shadow_maps += 1
+            stats.shadow_texels += n * n
+
+    def _copy_scratch(self, x0, y0, n, shaders):
+        import gpu
+        from gpu_extras.batch import batch_for_shader
+
+        shader = shaders.get(SCALED_COPY)
+        if self._copy_batch is None:
+            self._copy_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
+        with self._framebuffer.bind():
+            gpu.state.viewport_set(x0, y0, n, n)
+            shader.bind()
+            shader.uniform_int("origin", (x0, y0))
+            shader.uniform_float("scale", 1.0)
+            shader.uniform_sampler("src_color", self._scratch[0])
+            self._copy_batch.draw(shader)

@@ -1,0 +1,142 @@
+"""The frame's shadow pass: plan the maps the lights need (``shadows.planning``, numpy only),
+apply shadow linking to each map's casters, and draw the maps whose content changed into the
+atlas (``shadow_maps.ShadowAtlas``)."""
+
+import numpy as np
+
+from ..shadows import lightspace
+from ..shadows.planning import MAX_SHADOW_TILES, Density, plan_shadows
+from .draw_list import corners_of
+from .shadow_maps import Caster, ShadowAtlas
+
+UNSET = object()  # ``ShadowPass.depth_range`` before this frame's first plan
+
+
+class ShadowPass:
+    def __init__(self, pool=None):
+        self.atlas = ShadowAtlas(pool)
+        self.depth_range = UNSET  # the frame's visible depth range, once a plan computed it
+        self._receivers = None  # and what the camera sees (lightspace.visible_receivers)
+
+    def begin_frame(self):
+        """Forget the last frame's camera-dependent bounds."""
+        self.depth_range = UNSET
+        self._receivers = None
+
+    def plan(self, draws, lights, camera, settings, size, map_size=None):
+        """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
+        (width, height), with maps of ``map_size`` (default: the setting)."""
+        corners = corners_of(draws)
+        view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
+        map_size = max(1, int(settings.shadow_map_size)) if map_size is None else map_size
+        if self.depth_range is UNSET:
+            # The visible depth range and the visible receivers depend only on the unjittered
+            # camera and the instances' bounds: once per frame, not per sample.
+            self.depth_range = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
+            self._receivers = lightspace.visible_receivers(corners, camera.projection @ camera.view)
+        return plan_shadows(
+            lights,
+            corners,
+            map_size,
+            view_corners,
+            camera,
+            int(settings.shadow_cascades),
+            self.depth_range,
+            kernel=fixed_kernel(settings),
+            pcss=settings.shadow_filter == "PCSS",
+            receivers=self._receivers,
+            density=_density(camera, settings, size),
+        )
+
+    def draw(self, draws, lights, camera, settings, size, stats, shaders, materials, textures, origin, alpha_offset):
+        """Plan the maps this frame needs (numpy) and draw the ones whose content changed.
+        ``materials`` (``MaterialBlocks``) and ``textures`` serve alpha cutouts. Returns the plan."""
+        map_size = max(1, int(settings.shadow_map_size))
+        plan = self.plan(draws, lights, camera, settings, size, map_size)
+        if not plan.tiles:
+            return plan
+        columns, _rows = self.atlas.grid(len(plan.tiles))
+        clamped = min(map_size, _gpu_texture_limit() // columns)
+        if max(t.size for t in plan.tiles) > clamped:
+            stats.messages.append(
+                f"Penumbra: shadow map size {map_size} clamped to {clamped}: {len(plan.tiles)} maps share this "
+                "GPU's largest texture"
+            )
+            map_size = clamped
+            plan = self.plan(draws, lights, camera, settings, size, map_size)
+        if plan.unshadowed:
+            stats.messages.append(
+                f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
+            )
+        for i, entry in plan.lights.items():  # shadow linking: only the light's blockers cast
+            blockers = lights[i].blockers
+            if blockers is not None:
+                for t in entry.tiles:
+                    if t >= 0:
+                        tile = plan.tiles[t]
+                        tile.casters = np.array(
+                            [c for c in tile.casters if blockers.links(draws[c].instance.names)], dtype=np.int64
+                        )
+        self.atlas.place(plan, settings.shadow_depth_format)
+        casters = [caster(d, materials, textures) for d in draws]
+        self.atlas.render(plan, casters, shaders, settings.shadow_cull_front, stats, alpha_offset, origin)
+        return plan
+
+
+def caster(d, materials, textures):
+    """What draw ``d`` draws into shadow maps (``shadow_maps.Caster``), or None when it casts
+    no shadow (Ray Visibility > Shadow off). Parts with alpha cover each map texel in a
+    fraction alpha of the samples (``shadow_maps.ShadowAtlas.render``)."""
+    if not d.instance.shadow:
+        return None
+    mats = [(index, batch, d.material(index)) for index, batch in d.parts]
+    cull = bool(mats) and all(m.cull_shadow for _i, _b, m in mats)
+    # Material > Settings > Transparent Shadows off: its alpha casts as an opaque surface.
+    if not any(m.uses_alpha and m.transparent_shadow for _i, _b, m in mats):
+        return Caster([d.whole], d.model, d.det, d.identity, cull_back=cull, closed=d.closed, corners=d.corners)
+    solid, cutouts = [], []
+    for _index, batch, mat in mats:
+        if not (mat.uses_alpha and mat.transparent_shadow):
+            solid.append(batch)
+        elif "alpha" in mat.textures:
+            cutouts.append((batch, materials.get(mat), textures.get(mat.textures["alpha"].image)))
+        elif mat.alpha > 0.0:
+            cutouts.append((batch, materials.get(mat), None))
+    identity = (*d.identity, tuple(id(m) for _i, _b, m in mats))
+    return Caster(solid, d.model, d.det, identity, cutouts, cull_back=cull)
+
+
+def _density(camera, settings, size):
+    """How finely this frame's camera sees (``planning.Density``), or None when maps keep
+    their full size (Texels per Pixel 0)."""
+    per_pixel = float(settings.shadow_texels_per_pixel)
+    if not per_pixel > 0.0 or size is None:
+        return None
+    per_depth, constant = lightspace.pixel_footprint(camera.projection, camera.is_ortho, *size)
+    return Density(np.asarray(camera.view, dtype=np.float64), per_depth, constant, per_pixel)
+
+
+def fixed_kernel(settings):
+    """The radius in texels the scene's shadow filter reads around a lookup (not PCSS, whose
+    kernel follows each light's size)."""
+    kind = settings.shadow_filter
+    if kind == "PCF":
+        return (max(int(settings.pcf_kernel_size), 1) // 2) * max(float(settings.pcf_spacing), 0.0) + 1.0
+    if kind == "JITTER":
+        return max(float(settings.shadow_filter_radius), 0.0) + 1.0
+    return 1.0
+
+
+def _view_corners(camera):
+    """The camera frustum's world corners, or None when its matrices are degenerate."""
+    try:
+        c = lightspace.frustum_corners(camera.projection @ camera.view)
+    except np.linalg.LinAlgError:
+        return None
+    return c if np.all(np.isfinite(c)) else None
+
+
+def _gpu_texture_limit():
+    import gpu
+
+    return gpu.capabilities.max_texture_size_get()
