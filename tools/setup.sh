@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Creates .venv/blender-<line> with bpy and tools/requirements.txt (numpy, OpenImageIO, pytest,
-# matplotlib, ruff), and makes sure Mesa's EGL (headless OpenGL through llvmpipe) is installed.
+# matplotlib, ruff) at the exact versions of tools/lock/blender-<line>.txt, and makes sure Mesa's
+# EGL (headless OpenGL through llvmpipe) is installed. tools/lock.sh refreshes the lock files.
 #   tools/setup.sh 5.2        # Blender 5.2 line (Python 3.13)
 #   tools/setup.sh 4.5        # Blender 4.5 LTS (Python 3.11)
-# Re-running is cheap: a venv whose requirements did not change is left alone.
+# Re-running is cheap: a venv whose lock file did not change is left alone.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -53,14 +54,23 @@ if [ -z "$python" ]; then
 fi
 
 venv=".venv/blender-$line"
+lock="tools/lock/blender-$line.txt"
 stamp="$venv/.requirements"
-want="$(cat tools/requirements.txt) bpy==$line.* $("$python" --version 2>&1)"
+want="$(cat "$lock") $("$python" --version 2>&1)"
 if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ] && [ -x "$venv/bin/python" ]; then
   exit 0
 fi
-echo "setup: creating $venv with $python"
+echo "setup: creating $venv with $python ($lock)"
 rm -rf "$venv"
 "$python" -m venv "$venv"
-"$venv/bin/python" -m pip install -q --upgrade pip
-"$venv/bin/python" -m pip install -q "bpy==$line.*" -r tools/requirements.txt
+"$venv/bin/python" -m pip install -q --disable-pip-version-check "$(grep '^pip==' "$lock")"
+# Every package at its locked version; --no-deps: the lock lists the dependencies too, so
+# nothing unlisted (and unpinned) comes in.
+"$venv/bin/python" -m pip install -q --disable-pip-version-check --no-deps -r "$lock"
+# A lock that misses a dependency fails here, not in a test. (pip check also calls bpy 4.5's
+# wheel "not supported on this platform", from its tags alone: that line is not a failure.)
+broken="$("$venv/bin/python" -m pip check 2>&1 | grep -v "is not supported on this platform" | grep -v "^No broken" || true)"
+if [ -n "$broken" ]; then
+  echo "setup: $lock is incomplete:" >&2; echo "$broken" >&2; exit 1
+fi
 echo "$want" > "$stamp"
