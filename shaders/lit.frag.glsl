@@ -5,7 +5,7 @@
  * by its shadow visibility; back faces of a light (N.L <= 0) skip the shadow filter.
  * Emission adds after lighting and is never shadowed.
  *
- * The material comes from the MaterialData block and, per variant (engine/programs.py
+ * The material comes from the MaterialData block and, per variant (engine/frame/programs.py
  * material_defines), image textures, a colour attribute, a normal map and the alpha mode.
  *
  * The lit pass pays only for what it uses: lights sampled over their extent come first
@@ -32,7 +32,7 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
                inout float unshadowed)
 {
 #if LIGHT_LINKING
-  /* Light linking: this object's bit of light i (engine/renderer.py, Renderer._light_masks). */
+  /* Light linking: this object's bit of light i (engine/frame/draw_list.py, light_masks). */
   if (((uint(light_mask[i >> 5]) >> uint(i & 31)) & 1u) == 0u) {
     return;
   }
@@ -232,7 +232,7 @@ void main()
   vec3 color = world_light(s, rough, ab);
   float arriving = 0.0, unshadowed = 0.0;
 #if LIGHT_BINS
-  /* Only the lights this pixel's screen bin lists (engine/light_bins.py): word w of the bin
+  /* Only the lights this pixel's screen bin lists (engine/shadows/light_bins.py): word w of the bin
    * holds lights w * LIGHT_WORD_BITS + bit, as exact small integers in a float channel.
    * One loop per class of light (sampled, with a map, without) walks the set bits of all four
    * words in order. On llvmpipe a loop's body runs at least once (masked) even when no pixel
@@ -263,7 +263,7 @@ void main()
   BIN_LOOP(words & ~shadowed_mask, NO_SHADOW)
 #  endif
 #elif UNROLLED_LIGHTS
-  /* The light counts are compiled in (programs.py UNROLLED_LIGHTS): one call per light, each
+  /* The light counts are compiled in (frame/programs.py UNROLLED_LIGHTS): one call per light, each
    * reading its LightData at a constant offset; the counts fold each call to its filter. */
 #  define LIGHT_FILTER(k) \
     ((k) < SAMPLED_COUNT ? FILTER_PCSS : (k) < SHADOWED_COUNT ? SHADOW_FILTER : NO_SHADOW)

@@ -16,7 +16,7 @@ void main()
   }
 #endif
 #if DEPTH_FORMAT == DEPTH_FLOAT32
-#  if !RASTER_DEPTH /* orthographic tiles rasterise this depth already (programs.py) */
+#  if !RASTER_DEPTH /* orthographic tiles rasterise this depth already (frame/programs.py) */
   gl_FragDepth = clamp((v_distance - tile.near) / (tile.far - tile.near), 0.0, 1.0);
 #  endif
 #else

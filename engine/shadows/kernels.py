@@ -26,11 +26,11 @@ def gaussian_1d(radius, sigma=None):
 
 
 def pcf_kernel(size, sigma=None):
-    """Normalised ``size`` x ``size`` Gaussian weights (the seeds' 5x5 kernel, generalised).
+    """Normalised ``size`` x ``size`` Gaussian weights of percentage-closer filtering
+    (Reeves, Salesin and Cook 1987, "Rendering Antialiased Shadows with Depth Maps").
 
     Returns an array of rows ``(dx, dy, weight)`` with integer texel offsets. ``size`` is made
-    odd; ``sigma`` defaults to ``size / 5``, which for 5x5 reproduces seed 000's table
-    (centre 0.1621, (1, 0) 0.0983, (2, 1) 0.0133) to four decimals.
+    odd; ``sigma`` defaults to ``size / 5`` texels (one texel for the usual 5x5 kernel).
     """
     w1 = pcf_weights(size, sigma)
     r = len(w1) // 2
@@ -56,7 +56,9 @@ RING = 8  # samples per ring of the jittered disk; the outer ring is evaluated f
 
 
 def jitter_disk(size=32, samples=16, seed=1):
-    """Per-pixel jittered disk samples (seed 003 / stratified polar warping).
+    """Per-pixel jittered disk samples, stored in a 3-D texture indexed by the pixel, with an
+    early exit when the outer ring agrees (Uralsky 2005, "Efficient Soft-Edged Shadows Using
+    Pixel Shader Branching", GPU Gems 2 ch. 17); strata warped to the disk by polar mapping.
 
     Returns (size, size, samples, 2) offsets inside the unit disk. Samples come in rings of
     ``RING``, outermost ring first, so a shader can test the outer ring and stop early when it

@@ -12,7 +12,9 @@ import numpy as np
 from . import light_bins
 
 
-# Maps clip-space xyz in [-1, 1] to texture space [0, 1] (seed 004's "bias matrix").
+# Maps clip-space xyz in [-1, 1] to texture space [0, 1]: the "bias matrix" of projective shadow
+# texturing (Segal et al. 1992, "Fast Shadows and Lighting Effects Using Texture Mapping";
+# Everitt, Rege and Cebenoyan 2001, "Hardware Shadow Mapping").
 def from_origin(origin):
     """The 4x4 translation by ``origin``: a world -> X matrix times it takes positions relative
     to ``origin`` (the frame origin the GPU works around; see ``Renderer.render``)."""
@@ -425,7 +427,8 @@ def _receivers_in_rect(parts, view, lo, hi):
 
 
 def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0, flat_free=None):
-    """Tight sun fit (seed 002: a loose box wastes the map): the map covers only the receivers
+    """Tight sun fit (a loose box wastes the map's texels; cf. Lauritzen, Salvi and Lefohn 2011,
+    "Sample Distribution Shadow Maps"): the map covers only the receivers
     the camera can see that some caster can shadow, and every caster that can shadow them.
     ``corners``: (N, 8, 3) world box corners of all geometry; ``view_corners``: the 8 world
     corners of the camera frustum (or of the slice of it a cascade covers); ``soft``: the

@@ -2,8 +2,9 @@
 #define DEPTH_ENCODING_GLSL
 
 /* Shadow depth in [0, 1] as stored in the atlas. FLOAT32/FLOAT16 use the red channel of a
- * float texture; RGBA8 packs it into four 8-bit channels (seed 000's encoding), giving about
- * 32 bits of fixed-point precision from a plain RGBA8 target. */
+ * float texture; RGBA8 packs it into four 8-bit channels (the fixed-point split used where
+ * float targets are unavailable, as in WebGL 1), giving about 32 bits of fixed-point
+ * precision from a plain RGBA8 target. */
 vec4 encode_depth(float d)
 {
 #if DEPTH_FORMAT == DEPTH_RGBA8

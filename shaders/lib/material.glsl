@@ -1,7 +1,7 @@
 /* Image textures as Blender's Image Texture node reads them: interpolation (0 Closest,
  * 1 Linear) and extension (0 Repeat, 1 Extend, 2 Clip, 3 Mirror) are applied here with
  * texelFetch, so they do not depend on the texture's sampler state. Images are uploaded as
- * scene-linear RGBA with straight alpha (engine/textures.py). */
+ * scene-linear RGBA with straight alpha (engine/scene/textures.py). */
 
 #ifndef MATERIAL_GLSL
 #define MATERIAL_GLSL

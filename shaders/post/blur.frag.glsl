@@ -1,6 +1,6 @@
 /* BLUR_PASS selects the pass (blur.py's PASS):
  *   BLUR_AXIS   one 1-D pass of the separable Gaussian along ``direction``. Weights come
- *               normalised from Python (kernels.py); samples outside the image are clamped to
+ *               normalised from Python (engine/shadows/kernels.py); samples outside the image are clamped to
  *               the edge.
  *   BLUR_DOWN   each half-size pixel: the mean of the 2x2 input pixels it covers (those inside
  *               the image)

@@ -28,10 +28,11 @@ def test_pcf_kernel_is_normalised_separable_gaussian():
     assert k[:, 2].sum() == pytest.approx(1.0)
     grid = k[:, 2].reshape(5, 5)
     np.testing.assert_allclose(grid, np.outer(grid.sum(1), grid.sum(0)), rtol=1e-12)
-    # Seed 000's hand-made 5x5 table: centre 0.1621, (1, 0) 0.0983, (2, 1) 0.0133.
+    # sigma = 5 / 5 = one texel: weights exp(-(dx^2 + dy^2) / 2), normalised (hand-derived:
+    # centre 1 / (1 + 2 e^-0.5 + 2 e^-2)^2 = 0.1621).
+    g = np.exp(-(np.arange(-2, 3) ** 2) / 2.0)
+    np.testing.assert_allclose(grid, np.outer(g, g) / g.sum() ** 2, rtol=1e-12)
     assert grid[2, 2] == pytest.approx(0.1621, abs=1e-4)
-    assert grid[2, 3] == pytest.approx(0.0983, abs=1e-4)
-    assert grid[3, 4] == pytest.approx(0.0133, abs=1e-4)
     assert kernels.pcf_kernel(4).shape == (25, 3)  # even sizes are made odd
     np.testing.assert_allclose(kernels.pcf_kernel(1), [[0, 0, 1]])
 

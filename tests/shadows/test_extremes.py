@@ -16,7 +16,7 @@ from devkit.scenes import WHITE_ALBEDO as ALBEDO
 
 @pytest.mark.parametrize("fit, bound", [("VIEW", 0.95), ("SCENE", None)])
 def test_tight_sun_fit_keeps_shadows_sharp_in_a_huge_scene(shadow_scene, analytic_shadow, fit, bound):
-    """Seed 002: a map fitted to a 2 km ground leaves a 1 m box a texel wide; fitted to the
+    """A map fitted to a 2 km ground leaves a 1 m box a texel wide; fitted to the
     view it stays exact. The loose fit's IoU is measured to show the difference."""
     scene = shadow_scene("SUN", "NONE", size=128)
     scene.objects["Plane"].scale = (70.0, 70.0, 1.0)  # 2.1 km
