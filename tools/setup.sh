@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Creates .venv/blender-<line> with bpy and tools/requirements.txt (numpy, OpenImageIO, pytest,
-# matplotlib, ruff) at the exact versions of tools/lock/blender-<line>.txt, and makes sure Mesa's
-# EGL (headless OpenGL through llvmpipe) is installed. tools/lock.sh refreshes the lock files.
+# matplotlib, ruff, openjd-cli) at the exact versions of tools/lock/blender-<line>.txt, and makes
+# sure Mesa's EGL (headless OpenGL through llvmpipe) is installed. tools/lock.sh refreshes the
+# lock files.
 #   tools/setup.sh 5.2        # Blender 5.2 line (Python 3.13)
 #   tools/setup.sh 4.5        # Blender 4.5 LTS (Python 3.11)
 # Re-running is cheap: a venv whose lock file did not change is left alone.
