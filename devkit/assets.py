@@ -1,34 +1,50 @@
-"""The shared real meshes (``../shared/assets/`` next to the project root; see its README for
-each mesh's source and terms). Nothing here ships in the extension."""
+"""Real meshes for the reference kit, the benchmarks and tests, kept in this repository in a
+compact form (``devkit/meshes/*.npz``: see the README there for each mesh's source and terms,
+and ``tools/mesh_to_npz.py`` for the format). Nothing here ships in the extension."""
+
+from pathlib import Path
 
 import bpy
 import numpy as np
 from mathutils import Matrix, Vector
 
-from devkit.session import ROOT, stdout_to_stderr
+MESHES = Path(__file__).resolve().parent / "meshes"
+BUNNY = MESHES / "stanford-bunny.npz"  # 69,451 triangles
+SPOT = MESHES / "spot.npz"  # 5,856 triangles
 
-ASSETS = ROOT.parent / "shared" / "assets"
-BUNNY = ASSETS / "stanford-bunny.obj"  # 69,451 triangles
-SPOT = ASSETS / "spot.obj"  # 5,856 triangles
+
+def mesh_from_file(path, name):
+    """A new flat-shaded mesh datablock ``name`` from a ``.npz`` of ``positions``,
+    ``triangles`` and (optionally) per-corner ``uv``."""
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no such test mesh (see {MESHES / 'README.md'})")
+    with np.load(path) as data:
+        positions = np.ascontiguousarray(data["positions"], np.float32)
+        triangles = np.ascontiguousarray(data["triangles"], np.int32)
+        uv = np.ascontiguousarray(data["uv"], np.float32) if "uv" in data.files else None
+    me = bpy.data.meshes.new(name)
+    me.vertices.add(len(positions))
+    me.vertices.foreach_set("co", positions.ravel())
+    me.loops.add(triangles.size)
+    me.loops.foreach_set("vertex_index", triangles.ravel())
+    me.polygons.add(len(triangles))
+    me.polygons.foreach_set("loop_start", np.arange(0, triangles.size, 3, dtype=np.int32))
+    if uv is not None:
+        me.uv_layers.new(name="UVMap").data.foreach_set("uv", uv.ravel())
+    me.update(calc_edges=True)
+    me.shade_flat()
+    if me.validate(verbose=False):
+        raise ValueError(f"{path}: the mesh did not validate")
+    return me
 
 
 def import_mesh(scene, path, height=1.0, name=None):
-    """Import an OBJ file into ``scene``'s master collection as one object, scaled to
-    ``height`` and standing on z = 0 at the origin. Returns the object."""
-    if not path.exists():
-        raise FileNotFoundError(f"{path}: the shared assets folder is missing")
-    before = set(bpy.data.objects)
-    with stdout_to_stderr():  # the importer prints its timing to stdout
-        bpy.ops.wm.obj_import(filepath=str(path))
-    ob = next(o for o in bpy.data.objects if o not in before and o.type == "MESH")
-    if name:
-        ob.name = ob.data.name = name
-    for collection in list(ob.users_collection):
-        collection.objects.unlink(ob)
+    """Add the mesh in ``path`` (one of the constants above) to ``scene``'s master collection
+    as one object, scaled to ``height`` and standing on z = 0 at the origin. Returns the object."""
+    name = name or path.stem
+    me = mesh_from_file(path, name)
+    ob = bpy.data.objects.new(name, me)
     scene.collection.objects.link(ob)
-    me = ob.data
-    me.transform(ob.matrix_world)  # the importer's Y-up to Z-up rotation, baked in
-    ob.matrix_world = Matrix.Identity(4)
     co = np.empty(len(me.vertices) * 3, np.float64)
     me.vertices.foreach_get("co", co)
     co = co.reshape(-1, 3)

@@ -4,11 +4,13 @@
 Nothing here imports ``bpy`` at import time: ``isolate()`` must run before Blender starts.
 """
 
+import atexit
 import contextlib
 import importlib.util
 import os
 import sys
 import tempfile
+import threading
 import traceback
 from pathlib import Path
 
@@ -150,6 +152,62 @@ def stdout_to_stderr():
         os.close(saved)
 
 
+# Blender prints these three lines to stderr when it first makes its headless GPU context (Mesa's
+# EGL refuses one configuration, and Blender goes on with another): harmless, but they read as
+# failures. ``quiet_gpu_start`` drops exactly these lines.
+EGL_NOISE = b"EGL Error (0x3009): EGL_BAD_MATCH"
+_quiet = {}  # the running filter: original stderr descriptor and pump thread
+
+
+def quiet_gpu_start():
+    """From here on, file descriptor 2 (C code's stderr as well as Python's) passes through a
+    filter that drops Blender's ``EGL_BAD_MATCH`` start-up lines (``EGL_NOISE``); every other
+    byte, warnings included, reaches the original stderr unchanged and at once (a partial line
+    waits only while it could still become a noise line). Tools call this first (``tools``
+    package); ``hard_exit`` and interpreter exit flush it. Child processes inherit it."""
+    if _quiet:
+        return
+    sys.stderr.flush()
+    original = os.dup(2)
+    read, write = os.pipe()
+    os.dup2(write, 2)
+    os.close(write)
+
+    def forward(data):
+        while data:
+            data = data[os.write(original, data) :]
+
+    def pump():
+        pending = b""
+        while chunk := os.read(read, 65536):
+            pending += chunk
+            *lines, pending = pending.split(b"\n")
+            forward(b"".join(line + b"\n" for line in lines if not line.startswith(EGL_NOISE)))
+            if pending and not (EGL_NOISE.startswith(pending) or pending.startswith(EGL_NOISE)):
+                forward(pending)
+                pending = b""
+        if pending and not pending.startswith(EGL_NOISE):
+            forward(pending)
+        os.close(read)
+
+    thread = threading.Thread(target=pump, name="stderr-filter", daemon=True)
+    thread.start()
+    _quiet.update(original=original, thread=thread)
+    atexit.register(_quiet_stop)
+
+
+def _quiet_stop():
+    """Put the original stderr back and let the filter pass on what it still holds."""
+    if not _quiet:
+        return
+    with contextlib.suppress(Exception):
+        sys.stderr.flush()
+    os.dup2(_quiet["original"], 2)  # the pipe's last writer here: the pump sees its end
+    _quiet["thread"].join(timeout=2.0)  # a child still writing to it keeps it open: do not wait on it
+    os.close(_quiet.pop("original"))
+    _quiet.clear()
+
+
 def hard_exit(status=0):
     """Flush stdout and stderr, then leave the process with ``status`` without running the
     interpreter's and bpy's exit handlers: with Blender 4.5 as a module, a static destructor can
@@ -158,6 +216,7 @@ def hard_exit(status=0):
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
             stream.flush()
+    _quiet_stop()
     os._exit(status)
 
 
