@@ -12,7 +12,11 @@ batches belong to the context that made them and are made again by each render. 
 taken from the pool holds the last render's pixels; the renderer clears or redraws all of it
 (its shadow maps start empty, so every map is drawn again).
 
-The pool holds at most ``budget`` bytes between renders, oldest textures dropped first. It is
+The pool holds what the last frame used, and at most ``budget`` bytes, oldest textures dropped
+first. A frame is one (scene, frame number, resolution): its view layers and views share it. At
+the end of each render (``end_render``) the pool drops every texture the current frame did not
+give back, so a large frame's targets are freed as soon as a smaller frame (or a render with
+fewer passes or maps) follows, and a run of equal frames holds one frame's textures. It is
 emptied when the extension is unregistered (Blender disables add-ons on exit before it shuts
 its GPU module down) and when the interpreter exits, so no texture outlives the GPU module.
 """
@@ -42,6 +46,9 @@ class TexturePool:
         self.budget = budget
         self._held = []  # (width, height, format, texture), oldest first
         self.taken = 0  # textures handed out again (what the pool saved)
+        self._frame_key = None  # what the current frame is (``begin_render``)
+        self._frame = 0  # a number per frame; each held texture's is where it was last given
+        self._given = {}  # id(texture) -> the frame number it was last given in
 
     def __len__(self):
         return len(self._held)
@@ -68,11 +75,31 @@ class TexturePool:
                 continue  # larger than the whole pool: freed by the caller now
             if all(texture is not t for *_k, t in self._held):
                 self._held.append((texture.width, texture.height, texture.format, texture))
+            self._given[id(texture)] = self._frame
         while self._held and self.held_bytes > self.budget:
             self._held.pop(0)
+        self._forget_dropped()
+
+    def begin_render(self, frame_key):
+        """A render of ``frame_key`` (scene, frame number, resolution) starts: a key other than
+        the last one's begins a new frame."""
+        if frame_key != self._frame_key:
+            self._frame_key = frame_key
+            self._frame += 1
+
+    def end_render(self):
+        """A render ended (its textures given back): drop every held texture the current frame
+        did not give, inside the render's GPU context."""
+        self._held = [entry for entry in self._held if self._given.get(id(entry[3])) == self._frame]
+        self._forget_dropped()
+
+    def _forget_dropped(self):
+        held = {id(t) for *_k, t in self._held}
+        self._given = {key: frame for key, frame in self._given.items() if key in held}
 
     def clear(self):
         self._held.clear()
+        self._given.clear()
 
 
 def new_texture(pool, size, fmt):

@@ -225,10 +225,13 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         scene = depsgraph.scene
         layer = depsgraph.view_layer.name
         self.texture_pool = gpu_pool.FINAL_RENDERS
+        r = scene.render
+        self.texture_pool.begin_render(
+            (scene.name, scene.frame_current, self.resolution_x, self.resolution_y, r.use_border)
+        )
         if scene.camera is None:
             self.report({"ERROR"}, f"Penumbra: scene '{scene.name}' has no active camera; set one in Scene Properties")
             return
-        r = scene.render
         width, height = self.resolution_x, self.resolution_y
         window = render_window(
             width, height, r.use_border, (r.border_min_x, r.border_min_y, r.border_max_x, r.border_max_y)
@@ -315,6 +318,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         finally:
             # A final-render engine instance renders one frame; free while the context lives.
             self.free_gpu()
+            self.texture_pool.end_render()  # the pool keeps what this frame used, no more
 
     @staticmethod
     def _mist(scene, camera, out, width, height):

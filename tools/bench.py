@@ -9,6 +9,8 @@
     post      cost of each post layer; separable against direct 2-D blur -> <out>/post_costs.csv
     shadows   shadow error against frame time, scaling, per-frame work, JITTER early out
               -> <out>/shadow_tradeoff.csv, shadow_pareto.png, scaling.csv, scaling.png
+    soak      process memory over repeated F12 renders (300 of a 160x90 frame by default)
+              -> <out>/soak.csv
 
 Run from the repository root, e.g.::
 
@@ -22,9 +24,9 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import frame, perf, post, samples, shadows
+from tools.benchmarks import frame, perf, post, samples, shadows, soak
 
-COMMANDS = {"frame": frame, "perf": perf, "post": post, "samples": samples, "shadows": shadows}
+COMMANDS = {"frame": frame, "perf": perf, "post": post, "samples": samples, "shadows": shadows, "soak": soak}
 
 
 def main(argv=None):

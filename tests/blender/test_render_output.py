@@ -347,6 +347,44 @@ def test_final_renders_take_their_textures_from_the_pool_and_draw_every_map_agai
     assert 0 < result["budget_held"] <= result["budget"]
 
 
+def test_the_pool_holds_what_the_last_frame_used():
+    """Repeated renders of one frame hold one frame's textures (no growth); a large frame's
+    targets are released as soon as a small frame follows, and the small frame's textures are
+    then exactly what the pool holds, as before the large one (``TexturePool.end_render``)."""
+    result, _ = run_child(
+        """
+        from penumbra.engine import gpu_pool
+        pool = gpu_pool.FINAL_RENDERS
+        scene = demo(96, 64)
+
+        def held():
+            return sorted([w, h, f] for w, h, f, _t in pool._held)
+
+        small = []
+        for i in range(3):
+            combined(scene, f"small{i}")
+            small.append((pool.held_bytes, held()))
+        taken = pool.taken
+        scene.render.resolution_x, scene.render.resolution_y = 320, 180
+        large = []
+        for i in range(2):
+            combined(scene, f"large{i}")
+            large.append((pool.held_bytes, held()))
+        scene.render.resolution_x, scene.render.resolution_y = 96, 64
+        combined(scene, "small again")
+        report(small=small, large=large, again=[pool.held_bytes, held()], taken=taken)
+        """
+    )
+    small, large, again = result["small"], result["large"], result["again"]
+    assert small[0] == small[1] == small[2]  # equal frames: one frame's textures, no growth
+    assert large[0] == large[1]
+    assert result["taken"] >= 2 * 5  # the second and third small renders took their targets from the pool
+    assert any(w == 320 and h == 180 for w, h, _f in large[1][1])  # the large frame's targets were held
+    assert not any(w == 320 and h == 180 for w, h, _f in again[1])  # ... and are gone after a small frame
+    assert again == list(small[2])  # what a small frame holds, bytes and textures
+    assert small[0][0] < large[0][0]
+
+
 @pytest.mark.skipif(bpy.app.version < (5, 0, 0), reason="bpy 4.5 as a module can hang in its own exit after GPU work")
 def test_pooled_textures_are_freed_before_blender_exits():
     """Renders leave textures in the pool, and the interpreter still exits normally (no hard
