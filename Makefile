@@ -7,6 +7,8 @@ PYTEST_ARGS ?=
 # make bench BENCH=perf ARGS=--quick           frame cost and scaling against Workbench
 # make bench BENCH=post                        cost of each post layer
 # make bench BENCH=shadows ARGS=--quick        shadow error against time (ARGS: that command's options)
+# make bench BENCH=samples                     render samples: error against time, against Cycles and EEVEE
+# make bench BENCH=soak                        process memory over 300 F12 renders
 BENCH ?= frame
 ARGS ?=
 

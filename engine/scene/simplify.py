@@ -9,7 +9,7 @@ best (Lindstrom's out-of-core simplification: the sum of the triangles' plane qu
 minimised inside the cell), so flat and gently curved parts keep their surface while the
 triangle count drops. A vertex never leaves its cell: no surface point moves further than a
 cell's diagonal, and measured errors are far smaller (``python -m tools.bench perf --sections
-simplify``). The same level draws the instance in the lit pass and into every shadow map, so a
+instances``). The same level draws the instance in the lit pass and into every shadow map, so a
 surface and its shadow agree.
 
 Only what needs no more than positions and normals is simplified: meshes whose materials read
