@@ -19,8 +19,8 @@ from devkit.extension import build_zip
 from devkit.imageio import read_exr
 from devkit.session import ROOT, child_env, isolated_env
 
-# Folders and files that exist only for development and must stay out of the zip.
-DEV_ONLY_DIRS = ("devkit/", "tests/", "tools/", ".venv/", ".ci/", ".git/")
+# Folders and files that are not the add-on (development, the farm job) and must stay out of the zip.
+DEV_ONLY_DIRS = ("devkit/", "tests/", "tools/", "farm/", ".venv/", ".ci/", ".git/")
 DEV_ONLY_FILES = ("Makefile", "pytest.ini", "ruff.toml", ".gitignore")
 
 # Scene constants shared by the render script and the assertions below.
