@@ -171,6 +171,28 @@ def test_a_task_given_a_broken_blend_fails_alone_and_the_other_tasks_write_their
         assert same_bits(pixels, serial_frames[f]), f"frame {f}"
 
 
+def test_a_stereo_scene_writing_each_eye_apart_passes_the_frame_check(
+    tmp_path, extension_zip, blender_command, scene_file, worker_env
+):
+    """After the render the task checks every file Blender should have written: with stereo
+    output written per eye, that is frame_0001_L.exr and frame_0001_R.exr, not frame_0001.exr."""
+    stereo = tmp_path / "stereo.blend"
+    make_stereo = (
+        "import bpy; r = bpy.context.scene.render; r.use_multiview = True; r.views_format = 'STEREO_3D'; "
+        f"r.image_settings.views_format = 'INDIVIDUAL'; bpy.ops.wm.save_as_mainfile(filepath={str(stereo)!r})"
+    )
+    status, log = run(
+        [blender_command, "-b", scene_file, "--python-exit-code", 1, "--python-expr", make_stereo], worker_env
+    )
+    assert status == 0 and stereo.is_file(), log[-6000:]
+    out = tmp_path / "renders"
+    params = job_params(stereo, out, blender_command, ExtensionZip=extension_zip)
+    status, log = run(farm.openjd_run(params, [{"Frame": "1-2"}]), worker_env)
+    assert status == 0, log[-8000:]
+    assert "Penumbra job: wrote 4 files" in log, log[-8000:]
+    assert sorted(p.name for p in out.iterdir()) == [f"frame_{f:04d}_{eye}.exr" for f in (1, 2) for eye in "LR"]
+
+
 def fake_extension_zip(path):
     """A valid extension named penumbra that registers nothing (so no PENUMBRA engine)."""
     manifest = (session.ROOT / "blender_manifest.toml").read_text().split("[build]")[0]
