@@ -38,6 +38,17 @@ def user_home():
 _exit_status = 0
 
 
+def pytest_runtest_logreport(report):
+    """A failing test's captured stderr without Blender's EGL_BAD_MATCH start-up lines (pytest
+    captures file descriptor 2 itself during a test; ``session.quiet_gpu_start`` covers the
+    tools)."""
+    noise = session.EGL_NOISE.decode()
+    report.sections = [
+        (name, "".join(line for line in text.splitlines(keepends=True) if not line.startswith(noise)))
+        for name, text in report.sections
+    ]
+
+
 def pytest_sessionfinish(exitstatus):
     global _exit_status
     _exit_status = int(exitstatus)
