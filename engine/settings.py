@@ -259,6 +259,19 @@ SCENE_PARAMS = (
         active_when=("shadow_filter", "early_out"),
     ),
     Param(
+        "shadow_caster_detail",
+        "FLOAT",
+        2.0,
+        "Draw detailed casters into each shadow map with their triangles merged on a grid of this "
+        "many map texels (at the caster's nearest point to the light; every vertex stays in its "
+        "cell), so a map costs what it can resolve. The image keeps every triangle. 0: every "
+        "triangle in every map",
+        min=0.0,
+        soft_max=4.0,
+        label="Caster Detail",
+        section=SHADOWS,
+    ),
+    Param(
         "shadow_bias",
         "FLOAT",
         0.5,

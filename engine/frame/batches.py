@@ -9,6 +9,7 @@ class Batches:
     def __init__(self):
         self.meshes = {}  # (geometry key, serial) -> (whole, parts)
         self.levels = {}  # (geometry key, serial, level) -> (whole, parts) of ``simplify.simplified``
+        self._used = set()  # the levels drawn this frame (lit pass or shadow maps)
 
     def get(self, key, geo):
         """The batches of the snapshot's geometry ``key``, built on first use of its serial."""
@@ -17,15 +18,17 @@ class Batches:
     def level(self, key, lod):
         """The batches of a level of detail ``lod`` (``simplify.simplified``), kept under
         ``key`` = (geometry key, serial, level)."""
+        self._used.add(key)
         return self._get(self.levels, key, lod)
 
-    def keep(self, live, used_levels):
-        """Release the batches of geometry no longer in the snapshot (``live``: (key, serial)
-        pairs) and of levels of detail this frame did not draw."""
+    def keep(self, live):
+        """At the end of a frame: release the batches of geometry no longer in the snapshot
+        (``live``: (key, serial) pairs) and of levels of detail this frame did not draw."""
         for stale in [k for k in self.meshes if k not in live]:
             del self.meshes[stale]
-        for stale in [k for k in self.levels if k not in used_levels]:
+        for stale in [k for k in self.levels if k not in self._used]:
             del self.levels[stale]
+        self._used = set()
 
     @staticmethod
     def _get(cache, cache_key, geo):

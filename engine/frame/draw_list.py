@@ -30,6 +30,8 @@ class Draw:
     identity: tuple  # what a shadow tile's content depends on
     corners: np.ndarray  # (8, 3) world corners of the instance's bounds
     closed: bool = False  # a closed opaque surface: back faces hidden from outside its bounds
+    geometry: object = None  # the extract.Geometry drawn whole (None: drawn at a level of detail)
+    triangles: int = 0  # triangles of what it draws
 
     def material(self, index):
         materials = self.instance.materials
@@ -38,15 +40,13 @@ class Draw:
 
 
 def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size=None):
-    """The frame's instances with their batches (``batches.Batches``); batches of geometry no
-    longer in the snapshot are released. Per-instance numbers (sign of the matrix, world
+    """The frame's instances with their batches (``batches.Batches``). Per-instance numbers (sign of the matrix, world
     bounds, level of detail) are computed for all instances at once. Model matrices reach the
     GPU relative to ``origin`` (the frame origin)."""
     from mathutils import Matrix
 
     kept = [(inst, snapshot.geometry[inst.key]) for inst in snapshot.instances if inst.key in snapshot.geometry]
     draws = []
-    used_levels = set()
     if kept:
         matrices = np.stack([inst.matrix for inst, _geo in kept])
         bounds = np.stack([geo.bounds for _inst, geo in kept])
@@ -58,7 +58,6 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
             lod = simplify.simplified(geo, levels[i]) if levels[i] is not None else None
             if lod is not None:
                 key = (inst.key, geo.serial, levels[i])
-                used_levels.add(key)
                 whole, parts = batches.level(key, lod)
                 identity = (inst.key, inst.matrix.tobytes(), geo.serial, levels[i])
                 stats.simplified += 1
@@ -69,11 +68,12 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
             model[:3, 3] -= origin
             model = Matrix(model.tolist())
             draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
+            draw.geometry = geo if lod is None else None
+            draw.triangles = (lod or geo).triangle_count
             closed = CULL_CLOSED and geo.closed and lod is None  # a level is not tested for closedness
             draw.closed = closed and not any(draw.material(m).uses_alpha for m, _b in parts)
             draws.append(draw)
             stats.triangles += (lod or geo).triangle_count
-    batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()}, used_levels)
     return draws
 
 

@@ -126,6 +126,7 @@ class Renderer:
                 break
         if accumulate and stats.samples:
             film.resolve(aux, emission)
+        self.batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()})
         color = self._post_pass(settings, stats)
         stats.shadow_bytes = self.shadows.memory_bytes if plan is not None and plan.tiles else 0
         stats.texture_bytes = (
@@ -157,6 +158,7 @@ class Renderer:
             self.shaders,
             self.materials,
             self.textures,
+            self.batches,
             self._origin,
             alpha_offset,
         )

@@ -2,6 +2,7 @@
 it (``Caster``). Which maps a frame needs, and how each is fitted, is decided beforehand
 without a GPU (``shadows.planning.plan_shadows``)."""
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -31,6 +32,21 @@ class Caster:
     cull_back: bool = False  # every material asks for shadow back-face culling: faces away from the light cast nothing
     closed: bool = False  # a closed opaque surface (renderer.CULL_CLOSED): its back faces are hidden from outside
     corners: object = None  # (8, 3) world corners of its bounds, with ``closed``
+    triangles: int = 0  # triangles of ``batches`` (drawn whole)
+    level: int = None  # drawn into this map at a level of detail (``_at_level``), else None
+
+
+def _at_level(caster, batches, level, triangles):
+    """``caster`` as drawn into one map at a level of detail: its content key names the level,
+    and back faces are not culled (a merged surface is not tested for closedness)."""
+    return dataclasses.replace(
+        caster,
+        batches=batches,
+        identity=(*caster.identity, "level", level),
+        closed=False,
+        triangles=triangles,
+        level=level,
+    )
 
 
 class ShadowAtlas:
@@ -128,10 +144,13 @@ class ShadowAtlas:
         self._ubos[index].update(raw)
         return self._ubos[index]
 
-    def render(self, plan, draws, shaders, cull_front, stats, alpha_offset=0.5, origin=None):
+    def render(self, plan, draws, shaders, cull_front, stats, alpha_offset=0.5, origin=None, levels=None):
         """Draw every tile of ``plan`` whose content changed. ``draws``: per instance a
         ``Caster``, or None for an instance that casts no shadow; a tile's key is its fit and
-        its casters. ``origin``: the frame origin the casters' model matrices are relative to."""
+        its casters. ``origin``: the frame origin the casters' model matrices are relative to.
+        ``levels``: {(tile index, instance index): (batches, level, triangles)}, casters drawn
+        into that tile at a level of detail (``shadow_pass.map_levels``) instead of whole."""
+        levels = levels or {}
         import gpu
 
         depth_only = DEPTH_FORMAT[self.depth_format].depth_only
@@ -145,7 +164,11 @@ class ShadowAtlas:
 
         work = []
         for index, tile in enumerate(plan.tiles):
-            casters = [draws[c] for c in tile.casters if draws[c] is not None]
+            casters = []
+            for c in tile.casters:
+                if draws[c] is not None:
+                    lod = levels.get((index, c))
+                    casters.append(draws[c] if lod is None else _at_level(draws[c], *lod))
             key = (
                 tile.fit.view_proj.tobytes(),
                 tile.fit.near,
@@ -208,6 +231,7 @@ class ShadowAtlas:
                     for batch in caster.batches:
                         batch.draw(shader)
                         stats.draws += 1
+                    stats.shadow_triangles += caster.triangles
                 gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
                 for caster in casters:
                     for batch, material_ubo, texture in caster.cutouts:
@@ -229,6 +253,7 @@ class ShadowAtlas:
                 self._copy_scratch(x0, y0, n, shaders)
                 stats.passes += 1
             self._contents[index] = key
+            stats.shadow_simplified += sum(1 for c in casters if c.level is not None)
             stats.passes += 1
             stats.shadow_maps += 1
             stats.shadow_texels += n * n

@@ -4,6 +4,7 @@ atlas (``shadow_maps.ShadowAtlas``)."""
 
 import numpy as np
 
+from ..scene import simplify
 from ..shadows import lightspace
 from ..shadows.planning import MAX_SHADOW_TILES, Density, plan_shadows
 from .draw_list import corners_of
@@ -48,9 +49,12 @@ class ShadowPass:
             density=_density(camera, settings, size),
         )
 
-    def draw(self, draws, lights, camera, settings, size, stats, shaders, materials, textures, origin, alpha_offset):
+    def draw(
+        self, draws, lights, camera, settings, size, stats, shaders, materials, textures, batches, origin, alpha_offset
+    ):
         """Plan the maps this frame needs (numpy) and draw the ones whose content changed.
-        ``materials`` (``MaterialBlocks``) and ``textures`` serve alpha cutouts. Returns the plan."""
+        ``materials`` (``MaterialBlocks``) and ``textures`` serve alpha cutouts; ``batches``
+        (``Batches``) the casters' levels of detail in each map. Returns the plan."""
         map_size = max(1, int(settings.shadow_map_size))
         plan = self.plan(draws, lights, camera, settings, size, map_size)
         if not plan.tiles:
@@ -79,7 +83,8 @@ class ShadowPass:
                         )
         self.atlas.place(plan, settings.shadow_depth_format)
         casters = [caster(d, materials, textures) for d in draws]
-        self.atlas.render(plan, casters, shaders, settings.shadow_cull_front, stats, alpha_offset, origin)
+        levels = map_levels(plan, draws, casters, batches, float(getattr(settings, "shadow_caster_detail", 0.0)))
+        self.atlas.render(plan, casters, shaders, settings.shadow_cull_front, stats, alpha_offset, origin, levels)
         return plan
 
 
@@ -93,7 +98,16 @@ def caster(d, materials, textures):
     cull = bool(mats) and all(m.cull_shadow for _i, _b, m in mats)
     # Material > Settings > Transparent Shadows off: its alpha casts as an opaque surface.
     if not any(m.uses_alpha and m.transparent_shadow for _i, _b, m in mats):
-        return Caster([d.whole], d.model, d.det, d.identity, cull_back=cull, closed=d.closed, corners=d.corners)
+        return Caster(
+            [d.whole],
+            d.model,
+            d.det,
+            d.identity,
+            cull_back=cull,
+            closed=d.closed,
+            corners=d.corners,
+            triangles=d.triangles,
+        )
     solid, cutouts = [], []
     for _index, batch, mat in mats:
         if not (mat.uses_alpha and mat.transparent_shadow):
@@ -103,7 +117,41 @@ def caster(d, materials, textures):
         elif mat.alpha > 0.0:
             cutouts.append((batch, materials.get(mat), None))
     identity = (*d.identity, tuple(id(m) for _i, _b, m in mats))
-    return Caster(solid, d.model, d.det, identity, cutouts, cull_back=cull)
+    return Caster(solid, d.model, d.det, identity, cutouts, cull_back=cull, triangles=d.triangles)
+
+
+def map_levels(plan, draws, casters, batches, cell_texels):
+    """Casters drawn into a map at that map's texel footprint: {(tile index, draw index):
+    (batches, level, triangles)} for each opaque caster of at least ``simplify.MIN_TRIANGLES``
+    triangles (drawn whole in the lit pass) whose clustering at cells of ``cell_texels`` map
+    texels (at the caster's nearest depth in the map) keeps at most ``simplify.WORTH`` of its
+    triangles. A cluster's vertex stays inside its cell, so the caster's outline in the map
+    moves less than a cell's diagonal; the lit pass still draws every triangle. Empty when
+    ``cell_texels`` is 0 (Caster Detail off)."""
+    out = {}
+    if not cell_texels > 0.0:
+        return out
+    for t, tile in enumerate(plan.tiles):
+        fit = tile.fit
+        for c in tile.casters:
+            d, cast = draws[c], casters[c]
+            geo = d.geometry
+            if cast is None or cast.cutouts or geo is None or geo.triangle_count < simplify.MIN_TRIANGLES:
+                continue
+            if fit.orthographic:
+                footprint, depth = (0.0, fit.texel), 1.0
+            else:
+                z = -(d.corners @ fit.view[2, :3] + fit.view[2, 3])  # depths along the light's view axis
+                footprint, depth = (fit.texel_per_distance, 0.0), max(float(z.min()), fit.near)
+            extent = float(np.max(geo.bounds[1] - geo.bounds[0]))
+            stretch = float(np.linalg.svd(np.asarray(d.instance.matrix)[:3, :3], compute_uv=False)[0])
+            level = simplify.level_for(extent, stretch, depth, footprint, cell_texels)
+            lod = simplify.simplified(geo, level) if level is not None else None
+            if lod is None:
+                continue
+            whole, _parts = batches.level((d.instance.key, geo.serial, level), lod)
+            out[t, c] = ([whole], level, lod.triangle_count)
+    return out
 
 
 def _density(camera, settings, size):

@@ -10,6 +10,8 @@ class FrameStats:
     shadow_maps: int = 0  # maps drawn this frame
     shadow_maps_reused: int = 0  # maps whose fit and casters did not change: not redrawn
     shadow_texels: int = 0  # texels of the maps drawn (each its size squared: the depth pass's fill)
+    shadow_triangles: int = 0  # triangles drawn into the maps drawn (each map counts its casters')
+    shadow_simplified: int = 0  # casters drawn into a map at its texel footprint (``shadow_pass.map_levels``)
     passes: int = 0
     post_passes: int = 0
     post_layers: int = 0  # post layers drawn (consecutive point layers share one pass)
