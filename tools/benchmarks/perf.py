@@ -22,6 +22,11 @@ Sections (``--sections``, all by default):
               against every triangle drawn); closed cows
   triangles   one grid mesh of 70k ... 2M triangles: F12, and extraction against a bare copy
               of the same data with ``foreach_get`` (the limit for reading a mesh from Python)
+  map_detail  a 1.1M-triangle bunny (the scan, subdivided twice) under a 1.5 m area light at
+              480x270 and 16 samples (its maps redrawn each sample from a point of the light):
+              Shadows > Caster Detail 0 (every triangle in every map) against the default 2
+              map texels, F12 time and triangles drawn into maps, and the image's error
+              between the two
   materials   16 UV spheres on a ground at 960x540 with constant materials, a 1024² image
               on Base Color, and Base Color + Roughness + a normal map (the textured variants'
               cost against the constant one)
@@ -41,7 +46,17 @@ import numpy as np
 from devkit import assets, engines, report, scenes, session
 
 HELP = "frame cost and scaling as ratios to Workbench (AA off, shadows on)"
-SECTIONS = ("resolution", "passes", "viewport", "lights", "objects", "instances", "triangles", "materials")
+SECTIONS = (
+    "resolution",
+    "passes",
+    "viewport",
+    "lights",
+    "objects",
+    "instances",
+    "map_detail",
+    "triangles",
+    "materials",
+)
 CSV_FIELDS = ["section", "case", "penumbra_ms", "workbench_ms", "ratio", "note", "runs", "blender"]
 
 
@@ -504,6 +519,64 @@ def section_instances(plan):
         case = f"{n} closed cow instances (94k triangles each)"
         rows.append(_row("instances", case, t, f"{t['PENUMBRA'] / first:.2f}x one", plan["runs"]))
     return rows
+
+
+def section_map_detail(plan):
+    """Penumbra only: Caster Detail 0 and 2 interleaved, F12 medians; the note gives the
+    triangles drawn into maps per frame (``FrameStats.shadow_triangles``) and the error."""
+    from devkit.render import render
+
+    scene = bunny_field(1, subdivisions=2)
+    scene.render.resolution_x, scene.render.resolution_y = 480, 270
+    for ob in [o for o in scene.objects if o.type == "LIGHT"]:
+        bpy.data.objects.remove(ob)
+    scenes.light(scene, "Area", "AREA", 400.0, location=(1.0, -1.5, 3.0), rotation=(math.radians(35), 0, 0), size=1.5)
+    _penumbra(scene)
+    scene.penumbra.render_samples = 16
+    triangles = sum(len(p.vertices) - 2 for p in scene.objects["Bunny"].data.polygons)
+    images, drawn, times = {}, {}, {0.0: [], 2.0: []}
+    for detail in times:
+        scene.penumbra.shadow_caster_detail = detail
+        images[detail] = render(scene)["Combined"][..., :3]  # also the warm-up
+        drawn[detail] = _map_triangles(scene)
+    for _ in range(plan["runs"]):
+        for detail in times:
+            scene.penumbra.shadow_caster_detail = detail
+            start = time.perf_counter()
+            _render()
+            times[detail].append(time.perf_counter() - start)
+    diff = np.abs(images[2.0] - images[0.0]).max(axis=-1)
+    rows = []
+    for detail, values in times.items():
+        t = {"PENUMBRA": statistics.median(values)}
+        note = f"{drawn[detail] / 16 / 1e6:.2f}M triangles into maps per sample ({triangles / 1e6:.2f}M in the mesh)"
+        if detail:
+            note += (
+                f"; {times[0.0] and statistics.median(times[0.0]) / t['PENUMBRA']:.2f}x faster than every "
+                f"triangle; image error against it: mean {diff.mean():.5f}, max {diff.max():.3f}"
+            )
+        rows.append(_row("map_detail", f"16 samples, Caster Detail {detail:g}", t, note, plan["runs"]))
+    return rows
+
+
+def _map_triangles(scene):
+    """Triangles drawn into shadow maps by one F12 of ``scene`` (its FrameStats)."""
+    from penumbra.engine.render_engine import PenumbraEngineCore
+
+    seen = []
+    original = PenumbraEngineCore.render_frame
+
+    def recording(self, *args, **kwargs):
+        out = original(self, *args, **kwargs)
+        seen.append(out.stats.shadow_triangles)
+        return out
+
+    PenumbraEngineCore.render_frame = recording
+    try:
+        _render()
+    finally:
+        PenumbraEngineCore.render_frame = original
+    return sum(seen)
 
 
 def section_triangles(plan):
