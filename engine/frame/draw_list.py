@@ -2,6 +2,7 @@
 detail; the order the lit pass draws them in; which lights reach what the camera sees; and
 each instance's light-linking mask."""
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +31,23 @@ class Draw:
     identity: tuple  # what a shadow tile's content depends on
     corners: np.ndarray  # (8, 3) world corners of the instance's bounds
     closed: bool = False  # a closed opaque surface: back faces hidden from outside its bounds
+    # () -> [(material index, GPUBatch)] with the Shadow Terminator's corner data, built on
+    # first call; None where the geometry offset does not apply (offset 0, flat faces only).
+    terminator_parts: object = None
+
+    def terminator_features(self, shadowed):
+        """The lit-pass features of the instance's Shadow Terminator settings
+        (``programs.TERMINATOR_FEATURES``); ``shadowed``: the frame has shadow maps (without
+        them the offsets of the shadow point do nothing)."""
+        term = self.instance.terminator
+        out = set()
+        if shadowed and self.terminator_parts is not None:
+            out.add("TERMINATOR_OFFSET")
+        if shadowed and term.world_normal_offset(self.instance.matrix) > 0.0:
+            out.add("TERMINATOR_NORMAL")
+        if term.shading_offset > 0.0:
+            out.add("TERMINATOR_SHADING")
+        return frozenset(out)
 
     def material(self, index):
         materials = self.instance.materials
@@ -63,12 +81,15 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
                 identity = (inst.key, inst.matrix.tobytes(), geo.serial, levels[i])
                 stats.simplified += 1
             else:
+                key = (inst.key, geo.serial)
                 whole, parts = batches.get(inst.key, geo)
                 identity = (inst.key, inst.matrix.tobytes(), geo.serial)
             model = inst.matrix.copy()
             model[:3, 3] -= origin
             model = Matrix(model.tolist())
             draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
+            if inst.terminator.geometry_offset > 0.0 and (lod or geo).smooth:
+                draw.terminator_parts = functools.partial(batches.terminator, key, lod or geo)
             closed = CULL_CLOSED and geo.closed and lod is None  # a level is not tested for closedness
             draw.closed = closed and not any(draw.material(m).uses_alpha for m, _b in parts)
             draws.append(draw)
