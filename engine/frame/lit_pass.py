@@ -4,6 +4,7 @@ Environment Texture behind it."""
 
 import numpy as np
 
+from ...shaders.loader import set_uniforms
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
 from .programs import BACKGROUND, JITTER_SIZE, SHADOW_SAMPLER, lit_program, terminator_uniforms
@@ -99,8 +100,8 @@ class LitPass:
                     shader.uniform_float("model", d.model)
                     if masks is not None:
                         shader.uniform_int("light_mask", masks[id(d)])
-                    for name, value in terminators.get(id(d), {}).items():
-                        shader.uniform_float(name, value)
+                    if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
+                        set_uniforms(shader, terminators[id(d)])
                     last, bound["model_shader"] = d, shader
                 shader.uniform_block("material", self.materials.get(mat))
                 for channel, ref in mat.textures.items():
