@@ -76,22 +76,26 @@ def corner_data(positions, normals, indices):
     Positions and normals are the object's (local) ones; the lit pass moves the offset to
     world space with the model matrix, as Cycles does for instanced objects."""
     tris = np.asarray(indices, np.int64).reshape(-1, 3)
-    V = np.asarray(positions, np.float64)[tris]  # (t, 3 vertices, 3)
-    N = np.asarray(normals, np.float64)[tris]
-    V = np.where(np.isfinite(V), V, 0.0)
-    N = np.where(np.isfinite(N), N, 0.0)
+    V = np.asarray(positions, np.float32)[tris].astype(np.float64)  # (t, 3 vertices, 3)
+    N = np.asarray(normals, np.float32)[tris].astype(np.float64)
+    V[~np.isfinite(V)] = 0.0
+    N[~np.isfinite(N)] = 0.0
     t = len(tris)
+    # d[t, k, i] = dot(V_k - V_i, N_i): k a corner, i a vertex.
+    vn = np.einsum("tkx,tix->tki", V, N)  # dot(V_k, N_i)
+    d = vn - np.diagonal(vn, axis1=1, axis2=2)[:, None, :]
     a = np.einsum("ij,ij->i", N[:, 2] - N[:, 0], V[:, 0] - V[:, 2])
     b = np.einsum("ij,ij->i", N[:, 2] - N[:, 1], V[:, 1] - V[:, 2])
     c = np.einsum("ij,ij->i", N[:, 1] - N[:, 0], V[:, 1] - V[:, 0])
-    # d[k, i] = dot(V_k - V_i, N_i) per triangle: k a corner, i a vertex.
-    d = np.einsum("tkij,tij->tki", V[:, :, None, :] - V[:, None, :, :], N)
-    eye = np.eye(3, dtype=bool)
-    others = np.where(eye[None], -np.inf, d)  # dot(V_j - V_i, N_i) for j != i
-    front_env = np.maximum(others.max(axis=1), 0.0)  # (t, i)
-    back_env = np.maximum((np.where(eye[None], -np.inf, -d)).max(axis=1), 0.0)
+    # Envelope terms: max over j != i of dot(V_j - V_i, N_i) (front) and of its negative (back).
+    # d[:, i, i] = 0, so the off-diagonal maxima come from the other two corners.
+    k1, k2 = np.array([1, 0, 0]), np.array([2, 2, 1])
+    i3 = np.arange(3)
+    dj, dk = d[:, k1, i3], d[:, k2, i3]  # (t, i): the two other corners of vertex i
+    front_env = np.maximum(np.maximum(dj, dk), 0.0)
+    back_env = np.maximum(np.maximum(-dj, -dk), 0.0)
     # At corner k: dot(V_i - V_k, N_i) + front_env_i and dot(V_k - V_i, N_i) + back_env_i.
-    front = -d + front_env[:, None, :]
+    front = front_env[:, None, :] - d
     back = d + back_env[:, None, :]
     bary = np.zeros((t, 3, 2))
     bary[:, 0, 0] = 1.0
@@ -103,9 +107,10 @@ def corner_data(positions, normals, indices):
 
 def _finite32(a):
     a = np.asarray(a, np.float64)
-    a = np.where(np.isfinite(a), a, 0.0)
+    a[~np.isfinite(a)] = 0.0
     big = float(np.finfo(np.float32).max) / 4.0
-    return np.ascontiguousarray(np.clip(a, -big, big), np.float32)
+    np.clip(a, -big, big, out=a)
+    return np.ascontiguousarray(a, np.float32)
 
 
 def smooth_offset(V, N, bary, toward_viewer):
