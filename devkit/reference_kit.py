@@ -36,6 +36,15 @@ room       a point light (radius 0.05) in a closed 6 x 5 x 3 m room with a table
            bunny: cube-face seams cross floor and wall shadows
 =========  ============================================================================
 
+The shadow terminator (``TERMINATOR_SCENES``; Object › Shading › Shadow Terminator):
+
+===============  ======================================================================
+terminator       a low-poly smooth UV sphere (16 x 8, radius 1) on the ground under a
+                 sharp sun 25 deg above the horizon, seen across its terminator;
+                 Geometry Offset 0.1 (Blender's default)
+terminator_off   the same with Geometry Offset 0: the facets' stair-stepped terminator
+===============  ======================================================================
+
 Visibility is (render with shadows) / (render with the light's ``use_shadow`` off), in
 luminance, so light units, falloff and cone shapes cancel and only the shadow term remains.
 Engines are set up by ``devkit.engines``; its Cycles renders direct light only, so indirect
@@ -316,6 +325,54 @@ def room(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
     return scene
 
 
+TERMINATOR_SEGMENTS, TERMINATOR_RINGS = 16, 8
+TERMINATOR_CENTER = (0.0, 0.0, 1.0)
+
+
+def terminator(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT, geometry_offset=0.1, shading_offset=0.0):
+    """A smooth 16 x 8 UV sphere of radius 1 resting on the ground, a sun (angle 0.5 deg) 25
+    deg above the horizon from +X, the camera looking at the sphere across the terminator."""
+    scene, grey = _stage(width, height)
+    ob = scenes.uv_sphere(
+        scene,
+        "Sphere",
+        center=TERMINATOR_CENTER,
+        radius=1.0,
+        segments=TERMINATOR_SEGMENTS,
+        rings=TERMINATOR_RINGS,
+        mat=grey,
+    )
+    ob.rotation_euler = (0.0, 0.0, math.radians(7.0))  # facets not aligned with the sun
+    ob.shadow_terminator_geometry_offset = geometry_offset
+    ob.shadow_terminator_shading_offset = shading_offset
+    _sharp_sun(scene, 25.0, azimuth_deg=90.0)
+    scenes.look_at(scene, (1.2, -5.5, 2.2), (0.0, 0.0, 0.9), lens=60.0)
+    return scene
+
+
+def terminator_off(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    return terminator(width, height, geometry_offset=0.0)
+
+
+def sphere_mask(scene, center, radius):
+    """Pixels (h, w), row 0 at the bottom, whose centre's camera ray meets the sphere
+    (``center``, ``radius``)."""
+    view, proj, w, h = camera_matrices(scene)
+    inv = np.linalg.inv(proj @ view)
+    xs = (np.arange(w) + 0.5) / w * 2.0 - 1.0
+    ys = (np.arange(h) + 0.5) / h * 2.0 - 1.0
+    X, Y = np.meshgrid(xs, ys)
+    near = np.stack([X, Y, -np.ones_like(X), np.ones_like(X)], axis=-1) @ inv.T
+    far = np.stack([X, Y, np.ones_like(X), np.ones_like(X)], axis=-1) @ inv.T
+    a = near[..., :3] / near[..., 3:4]
+    d = far[..., :3] / far[..., 3:4] - a
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    oc = a - np.asarray(center, np.float64)
+    b = np.einsum("...i,...i", oc, d)
+    c = np.einsum("...i,...i", oc, oc) - radius * radius
+    return b * b - c > 0.0
+
+
 SCENES = {
     "sun_hard": sun_hard,
     "sun_soft": sun_soft,
@@ -329,10 +386,13 @@ SCENES = {
     "tiny": tiny,
     "lamp": lamp,
     "room": room,
+    "terminator": terminator,
+    "terminator_off": terminator_off,
 }
 LIGHT_SCENES = ("sun_hard", "sun_soft", "spot", "point", "area", "contact")
 SOFT_SCENES = ("sun_soft", "spot", "point", "area", "contact")  # visibly soft shadows in Cycles
 DETAILED_SCENES = ("bunny", "suzanne", "grazing", "tiny", "lamp", "room")  # detailed casters, large grounds
+TERMINATOR_SCENES = ("terminator", "terminator_off")
 
 
 def build(name, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):

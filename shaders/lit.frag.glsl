@@ -13,18 +13,61 @@
  * map (up to frame.shadowed_count, the scene's filter), then lights without a map (no filter
  * code); a scene without lights runs no loop. With several
  * local lights, each pixel loops only over the lights its screen bin lists; with a few lights
- * and no bins, the counts are compiled in and each light is called by its constant index. */
+ * and no bins, the counts are compiled in and each light is called by its constant index.
+ *
+ * Object > Shading > Shadow Terminator (engine/scene/terminator.py), per object variant:
+ * TERMINATOR_OFFSET lifts each light's shadow point towards the smooth surface the vertex
+ * normals imply (Cycles' Geometry Offset), TERMINATOR_NORMAL moves it along the normal (EEVEE's
+ * Normal Offset), TERMINATOR_SHADING raises the cosine term's frequency (Cycles' Shading
+ * Offset). */
 
 struct Surface {
   vec3 P, N, V;
   vec3 Ng; /* the interpolated mesh normal, before any normal map: what shadow biases follow */
   vec3 Nf; /* the drawn facet's normal (the plane the shadow map holds), on Ng's side */
+  vec3 Nv; /* the drawn facet's normal on the side it is seen from */
+#if TERMINATOR_OFFSET
+  vec3 smooth_offset; /* from the flat triangle to the smooth surface (world) */
+#endif
   vec3 albedo, f0;
   float shininess;
   float alpha; /* GGX roughness (Principled roughness squared) */
 };
 
 #define NO_SHADOW -1
+
+#if TERMINATOR_OFFSET
+/* Cycles' smooth-surface offset at this fragment (engine/scene/terminator.py smooth_offset):
+ * the interpolated normal times the height of the parabola through the triangle's vertex
+ * normals, bounded by the vertices' tangent planes (affine over the triangle, interpolated
+ * exactly from the corners). ``Nv``: the facet's normal towards the viewer; seen from
+ * behind its normals the offset goes the other way. */
+vec3 smooth_surface_offset(vec3 Nv)
+{
+  float u = v_tbary.x, v = v_tbary.y;
+  float a = v_tabc.x, b = v_tabc.y, c = v_tabc.z;
+  float h = a * u * (u - 1.0) + (a + b + c) * u * v + b * v * (v - 1.0);
+  vec3 n = v_tnormal;
+  if (dot(n, Nv) > 0.0) {
+    vec3 e = max(v_tfront, vec3(0.0));
+    h = max(min(min(e.x, e.y), e.z), 0.5 * h);
+  }
+  else {
+    vec3 e = max(v_tback, vec3(0.0));
+    h = min(-min(min(e.x, e.y), e.z), 0.5 * h);
+  }
+  vec3 o = n * h;
+  return (any(isnan(o)) || any(isinf(o))) ? vec3(0.0) : o;
+}
+
+/* How much of the offset light direction L gets: all of it where the smooth normal (NL) and
+ * the facet (NgL) are at a grazing angle to it, none beyond the Geometry Offset. */
+float smooth_offset_amount(float NL, float NgL)
+{
+  float cutoff = terminator_geometry_offset;
+  return (NL < cutoff) ? clamp(2.0 - (NgL + NL) / cutoff, 0.0, 1.0) : clamp(1.0 - NgL / cutoff, 0.0, 1.0);
+}
+#endif
 
 /* Add light i's contribution. ``filter_id`` is a literal at each call (FILTER_* or NO_SHADOW), so
  * the compiler keeps a shadow filter only where a light has a map, and only that one. */
@@ -45,13 +88,27 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   if (NdotL <= 0.0 || irradiance <= 0.0) {
     return;
   }
+  /* The cosine term; Cycles' Shading Offset replaces cos(theta) by max(cos(f theta), 0). */
+#if TERMINATOR_SHADING
+  float cosine = max(cos(acos(min(NdotL, 1.0)) * terminator_shading_frequency), 0.0);
+#else
+  float cosine = NdotL;
+#endif
   /* Shadow pass: direct light that arrives over direct light that would arrive unshadowed,
    * each light weighted by the luminance of its irradiance here (1 where no light reaches). */
-  float weight = dot(L.color, vec3(0.2126, 0.7152, 0.0722)) * irradiance * NdotL;
+  float weight = dot(L.color, vec3(0.2126, 0.7152, 0.0722)) * irradiance * cosine;
   float NgdotL = dot(s.Ng, to_light);
+  vec3 shadow_P = s.P;
+#if TERMINATOR_OFFSET
+  shadow_P += s.smooth_offset * smooth_offset_amount(NgdotL, dot(s.Nv, to_light));
+#endif
+#if TERMINATOR_NORMAL
+  /* EEVEE: along the normal, by Normal Offset x saturate(1 - N.L / Geometry Offset). */
+  shadow_P += s.Ng * (clamp(1.0 - NgdotL / terminator_geometry_offset, 0.0, 1.0) * terminator_normal_offset);
+#endif
   float visibility = (filter_id == NO_SHADOW) ? 1.0 :
                      (NgdotL <= 0.0) ? 0.0 :
-                                       shadow_visibility(L, s.P, s.Ng, s.Nf, NgdotL, filter_id);
+                                       shadow_visibility(L, shadow_P, s.Ng, s.Nf, NgdotL, dot(s.Nf, to_light), filter_id);
   unshadowed += weight;
   arriving += weight * visibility;
 #if SPECULAR_MODEL == SPECULAR_GGX
@@ -70,7 +127,7 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
    * angles either, as the Principled BSDF at Specular 0. */
   float f90 = clamp(50.0 * dot(s.f0, vec3(0.3333)), 0.0, 1.0);
   vec3 spec = (s.f0 + (f90 - s.f0) * fw) * (D * Vis);
-  vec3 E = L.color * (irradiance * NdotL * visibility);
+  vec3 E = L.color * (irradiance * cosine * visibility);
   color += E * (s.albedo / M_PI * L.diffuse_factor + spec * L.specular_factor);
 #else
 #  if SPECULAR_MODEL == SPECULAR_BLINN
@@ -80,7 +137,7 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   vec3 R = reflect(-to_light, s.N);
   float spec = (s.shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, s.V), 0.0), s.shininess);
 #  endif
-  vec3 E = L.color * (irradiance * NdotL * visibility);
+  vec3 E = L.color * (irradiance * cosine * visibility);
   color += E * (s.albedo / M_PI * L.diffuse_factor + s.f0 * spec * L.specular_factor);
 #endif
 }
@@ -179,8 +236,12 @@ void main()
     vec3 f = cross(dFdx(s.P), dFdy(s.P));
     float fl = length(f);
     s.Nf = (fl > 1e-30) ? f / fl : s.Ng;
+    s.Nv = (dot(s.Nf, s.V) < 0.0) ? -s.Nf : s.Nf;
     s.Nf = (dot(s.Nf, s.Ng) < 0.0) ? -s.Nf : s.Nf;
   }
+#if TERMINATOR_OFFSET
+  s.smooth_offset = smooth_surface_offset(s.Nv);
+#endif
 #if TEX_NORMAL
   {
     /* Tangent-space normal map (Blender's Normal Map node): MikkTSpace tangent and sign from

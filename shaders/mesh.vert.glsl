@@ -1,7 +1,9 @@
 /* World-space position and normal for the lit pass. The normal matrix is the cofactor of the
  * model matrix (det * inverse-transpose): defined for zero scale, and its sign flip keeps
  * normals outward under negative scale. Tangents (normal maps) move with the model matrix;
- * their bitangent sign flips with a mirroring one. */
+ * their bitangent sign flips with a mirroring one. With TERMINATOR_OFFSET the triangle's corner
+ * data (engine/scene/terminator.py corner_data) passes through, and the object normal moves by
+ * the model matrix itself (Cycles' direction transform of the offset's normal). */
 void main()
 {
   vec4 wp = model * vec4(pos, 1.0);
@@ -16,6 +18,13 @@ void main()
 #endif
 #if HAS_VCOL
   v_color = col;
+#endif
+#if TERMINATOR_OFFSET
+  v_tbary = tbary;
+  v_tabc = tabc;
+  v_tfront = tfront;
+  v_tback = tback;
+  v_tnormal = m * nor;
 #endif
 #if HAS_TANGENT
   v_tangent = vec4(m * tan.xyz, tan.w * (det < 0.0 ? -1.0 : 1.0));

@@ -11,6 +11,8 @@
               -> <out>/shadow_tradeoff.csv, shadow_pareto.png, scaling.csv, scaling.png
     soak      process memory over repeated F12 renders (300 of a 160x90 frame by default)
               -> <out>/soak.csv
+    terminator  frame time with Shadow Terminator Geometry Offset 0 against 0.1 (smooth
+              spheres) -> stdout
 
 Run from the repository root, e.g.::
 
@@ -24,9 +26,17 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import frame, perf, post, samples, shadows, soak
+from tools.benchmarks import frame, perf, post, samples, shadows, soak, terminator
 
-COMMANDS = {"frame": frame, "perf": perf, "post": post, "samples": samples, "shadows": shadows, "soak": soak}
+COMMANDS = {
+    "frame": frame,
+    "perf": perf,
+    "post": post,
+    "samples": samples,
+    "shadows": shadows,
+    "soak": soak,
+    "terminator": terminator,
+}
 
 
 def main(argv=None):

@@ -33,6 +33,10 @@ INCLUDE = {
     "EEVEE_WORLD_PT_surface",  # the world colour (ambient)
     "EEVEE_WORLD_PT_mist",  # the Mist pass's start, depth and falloff
     "MATERIAL_PT_viewport",  # viewport display colour: the fallback material
+    # Object > Shading > Shadow Terminator: Geometry Offset and Shading Offset (as for Cycles),
+    # plus EEVEE's Normal Offset, drawn by ``draw_normal_offset`` (Blender's panel shows it for
+    # EEVEE only).
+    "OBJECT_PT_shadow_terminator",
     "WORLD_PT_viewport_display",
 }
 
@@ -54,6 +58,16 @@ def panels():
 
 
 _added = []
+_hooked = []
+
+
+def draw_normal_offset(self, context):
+    """EEVEE's Normal Offset, which Penumbra honours too, below Blender's own rows."""
+    if context.engine != ENGINE or context.object is None:
+        return
+    layout = self.layout
+    layout.use_property_split = True
+    layout.prop(context.object, "shadow_terminator_normal_offset", text="Normal Offset")
 
 
 def register():
@@ -61,9 +75,16 @@ def register():
         if ENGINE not in panel.COMPAT_ENGINES:
             panel.COMPAT_ENGINES.add(ENGINE)
             _added.append(panel)
+    terminator = getattr(bpy.types, "OBJECT_PT_shadow_terminator", None)
+    if terminator is not None:
+        terminator.append(draw_normal_offset)
+        _hooked.append(terminator)
 
 
 def unregister():
     for panel in _added:
         panel.COMPAT_ENGINES.discard(ENGINE)
     _added.clear()
+    for panel in _hooked:
+        panel.remove(draw_normal_offset)
+    _hooked.clear()

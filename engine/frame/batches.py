@@ -1,6 +1,10 @@
 """GPU batches of the scene's geometry: built once per mesh datablock (and per level of
 detail), kept while the geometry is in the scene, rebuilt only when it changes."""
 
+import numpy as np
+
+from ..scene import terminator
+
 
 class Batches:
     """(all-triangles batch, [(material index, batch)]) per Geometry: ``whole`` for shadow
@@ -9,6 +13,7 @@ class Batches:
     def __init__(self):
         self.meshes = {}  # (geometry key, serial) -> (whole, parts)
         self.levels = {}  # (geometry key, serial, level) -> (whole, parts) of ``simplify.simplified``
+        self.terminators = {}  # (geometry key, serial[, level]) -> parts with the terminator's corner data
         self._used = set()  # the levels drawn this frame (lit pass or shadow maps)
 
     def get(self, key, geo):
@@ -21,13 +26,27 @@ class Batches:
         self._used.add(key)
         return self._get(self.levels, key, lod)
 
+    def terminator(self, cache_key, geo):
+        """The lit pass's parts of ``geo`` for objects with a Shadow Terminator geometry
+        offset: one vertex per triangle corner (no index sharing), each with its triangle's
+        ``terminator.corner_data`` beside the usual attributes; built on first use of
+        ``cache_key`` ((geometry key, serial) or a level's key)."""
+        self._used.add(cache_key)
+        cached = self.terminators.get(cache_key)
+        if cached is None:
+            cached = self.terminators[cache_key] = _terminator_parts(geo)
+        return cached
+
     def keep(self, live):
         """At the end of a frame: release the batches of geometry no longer in the snapshot
-        (``live``: (key, serial) pairs) and of levels of detail this frame did not draw."""
+        (``live``: (key, serial) pairs) and of levels of detail and terminator streams this
+        frame did not draw."""
         for stale in [k for k in self.meshes if k not in live]:
             del self.meshes[stale]
         for stale in [k for k in self.levels if k not in self._used]:
             del self.levels[stale]
+        for stale in [k for k in self.terminators if k not in live and k not in self._used]:
+            del self.terminators[stale]
         self._used = set()
 
     @staticmethod
@@ -37,14 +56,7 @@ class Batches:
         cached = cache.get(cache_key)
         if cached is not None:
             return cached
-        fmt = gpu.types.GPUVertFormat()
-        attrs = {"pos": geo.positions, "nor": geo.normals, "uv": geo.uvs, "col": geo.colors, "tan": geo.tangents}
-        attrs = {name: data for name, data in attrs.items() if data is not None}
-        for name, data in attrs.items():
-            fmt.attr_add(id=name, comp_type="F32", len=data.shape[1], fetch_mode="FLOAT")
-        vbo = gpu.types.GPUVertBuf(fmt, len(geo.positions))
-        for name, data in attrs.items():
-            vbo.attr_fill(name, data)
+        vbo = _vertex_buffer(_attributes(geo), len(geo.positions))
         whole = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices))
         parts = []
         for mat_index, first, count in geo.ranges:
@@ -55,3 +67,39 @@ class Batches:
             parts.append((mat_index, gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)))
         cache[cache_key] = (whole, parts)
         return cache[cache_key]
+
+
+def _attributes(geo):
+    """The vertex attributes of ``geo`` by shader input name (those it has)."""
+    attrs = {"pos": geo.positions, "nor": geo.normals, "uv": geo.uvs, "col": geo.colors, "tan": geo.tangents}
+    return {name: data for name, data in attrs.items() if data is not None}
+
+
+def _vertex_buffer(attrs, count):
+    import gpu
+
+    fmt = gpu.types.GPUVertFormat()
+    for name, data in attrs.items():
+        fmt.attr_add(id=name, comp_type="F32", len=data.shape[1], fetch_mode="FLOAT")
+    vbo = gpu.types.GPUVertBuf(fmt, count)
+    for name, data in attrs.items():
+        vbo.attr_fill(name, data)
+    return vbo
+
+
+def _terminator_parts(geo):
+    """[(material index, GPUBatch)] of ``geo`` with a vertex per triangle corner carrying the
+    geometry offset's corner data (``terminator.ATTRIBUTES``)."""
+    import gpu
+
+    corners = np.ascontiguousarray(geo.indices, np.int32).ravel()
+    attrs = {name: np.ascontiguousarray(data[corners]) for name, data in _attributes(geo).items()}
+    attrs.update(terminator.corner_data(geo.positions, geo.normals, geo.indices))
+    vbo = _vertex_buffer(attrs, len(corners))
+    parts = []
+    for mat_index, first, count in geo.ranges:
+        seq = np.arange(3 * first, 3 * (first + count), dtype=np.int32).reshape(-1, 3)
+        parts.append(
+            (mat_index, gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=seq)))
+        )
+    return parts

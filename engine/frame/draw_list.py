@@ -2,6 +2,7 @@
 detail; the order the lit pass draws them in; which lights reach what the camera sees; and
 each instance's light-linking mask."""
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,6 +16,10 @@ DEFAULT_MATERIAL = Material()  # for faces whose material slot is empty
 # their back faces, in the lit pass and in shadow maps: those faces are hidden by the mesh's
 # own front faces, so the image is the same and the rasteriser sets up half the triangles.
 CULL_CLOSED = True
+# Object › Shading › Shadow Terminator › Geometry Offset applies where a mesh's facets are at least
+# this many pixels across: below it a pixel averages several facets, and no staircase shows, so
+# the per-corner stream and its variant are not paid for.
+TERMINATOR_MIN_PIXELS = 1.0
 _CORNER_BITS = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=bool)  # box corners
 
 
@@ -32,6 +37,23 @@ class Draw:
     closed: bool = False  # a closed opaque surface: back faces hidden from outside its bounds
     geometry: object = None  # the extract.Geometry drawn whole (None: drawn at a level of detail)
     triangles: int = 0  # triangles of what it draws
+    # () -> [(material index, GPUBatch)] with the Shadow Terminator's corner data, built on
+    # first call; None where the geometry offset does not apply (offset 0, flat faces only).
+    terminator_parts: object = None
+
+    def terminator_features(self, shadowed):
+        """The lit-pass features of the instance's Shadow Terminator settings
+        (``programs.TERMINATOR_FEATURES``); ``shadowed``: the frame has shadow maps (without
+        them the offsets of the shadow point do nothing)."""
+        term = self.instance.terminator
+        out = set()
+        if shadowed and self.terminator_parts is not None:
+            out.add("TERMINATOR_OFFSET")
+        if shadowed and term.world_normal_offset(self.instance.matrix) > 0.0:
+            out.add("TERMINATOR_NORMAL")
+        if term.shading_offset > 0.0:
+            out.add("TERMINATOR_SHADING")
+        return frozenset(out)
 
     def material(self, index):
         materials = self.instance.materials
@@ -54,6 +76,7 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
         local = np.where(_CORNER_BITS[None], bounds[:, None, 1], bounds[:, None, 0])  # (n, 8, 3)
         corners = np.einsum("nij,nkj->nki", matrices[:, :3, :3], local) + matrices[:, None, :3, 3]
         levels = _levels(kept, matrices, bounds, corners, camera, settings, size)
+        facets = _facet_pixels(kept, matrices, bounds, corners, camera, size)
         for i, (inst, geo) in enumerate(kept):
             lod = simplify.simplified(geo, levels[i]) if levels[i] is not None else None
             if lod is not None:
@@ -62,6 +85,7 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
                 identity = (inst.key, inst.matrix.tobytes(), geo.serial, levels[i])
                 stats.simplified += 1
             else:
+                key = (inst.key, geo.serial)
                 whole, parts = batches.get(inst.key, geo)
                 identity = (inst.key, inst.matrix.tobytes(), geo.serial)
             model = inst.matrix.copy()
@@ -70,11 +94,33 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
             draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
             draw.geometry = geo if lod is None else None
             draw.triangles = (lod or geo).triangle_count
+            if inst.terminator.geometry_offset > 0.0 and (lod or geo).smooth and facets[i] >= TERMINATOR_MIN_PIXELS:
+                draw.terminator_parts = functools.partial(batches.terminator, key, lod or geo)
             closed = CULL_CLOSED and geo.closed and lod is None  # a level is not tested for closedness
             draw.closed = closed and not any(draw.material(m).uses_alpha for m, _b in parts)
             draws.append(draw)
             stats.triangles += (lod or geo).triangle_count
     return draws
+
+
+def _facet_pixels(kept, matrices, bounds, corners, camera, size):
+    """Each instance's typical facet width in pixels at its point nearest the camera (an edge of
+    a mesh of T triangles over its bounds' largest side E: about 2 E / sqrt(T)); infinite where
+    it is unknown (no camera, through the near plane)."""
+    out = np.full(len(kept), np.inf)
+    if camera is None or size is None:
+        return out
+    per_depth, constant = lightspace.pixel_footprint(camera.projection, camera.is_ortho, *size)
+    view = np.asarray(camera.view, dtype=np.float64)
+    nearest = np.min(-(corners @ view[2, :3] + view[2, 3]), axis=1)
+    pixel = per_depth * np.maximum(nearest, 0.0) + constant
+    stretch = np.linalg.svd(matrices[:, :3, :3], compute_uv=False)[:, 0]
+    extent = np.max(bounds[:, 1] - bounds[:, 0], axis=1)
+    count = np.array([max(geo.triangle_count, 1) for _inst, geo in kept], np.float64)
+    edge = 2.0 * extent * stretch / np.sqrt(count)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        facets = edge / pixel
+    return np.where((nearest > 0.0) & (pixel > 0.0) & np.isfinite(facets), facets, np.inf)
 
 
 def _levels(kept, matrices, bounds, corners, camera, settings, size):

@@ -4,9 +4,10 @@ Environment Texture behind it."""
 
 import numpy as np
 
+from ...shaders.loader import set_uniforms
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
-from .programs import BACKGROUND, JITTER_SIZE, SHADOW_SAMPLER, lit_program
+from .programs import BACKGROUND, JITTER_SIZE, SHADOW_SAMPLER, lit_program, terminator_uniforms
 
 
 class LitPass:
@@ -50,10 +51,17 @@ class LitPass:
             outside = {id(d) for d, ok in zip(closed, beyond, strict=True) if ok}
             stats.closed_culled += len(outside)
         opaque, blended = [], []
+        terminators = {}  # id(draw) -> {push constant: value} of its Shadow Terminator features
         for rank, d in enumerate(front_to_back(draws, camera)):
-            for mat_index, batch in d.parts:
+            # Object > Shading > Shadow Terminator: its own variant and, with a geometry
+            # offset, the parts carrying the corner data (only when there are shadow maps).
+            term = d.terminator_features(atlas is not None)
+            parts = d.terminator_parts() if "TERMINATOR_OFFSET" in term else d.parts
+            if term:
+                terminators[id(d)] = terminator_uniforms(term, d.instance.terminator, d.instance.matrix)
+            for mat_index, batch in parts:
                 mat = d.material(mat_index)
-                features = mat.features | ({"HOLDOUT"} if d.instance.holdout else set())
+                features = mat.features | ({"HOLDOUT"} if d.instance.holdout else set()) | term
                 entry = (features, rank, d, batch, mat)
                 (blended if "ALPHA_BLEND" in features and not d.instance.holdout else opaque).append(entry)
         opaque.sort(key=lambda e: (sorted(e[0]), e[1]))
@@ -92,6 +100,8 @@ class LitPass:
                     shader.uniform_float("model", d.model)
                     if masks is not None:
                         shader.uniform_int("light_mask", masks[id(d)])
+                    if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
+                        set_uniforms(shader, terminators[id(d)])
                     last, bound["model_shader"] = d, shader
                 shader.uniform_block("material", self.materials.get(mat))
                 for channel, ref in mat.textures.items():

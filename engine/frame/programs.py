@@ -124,9 +124,19 @@ MATERIAL_STRUCT = Struct(
 ALPHA_MODES = {"OPAQUE": 0, "HASHED": 1, "BLEND": 2}
 
 
+# An object's Object > Shading > Shadow Terminator (``scene.terminator``) as lit-pass features:
+# TERMINATOR_OFFSET  Cycles' Geometry Offset: the shadow point lifted towards the smooth
+#                    surface, from per-corner data (``batches.Batches.terminator``)
+# TERMINATOR_NORMAL  EEVEE's Normal Offset: the shadow point moved along the normal
+# TERMINATOR_SHADING Cycles' Shading Offset: the cosine term's frequency raised
+# Each is a define of its own variant; objects without them compile and draw as before.
+TERMINATOR_FEATURES = ("TERMINATOR_OFFSET", "TERMINATOR_NORMAL", "TERMINATOR_SHADING")
+
+
 def material_defines(features):
     """Defines of a material variant: which channels sample a texture (TEX_<CHANNEL>), which
-    vertex data exist (HAS_UV, HAS_VCOL, HAS_TANGENT), the alpha mode, holdout."""
+    vertex data exist (HAS_UV, HAS_VCOL, HAS_TANGENT), the alpha mode, holdout, and the
+    object's Shadow Terminator features (TERMINATOR_FEATURES)."""
     out = {f"TEX_{c.upper()}": f"TEX_{c.upper()}" in features for c in CHANNELS}
     uv = any(out.values())
     out["HAS_UV"] = uv
@@ -135,6 +145,8 @@ def material_defines(features):
     mode = next((m for m in ALPHA_MODES if f"ALPHA_{m}" in features), "OPAQUE")
     out["ALPHA_MODE"] = ALPHA_MODES[mode]
     out["HOLDOUT"] = "HOLDOUT" in features
+    for name in TERMINATOR_FEATURES:
+        out[name] = name in features
     return out
 
 
@@ -194,6 +206,21 @@ _FEATURE_INPUTS = {  # vertex data a material feature reads: (type, name, varyin
     "VCOL": ("VEC4", "col", "v_color"),
     "TANGENT": ("VEC4", "tan", "v_tangent"),
 }
+# The geometry offset's per-corner data (``terminator.corner_data``): (type, input, varying,
+# interpolation); the parabola's coefficients are one per triangle. v_tnormal is the
+# interpolated object normal moved by the model matrix (not normalised, as Cycles uses it).
+_TERMINATOR_INPUTS = (
+    ("VEC2", "tbary", "v_tbary", "smooth"),
+    ("VEC3", "tabc", "v_tabc", "flat"),
+    ("VEC3", "tfront", "v_tfront", "smooth"),
+    ("VEC3", "tback", "v_tback", "smooth"),
+)
+# Per-draw values of the terminator features (the object's settings), set like ``model``:
+TERMINATOR_UNIFORMS = {
+    "TERMINATOR_OFFSET": ("terminator_geometry_offset",),  # Geometry Offset (0-1)
+    "TERMINATOR_NORMAL": ("terminator_geometry_offset", "terminator_normal_offset"),  # world units
+    "TERMINATOR_SHADING": ("terminator_shading_frequency",),  # 1 / (1 - Shading Offset / 2)
+}
 
 
 def _with_features(program, features, name):
@@ -205,14 +232,38 @@ def _with_features(program, features, name):
         if on
     ]
     samplers = tuple(("FLOAT_2D", f"tex_{c}") for c in CHANNELS if defines[f"TEX_{c.upper()}"])
+    vertex_in = tuple(_FEATURE_INPUTS[k][:2] for k in kinds)
+    varyings = tuple(("smooth", _FEATURE_INPUTS[k][0], _FEATURE_INPUTS[k][2]) for k in kinds)
+    if defines["TERMINATOR_OFFSET"]:
+        vertex_in += tuple((typ, name) for typ, name, _v, _q in _TERMINATOR_INPUTS)
+        varyings += tuple((q, typ, v) for typ, _n, v, q in _TERMINATOR_INPUTS) + (("smooth", "VEC3", "v_tnormal"),)
+    uniforms = []
+    for feature, names in TERMINATOR_UNIFORMS.items():
+        uniforms += [n for n in names if defines[feature] and n not in uniforms]
     return replace(
         program,
         name=name,
-        vertex_in=program.vertex_in + tuple(_FEATURE_INPUTS[k][:2] for k in kinds),
-        varyings=program.varyings + tuple(("smooth", _FEATURE_INPUTS[k][0], _FEATURE_INPUTS[k][2]) for k in kinds),
+        vertex_in=program.vertex_in + vertex_in,
+        varyings=program.varyings + varyings,
+        push_constants=program.push_constants + tuple(("FLOAT", n) for n in uniforms),
         samplers=program.samplers + samplers,
         defines=program.defines + tuple(defines.items()),
     )
+
+
+def terminator_uniforms(features, terminator, matrix):
+    """{push constant: value} of an instance's ``terminator.Terminator`` settings for a
+    variant with ``features`` (its world matrix ``matrix`` scales EEVEE's Normal Offset)."""
+    values = {
+        "terminator_geometry_offset": terminator.geometry_offset,
+        "terminator_normal_offset": terminator.world_normal_offset(matrix),
+        "terminator_shading_frequency": terminator.frequency,
+    }
+    out = {}
+    for feature, names in TERMINATOR_UNIFORMS.items():
+        if feature in features:
+            out.update({n: float(values[n]) for n in names})
+    return out
 
 
 # A final render with the Emission pass: the lit pass also writes each surface's emission.

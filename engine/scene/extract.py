@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .materials import material_from_blender, world_from_blender
+from .terminator import Terminator
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
 # Object types Blender's own engines render that Penumbra does not: named in the report.
@@ -40,6 +41,7 @@ class Geometry:
     colors: np.ndarray | None = None  # (vertices, 4) float32 linear: a colour attribute
     tangents: np.ndarray | None = None  # (vertices, 4) float32 MikkTSpace tangent and sign; w 0: none
     closed: bool = False  # the triangles bound solids with outward normals (``closed_outward``)
+    smooth: bool = False  # some faces are smooth-shaded (normals not all the faces' own)
     messages: tuple = ()
     deps: frozenset = frozenset()
     serial: int = 0  # distinguishes rebuilt geometry of the same key (GPU batches key on it)
@@ -86,6 +88,7 @@ class MeshInstance:
     camera: bool = True  # seen by the camera (Ray Visibility > Camera)
     holdout: bool = False  # Object > Visibility > Holdout: alpha 0 where it covers
     names: tuple = ()  # the object's name and its instancer's: what light linking matches
+    terminator: Terminator = Terminator()  # Object > Shading > Shadow Terminator
 
 
 @dataclass(frozen=True)
@@ -381,6 +384,7 @@ def geometry_from_mesh(mesh, needs=None):
         colors=colors,
         tangents=tangents,
         closed=closed,
+        smooth=mesh.normals_domain != "FACE",
         messages=tuple(messages),
     )
 
@@ -657,6 +661,16 @@ class SceneCache:
                 held[key] = bool(base.holdout_get(view_layer=depsgraph.view_layer))
             return held[key] or bool(getattr(orig, "is_holdout", False))
 
+        terminators = {}
+
+        def terminator(ob):
+            """Object > Shading > Shadow Terminator of ``ob`` (the instanced object's own, as
+            Cycles reads it), read once per object and snapshot."""
+            key = ob.name_full
+            if key not in terminators:
+                terminators[key] = Terminator.of(ob)
+            return terminators[key]
+
         messages = []
         for inst in depsgraph.object_instances:
             ob = inst.object
@@ -719,6 +733,7 @@ class SceneCache:
                     shadow=shadow,
                     camera=camera,
                     holdout=holdout(orig, inst),
+                    terminator=terminator(ob),
                     names=(orig.name_full, inst.parent.original.name_full)
                     if inst.is_instance and inst.parent is not None
                     else (orig.name_full,),

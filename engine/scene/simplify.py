@@ -166,6 +166,7 @@ def cluster(geo, level):
         np.ascontiguousarray(indices, np.int32),
         ranges,
         np.array([lo, hi]),
+        smooth=geo.smooth,
     )
 
 

@@ -18,7 +18,14 @@
  *                  neither acne nor a reason to bias the whole kernel. Without it (or where
  *                  the facet faces away from the light) the slope bias grows with the
  *                  kernel: tan(theta) * max(1, r)
- * scaled per light by LightData.bias_scale (light.penumbra.bias_scale). */
+ * scaled per light by LightData.bias_scale (light.penumbra.bias_scale).
+ *
+ * Where the drawn facet turns away from the light (NfdotL <= 0) while the smooth normal faces
+ * it, the point lies behind its own facet as seen from the light: on a closed smooth mesh it
+ * is shadowed by the mesh itself, as a ray tracer draws it (the low-poly shadow terminator).
+ * The angle-dependent terms (normal offset and slope bias, which grow without bound at the
+ * terminator and would hide that self-shadowing) are left out there; only the constant bias
+ * remains. Object > Shading > Shadow Terminator (lit.frag.glsl) then moves the point itself. */
 
 float pixel_hash(vec2 frag); /* lib/material.glsl */
 
@@ -107,7 +114,7 @@ float shadow_disk(ivec2 origin, vec2 st, float ref, float r, vec2 grad)
 /* ``filter_id`` is a literal at every call (FILTER_*), so each call compiles to its one filter:
  * lights sampled over their extent use PCSS with their per-sample size, the others the
  * scene's filter. */
-float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, const int filter_id)
+float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float NfdotL, const int filter_id)
 {
   int mode = L.shadow_mode;
   if (mode == SHADOW_MODE_NONE) {
@@ -149,6 +156,10 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, const
   float cos_t = clamp(NdotL, 1e-4, 1.0);
   float sin_t = sqrt(1.0 - cos_t * cos_t);
   float tan_t = min(sin_t / cos_t, 60.0);
+  if (NfdotL <= 0.0) {
+    sin_t = 0.0; /* the facet turns away from the light: see above */
+    tan_t = 0.0;
+  }
   float dist = max(-(T.view * vec4(P, 1.0)).z, 0.0);
   float texel = T.texel + T.texel_per_distance * dist;
 

@@ -14,6 +14,7 @@ SHOWN = [
     "DATA_PT_EEVEE_light", "DATA_PT_camera", "DATA_PT_lens", "DATA_PT_context_mesh", "DATA_PT_vertex_colors",
     "EEVEE_MATERIAL_PT_surface", "EEVEE_WORLD_PT_surface", "OBJECT_PT_visibility", "OBJECT_PT_custom_props",
     "OBJECT_PT_shading",  # holds Light Linking and Shadow Linking
+    "OBJECT_PT_shadow_terminator",  # Geometry, Shading and (drawn by compat) Normal Offset
     "PHYSICS_PT_add", "PARTICLE_PT_context_particles", "PENUMBRA_PT_film", "PENUMBRA_PT_passes",
 ]  # fmt: skip
 HIDDEN = [
@@ -40,6 +41,19 @@ def test_panels_of_ignored_features_are_hidden(penumbra, name):
     if panel is None:
         pytest.skip(f"{name} does not exist in Blender {bpy.app.version_string}")
     assert "PENUMBRA" not in getattr(panel, "COMPAT_ENGINES", set())
+
+
+def test_shadow_terminator_panel_draws_all_three_offsets(penumbra):
+    """Blender's Shadow Terminator panel draws Geometry and Shading Offset for an engine other
+    than EEVEE; Penumbra also honours EEVEE's Normal Offset, drawn by a hook of its own."""
+    from penumbra.ui import compat
+
+    panel = _panel("OBJECT_PT_shadow_terminator")
+    assert compat.draw_normal_offset in panel._dyn_ui_initialize()
+    scene = scenes.empty_scene(8, 8)
+    sphere = scenes.uv_sphere(scene, segments=8, rings=4)
+    context = type("Context", (), {"object": sphere, "engine": "PENUMBRA"})
+    assert panel.poll(context)  # its poll reads COMPAT_ENGINES, which now holds PENUMBRA
 
 
 def test_every_shown_panel_is_generic_or_chosen(penumbra):
