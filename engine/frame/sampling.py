@@ -218,3 +218,49 @@ def light_at_sample(light, light_index, s, count):
         direction = np.array([r_xy * math.cos(phi), r_xy * math.sin(phi), z])
         m[:3, 3] = m[:3, 3] + light.radius * w ** (1.0 / 3.0) * direction
     return dataclasses.replace(light, matrix=m, penumbra_scale=scale, sampled=True)
+
+
+# --- adaptive sampling ------------------------------------------------------------------------
+
+ADAPTIVE_STEP = 4  # samples between two convergence checks (Cycles' adaptive step)
+THRESHOLD_SCALE = 5.0  # Cycles scales the Noise Threshold by 5 before comparing the error with it
+
+
+def auto_min_samples(threshold):
+    """Cycles' automatic Min Samples of a Noise Threshold: 0.1 -> 32, 0.01 -> 64, 0.001 -> 128."""
+    return max(ADAPTIVE_STEP, math.ceil(16.0 / threshold**0.3))
+
+
+@dataclasses.dataclass(frozen=True)
+class Adaptive:
+    """What may end a frame's sampling before its last sample. ``threshold``: Cycles' Noise
+    Threshold (0: every pixel takes every sample); a pixel whose error estimate (and its
+    neighbours') is below it after ``min_samples`` takes no more samples, checked every
+    ``step`` samples. ``time_limit``: seconds the samples may take (0: none)."""
+
+    threshold: float = 0.0
+    min_samples: int = ADAPTIVE_STEP
+    time_limit: float = 0.0
+    step: int = ADAPTIVE_STEP
+
+    def checks_at(self, done):
+        """Whether the convergence check runs after ``done`` samples (an even count, so half of
+        them are the "every other sample" the estimate compares with)."""
+        return self.threshold > 0.0 and done >= self.min_samples and done % self.step == 0
+
+
+def adaptive_settings(use, threshold, min_samples, time_limit, sample_count):
+    """The ``Adaptive`` of a frame of ``sample_count`` samples (0: without end) from its
+    settings, or None when nothing can end it early: adaptive sampling off, a threshold of 0,
+    or a first check that would come after the last sample; and no time limit."""
+    threshold = float(threshold) if use else 0.0
+    if threshold > 0.0:
+        first = max(ADAPTIVE_STEP, int(min_samples)) if min_samples > 0 else auto_min_samples(threshold)
+        first = -(-first // ADAPTIVE_STEP) * ADAPTIVE_STEP  # checks fall on multiples of the step
+        if 0 < sample_count <= first:
+            threshold = 0.0  # the last sample comes before any check: the frame is the plain one
+    else:
+        first = ADAPTIVE_STEP
+    if threshold <= 0.0 and time_limit <= 0.0:
+        return None
+    return Adaptive(threshold=threshold, min_samples=first if threshold > 0.0 else 0, time_limit=float(time_limit))
