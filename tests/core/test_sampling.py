@@ -112,3 +112,26 @@ def test_only_lights_whose_penumbra_reaches_a_texel_move_between_samples():
     assert sampling.penumbra_texels(spot, persp) == pytest.approx(100.0)
     lights = [tiny_sun, sun, spot, unshadowed_spot, area]
     assert sampling.sampled_lights(lights, plan_for([ortho, ortho, persp, None, None])) == {1, 2, 4}
+
+
+# --- adaptive sampling ------------------------------------------------------------------------
+
+
+def test_automatic_min_samples_follow_cycles():
+    """Cycles: threshold 0.1 -> 32, 0.01 -> 64, 0.001 -> 128 samples before the first check."""
+    assert [sampling.auto_min_samples(t) for t in (0.1, 0.01, 0.001)] == [32, 64, 128]
+
+
+def test_adaptive_settings_off_cases_and_check_schedule():
+    settings = sampling.adaptive_settings
+    assert settings(False, 0.01, 8, 0.0, 64) is None  # off
+    assert settings(True, 0.0, 8, 0.0, 64) is None  # threshold 0: off too
+    assert settings(True, 0.01, 0, 0.0, 64) is None  # automatic 64: no check before the last sample
+    assert settings(True, 0.01, 0, 0.0, 16) is None
+    limited = settings(True, 0.01, 0, 2.5, 16)  # the time limit alone
+    assert limited.threshold == 0.0 and limited.time_limit == 2.5 and not limited.checks_at(8)
+    a = settings(True, 0.01, 6, 0.0, 64)  # checks on multiples of the step from Min Samples on
+    assert a.min_samples == 8 and [n for n in range(1, 21) if a.checks_at(n)] == [8, 12, 16, 20]
+    endless = settings(True, 0.1, 0, 0.0, 0)  # the viewport refining without end
+    assert endless.min_samples == 32
+    assert settings(True, 0.01, 1, 0.0, 64).min_samples == sampling.ADAPTIVE_STEP
