@@ -126,6 +126,28 @@ def test_the_viewport_stops_refining_a_converged_frame_and_says_so(penumbra, gpu
     assert statuses[-1] == "Sample 4/64 | Noise Threshold reached" and not refining
 
 
+def test_the_viewports_time_limit_ends_endless_refinement(penumbra, gpu_call):
+    scene = _soft_demo(48, 27)
+    scene.penumbra.viewport_samples = 0  # refine without end
+    scene.penumbra.use_preview_adaptive_sampling = False
+    scene.penumbra.preview_time_limit = 0.3
+
+    def job(engine, depsgraph):
+        cam = scene.camera.evaluated_get(depsgraph)
+        view = cam.matrix_world.inverted()
+        window = cam.calc_matrix_camera(depsgraph, x=48, y=27, scale_x=1.0, scale_y=1.0)
+        start = time.monotonic()
+        redraws = 0
+        while engine.viewport_frame(depsgraph, view, window, 48, 27)[1]:
+            redraws += 1
+            assert redraws < 10000
+        return redraws, time.monotonic() - start, engine.viewport_status(), engine.refining()
+
+    redraws, elapsed, status, refining = gpu_call(job)
+    assert status == f"Sample {redraws} | Time Limit reached" and not refining
+    assert 0.3 <= elapsed < 3.0 and redraws >= 2
+
+
 def test_time_limit_stops_within_one_sample_of_the_budget(penumbra, gpu_call):
     """The clock starts with the samples (the scene is extracted and planned before it); the
     frame ends after the first sample that finds the budget spent, so the samples take at
