@@ -128,7 +128,8 @@ class Renderer:
                 jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
                 view_camera = dataclasses.replace(camera, projection=jittered)
             sample_lights = [
-                sampling.light_at_sample(lt, i, s, sample_count) if i in moving else lt for i, lt in enumerate(lights)
+                sampling.light_at_sample(lt, i, s, sample_count, noise) if i in moving else lt
+                for i, lt in enumerate(lights)
             ]
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
             plan = self._sample(

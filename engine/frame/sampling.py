@@ -112,6 +112,38 @@ def _light_point(s, light_index, dims, count):
     return [(c + rotation[d]) % 1.0 for d, c in enumerate(coords)]
 
 
+def sobol_2(index):
+    """The second dimension of the Sobol' sequence (its generator matrix is Pascal's mod 2),
+    as 32 bits: with the van der Corput sequence it forms a (0, 2)-sequence in base 2."""
+    v, result, i = 1 << 31, 0, int(index)
+    while i:
+        if i & 1:
+            result ^= v
+        i >>= 1
+        v ^= v >> 1
+    return result
+
+
+@functools.lru_cache(maxsize=256)
+def _progressive_scramble(light_index):
+    """Per light: XOR masks of the first two coordinates' 32 bits and a rotation of the third."""
+    rng = np.random.default_rng(0x5851F42D + 104729 * light_index)
+    return int(rng.integers(0, 1 << 32)), int(rng.integers(0, 1 << 32)), float(rng.random())
+
+
+def _light_point_progressive(s, light_index, dims):
+    """Sample ``s``'s point in [0, 1)^dims for light ``light_index`` when a frame may stop any
+    pixel after any multiple of 4 samples (adaptive sampling): the (0, 2)-sequence (van der
+    Corput, Sobol' 2) digitally shifted per light, whose first 2^k points are stratified for
+    every k, so a pixel stopped early has sampled the whole light evenly; a third coordinate
+    from the radical inverse in base 3, rotated per light."""
+    x_mask, y_mask, rotation = _progressive_scramble(light_index)
+    x = int(radical_inverse(s, 2) * (1 << 32)) ^ x_mask
+    y = sobol_2(s) ^ y_mask
+    coords = [x / 2.0**32, y / 2.0**32, (radical_inverse(s, 3) + rotation) % 1.0]
+    return coords[:dims]
+
+
 def concentric_disk(u, v):
     """Shirley-Chiu map of [0, 1)^2 to the unit disk (area-preserving, low distortion)."""
     a, b = 2.0 * u - 1.0, 2.0 * v - 1.0
@@ -175,16 +207,29 @@ def sampled_lights(lights, plan):
     return out
 
 
-def light_at_sample(light, light_index, s, count):
+def light_at_sample(light, light_index, s, count, progressive=False):
     """``light`` as it shines in sample ``s`` of ``count``: moved to a point of itself (a
     direction inside its cone for a sun), with PCSS's light size scaled by 1/sqrt(count).
-    Lights without size, and every light in a frame of one sample, keep the light's centre."""
+    Lights without size, and every light in a frame of one sample, keep the light's centre.
+    ``progressive``: pixels may stop early (adaptive sampling), so the points come from a
+    sequence whose every power-of-two prefix is stratified (``_light_point_progressive``)
+    rather than from the shuffled set of ``count``, which only the whole set stratifies."""
     if count <= 1 or not has_size(light):
         return light
+    if progressive:
+
+        def point(dims):
+            return _light_point_progressive(s, light_index, dims)
+
+    else:
+
+        def point(dims):
+            return _light_point(s, light_index, dims, count)
+
     scale = 1.0 / math.sqrt(count)
     m = np.array(light.matrix, dtype=np.float64)
     if light.type == "SUN":
-        x, y = concentric_disk(*_light_point(s, light_index, 2, count))
+        x, y = concentric_disk(*point(2))
         d = light.direction
         u, v = _basis(d)
         tan_half = math.tan(0.5 * min(light.angle, math.pi * 0.99))
@@ -198,7 +243,7 @@ def light_at_sample(light, light_index, s, count):
         xa /= np.linalg.norm(xa)
         m[:3, 0], m[:3, 1], m[:3, 2] = xa, np.cross(z, xa), z
     elif light.type == "AREA":
-        u, v = _light_point(s, light_index, 2, count)
+        u, v = point(2)
         if light.shape in ("DISK", "ELLIPSE"):
             x, y = concentric_disk(u, v)
             x, y = 0.5 * x, 0.5 * y
@@ -207,11 +252,11 @@ def light_at_sample(light, light_index, s, count):
         local = np.array([x * light.size_x, y * light.size_y, 0.0, 1.0])
         m[:3, 3] = (m @ local)[:3]  # the light's own axes carry its object scale
     elif light.type == "SPOT":
-        x, y = concentric_disk(*_light_point(s, light_index, 2, count))
+        x, y = concentric_disk(*point(2))
         u, v = _basis(light.direction)
         m[:3, 3] = m[:3, 3] + light.radius * (x * u + y * v)
     else:  # POINT: uniform in the ball, which looks the same from every direction
-        u, v, w = _light_point(s, light_index, 3, count)
+        u, v, w = point(3)
         z = 1.0 - 2.0 * u
         r_xy = math.sqrt(max(0.0, 1.0 - z * z))
         phi = 2.0 * math.pi * v
