@@ -43,7 +43,6 @@ class Renderer:
         self.materials = MaterialBlocks()
         self.batches = Batches()
         self.film = Film(self.shaders, pool)
-        self.film.count_shaded = False  # tests: the lit pass counts the pixels it shades (``film.shaded_total``)
         self.shadow_pass = ShadowPass(pool)
         self.lit_pass = LitPass(self.shaders, self.materials, self.textures)
         self.post = post_stack()
