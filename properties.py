@@ -62,6 +62,8 @@ def property_for(param, update=redraw_viewports):
         kw["subtype"] = "PIXEL"
     if param.type == "FLOAT":
         kw.setdefault("subtype", param.subtype)
+        if param.precision is not None:
+            kw["precision"] = param.precision
         return FloatProperty(default=param.default, **_limits(param, float), **kw)
     if param.type == "INT":
         return IntProperty(default=param.default, **_limits(param, int), **kw)

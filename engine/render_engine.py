@@ -1,6 +1,7 @@
 """The RenderEngine subclass: thin glue from Blender's callbacks to the Renderer."""
 
 import sys
+import time
 import traceback
 
 import bpy
@@ -16,6 +17,7 @@ from .frame.output import (
     view_distance_scale,
     viewport_window,
 )
+from .frame.sampling import adaptive_settings
 from .scene.extract import SceneCache, camera_from_scene, camera_from_view
 
 ENDLESS_SAMPLES = 64  # how finely soft lights are split when the viewport refines without end
@@ -23,6 +25,9 @@ ENDLESS_SAMPLES = 64  # how finely soft lights are split when the viewport refin
 # The Emission pass's name on this Blender line, as its own engines register it (the
 # compositor's Render Layers socket): "Emit" up to 4.5, "Emission" from 5.0.
 EMISSION_PASS = "Emission" if bpy.app.version >= (5, 0, 0) else "Emit"
+
+# What the render report and the viewport's text say when a frame stopped before its last sample.
+STOPPED = {"converged": "Noise Threshold reached", "time limit": "Time Limit reached"}
 
 
 class PenumbraEngineCore:
@@ -38,6 +43,8 @@ class PenumbraEngineCore:
         self.last_stats = None
         self._reported = None
         self._shown = None  # (view key, FrameOutput) of the frame the viewport shows
+        self._started = 0.0  # when the viewport's refinement of the shown frame began (monotonic)
+        self._stopped = ""  # why it stopped before its last sample (FrameStats.stopped)
 
     def free_gpu(self):
         """Release this instance's GPU resources. Call it while the GPU context is active:
@@ -60,6 +67,8 @@ class PenumbraEngineCore:
         sample_count=1,
         on_sample=None,
         emission=False,
+        adaptive=None,
+        deadline=None,
     ):
         """Extract, then render samples ``samples`` of a frame of ``sample_count`` samples
         (``Renderer.render``); returns the renderer's FrameOutput. ``pixel_scale`` scales the
@@ -89,6 +98,8 @@ class PenumbraEngineCore:
             sample_count,
             on_sample=on_sample,
             emission=emission,
+            adaptive=adaptive,
+            deadline=deadline,
         )
         self.last_stats = out.stats
         return out
@@ -99,7 +110,9 @@ class PenumbraEngineCore:
           region's resolution (post sizes scaled alike);
         * otherwise, after any change (``view_update`` calls ``scene_changed``) or a stop: the
           first full-resolution sample, then one more sample per redraw, accumulated, until
-          ``viewport_samples`` (0: without end); then the same frame again, nothing rendered.
+          ``viewport_samples`` (0: without end), or until adaptive sampling finds every pixel
+          converged or the viewport's time limit passes; then the same frame again, nothing
+          rendered.
         Sample k of the viewport is sample k of a final render, so N redraws show what a final
         render of N samples shows. Returns (FrameOutput, whether it rendered); ``refining()``
         says whether another redraw would render more."""
@@ -107,28 +120,59 @@ class PenumbraEngineCore:
         settings = depsgraph.scene.penumbra
         target = int(settings.viewport_samples)
         count = target if target > 0 else ENDLESS_SAMPLES
+        adaptive = adaptive_settings(
+            settings.use_preview_adaptive_sampling,
+            settings.preview_adaptive_threshold,
+            settings.preview_adaptive_min_samples,
+            settings.preview_time_limit,
+            target,
+        )
         shown = self._shown
         if shown is not None and shown[0] == key and shown[1].width == width:
             done = shown[2]
-            if not self._wants_sample(done, target):
+            if not self._wants_sample(done, target) or self._stopped:
                 return shown[1], False
             camera = camera_from_view(view_matrix, window_matrix)
+            deadline = self._started + adaptive.time_limit if adaptive is not None and adaptive.time_limit else None
             out = self.render_frame(
-                depsgraph, camera, width, height, aux=False, samples=(done, done + 1), sample_count=count
+                depsgraph,
+                camera,
+                width,
+                height,
+                aux=False,
+                samples=(done, done + 1),
+                sample_count=count,
+                adaptive=adaptive,
+                deadline=deadline,
             )
-            self._shown = (key, out, done + 1, target)
+            self._shown = (key, out, done + out.stats.samples, target)
+            self._stopped = out.stats.stopped
             return out, True
         scale = float(settings.navigation_scale)
         moving = shown is not None and shown[0][:2] == (width, height) and shown[0] != key and scale < 1.0
         camera = camera_from_view(view_matrix, window_matrix)
         self._shown = None
+        self._stopped = ""
         if moving:
             w, h = max(1, round(width * scale)), max(1, round(height * scale))
             out = self.render_frame(depsgraph, camera, w, h, pixel_scale=w / width, aux=False)
             self._shown = (key, out, 0, target)
         else:
-            out = self.render_frame(depsgraph, camera, width, height, aux=False, samples=(0, 1), sample_count=count)
+            self._started = time.monotonic()
+            deadline = self._started + adaptive.time_limit if adaptive is not None and adaptive.time_limit else None
+            out = self.render_frame(
+                depsgraph,
+                camera,
+                width,
+                height,
+                aux=False,
+                samples=(0, 1),
+                sample_count=count,
+                adaptive=adaptive,
+                deadline=deadline,
+            )
             self._shown = (key, out, 1, target)
+            self._stopped = out.stats.stopped
         return out, True
 
     @staticmethod
@@ -142,18 +186,21 @@ class PenumbraEngineCore:
         if shown is None:
             return False
         key, out, done, target = shown
-        return out.width < key[0] or self._wants_sample(done, target)
+        return out.width < key[0] or (self._wants_sample(done, target) and not self._stopped)
 
     def viewport_status(self):
-        """'Sample k/N' of the frame the viewport shows ('' before the first)."""
+        """'Sample k/N' of the frame the viewport shows ('' before the first), and why it
+        stopped early if it did ('Sample 40/64 | Noise Threshold reached')."""
         if self._shown is None or self._shown[2] == 0:
             return ""
         done, target = self._shown[2], self._shown[3]
-        return f"Sample {done}/{target}" if target else f"Sample {done}"
+        text = f"Sample {done}/{target}" if target else f"Sample {done}"
+        return f"{text} | {STOPPED[self._stopped]}" if self._stopped else text
 
     def scene_changed(self):
         """Something in the scene changed: the next viewport redraw renders afresh."""
         self._shown = None
+        self._stopped = ""
 
     def draw_display(self, scene, texture, width, height, window=None):
         """Draw a scene-linear texture through Blender's colour management (view transform,
@@ -270,7 +317,15 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     )
                 else:
                     camera = camera_from_scene(depsgraph, scene, width, height)
-                count = int(scene.penumbra.render_samples)
+                options = scene.penumbra
+                count = int(options.render_samples)
+                adaptive = adaptive_settings(
+                    options.use_adaptive_sampling,
+                    options.adaptive_threshold,
+                    options.adaptive_min_samples,
+                    options.time_limit,
+                    count,
+                )
                 label = f"Penumbra | {layer}{' | ' + view if view else ''}"
 
                 def on_sample(done, index=index, count=count, label=label):
@@ -289,9 +344,14 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     sample_count=count,
                     on_sample=on_sample,
                     emission=vl.use_pass_emit,
+                    adaptive=adaptive,
                 )
                 if out.stats.cancelled:
                     return  # cancelled: no result is written for this view
+                if out.stats.stopped:
+                    stopped = f"Sample {out.stats.samples}/{count} | {STOPPED[out.stats.stopped]}"
+                    self.update_stats("", f"{label} | {stopped}")
+                    self.report({"INFO"}, f"Penumbra: {label[11:]}: {stopped}")
                 for message in out.stats.messages:
                     if message not in reported:
                         reported.add(message)

@@ -40,6 +40,8 @@ class Param:
     section: str = None  # panel section it is drawn in; None: not drawn by the generic panels
     active_when: tuple = None  # (other param, fact): greyed out unless enum[other].fact is true
     unit: str = None  # "PIXELS": a size in output pixels, scaled with the resolution %
+    precision: int = None  # FLOAT: digits a field shows (Blender's default 3 otherwise)
+    switch: str = None  # a BOOL setting drawn as this row's checkbox (Cycles' "Noise Threshold" row)
 
     def __post_init__(self):
         if self.type not in TYPES:
@@ -120,6 +122,8 @@ def values(params, source):
 # --- scene settings (scene.penumbra) ------------------------------------------------------
 
 SAMPLING = "sampling"
+SAMPLING_VIEWPORT = "sampling_viewport"  # the Sampling panel's Viewport and Render subpanels (as Cycles')
+SAMPLING_RENDER = "sampling_render"
 SHADOWS = "shadows"
 LIGHTING = "lighting"
 VIEWPORT = "viewport"
@@ -127,16 +131,26 @@ SIMPLIFY = "simplify"
 
 SCENE_PARAMS = (
     Param(
-        "render_samples",
-        "INT",
-        16,
-        "Samples per pixel of a final render: each one jitters the image within the pixel filter and "
-        "lights soft lights from another point of themselves",
-        min=1,
-        max=4096,
-        soft_max=256,
-        label="Render",
-        section=SAMPLING,
+        "use_preview_adaptive_sampling",
+        "BOOL",
+        True,
+        "Automatically reduce the number of samples per pixel based on estimated noise level, for viewport renders",
+        label="Use Adaptive Sampling",
+        section=SAMPLING_VIEWPORT,
+    ),
+    Param(
+        "preview_adaptive_threshold",
+        "FLOAT",
+        0.1,
+        "Noise level step to stop sampling at, lower values reduce noise at the cost of render time, for viewport "
+        "renders. Zero turns adaptive sampling off (every pixel takes every sample)",
+        min=0.0,
+        max=1.0,
+        soft_min=0.001,
+        precision=4,
+        label="Noise Threshold",
+        section=SAMPLING_VIEWPORT,
+        switch="use_preview_adaptive_sampling",
     ),
     Param(
         "viewport_samples",
@@ -146,8 +160,87 @@ SCENE_PARAMS = (
         min=0,
         max=4096,
         soft_max=256,
-        label="Viewport",
-        section=SAMPLING,
+        label="Max Samples",
+        section=SAMPLING_VIEWPORT,
+    ),
+    Param(
+        "preview_adaptive_min_samples",
+        "INT",
+        0,
+        "Minimum AA samples for adaptive sampling, to discover noisy features before stopping sampling. Zero for "
+        "automatic setting based on noise threshold, for viewport renders",
+        min=0,
+        max=4096,
+        label="Min Samples",
+        section=SAMPLING_VIEWPORT,
+    ),
+    Param(
+        "preview_time_limit",
+        "FLOAT",
+        0.0,
+        "Limit the time the viewport keeps refining a still view, in seconds (excluding synchronization time). "
+        "Zero disables the limit",
+        min=0.0,
+        step=100,
+        subtype="TIME_ABSOLUTE",
+        label="Time Limit",
+        section=SAMPLING_VIEWPORT,
+    ),
+    Param(
+        "use_adaptive_sampling",
+        "BOOL",
+        True,
+        "Automatically reduce the number of samples per pixel based on estimated noise level",
+        label="Use Adaptive Sampling",
+        section=SAMPLING_RENDER,
+    ),
+    Param(
+        "adaptive_threshold",
+        "FLOAT",
+        0.01,
+        "Noise level step to stop sampling at, lower values reduce noise at the cost of render time. Zero turns "
+        "adaptive sampling off (every pixel takes every sample)",
+        min=0.0,
+        max=1.0,
+        soft_min=0.001,
+        precision=4,
+        label="Noise Threshold",
+        section=SAMPLING_RENDER,
+        switch="use_adaptive_sampling",
+    ),
+    Param(
+        "render_samples",
+        "INT",
+        16,
+        "Samples per pixel of a final render: each one jitters the image within the pixel filter and "
+        "lights soft lights from another point of themselves",
+        min=1,
+        max=4096,
+        soft_max=256,
+        label="Max Samples",
+        section=SAMPLING_RENDER,
+    ),
+    Param(
+        "adaptive_min_samples",
+        "INT",
+        0,
+        "Minimum AA samples for adaptive sampling, to discover noisy features before stopping sampling. Zero for "
+        "automatic setting based on noise threshold",
+        min=0,
+        max=4096,
+        label="Min Samples",
+        section=SAMPLING_RENDER,
+    ),
+    Param(
+        "time_limit",
+        "FLOAT",
+        0.0,
+        "Limit the render time (excluding synchronization time). Zero disables the limit",
+        min=0.0,
+        step=100,
+        subtype="TIME_ABSOLUTE",
+        label="Time Limit",
+        section=SAMPLING_RENDER,
     ),
     Param(
         "filter_size",

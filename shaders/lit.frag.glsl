@@ -381,4 +381,7 @@ void main()
   out_emission = vec4(emission, 1.0); /* the Emission pass: what the surface emits */
 #  endif
 #endif
+#if COUNT_SHADED
+  out_shaded = 1.0; /* this pixel was shaded in this sample (programs.LIT_COLOR_COUNTED) */
+#endif
 }

@@ -25,9 +25,20 @@ class PenumbraPanel:
 
 def draw_params(layout, group, params, section=None):
     """One row per declared ``Param`` of ``section`` (all when None), in declaration order,
-    greyed out where the declaration says the current values make it irrelevant."""
-    for p in params:
-        if section is not None and p.section != section:
+    greyed out where the declaration says the current values make it irrelevant. A row with a
+    ``switch`` carries that BOOL setting as its checkbox, as Cycles draws Noise Threshold."""
+    shown = [p for p in params if section is None or p.section == section]
+    switches = {p.switch for p in shown if p.switch}
+    for p in shown:
+        if p.name in switches:
+            continue
+        if p.switch:
+            col = layout.column(heading=p.ui_label, align=True)
+            row = col.row(align=True)
+            row.prop(group, p.switch, text="")
+            sub = row.row()
+            sub.active = bool(getattr(group, p.switch)) and p.is_active(group, params)
+            sub.prop(group, p.name, text="")
             continue
         row = layout.row()
         row.active = p.is_active(group, params)
@@ -48,6 +59,18 @@ class _SettingsPanel(PenumbraPanel):
 class PENUMBRA_PT_sampling(_SettingsPanel, bpy.types.Panel):
     bl_label = "Sampling"
     section = settings.SAMPLING
+
+
+class PENUMBRA_PT_sampling_viewport(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Viewport"
+    bl_parent_id = "PENUMBRA_PT_sampling"
+    section = settings.SAMPLING_VIEWPORT
+
+
+class PENUMBRA_PT_sampling_render(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Render"
+    bl_parent_id = "PENUMBRA_PT_sampling"
+    section = settings.SAMPLING_RENDER
 
 
 class PENUMBRA_PT_shadows(_SettingsPanel, bpy.types.Panel):
@@ -212,6 +235,8 @@ class PENUMBRA_PT_render_layers(PenumbraPanel, bpy.types.Panel):
 classes = (
     PENUMBRA_PT_material,
     PENUMBRA_PT_sampling,
+    PENUMBRA_PT_sampling_viewport,
+    PENUMBRA_PT_sampling_render,
     PENUMBRA_PT_film,
     PENUMBRA_PT_passes,
     PENUMBRA_PT_shadows,

@@ -9,7 +9,18 @@ import numpy as np
 
 from ..gpu_pool import new_texture
 from ..post.base import PostContext
-from .programs import SCALED_COPY, SCALED_COPY_SHADOW
+from .programs import (
+    CONVERGED_DEPTH,
+    CONVERGENCE,
+    MASKED_COPY,
+    MASKED_COPY_SHADOW_WEIGHT,
+    MASKED_COPY_WEIGHT,
+    SCALED_COPY,
+    SCALED_COPY_SHADOW,
+    WEIGHTED_RESOLVE,
+    WEIGHTED_RESOLVE_SHADOW,
+)
+from .sampling import THRESHOLD_SCALE
 
 
 @dataclass
@@ -68,7 +79,14 @@ class Film:
     (colour and z-buffer), ``fb`` (with the depth, shadow and normal passes) or ``fb_emit``
     (with Emission too); a multi-sample frame adds each sample into the accumulation targets
     (``accumulate``) and ``resolve`` writes their filtered average back into ``color`` (and
-    ``shadow``), which the post stack and the passes then read as a single sample's."""
+    ``shadow``), which the post stack and the passes then read as a single sample's.
+
+    Adaptive sampling (``begin(..., adaptive=True)``): every other sample is also added, twice
+    over, to a second accumulation; ``check`` compares the two per pixel on the GPU and marks
+    converged pixels in a mask (``mask``). Once a pixel converged, later samples add nothing to
+    it (``accumulate`` writes through the mask, with each pixel's own weight in a weight
+    target), the lit pass does not shade it (``mask_depth``) and ``resolve`` divides by each
+    pixel's weight. Until then every step is the plain accumulation's, to the bit."""
 
     def __init__(self, shaders, pool=None):
         self.shaders = shaders
@@ -82,6 +100,19 @@ class Film:
         self._emission_targets = None  # (accumulation, its framebuffer, the resolve's framebuffer)
         self._weight_sum = 0.0
         self._fullscreen_batch = None
+        # Adaptive sampling: the every-other-sample accumulation, the converged masks (read
+        # one, write the other), each pixel's weight once some pixel converged.
+        self.tracking = False
+        self.converged = 0  # pixels converged (no more samples)
+        self._half = self._half_fb = None
+        self._masks = self._mask_fbs = None
+        self._mask_index = 0
+        self._weight = None
+        self._masked_fbs = {}
+        # The shading count of tests (``count_shaded``): the lit pass writes 1 into ``shaded``
+        # for every pixel it shades; ``shaded_total`` adds them over the frame's samples.
+        self.count_shaded = False
+        self.shaded = self.fb_counted = self.shaded_total = self._shaded_total_fb = None
 
     # --- targets --------------------------------------------------------------------------
 
@@ -106,6 +137,12 @@ class Film:
             self.fb = gpu.types.GPUFrameBuffer(
                 depth_slot=self.zbuffer, color_slots=(self.color, self.depth, self.shadow, self.normal)
             )
+        if self.count_shaded and self.fb_counted is None:
+            self.shaded = new_texture(self.pool, (width, height), "R32F")
+            self.fb_counted = gpu.types.GPUFrameBuffer(depth_slot=self.zbuffer, color_slots=(self.color, self.shaded))
+            self.shaded_total = new_texture(self.pool, (width, height), "R32F")
+            self.shaded_total.clear(format="FLOAT", value=(0.0,))
+            self._shaded_total_fb = gpu.types.GPUFrameBuffer(color_slots=(self.shaded_total,))
         if emission and self.fb_emit is None:
             self.emission = new_texture(self.pool, (width, height), "RGBA32F")
             self.fb_emit = gpu.types.GPUFrameBuffer(
@@ -124,22 +161,31 @@ class Film:
             self.normal.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
         if emission:
             self.emission.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+        if self.shaded is not None:
+            self.shaded.clear(format="FLOAT", value=(0.0,))
 
     def target_bytes(self, aux, accumulate):
         """Bytes per pixel of the frame's targets: colour, z-buffer, and with ``aux`` depth,
-        shadow and normal; accumulation adds colour (and shadow)."""
+        shadow and normal; accumulation adds colour (and shadow); adaptive sampling its second
+        accumulation, two masks and, once some pixel converged, the weights."""
         per_pixel = 16 + 4 + (4 + 4 + 8 if aux else 0)
         if accumulate:
             per_pixel += 16 + (4 if aux else 0)
+            if self.tracking:
+                per_pixel += 16 + 4 + 4 + (4 if self._weight is not None else 0)
         return per_pixel * self.size[0] * self.size[1]
 
     # --- samples --------------------------------------------------------------------------
 
-    def begin(self, aux, emission, fresh):
+    def begin(self, aux, emission, fresh, adaptive=False):
         """Before a multi-sample frame's samples: the accumulation targets, cleared when the
-        frame starts afresh (``fresh``)."""
+        frame starts afresh (``fresh``); ``adaptive``: the frame estimates each pixel's error
+        (from a fresh start on)."""
         self._ensure_accumulation(aux)
         if fresh:
+            self._begin_adaptive(adaptive)
+            if self.shaded_total is not None:
+                self.shaded_total.clear(format="FLOAT", value=(0.0,))
             self._accum_color.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
             if self._accum_shadow is not None:
                 self._accum_shadow.clear(format="FLOAT", value=(0.0,))
@@ -147,13 +193,38 @@ class Film:
                 self._emission_accumulation().clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
             self._weight_sum = 0.0
 
-    def accumulate(self, weight, aux, emission):
-        """accumulation += weight * this sample (colour, shadow with ``aux``, and Emission)."""
-        self._scaled_copy(self._accum_fb, (self.color, self.shadow), weight, aux, blend="ADDITIVE_PREMULT")
+    def accumulate(self, weight, aux, emission, sample=0):
+        """accumulation += weight * this sample (colour, shadow with ``aux``, and Emission),
+        in the pixels that have not converged; ``sample``: its index (adaptive sampling adds
+        the odd ones to its second accumulation)."""
+        mask = self.mask
+        if mask is None:
+            self._scaled_copy(self._accum_fb, (self.color, self.shadow), weight, aux, blend="ADDITIVE_PREMULT")
+        else:
+            with_shadow = aux and self._accum_shadow is not None
+            samplers = {"src_color": self.color, "converged": mask}
+            if with_shadow:
+                samplers["src_shadow"] = self.shadow
+            program = MASKED_COPY_SHADOW_WEIGHT if with_shadow else MASKED_COPY_WEIGHT
+            self.fullscreen(program, self._masked_fb(with_shadow), samplers, {"scale": weight}, "ADDITIVE_PREMULT")
         if emission:
             _accum, accum_fb, _resolve_fb = self._emission_targets
-            self.fullscreen(SCALED_COPY, accum_fb, {"src_color": self.emission}, {"scale": weight}, "ADDITIVE_PREMULT")
+            self._copy(accum_fb, self.emission, weight, mask)
+        if self.tracking and sample % 2 == 1:
+            self._copy(self._half_fb, self.color, 2.0 * weight, mask)
+        if self._shaded_total_fb is not None:
+            self.fullscreen(
+                SCALED_COPY, self._shaded_total_fb, {"src_color": self.shaded}, {"scale": 1.0}, "ADDITIVE_PREMULT"
+            )
         self._weight_sum += weight
+
+    def _copy(self, framebuffer, source, scale, mask):
+        """framebuffer += scale * source, where not converged (``mask``, when some pixel is)."""
+        if mask is None:
+            self.fullscreen(SCALED_COPY, framebuffer, {"src_color": source}, {"scale": scale}, "ADDITIVE_PREMULT")
+        else:
+            samplers = {"src_color": source, "converged": mask}
+            self.fullscreen(MASKED_COPY, framebuffer, samplers, {"scale": scale}, "ADDITIVE_PREMULT")
 
     def keep_centre(self):
         """Keep the centred sample's depth and normal (a multi-sample frame's Depth and Normal
@@ -169,11 +240,127 @@ class Film:
         if self._resolve_fb is None or self._resolve_fb[0] != (self.size, with_shadow):
             slots = (self.color, self.shadow) if with_shadow else (self.color,)
             self._resolve_fb = ((self.size, with_shadow), gpu.types.GPUFrameBuffer(color_slots=slots))
+        if self._weight is not None:  # pixels hold different numbers of samples
+            samplers = {"src_color": self._accum_color, "weight": self._weight}
+            if with_shadow:
+                samplers["src_shadow"] = self._accum_shadow
+            program = WEIGHTED_RESOLVE_SHADOW if with_shadow else WEIGHTED_RESOLVE
+            self.fullscreen(program, self._resolve_fb[1], samplers, {})
+            if emission:
+                accum, _accum_fb, resolve_fb = self._emission_targets
+                self.fullscreen(WEIGHTED_RESOLVE, resolve_fb, {"src_color": accum, "weight": self._weight}, {})
+            return
         inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
         self._scaled_copy(self._resolve_fb[1], (self._accum_color, self._accum_shadow), inverse, aux)
         if emission:
             accum, _accum_fb, resolve_fb = self._emission_targets
             self.fullscreen(SCALED_COPY, resolve_fb, {"src_color": accum}, {"scale": inverse})
+
+    # --- adaptive sampling ----------------------------------------------------------------
+
+    @property
+    def mask(self):
+        """The converged mask (R32F, 1 where a pixel converged), or None while no pixel has."""
+        return self._masks[self._mask_index] if self.converged and self._masks is not None else None
+
+    def _begin_adaptive(self, adaptive):
+        """A fresh frame: no pixel converged; with ``adaptive`` the second accumulation and
+        the masks exist (at this size) and are cleared."""
+        import gpu
+
+        self.tracking = bool(adaptive)
+        self.converged = 0
+        self._give([self._weight])
+        self._weight = None
+        self._masked_fbs = {}
+        if not self.tracking:
+            return
+        size = self.size
+        if self._half is None or (self._half.width, self._half.height) != size:
+            self._give([self._half, *(self._masks or ())])
+            self._half = new_texture(self.pool, size, "RGBA32F")
+            self._half_fb = gpu.types.GPUFrameBuffer(color_slots=(self._half,))
+            self._masks = [new_texture(self.pool, size, "R32F") for _ in range(2)]
+            self._mask_fbs = [gpu.types.GPUFrameBuffer(color_slots=(m,)) for m in self._masks]
+        self._half.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+        for m in self._masks:
+            m.clear(format="FLOAT", value=(0.0,))
+        self._mask_index = 0
+
+    def check(self, threshold):
+        """The convergence check after an even number of samples: a pixel converges when the
+        error estimate of its 3x3 neighbourhood is below ``threshold`` (Cycles' Noise
+        Threshold); once converged it stays so. Returns the number of converged pixels."""
+
+        src, dst = self._mask_index, 1 - self._mask_index
+        samplers = {
+            "accum": self._accum_color,
+            "half_accum": self._half,
+            "converged": self._masks[src],
+            "weight": self._weight if self._weight is not None else self._masks[src],
+        }
+        uniforms = {
+            "threshold": float(threshold) * THRESHOLD_SCALE,
+            "weight_sum": float(self._weight_sum),
+            "per_pixel": 1.0 if self._weight is not None else 0.0,
+        }
+        self.fullscreen(CONVERGENCE, self._mask_fbs[dst], samplers, uniforms)
+        self._mask_index = dst
+        count = int(np.count_nonzero(texture_array(self._masks[dst], 1) > 0.5))
+        if count and self._weight is None:
+            # From now on pixels hold different numbers of samples; so far each has them all.
+            self._weight = new_texture(self.pool, self.size, "R32F")
+            self._weight.clear(format="FLOAT", value=(float(self._weight_sum),))
+            self._masked_fbs = {}
+        self.converged = count
+        return count
+
+    def finish(self):
+        """Wait until the GPU has drawn everything asked so far (one pixel read back)."""
+        with self._accum_fb.bind():
+            self._accum_fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+
+    def weights_array(self):
+        """Each pixel's weight (its samples' total), (height, width)."""
+        if self._weight is None:
+            return np.full(self.size[::-1], self._weight_sum, np.float32)
+        return texture_array(self._weight, 1)[..., 0]
+
+    def _masked_fb(self, with_shadow):
+        """The framebuffer a masked sample is added through: accumulation (colour, shadow) and
+        the weights."""
+        import gpu
+
+        fb = self._masked_fbs.get(with_shadow)
+        if fb is None:
+            slots = (
+                (self._accum_color, self._accum_shadow, self._weight)
+                if with_shadow
+                else (self._accum_color, self._weight)
+            )
+            fb = self._masked_fbs[with_shadow] = gpu.types.GPUFrameBuffer(color_slots=slots)
+        return fb
+
+    def mask_depth(self, framebuffer):
+        """Clear ``framebuffer``'s z-buffer and write the nearest depth where a pixel
+        converged, so the lit pass's surfaces fail the depth test there (no shading)."""
+        import gpu
+
+        width, height = self.size
+        shader = self.shaders.get(CONVERGED_DEPTH)
+        self._batch(shader)
+        with framebuffer.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            framebuffer.clear(depth=1.0)
+            gpu.state.depth_test_set("ALWAYS")
+            gpu.state.depth_mask_set(True)
+            gpu.state.color_mask_set(False, False, False, False)
+            shader.bind()
+            shader.uniform_sampler("converged", self.mask)
+            self._fullscreen_batch.draw(shader)
+            gpu.state.color_mask_set(True, True, True, True)
+            gpu.state.depth_mask_set(False)
+            gpu.state.depth_test_set("NONE")
 
     def _ensure_accumulation(self, aux):
         """The float32 accumulation targets of a multi-sample frame (colour, and shadow for a
@@ -216,18 +403,26 @@ class Film:
         program = SCALED_COPY_SHADOW if with_shadow else SCALED_COPY
         self.fullscreen(program, framebuffer, samplers, {"scale": scale}, blend)
 
-    def fullscreen(self, program, framebuffer, samplers, uniforms, blend="NONE"):
-        """One full-frame triangle of ``program`` into ``framebuffer``."""
-        import gpu
+    def _batch(self, shader):
         from gpu_extras.batch import batch_for_shader
 
-        shader = self.shaders.get(program)
         if self._fullscreen_batch is None:
             self._fullscreen_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
+        return self._fullscreen_batch
+
+    def fullscreen(self, program, framebuffer, samplers, uniforms, blend="NONE", depth_test="NONE"):
+        """One full-frame triangle of ``program`` into ``framebuffer`` (at depth 0.5 when
+        ``depth_test`` tests it against the framebuffer's z-buffer, which it does not write)."""
+        import gpu
+
+        shader = self.shaders.get(program)
+        self._batch(shader)
         width, height = self.size
         with framebuffer.bind():
             gpu.state.viewport_set(0, 0, width, height)
-            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_test_set(depth_test)
+            if depth_test != "NONE":
+                gpu.state.depth_mask_set(False)
             gpu.state.blend_set(blend)
             shader.bind()
             for name, tex in samplers.items():
@@ -238,6 +433,7 @@ class Film:
                 shader.uniform_float(name, value)
             self._fullscreen_batch.draw(shader)
             gpu.state.blend_set("NONE")
+            gpu.state.depth_test_set("NONE")
 
     # --- resources ------------------------------------------------------------------------
 
@@ -261,9 +457,18 @@ class Film:
                 self._accum_color,
                 self._accum_shadow,
                 accum,
+                self._half,
+                *(self._masks or ()),
+                self._weight,
+                self.shaded,
+                self.shaded_total,
             ]
         )
         self.fb = self.fb_color = self.fb_emit = self._accum_fb = self._resolve_fb = None
+        self._half = self._half_fb = self._masks = self._mask_fbs = self._weight = None
+        self._masked_fbs = {}
+        self.tracking, self.converged = False, 0
+        self.shaded = self.fb_counted = self.shaded_total = self._shaded_total_fb = None
         self._emission_targets = None
         self.color = self.zbuffer = self.depth = self.shadow = self.normal = self.emission = None
         self._accum_color = self._accum_shadow = None

@@ -38,9 +38,16 @@ class LitPass:
         # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
         bg = (0.0, 0.0, 0.0, 0.0) if settings.film_transparent else (*map(float, world_color[:3]), 1.0)
         emission = aux and emission
+        counted = film.fb_counted is not None and not aux  # the shading count of tests
+        fb = film.fb_emit if emission else (film.fb if aux else (film.fb_counted if counted else film.fb_color))
         film.clear(bg, aux, emission)
+        # Adaptive sampling: where a pixel converged the nearest depth goes first, so nothing
+        # (surface or world) is drawn there; the pixel is not shaded again.
+        converged = film.mask is not None
+        if converged:
+            film.mask_depth(fb)
         if world_data is not None and world_data.image is not None and not settings.film_transparent:
-            self._background(film, world_data, camera, origin)
+            self._background(film, world_data, camera, origin, "LESS_EQUAL" if converged else "NONE")
         # Closed instances wholly beyond the near plane: from there no back face shows.
         outside = set()
         closed = [d for d in draws if d.closed]
@@ -67,10 +74,12 @@ class LitPass:
         opaque.sort(key=lambda e: (sorted(e[0]), e[1]))
         blended.sort(key=lambda e: -e[1])
         width, height = film.size
-        bound = {"shader": None}
+        bound = {"shader": None, "counted": counted}
 
         def bind(features, with_aux):
-            program = lit_program(frozenset(features), with_aux, emission and with_aux)
+            program = lit_program(
+                frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux
+            )
             shader = self.shaders.get(program, data.defines)
             if bound["shader"] is shader:
                 return shader
@@ -109,15 +118,16 @@ class LitPass:
                 batch.draw(shader)
                 stats.draws += 1
 
-        fb = film.fb_emit if emission else (film.fb if aux else film.fb_color)
         with fb.bind():
             gpu.state.viewport_set(0, 0, width, height)
-            fb.clear(depth=1.0)
+            if not converged:
+                fb.clear(depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
             gpu.state.depth_mask_set(True)
             draw(opaque, aux)
         if blended:
             bound["shader"] = None
+            bound["counted"] = False  # blended surfaces draw into the colour target alone
             with film.fb_color.bind():
                 gpu.state.viewport_set(0, 0, width, height)
                 gpu.state.depth_test_set("LESS_EQUAL")
@@ -131,7 +141,7 @@ class LitPass:
         gpu.state.depth_mask_set(False)
         stats.passes += 1
 
-    def _background(self, film, world, camera, origin):
+    def _background(self, film, world, camera, origin, depth_test="NONE"):
         """The world's Environment Texture behind the scene (``programs.BACKGROUND``)."""
         from mathutils import Matrix
 
@@ -152,6 +162,7 @@ class LitPass:
                 "viewport_size": (float(width), float(height)),
                 "strength": float(world.strength),
             },
+            depth_test=depth_test,
         )
 
     def _ubo(self, name, data):

@@ -194,6 +194,7 @@ LIT = Program(
             "LIGHT_WORDS": LIGHT_WORDS,
             **material_defines(frozenset()),
             "EMISSION_OUTPUT": False,
+            "COUNT_SHADED": False,
         }.items()
     ),
 )
@@ -275,10 +276,21 @@ LIT_EMIT = replace(
 )
 
 
-def lit_program(features=frozenset(), aux=True, emission=False):
+# The viewport's lit pass that also writes 1 into a second target for every pixel it shades
+# (a fragment that passed the depth test): the shading count adaptive sampling is tested by.
+LIT_COLOR_COUNTED = replace(
+    LIT_COLOR,
+    name="lit_color_counted",
+    outputs=LIT_COLOR.outputs + (("FLOAT", "out_shaded"),),
+    defines=LIT.defines + (("COUNT_SHADED", True),),
+)
+
+
+def lit_program(features=frozenset(), aux=True, emission=False, counted=False):
     """The lit pass program of a material variant (``Material.features``, plus "HOLDOUT");
-    ``emission``: the variant also writes the Emission pass's target."""
-    base = LIT_EMIT if emission else (LIT if aux else LIT_COLOR)
+    ``emission``: the variant also writes the Emission pass's target; ``counted`` (colour
+    only): it also writes the shading count (``LIT_COLOR_COUNTED``)."""
+    base = LIT_EMIT if emission else (LIT if aux else (LIT_COLOR_COUNTED if counted else LIT_COLOR))
     if not features:
         return base
     return _with_features(base, features, f"{base.name}_{'_'.join(sorted(features)).lower()}")
@@ -333,6 +345,75 @@ SCALED_COPY_SHADOW = replace(
     samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "src_shadow")),
     outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
     defines=(("WITH_SHADOW", True),),
+)
+
+
+# Adaptive sampling (``film.Film``): a sample added only where the pixel has not converged
+# (``converged`` > 0.5: nothing written), with the pixel's own weight in a further target;
+# the accumulation resolved by each pixel's weight; the convergence check; and the nearest
+# depth written where a pixel converged, so the lit pass does not shade it.
+MASKED_COPY = Program(
+    name="masked_copy",
+    vertex="fullscreen.vert.glsl",
+    fragment="masked_copy.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "scale"),),
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "converged")),
+    outputs=(("VEC4", "out_color"),),
+    defines=(("WITH_SHADOW", False), ("WITH_WEIGHT", False)),
+)
+MASKED_COPY_WEIGHT = replace(
+    MASKED_COPY,
+    name="masked_copy_weight",
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_weight")),
+    defines=(("WITH_SHADOW", False), ("WITH_WEIGHT", True)),
+)
+MASKED_COPY_SHADOW_WEIGHT = replace(
+    MASKED_COPY,
+    name="masked_copy_shadow_weight",
+    samplers=MASKED_COPY.samplers + (("FLOAT_2D", "src_shadow"),),
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow"), ("VEC4", "out_weight")),
+    defines=(("WITH_SHADOW", True), ("WITH_WEIGHT", True)),
+)
+WEIGHTED_RESOLVE = Program(
+    name="weighted_resolve",
+    vertex="fullscreen.vert.glsl",
+    fragment="weighted_resolve.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "weight")),
+    outputs=(("VEC4", "out_color"),),
+    defines=(("WITH_SHADOW", False),),
+)
+WEIGHTED_RESOLVE_SHADOW = replace(
+    WEIGHTED_RESOLVE,
+    name="weighted_resolve_shadow",
+    samplers=WEIGHTED_RESOLVE.samplers + (("FLOAT_2D", "src_shadow"),),
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
+    defines=(("WITH_SHADOW", True),),
+)
+CONVERGENCE = Program(
+    name="convergence",
+    vertex="fullscreen.vert.glsl",
+    fragment="convergence.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    # per_pixel > 0.5: pixels hold their own weights (``weight``), else all ``weight_sum``.
+    push_constants=(("FLOAT", "threshold"), ("FLOAT", "weight_sum"), ("FLOAT", "per_pixel")),
+    samplers=(
+        ("FLOAT_2D", "accum"),
+        ("FLOAT_2D", "half_accum"),
+        ("FLOAT_2D", "converged"),
+        ("FLOAT_2D", "weight"),
+    ),
+    outputs=(("VEC4", "out_color"),),
+)
+CONVERGED_DEPTH = Program(
+    name="converged_depth",
+    vertex="fullscreen.vert.glsl",
+    fragment="converged_depth.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    samplers=(("FLOAT_2D", "converged"),),
+    outputs=(("VEC4", "out_color"),),
+    depth_write="ANY",
 )
 
 

@@ -8,6 +8,7 @@ GPU batches (``draw_list``, ``batches``), the shadow pass (``shadow_pass``), the
 """
 
 import dataclasses
+import time
 
 import numpy as np
 
@@ -64,6 +65,8 @@ class Renderer:
         sample_count=1,
         on_sample=None,
         emission=False,
+        adaptive=None,
+        deadline=None,
     ):
         """Samples ``samples[0] .. samples[1] - 1`` of a frame of ``sample_count`` samples
         (``frame/sampling.py``), added to the samples this renderer already accumulated for
@@ -72,7 +75,13 @@ class Renderer:
         ``aux``: also write the depth, shadow and normal targets (a final render's passes;
         depth and normal are the centred sample's, shadow is averaged like colour).
         ``on_sample(done)`` after each sample; returning False stops the frame there (cancel).
-        ``emission`` (with ``aux``): also write the Emission pass's target, averaged like colour."""
+        ``emission`` (with ``aux``): also write the Emission pass's target, averaged like colour.
+        ``adaptive`` (``sampling.Adaptive``): what may end the frame early. Its Noise
+        Threshold stops converged pixels (checked every few samples on the GPU; they are not
+        shaded again) and ends the frame when every pixel has converged; its time limit ends
+        it after the first sample that reaches it, counted from the first sample of this call
+        unless ``deadline`` (a ``time.monotonic()`` value) says when. Neither looks at a clock
+        when there is no time limit: a frame stays a function of the scene and its settings."""
         stats = FrameStats()
         compiled_before = self.shaders.compiled
         self.shadow_pass.begin_frame()
@@ -96,34 +105,55 @@ class Renderer:
             )
         start, stop = samples
         accumulate = sample_count > 1
+        adaptive = adaptive if accumulate else None
+        noise = adaptive is not None and adaptive.threshold > 0.0
         if accumulate:
-            film.begin(aux, emission, fresh=start == 0)
+            film.begin(aux, emission, fresh=start == 0, adaptive=noise)
         plan = None
         moving = set()
         if accumulate:
             moving = sampling.sampled_lights(lights, self.shadow_pass.plan(draws, lights, camera, settings, film.size))
         stats.lights_sampled = len(moving)
+        if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
+            deadline = time.monotonic() + adaptive.time_limit
+        pixels = width * height
         for s in range(start, stop):
+            if accumulate and film.converged >= pixels:
+                stats.stopped = "converged"  # (a later call of a frame that has converged)
+                break
             dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
             view_camera = camera
             if dx or dy:
                 jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
                 view_camera = dataclasses.replace(camera, projection=jittered)
             sample_lights = [
-                sampling.light_at_sample(lt, i, s, sample_count) if i in moving else lt for i, lt in enumerate(lights)
+                sampling.light_at_sample(lt, i, s, sample_count, noise) if i in moving else lt
+                for i, lt in enumerate(lights)
             ]
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
             plan = self._sample(
                 draws, sample_lights, camera, view_camera, snapshot, settings, aux, emission, stats, alpha_offset
             )
             if accumulate:
-                film.accumulate(weight, aux, emission)
+                stats.pixel_samples_skipped += film.converged
+                film.accumulate(weight, aux, emission, s)
             if aux and accumulate and s == 0:  # the centred sample's depth and normal
                 film.keep_centre()
             stats.samples += 1
+            # (No check after a frame's last sample: it ends there anyway.)
+            last = s + 1 == sample_count
+            if noise and not last and adaptive.checks_at(s + 1) and film.check(adaptive.threshold) >= pixels:
+                stats.stopped = "converged"
+            if deadline is not None and accumulate and not stats.stopped:
+                film.finish()  # the sample's GPU work done, so the clock counts it
+                if time.monotonic() >= deadline:
+                    stats.stopped = "time limit"
             if on_sample is not None and on_sample(s + 1) is False:
                 stats.cancelled = True
                 break
+            if stats.stopped:
+                break
+        stats.pixels_converged = film.converged if accumulate else 0
         if accumulate and stats.samples:
             film.resolve(aux, emission)
         self.batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()})

@@ -112,6 +112,38 @@ def _light_point(s, light_index, dims, count):
     return [(c + rotation[d]) % 1.0 for d, c in enumerate(coords)]
 
 
+def sobol_2(index):
+    """The second dimension of the Sobol' sequence (its generator matrix is Pascal's mod 2),
+    as 32 bits: with the van der Corput sequence it forms a (0, 2)-sequence in base 2."""
+    v, result, i = 1 << 31, 0, int(index)
+    while i:
+        if i & 1:
+            result ^= v
+        i >>= 1
+        v ^= v >> 1
+    return result
+
+
+@functools.lru_cache(maxsize=256)
+def _progressive_scramble(light_index):
+    """Per light: XOR masks of the first two coordinates' 32 bits and a rotation of the third."""
+    rng = np.random.default_rng(0x5851F42D + 104729 * light_index)
+    return int(rng.integers(0, 1 << 32)), int(rng.integers(0, 1 << 32)), float(rng.random())
+
+
+def _light_point_progressive(s, light_index, dims):
+    """Sample ``s``'s point in [0, 1)^dims for light ``light_index`` when a frame may stop any
+    pixel after any multiple of 4 samples (adaptive sampling): the (0, 2)-sequence (van der
+    Corput, Sobol' 2) digitally shifted per light, whose first 2^k points are stratified for
+    every k, so a pixel stopped early has sampled the whole light evenly; a third coordinate
+    from the radical inverse in base 3, rotated per light."""
+    x_mask, y_mask, rotation = _progressive_scramble(light_index)
+    x = int(radical_inverse(s, 2) * (1 << 32)) ^ x_mask
+    y = sobol_2(s) ^ y_mask
+    coords = [x / 2.0**32, y / 2.0**32, (radical_inverse(s, 3) + rotation) % 1.0]
+    return coords[:dims]
+
+
 def concentric_disk(u, v):
     """Shirley-Chiu map of [0, 1)^2 to the unit disk (area-preserving, low distortion)."""
     a, b = 2.0 * u - 1.0, 2.0 * v - 1.0
@@ -175,16 +207,29 @@ def sampled_lights(lights, plan):
     return out
 
 
-def light_at_sample(light, light_index, s, count):
+def light_at_sample(light, light_index, s, count, progressive=False):
     """``light`` as it shines in sample ``s`` of ``count``: moved to a point of itself (a
     direction inside its cone for a sun), with PCSS's light size scaled by 1/sqrt(count).
-    Lights without size, and every light in a frame of one sample, keep the light's centre."""
+    Lights without size, and every light in a frame of one sample, keep the light's centre.
+    ``progressive``: pixels may stop early (adaptive sampling), so the points come from a
+    sequence whose every power-of-two prefix is stratified (``_light_point_progressive``)
+    rather than from the shuffled set of ``count``, which only the whole set stratifies."""
     if count <= 1 or not has_size(light):
         return light
+    if progressive:
+
+        def point(dims):
+            return _light_point_progressive(s, light_index, dims)
+
+    else:
+
+        def point(dims):
+            return _light_point(s, light_index, dims, count)
+
     scale = 1.0 / math.sqrt(count)
     m = np.array(light.matrix, dtype=np.float64)
     if light.type == "SUN":
-        x, y = concentric_disk(*_light_point(s, light_index, 2, count))
+        x, y = concentric_disk(*point(2))
         d = light.direction
         u, v = _basis(d)
         tan_half = math.tan(0.5 * min(light.angle, math.pi * 0.99))
@@ -198,7 +243,7 @@ def light_at_sample(light, light_index, s, count):
         xa /= np.linalg.norm(xa)
         m[:3, 0], m[:3, 1], m[:3, 2] = xa, np.cross(z, xa), z
     elif light.type == "AREA":
-        u, v = _light_point(s, light_index, 2, count)
+        u, v = point(2)
         if light.shape in ("DISK", "ELLIPSE"):
             x, y = concentric_disk(u, v)
             x, y = 0.5 * x, 0.5 * y
@@ -207,14 +252,60 @@ def light_at_sample(light, light_index, s, count):
         local = np.array([x * light.size_x, y * light.size_y, 0.0, 1.0])
         m[:3, 3] = (m @ local)[:3]  # the light's own axes carry its object scale
     elif light.type == "SPOT":
-        x, y = concentric_disk(*_light_point(s, light_index, 2, count))
+        x, y = concentric_disk(*point(2))
         u, v = _basis(light.direction)
         m[:3, 3] = m[:3, 3] + light.radius * (x * u + y * v)
     else:  # POINT: uniform in the ball, which looks the same from every direction
-        u, v, w = _light_point(s, light_index, 3, count)
+        u, v, w = point(3)
         z = 1.0 - 2.0 * u
         r_xy = math.sqrt(max(0.0, 1.0 - z * z))
         phi = 2.0 * math.pi * v
         direction = np.array([r_xy * math.cos(phi), r_xy * math.sin(phi), z])
         m[:3, 3] = m[:3, 3] + light.radius * w ** (1.0 / 3.0) * direction
     return dataclasses.replace(light, matrix=m, penumbra_scale=scale, sampled=True)
+
+
+# --- adaptive sampling ------------------------------------------------------------------------
+
+ADAPTIVE_STEP = 4  # samples between two convergence checks (Cycles' adaptive step)
+THRESHOLD_SCALE = 5.0  # Cycles scales the Noise Threshold by 5 before comparing the error with it
+
+
+def auto_min_samples(threshold):
+    """Cycles' automatic Min Samples of a Noise Threshold: 0.1 -> 32, 0.01 -> 64, 0.001 -> 128."""
+    return max(ADAPTIVE_STEP, math.ceil(16.0 / threshold**0.3))
+
+
+@dataclasses.dataclass(frozen=True)
+class Adaptive:
+    """What may end a frame's sampling before its last sample. ``threshold``: Cycles' Noise
+    Threshold (0: every pixel takes every sample); a pixel whose error estimate (and its
+    neighbours') is below it after ``min_samples`` takes no more samples, checked every
+    ``step`` samples. ``time_limit``: seconds the samples may take (0: none)."""
+
+    threshold: float = 0.0
+    min_samples: int = ADAPTIVE_STEP
+    time_limit: float = 0.0
+    step: int = ADAPTIVE_STEP
+
+    def checks_at(self, done):
+        """Whether the convergence check runs after ``done`` samples (an even count, so half of
+        them are the "every other sample" the estimate compares with)."""
+        return self.threshold > 0.0 and done >= self.min_samples and done % self.step == 0
+
+
+def adaptive_settings(use, threshold, min_samples, time_limit, sample_count):
+    """The ``Adaptive`` of a frame of ``sample_count`` samples (0: without end) from its
+    settings, or None when nothing can end it early: adaptive sampling off, a threshold of 0,
+    or a first check that would come after the last sample; and no time limit."""
+    threshold = float(threshold) if use else 0.0
+    if threshold > 0.0:
+        first = max(ADAPTIVE_STEP, int(min_samples)) if min_samples > 0 else auto_min_samples(threshold)
+        first = -(-first // ADAPTIVE_STEP) * ADAPTIVE_STEP  # checks fall on multiples of the step
+        if 0 < sample_count <= first:
+            threshold = 0.0  # the last sample comes before any check: the frame is the plain one
+    else:
+        first = ADAPTIVE_STEP
+    if threshold <= 0.0 and time_limit <= 0.0:
+        return None
+    return Adaptive(threshold=threshold, min_samples=first if threshold > 0.0 else 0, time_limit=float(time_limit))

@@ -23,6 +23,9 @@ class FrameStats:
     samples: int = 0  # samples rendered by this call
     lights_sampled: int = 0  # lights that moved between samples (the others kept one map)
     cancelled: bool = False  # on_sample asked to stop before the last sample
+    stopped: str = ""  # why the frame ended before its last sample: "converged" or "time limit"
+    pixels_converged: int = 0  # pixels adaptive sampling stopped (Noise Threshold)
+    pixel_samples_skipped: int = 0  # of the samples taken, those converged pixels were not shaded in (summed)
     lights_out_of_view: int = 0  # lights that reach no visible surface: no map, no shading
     closed_culled: int = 0  # closed instances drawn without back faces (lit pass and each map)
     simplified: int = 0  # instances drawn at a level of detail (``simplify``; ``triangles`` counts its)

@@ -404,3 +404,27 @@ def test_pooled_textures_are_freed_before_blender_exits():
     pooled = int(next(ln for ln in proc.stdout.splitlines() if ln.startswith("POOLED ")).split()[1])
     assert pooled >= 3
     assert "Not freed memory blocks" not in out and "Traceback" not in out, out[-3000:]
+
+
+def test_the_report_says_the_samples_a_frame_stopped_at():
+    """A frame that stops early says so in the render report: every pixel converged (only hard
+    lights, no pixel filter: all samples alike), or its time limit passed."""
+    result, output = run_child(
+        """
+        scene = scenes.empty_scene(24, 24)
+        scene.view_layers[0].name = "ViewLayer"
+        scenes.box_over_plane(scene)
+        scenes.light(scene, "Sun", "SUN", 3.0, rotation=(0.3, 0.2, 0), angle=0.0)
+        scenes.top_camera(scene)
+        p = scene.penumbra
+        p.filter_size, p.render_samples, p.adaptive_min_samples = 0.0, 64, 8
+        bpy.ops.render.render()
+        scene.objects["Sun"].data.angle = 0.2  # soft: pixels keep sampling, until the limit
+        p.use_adaptive_sampling, p.render_samples, p.time_limit = False, 4096, 0.3
+        bpy.ops.render.render()
+        report(done=True)
+        """
+    )
+    assert result["done"]
+    assert "Penumbra: ViewLayer: Sample 8/64 | Noise Threshold reached" in output
+    assert "Time Limit reached" in output and "Sample 4096/4096" not in output

@@ -113,3 +113,36 @@ def test_settings_survive_a_later_layout_and_older_files(tmp_path):
         assert got["blur"] == 9, (name, got)  # renamed effect parameter, value kept
         assert got["added"] == 0.25 and got["filter"] == "PCSS" and got["bias_scale"] == 3.0
         assert got["version"] == 2
+
+
+ADAPTIVE = """
+import json
+import bpy
+from devkit import session
+session.load_penumbra().register()
+NEW = ("use_adaptive_sampling", "adaptive_threshold", "adaptive_min_samples", "time_limit",
+       "use_preview_adaptive_sampling", "preview_adaptive_threshold", "preview_adaptive_min_samples",
+       "preview_time_limit")
+p = bpy.context.scene.penumbra
+p.use_adaptive_sampling, p.adaptive_threshold, p.time_limit = False, 0.5, 9.0
+p.render_samples = 48
+for name in NEW:  # what a file saved before these settings existed holds: nothing
+    p.property_unset(name)
+path = FOLDER + "/before_adaptive.blend"
+bpy.ops.wm.save_as_mainfile(filepath=path)
+bpy.ops.wm.open_mainfile(filepath=path)
+p = bpy.context.scene.penumbra
+print("RESULT " + json.dumps({"values": {n: getattr(p, n) for n in NEW}, "samples": p.render_samples}))
+session.hard_exit(0)
+"""
+
+
+def test_a_file_from_before_adaptive_sampling_loads_with_its_defaults(tmp_path):
+    proc = run(f"FOLDER = {str(tmp_path)!r}\n" + textwrap.dedent(ADAPTIVE))
+    got = json.loads(next(ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT "))[len("RESULT ") :])
+    assert got["samples"] == 48
+    values = got["values"]
+    assert values["use_adaptive_sampling"] is True and values["use_preview_adaptive_sampling"] is True
+    assert abs(values["adaptive_threshold"] - 0.01) < 1e-7 and abs(values["preview_adaptive_threshold"] - 0.1) < 1e-7
+    assert values["adaptive_min_samples"] == values["preview_adaptive_min_samples"] == 0
+    assert values["time_limit"] == values["preview_time_limit"] == 0.0

@@ -112,3 +112,58 @@ def test_only_lights_whose_penumbra_reaches_a_texel_move_between_samples():
     assert sampling.penumbra_texels(spot, persp) == pytest.approx(100.0)
     lights = [tiny_sun, sun, spot, unshadowed_spot, area]
     assert sampling.sampled_lights(lights, plan_for([ortho, ortho, persp, None, None])) == {1, 2, 4}
+
+
+# --- adaptive sampling ------------------------------------------------------------------------
+
+
+def test_automatic_min_samples_follow_cycles():
+    """Cycles: threshold 0.1 -> 32, 0.01 -> 64, 0.001 -> 128 samples before the first check."""
+    assert [sampling.auto_min_samples(t) for t in (0.1, 0.01, 0.001)] == [32, 64, 128]
+
+
+def test_adaptive_settings_off_cases_and_check_schedule():
+    settings = sampling.adaptive_settings
+    assert settings(False, 0.01, 8, 0.0, 64) is None  # off
+    assert settings(True, 0.0, 8, 0.0, 64) is None  # threshold 0: off too
+    assert settings(True, 0.01, 0, 0.0, 64) is None  # automatic 64: no check before the last sample
+    assert settings(True, 0.01, 0, 0.0, 16) is None
+    limited = settings(True, 0.01, 0, 2.5, 16)  # the time limit alone
+    assert limited.threshold == 0.0 and limited.time_limit == 2.5 and not limited.checks_at(8)
+    a = settings(True, 0.01, 6, 0.0, 64)  # checks on multiples of the step from Min Samples on
+    assert a.min_samples == 8 and [n for n in range(1, 21) if a.checks_at(n)] == [8, 12, 16, 20]
+    endless = settings(True, 0.1, 0, 0.0, 0)  # the viewport refining without end
+    assert endless.min_samples == 32
+    assert settings(True, 0.01, 1, 0.0, 64).min_samples == sampling.ADAPTIVE_STEP
+
+
+def test_the_progressive_light_points_are_stratified_at_every_power_of_two():
+    """Adaptive frames may stop a pixel after any multiple of 4 samples: the first 2^k points of
+    a light's progressive sequence fall one in each elementary interval of area 2^-k (every
+    2^a x 2^(k-a) grid), a (0, k, 2)-net, for each light's own digital shift."""
+    for light_index in (0, 5):
+        points = np.array([sampling._light_point_progressive(s, light_index, 2) for s in range(64)])
+        for k in range(1, 7):
+            first = points[: 2**k]
+            for a in range(k + 1):
+                cells = np.floor(first[:, 0] * 2**a) * 2 ** (k - a) + np.floor(first[:, 1] * 2 ** (k - a))
+                assert len(np.unique(cells)) == 2**k, (light_index, k, a)
+    a = [sampling._light_point_progressive(s, 0, 2) for s in range(8)]
+    b = [sampling._light_point_progressive(s, 1, 2) for s in range(8)]
+    assert not np.allclose(a, b)  # lights do not move in step
+
+
+def test_progressive_points_keep_an_area_light_on_its_surface_and_centred_early():
+    """The first 16 of 64 progressive points are stratified along each side, so their mean is
+    within half a stratum (side / 32) of the light's centre; the first 16 of the shuffled set
+    of 64 (which only the whole set stratifies) need not be."""
+    light = _light("AREA", size_x=2.0, size_y=1.0, shape="RECTANGLE")
+    centre = light.position
+
+    def offsets(progressive):
+        return np.array([sampling.light_at_sample(light, 3, s, 64, progressive).position - centre for s in range(16)])
+
+    early = offsets(True)
+    assert np.all(np.abs(early[:, 0]) <= 1.0 + 1e-9) and np.all(np.abs(early[:, 1]) <= 0.5 + 1e-9)
+    assert abs(early[:, 0].mean()) <= 2.0 / 32 and abs(early[:, 1].mean()) <= 1.0 / 32
+    assert np.linalg.norm(early.mean(axis=0)) < np.linalg.norm(offsets(False).mean(axis=0))

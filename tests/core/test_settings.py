@@ -97,7 +97,15 @@ def test_active_when_follows_the_filter_facts():
 
 
 def test_every_scene_setting_is_drawn_by_a_panel_section():
-    sections = {settings.SAMPLING, settings.SHADOWS, settings.LIGHTING, settings.VIEWPORT, settings.SIMPLIFY}
+    sections = {
+        settings.SAMPLING,
+        settings.SAMPLING_VIEWPORT,
+        settings.SAMPLING_RENDER,
+        settings.SHADOWS,
+        settings.LIGHTING,
+        settings.VIEWPORT,
+        settings.SIMPLIFY,
+    }
     assert {p.section for p in settings.SCENE_PARAMS} <= sections
     assert all(p.section is not None for p in settings.SCENE_PARAMS + settings.LIGHT_PARAMS)
     assert {p.section for p in settings.VIEW_LAYER_PARAMS} == {settings.PASSES}

@@ -1,0 +1,18 @@
+/* out = scale * src where the pixel has not converged (adaptive sampling): a sample added to
+ * the accumulation (the blend state adds), to the every-other-sample accumulation the error
+ * estimate compares with, and to each pixel's own weight (programs.MASKED_COPY). A converged
+ * pixel keeps what it has. */
+void main()
+{
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  if (texelFetch(converged, p, 0).r > 0.5) {
+    discard;
+  }
+  out_color = scale * texelFetch(src_color, p, 0);
+#if WITH_SHADOW
+  out_shadow = vec4(scale * texelFetch(src_shadow, p, 0).r);
+#endif
+#if WITH_WEIGHT
+  out_weight = vec4(scale);
+#endif
+}

@@ -1,0 +1,12 @@
+/* The accumulation divided by each pixel's own weight: once adaptive sampling stopped some
+ * pixels, pixels hold different numbers of samples (programs.WEIGHTED_RESOLVE). */
+void main()
+{
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  float w = texelFetch(weight, p, 0).r;
+  float inverse = (w > 0.0) ? 1.0 / w : 0.0;
+  out_color = inverse * texelFetch(src_color, p, 0);
+#if WITH_SHADOW
+  out_shadow = vec4(inverse * texelFetch(src_shadow, p, 0).r);
+#endif
+}
