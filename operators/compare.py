@@ -139,7 +139,7 @@ class PENUMBRA_OT_compare_cycles(bpy.types.Operator):
     bl_label = "Compare with Cycles"
     bl_options = {"REGISTER"}
 
-    samples: IntProperty(name="Samples", description="Samples per pixel of both renders", default=64, min=1)
+    samples: IntProperty(name="Samples", description="Samples per pixel of both renders", default=64, min=1, max=4096)
     mode: EnumProperty(
         name="Cycles",
         items=(
@@ -205,6 +205,9 @@ class PENUMBRA_OT_compare_cycles(bpy.types.Operator):
                     if wm is not None:
                         wm.progress_update(step)
             image, numbers = self._build(images, times)
+        except Exception as exc:  # a failed render or read: a message, settings restored, no image
+            self.report({"ERROR"}, f"Penumbra: Compare with Cycles failed: {exc}")
+            return {"CANCELLED"}
         finally:
             saved.restore()
             bpy.app.handlers.render_cancel.remove(request_cancel)
@@ -318,10 +321,14 @@ class PENUMBRA_OT_compare_cycles(bpy.types.Operator):
         if old is not None:
             bpy.data.images.remove(old)
         image = bpy.data.images.new(IMAGE_NAME, 3 * w, h, alpha=True, float_buffer=True)
-        image.pixels.foreach_set(out.ravel())
-        image.update()
-        for key, value in numbers.items():
-            image[key] = value
+        try:
+            image.pixels.foreach_set(out.ravel())
+            image.update()
+            for key, value in numbers.items():
+                image[key] = value
+        except BaseException:
+            bpy.data.images.remove(image)
+            raise
         return image, numbers
 
     @staticmethod
