@@ -1,6 +1,6 @@
-from . import layers, presets
+from . import compare, layers, presets
 
-modules = (layers, presets)
+modules = (layers, presets, compare)
 
 
 def register():

@@ -60,6 +60,10 @@ class PENUMBRA_PT_sampling(_SettingsPanel, bpy.types.Panel):
     bl_label = "Sampling"
     section = settings.SAMPLING
 
+    def draw(self, context):
+        super().draw(context)
+        self.layout.operator("penumbra.compare_cycles", icon="IMAGE")
+
 
 class PENUMBRA_PT_sampling_viewport(_SettingsPanel, bpy.types.Panel):
     bl_label = "Viewport"
