@@ -52,6 +52,23 @@ def child_env(base=None):
     return env
 
 
+def run_result(script, timeout=300):
+    """Run ``script`` in a child Python (this interpreter, so the same bpy line; the repository
+    importable) and return (the dict it printed as its ``RESULT <json>`` line, everything it
+    printed). The child must exit 0 without a traceback: a crash there fails the caller, not its
+    process."""
+    import json
+    import subprocess
+
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+    log = proc.stderr[-3000:]
+    assert proc.returncode == 0, log
+    assert "Traceback" not in proc.stderr, log
+    line = next((ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")), None)
+    assert line is not None, proc.stdout[-2000:] + log
+    return json.loads(line[len("RESULT ") :]), proc.stdout + proc.stderr
+
+
 def load_penumbra():
     """Import the repository root as the package ``penumbra`` (its folder name may differ)."""
     if "penumbra" in sys.modules:

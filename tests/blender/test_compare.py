@@ -3,16 +3,13 @@ batch script would: a box over a plane under a sharp sun agrees with Cycles, eve
 touched comes back, a cancel leaves nothing behind, and a scene it cannot compare gets a clear
 message. The renders run in child processes, so a crash fails a test instead of the run."""
 
-import json
-import subprocess
-import sys
 import textwrap
 
 import bpy
 import pytest
 
 from devkit import scenes
-from devkit.session import ROOT
+from devkit.session import run_result
 
 PRELUDE = """
 import json, math
@@ -72,14 +69,7 @@ def report(**values):
 
 
 def run_child(body):
-    script = textwrap.dedent(PRELUDE) + textwrap.dedent(body)
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, cwd=ROOT)
-    log = proc.stderr[-3000:]
-    assert proc.returncode == 0, log
-    assert "Traceback" not in proc.stderr, log
-    line = next((ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")), None)
-    assert line is not None, proc.stdout[-2000:] + log
-    return json.loads(line[len("RESULT ") :]), proc.stdout + proc.stderr
+    return run_result(textwrap.dedent(PRELUDE) + textwrap.dedent(body), timeout=120)
 
 
 def test_box_over_plane_agrees_with_cycles_and_every_setting_comes_back():

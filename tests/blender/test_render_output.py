@@ -3,7 +3,6 @@ not), Blender's integer resolution rule, every view layer into its own layer, ev
 stereo render, a transparent film. Every render runs in a child process, so a crash (a render
 region with crop once segfaulted Blender) fails the test instead of the run."""
 
-import json
 import subprocess
 import sys
 import textwrap
@@ -11,7 +10,7 @@ import textwrap
 import bpy
 import pytest
 
-from devkit.session import ROOT
+from devkit.session import ROOT, run_result
 
 PRELUDE = """
 import json, os, tempfile
@@ -48,14 +47,7 @@ def report(**values):
 
 
 def run_child(body):
-    script = textwrap.dedent(PRELUDE) + textwrap.dedent(body)
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300, cwd=ROOT)
-    log = proc.stderr[-3000:]
-    assert proc.returncode == 0, log
-    assert "Traceback" not in proc.stderr, log
-    line = next((ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")), None)
-    assert line is not None, proc.stdout[-2000:] + log
-    return json.loads(line[len("RESULT ") :]), proc.stdout + proc.stderr
+    return run_result(textwrap.dedent(PRELUDE) + textwrap.dedent(body), timeout=300)
 
 
 @pytest.mark.parametrize("crop", [False, True])
