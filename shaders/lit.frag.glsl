@@ -49,9 +49,14 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
    * each light weighted by the luminance of its irradiance here (1 where no light reaches). */
   float weight = dot(L.color, vec3(0.2126, 0.7152, 0.0722)) * irradiance * NdotL;
   float NgdotL = dot(s.Ng, to_light);
+  /* On a closed surface seen from outside, a facet turned away from the light (its own plane,
+   * not the smoothed normal) is in the surface's own shadow: the ray to the light enters the
+   * solid. Decided exactly, with no bias, where the map's depths are nearly equal (lights
+   * with jittered maps, whose biases shrink with the samples; one-sample frames as before). */
+  bool turned = solid != 0 && L.jittered != 0 && dot(s.Nf, to_light) <= 0.0;
   float visibility = (filter_id == NO_SHADOW) ? 1.0 :
-                     (NgdotL <= 0.0) ? 0.0 :
-                                       shadow_visibility(L, s.P, s.Ng, s.Nf, NgdotL, filter_id);
+                     (NgdotL <= 0.0 || turned) ? 0.0 :
+                                                 shadow_visibility(L, s.P, s.Ng, s.Nf, NgdotL, filter_id);
   unshadowed += weight;
   arriving += weight * visibility;
 #if SPECULAR_MODEL == SPECULAR_GGX

@@ -100,8 +100,14 @@ class Renderer:
             film.begin(aux, emission, fresh=start == 0)
         plan = None
         moving = set()
+        # With map jitter every shadowed light changes from sample to sample (its maps' texel
+        # grid), so lights with an extent are sampled on it however small their penumbra.
+        jitter = accumulate and bool(settings.shadow_map_jitter)
         if accumulate:
-            moving = sampling.sampled_lights(lights, self.shadow_pass.plan(draws, lights, camera, settings, film.size))
+            first = self.shadow_pass.plan(draws, lights, camera, settings, film.size)
+            moving = sampling.sampled_lights(lights, first, every=jitter)
+            if jitter:
+                moving |= {i for i in first.lights if i < len(lights)}
         stats.lights_sampled = len(moving)
         for s in range(start, stop):
             dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
@@ -110,7 +116,8 @@ class Renderer:
                 jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
                 view_camera = dataclasses.replace(camera, projection=jittered)
             sample_lights = [
-                sampling.light_at_sample(lt, i, s, sample_count) if i in moving else lt for i, lt in enumerate(lights)
+                sampling.light_at_sample(lt, i, s, sample_count, jitter) if i in moving else lt
+                for i, lt in enumerate(lights)
             ]
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
             plan = self._sample(

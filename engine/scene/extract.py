@@ -138,6 +138,8 @@ class Light:
     shape: str = "SQUARE"  # area lights: SQUARE, RECTANGLE, DISK or ELLIPSE
     penumbra_scale: float = 1.0  # the light size PCSS sees, relative (1/sqrt(samples) when sampled)
     sampled: bool = False  # moves between samples: its shadow is PCSS of its per-sample size
+    map_jitter: tuple = (0.0, 0.0)  # this sample's shift of its maps' texel grid, in texels
+    jittered: bool = False  # its maps are shifted per sample (sampling.map_jitter) in this frame
     diffuse_factor: float = 1.0  # Light > Influence: how much it adds to diffuse and specular
     specular_factor: float = 1.0
     receivers: LinkSet | None = None  # light linking: what it lights (None: everything)

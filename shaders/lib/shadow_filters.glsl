@@ -248,6 +248,12 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, const
   float search_world = sun ? (receiver - near) * 2.0 * L.sun_tan_half_angle :
                              2.0 * L.shadow_radius * (receiver - near) / max(receiver, 1e-30);
   float search = clamp(0.5 * search_world / texel, 1.0, max_r);
+  if (L.jittered != 0 && 0.5 * search_world <= texel) {
+    /* This sample's penumbra is under two texels wide here (a light without size: none):
+     * one bilinear lookup, which the frame's jittered maps average into the edge filtered
+     * over about a texel, instead of a noisy disk of half a texel. */
+    return shadow_bilinear(origin, st, SHADOW_REF(1.0), grad);
+  }
   float ref = SHADOW_REF(search);
   float blockers = 0.0, blocker_sum = 0.0;
   for (int i = 0; i < DISK_SAMPLES; i++) {
