@@ -47,6 +47,7 @@ LIGHT_STRUCT = Struct(
         ("FLOAT", "diffuse_factor"),  # Light > Influence > Diffuse (EEVEE's), on the diffuse term
         ("FLOAT", "specular_factor"),  # Light > Influence > Specular, on the specular term
         ("INT", "jittered"),  # 1: its maps move by a sub-texel offset in each of the frame's samples
+        ("FLOAT", "offset_scale"),  # multiplies the normal offset (besides bias_scale)
         ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
         ("VEC4", "cascade_blend"),  # CASCADE: depth before each end over which the next one fades in
     ),

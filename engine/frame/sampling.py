@@ -255,17 +255,25 @@ def light_at_sample(light, light_index, s, count, jitter=False):
     if count <= 1:
         return light
     shift = map_jitter(s, light_index, count) if jitter else (0.0, 0.0)
-    # Jittered maps average the lookups of N texel grids: the biases (depth and normal offset,
-    # which move an edge by a fraction of a texel, the same way in every sample) shrink as
-    # 1/sqrt(N), as the texel noise they guard against averages out.
-    bias = light.bias_scale / math.sqrt(count) if jitter else light.bias_scale
+    # Jittered maps average the lookups of N texel grids, so the biases that move an edge
+    # the same way in every sample shrink as 1/sqrt(N), as the texel noise they guard against
+    # averages out: the normal offset (which shifts a sun's edges and erodes a local light's
+    # shadows by a fraction of a texel), and a sun's depth biases (its orthographic maps
+    # hold depth linear across texels, so the receiver plane is exact). A perspective map's
+    # depth is not linear across texels: there the depth biases stay, or grazing receivers
+    # far from a spot or point light show acne.
+    shrink = 1.0 / math.sqrt(count) if jitter else 1.0
+    bias = light.bias_scale * shrink if light.type == "SUN" else light.bias_scale
+    offset = light.offset_scale * shrink
     if not has_size(light):
         if not jitter:
             return light
         # Its shadow is a hard one on a moving texel grid: the sampled path (PCSS, which
         # reads a light without size with one bilinear lookup) rather than the scene's filter,
         # whose fixed kernel would blur every sample alike.
-        return dataclasses.replace(light, map_jitter=shift, bias_scale=bias, sampled=True, jittered=True)
+        return dataclasses.replace(
+            light, map_jitter=shift, bias_scale=bias, offset_scale=offset, sampled=True, jittered=True
+        )
     scale = 1.0 / math.sqrt(count)
     m = np.array(light.matrix, dtype=np.float64)
     if light.type == "SUN":
@@ -302,5 +310,12 @@ def light_at_sample(light, light_index, s, count, jitter=False):
         direction = np.array([r_xy * math.cos(phi), r_xy * math.sin(phi), z])
         m[:3, 3] = m[:3, 3] + light.radius * _ball_radius(u) * direction
     return dataclasses.replace(
-        light, matrix=m, penumbra_scale=scale, sampled=True, map_jitter=shift, bias_scale=bias, jittered=jitter
+        light,
+        matrix=m,
+        penumbra_scale=scale,
+        sampled=True,
+        map_jitter=shift,
+        bias_scale=bias,
+        offset_scale=offset,
+        jittered=jitter,
     )

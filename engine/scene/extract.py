@@ -133,6 +133,7 @@ class Light:
     use_shadow: bool = True
     size: float = 0.0  # area lights: the larger side (for PCSS softness)
     bias_scale: float = 1.0  # light.penumbra.bias_scale
+    offset_scale: float = 1.0  # and of the normal offset alone (shrinks with the samples when maps are jittered)
     size_x: float = 0.0  # area lights: the sides along the light's local X and Y
     size_y: float = 0.0
     shape: str = "SQUARE"  # area lights: SQUARE, RECTANGLE, DISK or ELLIPSE

@@ -18,7 +18,9 @@
  *                  neither acne nor a reason to bias the whole kernel. Without it (or where
  *                  the facet faces away from the light) the slope bias grows with the
  *                  kernel: tan(theta) * max(1, r)
- * scaled per light by LightData.bias_scale (light.penumbra.bias_scale). */
+ * scaled per light by LightData.bias_scale (light.penumbra.bias_scale; with jittered maps
+ * also 1/sqrt(samples) for a sun) and the normal offset by LightData.offset_scale (with
+ * jittered maps 1/sqrt(samples)). */
 
 float pixel_hash(vec2 frag); /* lib/material.glsl */
 
@@ -152,7 +154,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, const
   float dist = max(-(T.view * vec4(P, 1.0)).z, 0.0);
   float texel = T.texel + T.texel_per_distance * dist;
 
-  vec3 Po = P + N * (frame.normal_offset * bias_scale * texel * sin_t);
+  vec3 Po = P + N * (frame.normal_offset * bias_scale * L.offset_scale * texel * sin_t);
   vec4 vp = T.view * vec4(Po, 1.0);
   vec4 t = T.proj_tex * vp;
   if (t.w <= 0.0) {

@@ -132,7 +132,7 @@ def test_map_jitter_is_stratified_over_the_texel_and_leaves_sample_zero_alone():
     assert a != [sampling.map_jitter(s, 1, 16) for s in range(16)]
 
 
-def test_jittered_lights_carry_their_shift_and_biases_shrinking_as_one_over_root_n():
+def test_jittered_lights_carry_their_shift_and_offsets_shrinking_as_one_over_root_n():
     hard = _light("SUN")
     sun = _light("SUN", angle=math.radians(0.526))
     for light in (hard, sun):
@@ -141,6 +141,11 @@ def test_jittered_lights_carry_their_shift_and_biases_shrinking_as_one_over_root
         assert first.jittered and later.jittered and first.sampled and later.sampled
         assert first.map_jitter == (0.0, 0.0) and later.map_jitter == sampling.map_jitter(5, 0, 16)
         assert later.bias_scale == pytest.approx(light.bias_scale / 4)
+        assert later.offset_scale == pytest.approx(0.25)
+    # A spot's perspective maps keep their depth biases (depth is not linear across their
+    # texels); only its normal offset shrinks.
+    spot = sampling.light_at_sample(_light("SPOT", radius=0.02), 0, 5, 16, jitter=True)
+    assert spot.jittered and spot.bias_scale == 1.0 and spot.offset_scale == pytest.approx(0.25)
     assert sampling.light_at_sample(hard, 0, 5, 16) is hard  # no jitter: a hard light never changes
     assert sampling.light_at_sample(hard, 0, 0, 1, jitter=True) is hard  # one sample: the light itself
     # Sun points: stratified in the disc's area (Vogel's spiral), within the angle.
