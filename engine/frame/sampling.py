@@ -255,16 +255,14 @@ def light_at_sample(light, light_index, s, count, jitter=False):
     if count <= 1:
         return light
     shift = map_jitter(s, light_index, count) if jitter else (0.0, 0.0)
-    # Jittered maps average the lookups of N texel grids, so the biases that move an edge
-    # the same way in every sample shrink as 1/sqrt(N), as the texel noise they guard against
-    # averages out: the normal offset (which shifts a sun's edges and erodes a local light's
-    # shadows by a fraction of a texel), and a sun's depth biases (its orthographic maps
-    # hold depth linear across texels, so the receiver plane is exact). A perspective map's
-    # depth is not linear across texels: there the depth biases stay, or grazing receivers
-    # far from a spot or point light show acne.
-    shrink = 1.0 / math.sqrt(count) if jitter else 1.0
-    bias = light.bias_scale * shrink if light.type == "SUN" else light.bias_scale
-    offset = light.offset_scale * shrink
+    # Jittered maps average the lookups of N texel grids, so the normal offset, which moves
+    # every edge the same way in every sample (it shifts a sun's edges and erodes a local
+    # light's shadows by a fraction of a texel), shrinks as 1/sqrt(N), as the texel noise it
+    # guards against averages out. The depth biases stay: shrinking them bought nothing on
+    # the analytic scenes, gave a spot's grazing far ground acne (a perspective map's depth
+    # is not linear across texels) and darkened smooth low-poly terminators that Cycles
+    # lights with its shadow-terminator offset.
+    offset = light.offset_scale / math.sqrt(count) if jitter else light.offset_scale
     if not has_size(light):
         if not jitter:
             return light
@@ -272,7 +270,7 @@ def light_at_sample(light, light_index, s, count, jitter=False):
         # reads a light without size with one bilinear lookup) rather than the scene's filter,
         # whose fixed kernel would blur every sample alike.
         return dataclasses.replace(
-            light, map_jitter=shift, bias_scale=bias, offset_scale=offset, sampled=True, jittered=True
+            light, map_jitter=shift, offset_scale=offset, sampled=True, jittered=True
         )
     scale = 1.0 / math.sqrt(count)
     m = np.array(light.matrix, dtype=np.float64)
@@ -315,7 +313,6 @@ def light_at_sample(light, light_index, s, count, jitter=False):
         penumbra_scale=scale,
         sampled=True,
         map_jitter=shift,
-        bias_scale=bias,
         offset_scale=offset,
         jittered=jitter,
     )

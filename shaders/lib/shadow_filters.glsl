@@ -18,9 +18,8 @@
  *                  neither acne nor a reason to bias the whole kernel. Without it (or where
  *                  the facet faces away from the light) the slope bias grows with the
  *                  kernel: tan(theta) * max(1, r)
- * scaled per light by LightData.bias_scale (light.penumbra.bias_scale; with jittered maps
- * also 1/sqrt(samples) for a sun) and the normal offset by LightData.offset_scale (with
- * jittered maps 1/sqrt(samples)). */
+ * scaled per light by LightData.bias_scale (light.penumbra.bias_scale), and the normal offset
+ * also by LightData.offset_scale (1/sqrt(samples) with jittered maps). */
 
 float pixel_hash(vec2 frag); /* lib/material.glsl */
 

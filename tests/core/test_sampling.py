@@ -140,10 +140,7 @@ def test_jittered_lights_carry_their_shift_and_offsets_shrinking_as_one_over_roo
         later = sampling.light_at_sample(light, 0, 5, 16, jitter=True)
         assert first.jittered and later.jittered and first.sampled and later.sampled
         assert first.map_jitter == (0.0, 0.0) and later.map_jitter == sampling.map_jitter(5, 0, 16)
-        assert later.bias_scale == pytest.approx(light.bias_scale / 4)
-        assert later.offset_scale == pytest.approx(0.25)
-    # A spot's perspective maps keep their depth biases (depth is not linear across their
-    # texels); only its normal offset shrinks.
+        assert later.offset_scale == pytest.approx(0.25) and later.bias_scale == light.bias_scale
     spot = sampling.light_at_sample(_light("SPOT", radius=0.02), 0, 5, 16, jitter=True)
     assert spot.jittered and spot.bias_scale == 1.0 and spot.offset_scale == pytest.approx(0.25)
     assert sampling.light_at_sample(hard, 0, 5, 16) is hard  # no jitter: a hard light never changes
