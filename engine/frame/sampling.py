@@ -9,9 +9,12 @@ them with the film filter's weights:
   so offsets are distributed as the filter and the plain average converges to the image
   convolved with it.
 * **Soft lights.** A light with size (sun ``angle``, point/spot ``shadow_soft_size``, area
-  ``size``/``size_y`` and shape) shines from a different point of itself in each sample: the
-  points of a Hammersley set of N (stratified for any N, rotated per light so lights do not
-  move in step) on its disc, ball or area. Every sample's shadow map is a hard shadow from that
+  ``size``/``size_y`` and shape) shines from a different point of itself in each sample, in
+  an order and rotation of its own so lights do not move in step: a sun from Vogel's spiral
+  of N points on its disc (even along every axis), a point or spot light from a point of the
+  sphere of its radius as Cycles sees it (a ball density whose projection from any direction
+  is the uniform disc), an area light from a Hammersley set of N on its surface (stratified
+  for any N). Every sample's shadow map is a hard shadow from that
   point, so the average converges to the true visibility (Heckbert-Herf accumulation), and an
   area light's irradiance to the integral over its surface. Each sample stands for 1/N of
   the light, so in that sample it is shadowed by PCSS (whatever the scene's filter) with a
@@ -23,9 +26,11 @@ them with the film filter's weights:
   every sample rasterises the casters on another texel grid, so the average of the samples'
   lookups converges to the visibility filtered over one texel (the staircase and the
   sub-texel position of an edge average out) instead of one map's aliasing, whatever the
-  light's size. Such a light's maps are redrawn every sample; without jitter, a light
-  without size (or, jitter off, with a penumbra below a texel) is the same in every sample,
-  so its map is drawn once and reused.
+  light's size; its normal offset shrinks as 1/sqrt(N), and a sample whose penumbra is
+  under two texels reads one bilinear lookup. Such a light's maps are redrawn every sample,
+  and every light with an extent is sampled on it, however small its penumbra. Without
+  jitter, a light without size (or with a penumbra below a texel) is the same in every
+  sample, so its map is drawn once and reused.
 
 Sequences depend only on (s, N, light index): the viewport's k-th redraw and a final render's
 k-th sample are the same sample, so N redraws show what a final render of N samples shows.
@@ -269,9 +274,7 @@ def light_at_sample(light, light_index, s, count, jitter=False):
         # Its shadow is a hard one on a moving texel grid: the sampled path (PCSS, which
         # reads a light without size with one bilinear lookup) rather than the scene's filter,
         # whose fixed kernel would blur every sample alike.
-        return dataclasses.replace(
-            light, map_jitter=shift, offset_scale=offset, sampled=True, jittered=True
-        )
+        return dataclasses.replace(light, map_jitter=shift, offset_scale=offset, sampled=True, jittered=True)
     scale = 1.0 / math.sqrt(count)
     m = np.array(light.matrix, dtype=np.float64)
     if light.type == "SUN":
