@@ -13,6 +13,7 @@ grey Lambertian casters and a perspective camera looking down at an angle:
 sun_hard   sun, angle 0.5 deg, over a box, a floating sphere and a floating slab
 sun_soft   the same sun with angle 10 deg
 spot       spot light, radius (shadow_soft_size) 0.25, 70 deg cone, same casters
+spot_hard  the same spot with radius 0.02: near-hard shadows (not in LIGHT_SCENES)
 point      point light, radius 0.2, same casters
 area       square area light, size 1.0, facing down, same casters
 contact    a tall thin box (0.5 x 0.5 x 3) standing on the plane, sun with angle 8 deg:
@@ -148,6 +149,13 @@ def spot(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
     )
     scenes.aim(ob, (-0.2, 0.4, 0.0))
     _hide_from_camera(ob)
+    return scene
+
+
+def spot_hard(width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
+    """The spot scene with a near-point emitter (radius 2 cm): sharp shadows."""
+    scene = spot(width, height)
+    scene.objects["Spot"].data.shadow_soft_size = 0.02
     return scene
 
 
@@ -377,6 +385,7 @@ SCENES = {
     "sun_hard": sun_hard,
     "sun_soft": sun_soft,
     "spot": spot,
+    "spot_hard": spot_hard,
     "point": point,
     "area": area,
     "contact": contact,

@@ -253,6 +253,17 @@ SCENE_PARAMS = (
         section=SAMPLING,
         subtype="PIXEL",
     ),
+    Param(
+        "shadow_map_jitter",
+        "BOOL",
+        True,
+        "With several samples, shift every shadow map by a different fraction of a texel in each "
+        "sample (and light every sun, point and spot light from points of its disc or sphere, "
+        "however small): edges then converge to where the geometry puts them instead of keeping "
+        "one map's stair steps and offsets. Shadowed lights redraw their maps every sample",
+        label="Jitter Shadow Maps",
+        section=SAMPLING,
+    ),
     Param("shadow_filter", "ENUM", "PCF", "How shadow edges are filtered", enum=SHADOW_FILTER, section=SHADOWS),
     Param(
         "shadow_map_size",

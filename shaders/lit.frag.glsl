@@ -106,9 +106,20 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   /* EEVEE: along the normal, by Normal Offset x saturate(1 - N.L / Geometry Offset). */
   shadow_P += s.Ng * (clamp(1.0 - NgdotL / terminator_geometry_offset, 0.0, 1.0) * terminator_normal_offset);
 #endif
+  /* On a closed surface seen from outside, a facet turned away from the light (its own plane,
+   * not the smoothed normal) is in the surface's own shadow: the ray to the light enters the
+   * solid. Decided exactly, with no bias, where the map's depths are nearly equal (lights
+   * with jittered maps, whose biases shrink with the samples; one-sample frames as before).
+   * Not where Shadow Terminator's Geometry Offset moves the point off its facet: the map
+   * decides there, as Cycles' offset ray does. */
+#if TERMINATOR_OFFSET
+  bool turned = false;
+#else
+  bool turned = solid != 0 && L.jittered != 0 && dot(s.Nf, to_light) <= 0.0;
+#endif
   float visibility = (filter_id == NO_SHADOW) ? 1.0 :
-                     (NgdotL <= 0.0) ? 0.0 :
-                                       shadow_visibility(L, shadow_P, s.Ng, s.Nf, NgdotL, dot(s.Nf, to_light), filter_id);
+                     (NgdotL <= 0.0 || turned) ? 0.0 :
+                                                 shadow_visibility(L, shadow_P, s.Ng, s.Nf, NgdotL, dot(s.Nf, to_light), filter_id);
   unshadowed += weight;
   arriving += weight * visibility;
 #if SPECULAR_MODEL == SPECULAR_GGX

@@ -93,6 +93,16 @@ class LitPass:
             bound["shader"] = shader
             return shader
 
+        solid_found = {}
+
+        def solid_uniform(shader):
+            if shader not in solid_found:
+                try:
+                    solid_found[shader] = shader.uniform_from_name("solid") != -1
+                except ValueError:  # Blender raises where GL reports -1
+                    solid_found[shader] = False
+            return solid_found[shader]
+
         def draw(entries, with_aux):
             last = None
             for features, _rank, d, batch, mat in entries:
@@ -107,6 +117,8 @@ class LitPass:
                 shader = bind(features, with_aux)
                 if last is not d or bound.get("model_shader") is not shader:
                     shader.uniform_float("model", d.model)
+                    if solid_uniform(shader):  # compiled out where no light reads it
+                        shader.uniform_int("solid", int(id(d) in outside))
                     if masks is not None:
                         shader.uniform_int("light_mask", masks[id(d)])
                     if id(d) in terminators:  # skipping any the compiler removed (a holdout's)

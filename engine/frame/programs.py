@@ -46,6 +46,8 @@ LIGHT_STRUCT = Struct(
         ("FLOAT", "bias_scale"),  # light.penumbra.bias_scale
         ("FLOAT", "diffuse_factor"),  # Light > Influence > Diffuse (EEVEE's), on the diffuse term
         ("FLOAT", "specular_factor"),  # Light > Influence > Specular, on the specular term
+        ("INT", "jittered"),  # 1: its maps move by a sub-texel offset in each of the frame's samples
+        ("FLOAT", "offset_scale"),  # multiplies the normal offset (besides bias_scale)
         ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
         ("VEC4", "cascade_blend"),  # CASCADE: depth before each end over which the next one fades in
     ),
@@ -176,7 +178,8 @@ LIT = Program(
         "lib/material.glsl",
     ),
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
-    push_constants=(("MAT4", "model"), ("IVEC4", "light_mask")),
+    # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
+    push_constants=(("MAT4", "model"), ("IVEC4", "light_mask"), ("INT", "solid")),
     samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex"), ("FLOAT_2D", "light_bins")),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),

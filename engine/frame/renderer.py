@@ -111,8 +111,14 @@ class Renderer:
             film.begin(aux, emission, fresh=start == 0, adaptive=noise)
         plan = None
         moving = set()
+        # With map jitter every shadowed light changes from sample to sample (its maps' texel
+        # grid), so lights with an extent are sampled on it however small their penumbra.
+        jitter = accumulate and bool(settings.shadow_map_jitter)
         if accumulate:
-            moving = sampling.sampled_lights(lights, self.shadow_pass.plan(draws, lights, camera, settings, film.size))
+            first = self.shadow_pass.plan(draws, lights, camera, settings, film.size)
+            moving = sampling.sampled_lights(lights, first, every=jitter)
+            if jitter:
+                moving |= {i for i in first.lights if i < len(lights)}
         stats.lights_sampled = len(moving)
         if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
             deadline = time.monotonic() + adaptive.time_limit
@@ -127,7 +133,7 @@ class Renderer:
                 jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
                 view_camera = dataclasses.replace(camera, projection=jittered)
             sample_lights = [
-                sampling.light_at_sample(lt, i, s, sample_count, noise) if i in moving else lt
+                sampling.light_at_sample(lt, i, s, sample_count, jitter, progressive=noise) if i in moving else lt
                 for i, lt in enumerate(lights)
             ]
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5

@@ -9,16 +9,28 @@ them with the film filter's weights:
   so offsets are distributed as the filter and the plain average converges to the image
   convolved with it.
 * **Soft lights.** A light with size (sun ``angle``, point/spot ``shadow_soft_size``, area
-  ``size``/``size_y`` and shape) shines from a different point of itself in each sample: the
-  points of a Hammersley set of N (stratified for any N, rotated per light so lights do not
-  move in step) on its disc, ball or area. Every sample's shadow map is a hard shadow from that
+  ``size``/``size_y`` and shape) shines from a different point of itself in each sample, in
+  an order and rotation of its own so lights do not move in step: a sun from Vogel's spiral
+  of N points on its disc (even along every axis), a point or spot light from a point of the
+  sphere of its radius as Cycles sees it (a ball density whose projection from any direction
+  is the uniform disc), an area light from a Hammersley set of N on its surface (stratified
+  for any N). Every sample's shadow map is a hard shadow from that
   point, so the average converges to the true visibility (Heckbert-Herf accumulation), and an
   area light's irradiance to the integral over its surface. Each sample stands for 1/N of
   the light, so in that sample it is shadowed by PCSS (whatever the scene's filter) with a
   light 1/sqrt(N) the size (``penumbra_scale``): a few samples already give smooth penumbrae,
   many converge to the exact one, and the penumbra is not blurred twice. One sample is
   exactly the single-sample frame.
-* A light without size is the same in every sample, so its map is drawn once and reused.
+* **Map jitter.** With ``shadow_map_jitter`` on, sample s > 0 also shifts each shadowed
+  light's maps by a sub-texel offset (a stratified set over the texel, sample 0 unshifted):
+  every sample rasterises the casters on another texel grid, so the average of the samples'
+  lookups converges to the visibility filtered over one texel (the staircase and the
+  sub-texel position of an edge average out) instead of one map's aliasing, whatever the
+  light's size; its normal offset shrinks as 1/sqrt(N), and a sample whose penumbra is
+  under two texels reads one bilinear lookup. Such a light's maps are redrawn every sample,
+  and every light with an extent is sampled on it, however small its penumbra. Without
+  jitter, a light without size (or with a penumbra below a texel) is the same in every
+  sample, so its map is drawn once and reused.
 
 Sequences depend only on (s, N, light index): the viewport's k-th redraw and a final render's
 k-th sample are the same sample, so N redraws show what a final render of N samples shows.
@@ -112,6 +124,23 @@ def _light_point(s, light_index, dims, count):
     return [(c + rotation[d]) % 1.0 for d, c in enumerate(coords)]
 
 
+GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))
+
+
+def _disc_point(s, light_index, count):
+    """Sample ``s``'s point of the unit disc for light ``light_index`` of a frame of ``count``
+    samples: point j of Vogel's spiral of ``count`` points (radius sqrt((j + 1/2) / count),
+    angle j golden angles; equal areas), j in the light's shuffled order, the spiral turned
+    by the light's own angle. Its projection on every axis is evenly spread for every count,
+    so a straight shadow edge (which sees the disc through one axis) converges smoothly;
+    the Hammersley set's lattice at powers of two projects into clumps along some axes."""
+    order, rotation = _light_order(light_index, count)
+    j = int(order[s % count])
+    r = math.sqrt((j + 0.5) / count)
+    phi = j * GOLDEN_ANGLE + 2.0 * math.pi * rotation[0]
+    return r * math.cos(phi), r * math.sin(phi)
+
+
 def sobol_2(index):
     """The second dimension of the Sobol' sequence (its generator matrix is Pascal's mod 2),
     as 32 bits: with the van der Corput sequence it forms a (0, 2)-sequence in base 2."""
@@ -186,11 +215,13 @@ def penumbra_texels(light, fit):
     return 2.0 * light.shadow_radius / (fit.texel_per_distance * fit.near)
 
 
-def sampled_lights(lights, plan):
+def sampled_lights(lights, plan, every=False):
     """Indices of the lights that move between samples: area lights (their irradiance is an
     integral over the surface), and shadowed lights with an extent whose penumbra can be a
-    texel wide or more in their map. Every other light is the same in every sample, so its
-    map is drawn once."""
+    texel wide or more in their map; with ``every`` (maps jittered per sample, so every map
+    is redrawn anyway) every shadowed light with an extent, however small its penumbra: a
+    sub-texel penumbra still moves the edge's 50 % contour. Every other light is the same in
+    every sample (but for its map's jitter)."""
     out = set()
     for i, light in enumerate(lights):
         if not has_size(light):
@@ -202,20 +233,83 @@ def sampled_lights(lights, plan):
         if shadow is None:
             continue
         fits = [plan.tiles[t].fit for t in shadow.tiles if t >= 0]
-        if any(penumbra_texels(light, fit) >= 1.0 for fit in fits):
+        if every or any(penumbra_texels(light, fit) >= 1.0 for fit in fits):
             out.add(i)
     return out
 
 
-def light_at_sample(light, light_index, s, count, progressive=False):
+@functools.lru_cache(maxsize=256)
+def _jitter_set(light_index, count):
+    """The ``count`` sub-texel offsets of light ``light_index``'s maps, one per sample: a
+    Hammersley set of ``count`` points over the texel (stratified for every count), visited in
+    an order of its own (not the light points' nor the pixel offsets'), rotated (toroidally)
+    so that sample 0 is unshifted, then centred on [-1/2, 1/2)."""
+    rng = np.random.default_rng(0x51ED2701 + 104729 * light_index)
+    order = rng.permutation(count)
+    j = order.astype(np.float64)
+    points = np.stack([(j + 0.5) / count, [radical_inverse(int(k), 2) for k in order]], axis=1)
+    shifted = (points - points[0] + 0.5) % 1.0 - 0.5
+    shifted[0] = 0.0
+    return shifted
+
+
+def map_jitter(s, light_index, count):
+    """(x, y) texels by which sample ``s`` of ``count`` shifts light ``light_index``'s shadow
+    maps: (0, 0) for sample 0 and frames of one sample."""
+    if count <= 1 or s % count == 0:
+        return (0.0, 0.0)
+    x, y = _jitter_set(light_index, count)[s % count]
+    return (float(x), float(y))
+
+
+def _ball_radius(u):
+    """The radius (of a unit ball) below which a fraction ``u`` of the ball's points lie when
+    their density in the ball is 1 / sqrt(1 - r^2): the isotropic density whose projection
+    along every direction is uniform on the unit disc (the inverse Abel transform of a
+    uniform disc). CDF (theta - sin theta cos theta) / (pi / 2) with r = sin theta, inverted
+    by Newton's method."""
+    target = 0.5 * math.pi * min(max(u, 0.0), 1.0)
+    theta = math.pi / 4.0
+    for _ in range(40):
+        f = theta - math.sin(theta) * math.cos(theta) - target
+        d = 2.0 * math.sin(theta) ** 2
+        if d < 1e-12:
+            theta = (1.5 * target) ** (1.0 / 3.0)  # theta^3 * 2/3 near 0
+            continue
+        step = f / d
+        theta = min(max(theta - step, 0.0), 0.5 * math.pi)
+        if abs(step) < 1e-14:
+            break
+    return math.sin(theta)
+
+
+def light_at_sample(light, light_index, s, count, jitter=False, progressive=False):
     """``light`` as it shines in sample ``s`` of ``count``: moved to a point of itself (a
     direction inside its cone for a sun), with PCSS's light size scaled by 1/sqrt(count).
     Lights without size, and every light in a frame of one sample, keep the light's centre.
-    ``progressive``: pixels may stop early (adaptive sampling), so the points come from a
-    sequence whose every power-of-two prefix is stratified (``_light_point_progressive``)
-    rather than from the shuffled set of ``count``, which only the whole set stratifies."""
-    if count <= 1 or not has_size(light):
+    ``jitter``: its maps are also shifted by ``map_jitter`` (a light without size then
+    differs from sample to sample by that shift alone). ``progressive``: pixels may stop
+    early (adaptive sampling), so the points come from a sequence whose every power-of-two
+    prefix is stratified (``_light_point_progressive``) rather than from the set of ``count``
+    (the sun's spiral, the shuffled Hammersley set), which only the whole set stratifies."""
+    if count <= 1:
         return light
+    shift = map_jitter(s, light_index, count) if jitter else (0.0, 0.0)
+    # Jittered maps average the lookups of N texel grids, so the normal offset, which moves
+    # every edge the same way in every sample (it shifts a sun's edges and erodes a local
+    # light's shadows by a fraction of a texel), shrinks as 1/sqrt(N), as the texel noise it
+    # guards against averages out. The depth biases stay: shrinking them bought nothing on
+    # the analytic scenes, gave a spot's grazing far ground acne (a perspective map's depth
+    # is not linear across texels) and darkened smooth low-poly terminators that Cycles
+    # lights with its shadow-terminator offset.
+    offset = light.offset_scale / math.sqrt(count) if jitter else light.offset_scale
+    if not has_size(light):
+        if not jitter:
+            return light
+        # Its shadow is a hard one on a moving texel grid: the sampled path (PCSS, which
+        # reads a light without size with one bilinear lookup) rather than the scene's filter,
+        # whose fixed kernel would blur every sample alike.
+        return dataclasses.replace(light, map_jitter=shift, offset_scale=offset, sampled=True, jittered=True)
     if progressive:
 
         def point(dims):
@@ -229,7 +323,7 @@ def light_at_sample(light, light_index, s, count, progressive=False):
     scale = 1.0 / math.sqrt(count)
     m = np.array(light.matrix, dtype=np.float64)
     if light.type == "SUN":
-        x, y = concentric_disk(*point(2))
+        x, y = concentric_disk(*point(2)) if progressive else _disc_point(s, light_index, count)
         d = light.direction
         u, v = _basis(d)
         tan_half = math.tan(0.5 * min(light.angle, math.pi * 0.99))
@@ -251,18 +345,25 @@ def light_at_sample(light, light_index, s, count, progressive=False):
             x, y = u - 0.5, v - 0.5
         local = np.array([x * light.size_x, y * light.size_y, 0.0, 1.0])
         m[:3, 3] = (m @ local)[:3]  # the light's own axes carry its object scale
-    elif light.type == "SPOT":
-        x, y = concentric_disk(*point(2))
-        u, v = _basis(light.direction)
-        m[:3, 3] = m[:3, 3] + light.radius * (x * u + y * v)
-    else:  # POINT: uniform in the ball, which looks the same from every direction
+    else:  # POINT and SPOT: spheres of their radius, as Cycles and EEVEE draw them
+        # A point of the ball with density 1 / sqrt(r^2 - |p|^2): seen from any receiver,
+        # its projection is uniform on the disc of the sphere's outline, which is the light
+        # a sphere of uniform radiance sends (a uniform ball would crowd the disc's centre).
         u, v, w = point(3)
-        z = 1.0 - 2.0 * u
+        z = 1.0 - 2.0 * v
         r_xy = math.sqrt(max(0.0, 1.0 - z * z))
-        phi = 2.0 * math.pi * v
+        phi = 2.0 * math.pi * w
         direction = np.array([r_xy * math.cos(phi), r_xy * math.sin(phi), z])
-        m[:3, 3] = m[:3, 3] + light.radius * w ** (1.0 / 3.0) * direction
-    return dataclasses.replace(light, matrix=m, penumbra_scale=scale, sampled=True)
+        m[:3, 3] = m[:3, 3] + light.radius * _ball_radius(u) * direction
+    return dataclasses.replace(
+        light,
+        matrix=m,
+        penumbra_scale=scale,
+        sampled=True,
+        map_jitter=shift,
+        offset_scale=offset,
+        jittered=jitter,
+    )
 
 
 # --- adaptive sampling ------------------------------------------------------------------------

@@ -72,6 +72,13 @@ class ShadowPass:
             stats.messages.append(
                 f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
             )
+        for i, entry in plan.lights.items():  # this sample's sub-texel shift of the light's maps
+            shift = lights[i].map_jitter
+            if shift[0] or shift[1]:
+                for t in entry.tiles:
+                    if t >= 0:
+                        tile = plan.tiles[t]
+                        tile.fit = lightspace.shifted(tile.fit, shift, tile.size)
         for i, entry in plan.lights.items():  # shadow linking: only the light's blockers cast
             blockers = lights[i].blockers
             if blockers is not None:

@@ -136,11 +136,14 @@ class Light:
     use_shadow: bool = True
     size: float = 0.0  # area lights: the larger side (for PCSS softness)
     bias_scale: float = 1.0  # light.penumbra.bias_scale
+    offset_scale: float = 1.0  # and of the normal offset alone (shrinks with the samples when maps are jittered)
     size_x: float = 0.0  # area lights: the sides along the light's local X and Y
     size_y: float = 0.0
     shape: str = "SQUARE"  # area lights: SQUARE, RECTANGLE, DISK or ELLIPSE
     penumbra_scale: float = 1.0  # the light size PCSS sees, relative (1/sqrt(samples) when sampled)
     sampled: bool = False  # moves between samples: its shadow is PCSS of its per-sample size
+    map_jitter: tuple = (0.0, 0.0)  # this sample's shift of its maps' texel grid, in texels
+    jittered: bool = False  # its maps are shifted per sample (sampling.map_jitter) in this frame
     diffuse_factor: float = 1.0  # Light > Influence: how much it adds to diffuse and specular
     specular_factor: float = 1.0
     receivers: LinkSet | None = None  # light linking: what it lights (None: everything)

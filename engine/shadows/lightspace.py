@@ -144,6 +144,16 @@ class Fit:
         return bool(np.array_equal(self.proj[3], (0.0, 0.0, 0.0, 1.0)))
 
 
+def shifted(fit, texels, size):
+    """``fit`` with its texel grid moved by ``texels`` (x, y) of a map ``size`` texels wide: a
+    translation of clip space, exact for orthographic and perspective maps alike. The depth
+    range and texel size are unchanged."""
+    shift = np.eye(4)
+    shift[0, 3] = 2.0 * float(texels[0]) / size
+    shift[1, 3] = 2.0 * float(texels[1]) / size
+    return Fit(fit.view, shift @ fit.proj, fit.near, fit.far, fit.texel, fit.texel_per_distance)
+
+
 def fit_sun_ortho(direction, points, map_size, padding_texels=2.0):
     """Fit an orthographic light frustum for a sun shining along ``direction`` around ``points``.
 

@@ -18,7 +18,8 @@
  *                  neither acne nor a reason to bias the whole kernel. Without it (or where
  *                  the facet faces away from the light) the slope bias grows with the
  *                  kernel: tan(theta) * max(1, r)
- * scaled per light by LightData.bias_scale (light.penumbra.bias_scale).
+ * scaled per light by LightData.bias_scale (light.penumbra.bias_scale), and the normal offset
+ * also by LightData.offset_scale (1/sqrt(samples) with jittered maps).
  *
  * Where the drawn facet turns away from the light (NfdotL <= 0) while the smooth normal faces
  * it, the point lies behind its own facet as seen from the light: on a closed smooth mesh it
@@ -163,7 +164,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
   float dist = max(-(T.view * vec4(P, 1.0)).z, 0.0);
   float texel = T.texel + T.texel_per_distance * dist;
 
-  vec3 Po = P + N * (frame.normal_offset * bias_scale * texel * sin_t);
+  vec3 Po = P + N * (frame.normal_offset * bias_scale * L.offset_scale * texel * sin_t);
   vec4 vp = T.view * vec4(Po, 1.0);
   vec4 t = T.proj_tex * vp;
   if (t.w <= 0.0) {
@@ -259,6 +260,12 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
   float search_world = sun ? (receiver - near) * 2.0 * L.sun_tan_half_angle :
                              2.0 * L.shadow_radius * (receiver - near) / max(receiver, 1e-30);
   float search = clamp(0.5 * search_world / texel, 1.0, max_r);
+  if (L.jittered != 0 && 0.5 * search_world <= texel) {
+    /* This sample's penumbra is under two texels wide here (a light without size: none):
+     * one bilinear lookup, which the frame's jittered maps average into the edge filtered
+     * over about a texel, instead of a noisy disk of half a texel. */
+    return shadow_bilinear(origin, st, SHADOW_REF(1.0), grad);
+  }
   float ref = SHADOW_REF(search);
   float blockers = 0.0, blocker_sum = 0.0;
   for (int i = 0; i < DISK_SAMPLES; i++) {

@@ -112,6 +112,8 @@ def test_only_lights_whose_penumbra_reaches_a_texel_move_between_samples():
     assert sampling.penumbra_texels(spot, persp) == pytest.approx(100.0)
     lights = [tiny_sun, sun, spot, unshadowed_spot, area]
     assert sampling.sampled_lights(lights, plan_for([ortho, ortho, persp, None, None])) == {1, 2, 4}
+    # With jittered maps every shadowed light with an extent is sampled, however small.
+    assert sampling.sampled_lights(lights, plan_for([ortho, ortho, persp, None, None]), every=True) == {0, 1, 2, 4}
 
 
 # --- adaptive sampling ------------------------------------------------------------------------
@@ -161,9 +163,78 @@ def test_progressive_points_keep_an_area_light_on_its_surface_and_centred_early(
     centre = light.position
 
     def offsets(progressive):
-        return np.array([sampling.light_at_sample(light, 3, s, 64, progressive).position - centre for s in range(16)])
+        return np.array(
+            [sampling.light_at_sample(light, 3, s, 64, progressive=progressive).position - centre for s in range(16)]
+        )
 
     early = offsets(True)
     assert np.all(np.abs(early[:, 0]) <= 1.0 + 1e-9) and np.all(np.abs(early[:, 1]) <= 0.5 + 1e-9)
     assert abs(early[:, 0].mean()) <= 2.0 / 32 and abs(early[:, 1].mean()) <= 1.0 / 32
     assert np.linalg.norm(early.mean(axis=0)) < np.linalg.norm(offsets(False).mean(axis=0))
+
+
+def test_map_jitter_is_stratified_over_the_texel_and_leaves_sample_zero_alone():
+    for n in (4, 16, 64, 256):
+        shifts = np.array([sampling.map_jitter(s, 2, n) for s in range(n)])
+        assert tuple(shifts[0]) == (0.0, 0.0)
+        assert np.all(shifts >= -0.5) and np.all(shifts < 0.5)
+        # One point per 1/n strip of the texel along x, and the quarters evenly filled.
+        strips = np.floor((shifts[:, 0] + 0.5) * n + 1e-9).astype(int)
+        assert sorted(strips) == list(range(n))
+        quarters = np.histogram2d(shifts[:, 0], shifts[:, 1], bins=2, range=[[-0.5, 0.5], [-0.5, 0.5]])[0]
+        assert np.all(np.abs(quarters - n / 4) <= max(1, n // 16)), (n, quarters)
+    assert sampling.map_jitter(0, 0, 1) == (0.0, 0.0) and sampling.map_jitter(3, 0, 1) == (0.0, 0.0)
+    a = [sampling.map_jitter(s, 0, 16) for s in range(16)]
+    assert a == [sampling.map_jitter(s, 0, 16) for s in range(16)]  # a function of (s, N, light)
+    assert a != [sampling.map_jitter(s, 1, 16) for s in range(16)]
+
+
+def test_jittered_lights_carry_their_shift_and_offsets_shrinking_as_one_over_root_n():
+    hard = _light("SUN")
+    sun = _light("SUN", angle=math.radians(0.526))
+    for light in (hard, sun):
+        first = sampling.light_at_sample(light, 0, 0, 16, jitter=True)
+        later = sampling.light_at_sample(light, 0, 5, 16, jitter=True)
+        assert first.jittered and later.jittered and first.sampled and later.sampled
+        assert first.map_jitter == (0.0, 0.0) and later.map_jitter == sampling.map_jitter(5, 0, 16)
+        assert later.offset_scale == pytest.approx(0.25) and later.bias_scale == light.bias_scale
+    spot = sampling.light_at_sample(_light("SPOT", radius=0.02), 0, 5, 16, jitter=True)
+    assert spot.jittered and spot.bias_scale == 1.0 and spot.offset_scale == pytest.approx(0.25)
+    assert sampling.light_at_sample(hard, 0, 5, 16) is hard  # no jitter: a hard light never changes
+    assert sampling.light_at_sample(hard, 0, 0, 1, jitter=True) is hard  # one sample: the light itself
+    # Sun points: stratified in the disc's area (Vogel's spiral), within the angle.
+    cos = [float(sampling.light_at_sample(sun, 0, s, 64, jitter=True).direction @ sun.direction) for s in range(64)]
+    assert min(cos) >= math.cos(math.radians(0.263)) - 1e-12
+
+
+@pytest.mark.parametrize("kind", ["POINT", "SPOT"])
+def test_point_and_spot_lights_are_sampled_as_spheres_seen_as_uniform_discs(kind):
+    """From any direction, the sampled points' projection across it is uniform on the disc of
+    the sphere's radius (as Cycles samples a sphere light's visible disc): the fraction
+    inside radius rho is rho^2, within the stratified set's precision."""
+    light = _light(kind, radius=0.5)
+    n = 1024
+    offsets = np.array([sampling.light_at_sample(light, 0, s, n).position - light.position for s in range(n)])
+    assert np.linalg.norm(offsets, axis=1).max() <= 0.5 + 1e-9
+    rng = np.random.default_rng(1)
+    for axis in rng.normal(size=(4, 3)):
+        axis /= np.linalg.norm(axis)
+        across = offsets - np.outer(offsets @ axis, axis)
+        rho = np.linalg.norm(across, axis=1) / 0.5
+        for q in (0.25, 0.5, 0.75, 0.9):
+            assert abs(np.mean(rho <= q) - q * q) < 0.03, (axis, q)
+    assert sampling._ball_radius(0.0) == 0.0 and sampling._ball_radius(1.0) == pytest.approx(1.0)
+
+
+def test_a_shifted_fit_moves_the_texel_grid_by_that_many_texels():
+    from penumbra.engine.shadows import lightspace
+
+    view = lightspace.look_at(np.array([0.0, 0.0, 5.0]), np.array([0.0, 0.0, -1.0]))
+    for proj in (lightspace.orthographic(-2, 2, -2, 2, 1, 9), lightspace.perspective(1.0, 1.0, 1.0, 9.0)):
+        fit = lightspace.Fit(view, proj, 1.0, 9.0, texel=0.01)
+        moved = lightspace.shifted(fit, (0.25, -0.5), 512)
+        p = np.array([0.3, -0.2, 1.0, 1.0])
+        a, b = fit.view_proj @ p, moved.view_proj @ p
+        texels = (b[:2] / b[3] - a[:2] / a[3]) * 0.5 * 512
+        np.testing.assert_allclose(texels, [0.25, -0.5], atol=1e-9)
+        assert (moved.near, moved.far, moved.texel) == (fit.near, fit.far, fit.texel)

@@ -19,13 +19,14 @@ def _soft_demo(width, height):
 
 
 def _hard_scene(size=32):
-    """Only hard lights and no pixel filter: every sample is the same image, so every pixel
-    converges at the first check."""
+    """Only hard lights, no pixel filter and no map jitter: every sample is the same image, so
+    every pixel converges at the first check."""
     scene = scenes.empty_scene(size, size)
     scenes.box_over_plane(scene)
     scenes.light(scene, "Sun", "SUN", 3.0, rotation=(0.3, 0.2, 0), angle=0.0)
     scenes.top_camera(scene)
     scene.penumbra.filter_size = 0.0
+    scene.penumbra.shadow_map_jitter = False
     return scene
 
 

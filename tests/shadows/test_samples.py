@@ -230,6 +230,9 @@ def test_a_new_process_renders_the_same_bits(penumbra):
 
 
 def test_hard_lights_keep_one_map_and_soft_lights_move_theirs(penumbra, gpu_call):
+    """Without map jitter a hard light's map is drawn once and reused. With it (the default)
+    every shadowed light's map moves by a sub-texel offset in each sample after the first,
+    so it is redrawn each sample; a light without shadows draws no map either way."""
     from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.empty_scene(48, 48)
@@ -242,6 +245,7 @@ def test_hard_lights_keep_one_map_and_soft_lights_move_theirs(penumbra, gpu_call
         out = engine.render_frame(depsgraph, cam, 48, 48, samples=(0, 8), sample_count=8)
         return out.stats
 
+    scene.penumbra.shadow_map_jitter = False
     sun.data.angle = 0.0
     hard = gpu_call(job)
     sun.data.angle = math.radians(5)
@@ -249,6 +253,13 @@ def test_hard_lights_keep_one_map_and_soft_lights_move_theirs(penumbra, gpu_call
     assert hard.samples == soft.samples == 8
     assert (hard.shadow_maps, hard.shadow_maps_reused, hard.lights_sampled) == (1, 7, 0)
     assert (soft.shadow_maps, soft.lights_sampled) == (8, 1)
+    scene.penumbra.shadow_map_jitter = True
+    sun.data.angle = 0.0
+    jittered = gpu_call(job)
+    assert (jittered.shadow_maps, jittered.shadow_maps_reused, jittered.lights_sampled) == (8, 0, 1)
+    sun.data.use_shadow = False
+    unshadowed = gpu_call(job)
+    assert (unshadowed.shadow_maps, unshadowed.lights_sampled) == (0, 0)
 
 
 def test_one_sample_is_the_single_sample_frame(penumbra, gpu_call):
@@ -327,9 +338,10 @@ def test_cancelling_keeps_the_samples_done_and_raises_nothing(penumbra, gpu_call
 
 
 def test_filter_size_zero_and_ten_and_hard_lights_at_many_samples(penumbra, gpu_call):
-    """filter_size 0 jitters nothing: with only hard lights every sample is the same, so any
-    sample count gives the one-sample image. filter_size 10 (its maximum) stays finite and
-    keeps the mean brightness (the filter is normalised)."""
+    """filter_size 0 jitters no pixel: with only hard lights and no map jitter every sample
+    is the same, so any sample count gives the one-sample image (with map jitter the shadow
+    edges average over texel grids: the same image but for them). filter_size 10 (its
+    maximum) stays finite and keeps the mean brightness (the filter is normalised)."""
     from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.demo_scene(48, 27)
@@ -351,8 +363,15 @@ def test_filter_size_zero_and_ten_and_hard_lights_at_many_samples(penumbra, gpu_
 
         return gpu_call(job)
 
+    scene.penumbra.shadow_map_jitter = False
     one, many = frames(0.0)
     np.testing.assert_allclose(many, one, rtol=1e-6, atol=1e-7)
+    scene.penumbra.shadow_map_jitter = True
+    one_jittered, many = frames(0.0)
+    np.testing.assert_array_equal(one_jittered, one)  # one sample: no jitter at all
+    changed = np.abs(many - one).max(axis=-1) > 1e-4
+    assert 0 < changed.mean() < 0.2  # shadow edges only
+    assert abs(many[..., :3].mean() - one[..., :3].mean()) < 0.01 * one[..., :3].mean()
     one, wide = frames(10.0)
     assert np.isfinite(wide).all()
     assert abs(wide[..., :3].mean() - one[..., :3].mean()) < 0.05 * one[..., :3].mean()

@@ -52,6 +52,12 @@ def add_arguments(parser):
     parser.add_argument("--cache", type=Path, default=kit.DEFAULT_CACHE, help="Cycles reference cache folder")
     parser.add_argument("--width", type=int, default=None, help="frame width (480; 160 with --quick)")
     parser.add_argument("--height", type=int, default=None, help="frame height (270; 90 with --quick)")
+    parser.add_argument("--scenes", default=None, help="comma-separated reference scenes (default: the plan's)")
+    parser.add_argument("--samples", default=None, help="comma-separated Penumbra sample counts (default: the plan's)")
+    parser.add_argument("--cycles-spp", default=None, help="comma-separated Cycles spp to time (default: the plan's)")
+    parser.add_argument(
+        "--sweep-only", action="store_true", help="only the error/time sweep: no demo-scene cost, no close-up"
+    )
 
 
 def log(message):
@@ -191,13 +197,20 @@ def run(args):
         plan["runs"] = args.runs
     if args.width or args.height:
         plan["size"] = (args.width or plan["size"][0], args.height or plan["size"][1])
+    if args.scenes:
+        plan["scenes"] = tuple(name.strip() for name in args.scenes.split(",") if name.strip())
+    if args.samples:
+        plan["samples"] = tuple(int(n) for n in args.samples.split(","))
+    if args.cycles_spp:
+        plan["cycles_spp"] = tuple(int(n) for n in args.cycles_spp.split(","))
     args.out.mkdir(parents=True, exist_ok=True)
     session.load_penumbra().register()
     started = time.perf_counter()
     with session.stdout_to_stderr():
         rows = sweep(plan, args.cache)
-        first, extra = sample_cost(plan)
-        closeup(args.out / "samples_closeup.png")
+        if not args.sweep_only:
+            first, extra = sample_cost(plan)
+            closeup(args.out / "samples_closeup.png")
     means = mean_rows(rows)
     report.write_csv(args.out / "samples.csv", rows + means, CSV_FIELDS)
     plot(means, args.out / "samples.png", plan)
@@ -216,10 +229,18 @@ def run(args):
     scenes = ", ".join(plan["scenes"])
     print(f"### Samples against error (mean over {scenes}; {w}x{h}; Cycles {plan['reference_spp']} spp reference)\n")
     print(report.markdown_table(["Engine", "Samples", "Time (s)", "Shadow MAE", "Shadow IoU", "Image MAE"], cells))
-    print(
-        f"\nOne sample of the demo scene at 960x540 (soft spot): {first * 1e3:.0f} ms; each further sample "
-        f"{extra * 1e3:.0f} ms ({extra / first:.2f}x the first)."
-    )
+    per_scene = [
+        [r["scene"], r["engine"], r["samples"], f"{r['time_s']:.3f}", f"{r['shadow_mae']:.4f}"]
+        + [f"{r['shadow_iou']:.3f}"]
+        for r in rows
+    ]
+    columns = ["Scene", "Engine", "Samples", "Time (s)", "Shadow MAE", "Shadow IoU"]
+    print("\n" + report.markdown_table(columns, per_scene))
+    if not args.sweep_only:
+        print(
+            f"\nOne sample of the demo scene at 960x540 (soft spot): {first * 1e3:.0f} ms; each further sample "
+            f"{extra * 1e3:.0f} ms ({extra / first:.2f}x the first)."
+        )
     print(
         f"\nBlender {bpy.app.version_string}; GPU: {session.gpu_renderer() or 'n/a'}; {plan['runs']} timed render(s) "
         f"per configuration; {(time.perf_counter() - started) / 60:.1f} min. Wrote samples.csv, samples.png, "
