@@ -133,20 +133,8 @@ class PenumbraEngineCore:
             if not self._wants_sample(done, target) or self._stopped:
                 return shown[1], False
             camera = camera_from_view(view_matrix, window_matrix)
-            deadline = self._started + adaptive.time_limit if adaptive is not None and adaptive.time_limit else None
-            out = self.render_frame(
-                depsgraph,
-                camera,
-                width,
-                height,
-                aux=False,
-                samples=(done, done + 1),
-                sample_count=count,
-                adaptive=adaptive,
-                deadline=deadline,
-            )
+            out = self._viewport_sample(depsgraph, camera, width, height, done, count, adaptive)
             self._shown = (key, out, done + out.stats.samples, target)
-            self._stopped = out.stats.stopped
             return out, True
         scale = float(settings.navigation_scale)
         moving = shown is not None and shown[0][:2] == (width, height) and shown[0] != key and scale < 1.0
@@ -159,21 +147,27 @@ class PenumbraEngineCore:
             self._shown = (key, out, 0, target)
         else:
             self._started = time.monotonic()
-            deadline = self._started + adaptive.time_limit if adaptive is not None and adaptive.time_limit else None
-            out = self.render_frame(
-                depsgraph,
-                camera,
-                width,
-                height,
-                aux=False,
-                samples=(0, 1),
-                sample_count=count,
-                adaptive=adaptive,
-                deadline=deadline,
-            )
+            out = self._viewport_sample(depsgraph, camera, width, height, 0, count, adaptive)
             self._shown = (key, out, 1, target)
-            self._stopped = out.stats.stopped
         return out, True
+
+    def _viewport_sample(self, depsgraph, camera, width, height, done, count, adaptive):
+        """Sample ``done`` of the viewport's frame of ``count``, within the time limit counted
+        from its first sample (``_started``); remembers why refinement stopped, if it did."""
+        deadline = self._started + adaptive.time_limit if adaptive is not None and adaptive.time_limit else None
+        out = self.render_frame(
+            depsgraph,
+            camera,
+            width,
+            height,
+            aux=False,
+            samples=(done, done + 1),
+            sample_count=count,
+            adaptive=adaptive,
+            deadline=deadline,
+        )
+        self._stopped = out.stats.stopped
+        return out
 
     @staticmethod
     def _wants_sample(done, target):
