@@ -1,13 +1,13 @@
 """The RenderEngine subclass: thin glue from Blender's callbacks to the Renderer."""
 
 import sys
-import time
 import traceback
 
 import bpy
 import numpy as np
 
 from . import gpu_pool
+from .frame import sampling
 from .frame.output import (
     frame_in_region,
     mist_pass,
@@ -146,7 +146,7 @@ class PenumbraEngineCore:
             out = self.render_frame(depsgraph, camera, w, h, pixel_scale=w / width, aux=False)
             self._shown = (key, out, 0, target)
         else:
-            self._started = time.monotonic()
+            self._started = sampling.clock()
             out = self._viewport_sample(depsgraph, camera, width, height, 0, count, adaptive)
             self._shown = (key, out, 1, target)
         return out, True

@@ -8,7 +8,6 @@ GPU batches (``draw_list``, ``batches``), the shadow pass (``shadow_pass``), the
 """
 
 import dataclasses
-import time
 
 import numpy as np
 
@@ -80,7 +79,7 @@ class Renderer:
         Threshold stops converged pixels (checked every few samples on the GPU; they are not
         shaded again) and ends the frame when every pixel has converged; its time limit ends
         it after the first sample that reaches it, counted from the first sample of this call
-        unless ``deadline`` (a ``time.monotonic()`` value) says when. Neither looks at a clock
+        unless ``deadline`` (a ``sampling.clock()`` value) says when. Neither looks at a clock
         when there is no time limit: a frame stays a function of the scene and its settings."""
         stats = FrameStats()
         compiled_before = self.shaders.compiled
@@ -121,7 +120,7 @@ class Renderer:
                 moving |= {i for i in first.lights if i < len(lights)}
         stats.lights_sampled = len(moving)
         if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
-            deadline = time.monotonic() + adaptive.time_limit
+            deadline = sampling.clock() + adaptive.time_limit
         pixels = width * height
         for s in range(start, stop):
             if accumulate and film.converged >= pixels:
@@ -152,7 +151,7 @@ class Renderer:
                 stats.stopped = "converged"
             if deadline is not None and accumulate and not stats.stopped:
                 film.finish()  # the sample's GPU work done, so the clock counts it
-                if time.monotonic() >= deadline:
+                if sampling.clock() >= deadline:
                     stats.stopped = "time limit"
             if on_sample is not None and on_sample(s + 1) is False:
                 stats.cancelled = True

@@ -39,6 +39,7 @@ k-th sample are the same sample, so N redraws show what a final render of N samp
 import dataclasses
 import functools
 import math
+import time
 
 import numpy as np
 
@@ -367,6 +368,13 @@ def light_at_sample(light, light_index, s, count, jitter=False, progressive=Fals
 
 
 # --- adaptive sampling ------------------------------------------------------------------------
+
+
+def clock():
+    """Seconds on a monotonic clock: what Time Limit counts (read here only, so a test can
+    drive it)."""
+    return time.monotonic()
+
 
 ADAPTIVE_STEP = 4  # samples between two convergence checks (Cycles' adaptive step)
 THRESHOLD_SCALE = 5.0  # Cycles scales the Noise Threshold by 5 before comparing the error with it

@@ -4,7 +4,6 @@ one sample of its budget, and with the Noise Threshold at 0 (or adaptive samplin
 pass is bit-identical to the frame without adaptive sampling."""
 
 import math
-import time
 
 import numpy as np
 
@@ -127,76 +126,74 @@ def test_the_viewport_stops_refining_a_converged_frame_and_says_so(penumbra, gpu
     assert statuses[-1] == "Sample 4/64 | Noise Threshold reached" and not refining
 
 
-def test_the_viewports_time_limit_ends_endless_refinement(penumbra, gpu_call):
-    """The budget is a few redraws long, as measured first on this machine (shared machines are
-    slow at times): refinement stops once it is spent, within about a redraw of it."""
+class _Clock:
+    """``sampling.clock`` driven by the test: each reading is ``step`` seconds after the last, so
+    the samples a time limit allows do not depend on how fast this machine is."""
+
+    def __init__(self, step):
+        self.now, self.step = 0.0, step
+
+    def __call__(self):
+        now = self.now
+        self.now += self.step
+        return now
+
+
+def test_the_viewports_time_limit_ends_endless_refinement(penumbra, gpu_call, monkeypatch):
+    """The clock starts with the first sample and is read after each sample's GPU work: with
+    a reading 0.125 s after the last and a 0.45 s limit, the fourth sample (at 0.5 s) is the last,
+    and the viewport says so."""
+    from penumbra.engine.frame import sampling
+
     scene = _soft_demo(48, 27)
     scene.penumbra.viewport_samples = 0  # refine without end
     scene.penumbra.use_preview_adaptive_sampling = False
+    scene.penumbra.preview_time_limit = 0.45
+    monkeypatch.setattr(sampling, "clock", _Clock(0.125))
 
-    def redraws_until_stopped(limit):
-        scene.penumbra.preview_time_limit = limit
+    def job(engine, depsgraph):
+        cam = scene.camera.evaluated_get(depsgraph)
+        view = cam.matrix_world.inverted()
+        window = cam.calc_matrix_camera(depsgraph, x=48, y=27, scale_x=1.0, scale_y=1.0)
+        redraws = 0
+        while engine.viewport_frame(depsgraph, view, window, 48, 27)[1]:
+            redraws += 1
+            assert redraws < 100
+        return redraws, engine.viewport_status(), engine.refining()
 
-        def job(engine, depsgraph):
-            cam = scene.camera.evaluated_get(depsgraph)
-            view = cam.matrix_world.inverted()
-            window = cam.calc_matrix_camera(depsgraph, x=48, y=27, scale_x=1.0, scale_y=1.0)
-            engine.viewport_frame(depsgraph, view, window, 48, 27)  # the first sample starts the clock
-            start = time.monotonic()
-            redraws, longest = 1, 0.0
-            while True:
-                before = time.monotonic()
-                if not engine.viewport_frame(depsgraph, view, window, 48, 27)[1]:
-                    break
-                longest = max(longest, time.monotonic() - before)
-                redraws += 1
-                assert redraws < 10000
-            return redraws, time.monotonic() - start, longest, engine.viewport_status(), engine.refining()
-
-        return gpu_call(job)
-
-    _r, _e, redraw, _s, _f = redraws_until_stopped(0.2)  # warm-up; one redraw's time
-    limit = max(0.3, 4.0 * redraw)
-    redraws, elapsed, longest, status, refining = redraws_until_stopped(limit)
-    assert status == f"Sample {redraws} | Time Limit reached" and not refining
-    assert redraws >= 2
-    assert elapsed < limit + 2.0 * longest + 0.5
+    redraws, status, refining = gpu_call(job)
+    assert redraws == 4
+    assert status == "Sample 4 | Time Limit reached" and not refining
 
 
-def test_time_limit_stops_within_one_sample_of_the_budget(penumbra, gpu_call):
+def test_time_limit_stops_within_one_sample_of_the_budget(penumbra, gpu_call, monkeypatch):
     """The clock starts with the samples (the scene is extracted and planned before it); the
-    frame ends after the first sample that finds the budget spent, so the samples take at
-    least the budget and at most the budget plus the last sample."""
+    frame ends after the first sample that finds the budget spent: the samples take at least
+    the budget and at most the budget plus one sample. With 0.125 s a sample (exact in binary)
+    and a 0.4375 s budget that is 4 samples; 0.5 s gives 4 as well (the check is >=), 0.5625 s 5."""
+    from penumbra.engine.frame import sampling
     from penumbra.engine.frame.sampling import adaptive_settings
     from penumbra.engine.scene.extract import camera_from_scene
 
     scene = _soft_demo(64, 36)
-    limit = 0.6
 
-    def job(engine, depsgraph):
-        cam = camera_from_scene(depsgraph, scene, 64, 36)
-        engine.render_frame(depsgraph, cam, 64, 36, samples=(0, 2), sample_count=4096)  # shaders compiled
-        adaptive = adaptive_settings(False, 0.0, 0, limit, 4096)
-        ends = []
-        start = time.monotonic()
-        out = engine.render_frame(
-            depsgraph,
-            cam,
-            64,
-            36,
-            samples=(0, 4096),
-            sample_count=4096,
-            adaptive=adaptive,
-            on_sample=lambda done: ends.append(time.monotonic()),
-        )
-        return out.stats, start, ends
+    def samples_within(limit):
+        monkeypatch.setattr(sampling, "clock", _Clock(0.125))
 
-    stats, start, ends = gpu_call(job)
-    assert stats.stopped == "time limit" and 2 <= stats.samples < 4096 and len(ends) == stats.samples
-    longest = max(np.diff(ends))
-    assert ends[-1] - start >= limit  # the budget was used
-    assert ends[-2] - start < limit + 0.05  # the sample before the last ended within it (+ scheduling)
-    assert ends[-1] - start <= limit + longest + 0.05, (ends[-1] - start, longest)
+        def job(engine, depsgraph):
+            cam = camera_from_scene(depsgraph, scene, 64, 36)
+            adaptive = adaptive_settings(False, 0.0, 0, limit, 4096)
+            done = []
+            out = engine.render_frame(
+                depsgraph, cam, 64, 36, samples=(0, 4096), sample_count=4096, adaptive=adaptive, on_sample=done.append
+            )
+            return out.stats, done
+
+        stats, done = gpu_call(job)
+        assert stats.stopped == "time limit" and done == list(range(1, stats.samples + 1))
+        return stats.samples
+
+    assert [samples_within(limit) for limit in (0.4375, 0.5, 0.5625)] == [4, 4, 5]
 
 
 def test_threshold_zero_or_off_is_bit_identical_to_the_plain_frame(penumbra, gpu_call):
