@@ -111,3 +111,17 @@ def test_the_level_follows_the_map_and_is_kept_between_frames(gpu_call, detailed
         assert batches.keys() == batches_after.keys()
         assert all(batches[k] is batches_after[k] for k in batches)
     assert counts[128] < counts[512] <= triangles
+
+
+@pytest.mark.parametrize("detail", [1e-9, 1e6])
+def test_caster_detail_at_its_extremes(gpu_call, detailed_scene, detail):
+    """A vanishing cell draws every triangle (no level is worth it); a cell wider than the map
+    draws the coarsest level: a finite frame, a shadow still there, far fewer triangles."""
+    scene, triangles = detailed_scene
+    stats, shadow, color = _frame(gpu_call, scene, detail)
+    assert np.isfinite(shadow).all() and np.isfinite(color).all()
+    if detail < 1.0:
+        assert stats.shadow_simplified == 0 and stats.shadow_triangles == triangles
+    else:
+        assert stats.shadow_simplified == 1 and stats.shadow_triangles < 0.01 * triangles
+        assert (shadow < 0.5).mean() > 0.02  # the coarse ball still casts
