@@ -194,3 +194,62 @@ SHADOW_MODE = Enum(
         ("CASCADE", "Cascade", "Up to four maps over slices of the visible depth range (sun)", 2),
     ),
 )
+
+DEBUG_VIEW = Enum(
+    "debug view",
+    "DEBUG_VIEW",
+    (
+        ("NONE", "None", "The rendered image", 0),
+        (
+            "SHADOW_MAPS",
+            "Shadow Maps",
+            "The shadow atlas as drawn this frame (near dark, far light), each map outlined and labelled with its "
+            "light, cube face or cascade and size in texels",
+            1,
+            {"legend": "shadow atlas depth: near dark, far light; outlines: each map, labelled light/face/size"},
+        ),
+        (
+            "TEXEL_DENSITY",
+            "Texel Density",
+            "Shadow-map texels per screen pixel at each shaded point, of the worst-sampled light there: red "
+            "undersampled, green matched, blue wasted",
+            2,
+            {
+                "lit": True,
+                "legend": "texels per pixel (worst light): red < 1 undersampled, green 1 matched, blue > 1 wasted; "
+                "grey: no map",
+            },
+        ),
+        (
+            "CASCADES",
+            "Cascades",
+            "Which cascade of a sun's map shades each pixel",
+            3,
+            {"lit": True, "legend": "sun cascade: red 0, green 1, blue 2, yellow 3; grey: no cascaded sun"},
+        ),
+        (
+            "LIGHT_COST",
+            "Light Cost",
+            "Lights evaluated per pixel (the screen bins' lists)",
+            4,
+            {"lit": True, "legend": "lights evaluated per pixel: dark 0 to bright at the frame's most"},
+        ),
+        (
+            "SAMPLES",
+            "Samples",
+            "Samples taken per pixel (adaptive sampling stops converged pixels early)",
+            5,
+            {"legend": "samples per pixel: dark 1 to bright at the frame's samples"},
+        ),
+        (
+            "NOISE",
+            "Noise",
+            "The per-pixel error estimate adaptive sampling compares with the Noise Threshold",
+            6,
+            {"legend": "noise estimate: green below the Noise Threshold (converged), yellow to red up to 10x it"},
+        ),
+    ),
+    # lit: the lit pass writes the view's values instead of colour (the DEBUG_LIT variant);
+    # legend: what the colours mean (the viewport's text and the render report).
+    fact_defaults={"lit": False, "legend": ""},
+)

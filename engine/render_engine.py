@@ -346,6 +346,10 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     stopped = f"Sample {out.stats.samples}/{count} | {STOPPED[out.stats.stopped]}"
                     self.update_stats("", f"{label} | {stopped}")
                     self.report({"INFO"}, f"Penumbra: {label[11:]}: {stopped}")
+                legend = out.stats.debug_legend
+                if legend and legend not in reported:  # what a debug view's colours mean
+                    reported.add(legend)
+                    self.report({"INFO"}, f"Penumbra debug view {legend}")
                 for message in out.stats.messages:
                     if message not in reported:
                         reported.add(message)
@@ -422,7 +426,9 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         self._reported = None
         # What the final render would put in its report (lights left out, clamped maps) shows
         # in the viewport's text overlay, as Blender's engines show their status there.
-        self.update_stats("", " | ".join([self.viewport_status(), *out.stats.messages]).strip(" |"))
+        # A debug view says what its colours mean there too.
+        status = [self.viewport_status(), out.stats.debug_legend, *out.stats.messages]
+        self.update_stats("", " | ".join(t for t in status if t))
         window = self.viewport_region(context, depsgraph, width, height)
         if window is not None:  # an empty render region shows nothing
             self.draw_display(depsgraph.scene, out.color, width, height, window)

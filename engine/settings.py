@@ -15,7 +15,7 @@ its value). ``properties.py`` runs them when a file is loaded.
 import dataclasses
 from dataclasses import dataclass
 
-from .enums import DEPTH_FORMAT, SHADOW_FILTER, SPECULAR_MODEL, SUN_FIT
+from .enums import DEBUG_VIEW, DEPTH_FORMAT, SHADOW_FILTER, SPECULAR_MODEL, SUN_FIT
 
 TYPES = ("FLOAT", "INT", "BOOL", "COLOR", "ENUM", "IMAGE")
 
@@ -128,6 +128,7 @@ SHADOWS = "shadows"
 LIGHTING = "lighting"
 VIEWPORT = "viewport"
 SIMPLIFY = "simplify"
+DEBUG = "debug"
 
 SCENE_PARAMS = (
     Param(
@@ -458,6 +459,17 @@ SCENE_PARAMS = (
         label="Merge Below",
         section=SIMPLIFY,
         unit="PIXELS",
+    ),
+    Param(
+        "debug_view",
+        "ENUM",
+        "NONE",
+        "Show what a frame's quality and time went to instead of the image, in the viewport and the final "
+        "render: the shadow maps, texel density, sun cascades, lights per pixel, samples per pixel or the "
+        "noise estimate adaptive sampling uses",
+        enum=DEBUG_VIEW,
+        label="Debug View",
+        section=DEBUG,
     ),
 )
 

@@ -19,7 +19,11 @@
  * TERMINATOR_OFFSET lifts each light's shadow point towards the smooth surface the vertex
  * normals imply (Cycles' Geometry Offset), TERMINATOR_NORMAL moves it along the normal (EEVEE's
  * Normal Offset), TERMINATOR_SHADING raises the cosine term's frequency (Cycles' Shading
- * Offset). */
+ * Offset).
+ *
+ * DEBUG_LIT (the TEXEL_DENSITY, CASCADES and LIGHT_COST debug views, engine/frame/debug_view.py):
+ * the pixel writes the lights it evaluated, the cascade it read and its worst texel density
+ * instead of colour. */
 
 struct Surface {
   vec3 P, N, V;
@@ -79,6 +83,9 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   if (((uint(light_mask[i >> 5]) >> uint(i & 31)) & 1u) == 0u) {
     return;
   }
+#endif
+#if DEBUG_LIT
+  debug_lights += 1.0;
 #endif
   LightData L = lights[i];
   vec3 to_light;
@@ -303,6 +310,10 @@ void main()
   s.albedo *= clamp(1.0 - (f0_dielectric * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
   vec3 color = world_light(s, rough, ab);
   float arriving = 0.0, unshadowed = 0.0;
+#if DEBUG_LIT
+  debug_dPdx = dFdx(s.P);
+  debug_dPdy = dFdy(s.P);
+#endif
 #if LIGHT_BINS
   /* Only the lights this pixel's screen bin lists (engine/shadows/light_bins.py): word w of the bin
    * holds lights w * LIGHT_WORD_BITS + bit, as exact small integers in a float channel.
@@ -379,6 +390,9 @@ void main()
   out_color = vec4(color * a, a); /* premultiplied, blended over what is behind */
 #else
   out_color = vec4(color, 1.0);
+#endif
+#if DEBUG_LIT
+  out_color = vec4(debug_lights, debug_cascade, debug_density, 1.0); /* a lit debug view's values */
 #endif
 #if AUX_OUTPUTS
   out_depth = v_view_depth;

@@ -3,6 +3,7 @@
 import bpy
 
 from ..engine import settings
+from ..engine.enums import DEBUG_VIEW
 from ..engine.post import EFFECTS
 
 
@@ -103,6 +104,45 @@ class PENUMBRA_PT_simplify(_SettingsPanel, bpy.types.Panel):
     def draw(self, context):
         self.layout.active = context.scene.render.use_simplify
         super().draw(context)
+
+
+class PENUMBRA_PT_debug(_SettingsPanel, bpy.types.Panel):
+    """Debug views (``scene.penumbra.debug_view``) in Render Properties."""
+
+    bl_label = "Debug"
+    section = settings.DEBUG
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        super().draw(context)
+        view = context.scene.penumbra.debug_view
+        if view != "NONE":
+            self.layout.label(text=DEBUG_VIEW[view].legend, icon="INFO")
+
+
+class PENUMBRA_PT_shading_debug(bpy.types.Panel):
+    """The debug view in the viewport header's Shading popover, in Rendered shading (where
+    Cycles puts its Render Pass)."""
+
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "HEADER"
+    bl_parent_id = "VIEW3D_PT_shading"
+    bl_label = "Penumbra Debug"
+
+    @classmethod
+    def poll(cls, context):
+        space = context.space_data
+        return (
+            context.scene is not None
+            and context.scene.render.engine == "PENUMBRA"
+            and getattr(getattr(space, "shading", None), "type", None) == "RENDERED"
+        )
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(context.scene.penumbra, "debug_view", text="Debug View")
 
 
 class PENUMBRA_PT_film(PenumbraPanel, bpy.types.Panel):
@@ -248,6 +288,8 @@ classes = (
     PENUMBRA_PT_lighting,
     PENUMBRA_PT_viewport,
     PENUMBRA_PT_simplify,
+    PENUMBRA_PT_debug,
+    PENUMBRA_PT_shading_debug,
     PENUMBRA_UL_layers,
     PENUMBRA_MT_layer_add,
     PENUMBRA_PT_sidebar_layers,

@@ -12,6 +12,7 @@ from ..post.base import PostContext
 from .programs import (
     CONVERGED_DEPTH,
     CONVERGENCE,
+    CONVERGENCE_ERROR,
     MASKED_COPY,
     MASKED_COPY_SHADOW_WEIGHT,
     MASKED_COPY_WEIGHT,
@@ -36,6 +37,7 @@ class FrameOutput:
     depth_data: object = None  # arrays of the centred sample when several were accumulated
     normal_data: object = None
     emission: object = None  # GPUTexture, the Emission pass (when asked for)
+    debug: object = None  # debug_view.DebugImage when a debug view replaced the image
 
     def emission_array(self):
         return texture_array(self.emission, 4)[..., :3]
@@ -99,6 +101,7 @@ class Film:
         self._accum_color = self._accum_shadow = self._accum_fb = self._resolve_fb = None
         self._emission_targets = None  # (accumulation, its framebuffer, the resolve's framebuffer)
         self._weight_sum = 0.0
+        self.sample_weights = []  # each accumulated sample's filter weight, in order
         self._fullscreen_batch = None
         # Adaptive sampling: the every-other-sample accumulation, the converged masks (read
         # one, write the other), each pixel's weight once some pixel converged.
@@ -192,6 +195,7 @@ class Film:
             if emission:
                 self._emission_accumulation().clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
             self._weight_sum = 0.0
+            self.sample_weights = []
 
     def accumulate(self, weight, aux, emission, sample=0):
         """accumulation += weight * this sample (colour, shadow with ``aux``, and Emission),
@@ -217,6 +221,7 @@ class Film:
                 SCALED_COPY, self._shaded_total_fb, {"src_color": self.shaded}, {"scale": 1.0}, "ADDITIVE_PREMULT"
             )
         self._weight_sum += weight
+        self.sample_weights.append(float(weight))
 
     def _copy(self, framebuffer, source, scale, mask):
         """framebuffer += scale * source, where not converged (``mask``, when some pixel is)."""
@@ -325,6 +330,43 @@ class Film:
         if self._weight is None:
             return np.full(self.size[::-1], self._weight_sum, np.float32)
         return texture_array(self._weight, 1)[..., 0]
+
+    def samples_array(self):
+        """Samples each pixel took, (height, width): its weight (the filter weights of the
+        samples it was shaded in, which are the first ones: a pixel stops when it converges)
+        against the running totals of the samples' weights."""
+        totals = np.cumsum(np.asarray(self.sample_weights, np.float64))
+        if totals.size == 0:
+            return np.zeros(self.size[::-1], np.float32)
+        weights = self.weights_array().astype(np.float64)
+        counts = np.searchsorted(totals, weights * (1.0 - 1e-5), side="left") + 1
+        return np.where(weights > 0.0, np.minimum(counts, totals.size), 0).astype(np.float32)
+
+    def error_array(self):
+        """Each pixel's error estimate as adaptive sampling's check reads it (the largest of its
+        3x3 neighbourhood), in units of the Noise Threshold, (height, width); None when the
+        frame did not track it (a frame without adaptive sampling, or one sample)."""
+        import gpu
+
+        if not self.tracking or self._half is None or not self.sample_weights:
+            return None
+        target = new_texture(self.pool, self.size, "R32F")
+        framebuffer = gpu.types.GPUFrameBuffer(color_slots=(target,))
+        samplers = {
+            "accum": self._accum_color,
+            "half_accum": self._half,
+            "converged": self._masks[self._mask_index],
+            "weight": self._weight if self._weight is not None else self._masks[self._mask_index],
+        }
+        uniforms = {
+            "threshold": float(THRESHOLD_SCALE),
+            "weight_sum": float(self._weight_sum),
+            "per_pixel": 1.0 if self._weight is not None else 0.0,
+        }
+        self.fullscreen(CONVERGENCE_ERROR, framebuffer, samplers, uniforms)
+        values = texture_array(target, 1)[..., 0].copy()
+        self._give([target])
+        return values
 
     def _masked_fb(self, with_shadow):
         """The framebuffer a masked sample is added through: accumulation (colour, shadow) and

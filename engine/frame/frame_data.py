@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..enums import LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
+from ..enums import DEBUG_VIEW, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
 from ..shadows import kernels, light_bins, lightspace
 from ..shadows.kernels import RING
 from .programs import (
@@ -204,6 +204,7 @@ def build_frame_data(
             sampled > 0,
             (sampled, shadowed, len(lights)),
             any(light.receivers is not None for light in lights),
+            DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].lit,
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

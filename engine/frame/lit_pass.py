@@ -36,7 +36,10 @@ class LitPass:
         world_data, world_color = world
         shadow_tex = atlas.texture if atlas is not None else self._shadow_dummy()
         # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
-        bg = (0.0, 0.0, 0.0, 0.0) if settings.film_transparent else (*map(float, world_color[:3]), 1.0)
+        # A lit debug view's values start at 0 where no surface is (``DEBUG_LIT``).
+        debug = bool(data.defines.get("DEBUG_LIT"))
+        transparent = settings.film_transparent or debug
+        bg = (0.0, 0.0, 0.0, 0.0) if transparent else (*map(float, world_color[:3]), 1.0)
         emission = aux and emission
         counted = film.fb_counted is not None and not aux  # the shading count of tests
         fb = film.fb_emit if emission else (film.fb if aux else (film.fb_counted if counted else film.fb_color))
@@ -46,7 +49,7 @@ class LitPass:
         converged = film.mask is not None
         if converged:
             film.mask_depth(fb)
-        if world_data is not None and world_data.image is not None and not settings.film_transparent:
+        if world_data is not None and world_data.image is not None and not transparent:
             self._background(film, world_data, camera, origin, "LESS_EQUAL" if converged else "NONE")
         # Closed instances wholly beyond the near plane: from there no back face shows.
         outside = set()

@@ -409,6 +409,9 @@ CONVERGENCE = Program(
     ),
     outputs=(("VEC4", "out_color"),),
 )
+CONVERGENCE = replace(CONVERGENCE, defines=(("ERROR_OUTPUT", False),))
+# The NOISE debug view: each pixel's error estimate as the check reads it (``Film.error_array``).
+CONVERGENCE_ERROR = replace(CONVERGENCE, name="convergence_error", defines=(("ERROR_OUTPUT", True),))
 CONVERGED_DEPTH = Program(
     name="converged_depth",
     vertex="fullscreen.vert.glsl",
@@ -487,6 +490,7 @@ def lit_defines(
     sampled=False,
     light_counts=None,
     light_linking=False,
+    debug=False,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -500,7 +504,9 @@ def lit_defines(
     offsets instead of through a loop (about a tenth of the demo's lit pass on llvmpipe);
     otherwise a class of lights the frame has none of gets no loop (a loop's body costs one
     masked pass on llvmpipe even when it runs zero times). ``light_linking``: some light
-    lights only some objects; each object's ``light_mask`` says which."""
+    lights only some objects; each object's ``light_mask`` says which. ``debug``: the variant
+    writes what a lit debug view shows instead of colour (``DEBUG_LIT``: lights evaluated,
+    sun cascade + 1, texel density of the worst-sampled light, coverage)."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -528,4 +534,5 @@ def lit_defines(
         "SHADOWED_COUNT": counts[1],
         "LIGHT_COUNT": counts[2],
         "LIGHT_LINKING": bool(light_linking),
+        "DEBUG_LIT": bool(debug),
     }

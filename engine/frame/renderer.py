@@ -11,11 +11,12 @@ import dataclasses
 
 import numpy as np
 
+from ..enums import DEBUG_VIEW, DEPTH_FORMAT
 from ..gpu_pool import FINAL_IMAGES
 from ..post import post_stack
 from ..scene.textures import TextureCache
 from ..shadows import lightspace
-from . import sampling
+from . import debug_view, sampling
 from .batches import Batches
 from .draw_list import corners_of, draw_list, light_masks, lights_in_view
 from .film import Film, FrameOutput
@@ -45,6 +46,9 @@ class Renderer:
         self.shadow_pass = ShadowPass(pool)
         self.lit_pass = LitPass(self.shaders, self.materials, self.textures)
         self.post = post_stack()
+        self._last_plan = None  # the last sample's shadow plan (the SHADOW_MAPS view)
+        self._last_data = None  # and its frame data (light bins, light order)
+        self._last_lights = []  # the lights of the last sample (what its shadow plan indexes)
         self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
 
     @property
@@ -104,10 +108,13 @@ class Renderer:
             )
         start, stop = samples
         accumulate = sample_count > 1
-        adaptive = adaptive if accumulate else None
+        debug = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
+        # A lit debug view's values are not colour: no noise estimate of theirs ends a frame.
+        adaptive = adaptive if accumulate and not debug.lit else None
         noise = adaptive is not None and adaptive.threshold > 0.0
         if accumulate:
-            film.begin(aux, emission, fresh=start == 0, adaptive=noise)
+            # The NOISE view shows the estimate even where no threshold uses it.
+            film.begin(aux, emission, fresh=start == 0, adaptive=noise or debug.id == "NOISE")
         plan = None
         moving = set()
         # With map jitter every shadowed light changes from sample to sample (its maps' texel
@@ -162,15 +169,24 @@ class Renderer:
         if accumulate and stats.samples:
             film.resolve(aux, emission)
         self.batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()})
-        color = self._post_pass(settings, stats)
+        debug_image = None
+        if debug.id != "NONE":  # the view instead of the image (and instead of the post stack)
+            debug_image = self._debug_view(debug.id, accumulate, settings)
+            color = debug_view.upload(debug_image, settings.pixel_scale)
+            stats.debug_legend = debug_image.legend
+        else:
+            color = self._post_pass(settings, stats)
         stats.shadow_bytes = self.shadows.memory_bytes if plan is not None and plan.tiles else 0
         stats.texture_bytes = (
             film.target_bytes(aux, accumulate) + stats.shadow_bytes + film.post_ctx.memory_bytes + self.textures.bytes
         )
         stats.shaders_compiled = self.shaders.compiled - compiled_before
         if not aux:
-            return FrameOutput(color, None, None, stats, width, height, lit=film.color)
+            out = FrameOutput(color, None, None, stats, width, height, lit=film.color)
+            out.debug = debug_image
+            return out
         out = FrameOutput(color, film.depth, film.shadow, stats, width, height, lit=film.color, normal=film.normal)
+        out.debug = debug_image
         out.emission = film.emission if emission else None
         if accumulate and film.centre is not None:
             out.depth_data, out.normal_data = film.centre
@@ -183,6 +199,7 @@ class Renderer:
         film = self.film
         width, height = film.size
         lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats)
+        self._last_lights = lights
         plan = self.shadow_pass.draw(
             draws,
             lights,
@@ -197,6 +214,7 @@ class Renderer:
             self._origin,
             alpha_offset,
         )
+        self._last_plan = plan
         depth_range = self.shadow_pass.depth_range
         if depth_range is UNSET:  # no shadow plan this frame: the quick, wider bound
             depth_range = lightspace.box_depth_range(camera.projection, camera.view, corners_of(draws), camera.is_ortho)
@@ -221,6 +239,7 @@ class Renderer:
             alpha_offset=alpha_offset,
             origin=self._origin,
         )
+        self._last_data = data
         stats.binned = data.bins is not None
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
@@ -229,6 +248,27 @@ class Renderer:
             film, seen, view_camera, data, atlas, world, settings, aux, emission, stats, self._origin, masks
         )
         return plan
+
+    def _debug_view(self, view, accumulate, settings):
+        """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``)."""
+        from .film import texture_array
+
+        film = self.film
+        width, height = film.size
+        if DEBUG_VIEW[view].lit:
+            return debug_view.lit_view(view, texture_array(film.color, 4))
+        if view == "SAMPLES":
+            samples = film.samples_array() if accumulate else np.ones((height, width), np.float32)
+            return debug_view.samples_view(samples)
+        if view == "NOISE":
+            return debug_view.noise_view(film.error_array() if accumulate else None, film.size)
+        atlas = self.shadows
+        plan = self._last_plan
+        depths = None
+        if plan is not None and plan.tiles and atlas.texture is not None:
+            channels = DEPTH_FORMAT[atlas.depth_format].channels
+            depths = debug_view.atlas_depths(texture_array(atlas.texture, channels), atlas.depth_format)
+        return debug_view.shadow_maps_view(depths, plan, self._last_lights, film.size)
 
     def _post_pass(self, settings, stats):
         ctx = self.film.post_ctx

@@ -29,5 +29,6 @@ class FrameStats:
     lights_out_of_view: int = 0  # lights that reach no visible surface: no map, no shading
     closed_culled: int = 0  # closed instances drawn without back faces (lit pass and each map)
     simplified: int = 0  # instances drawn at a level of detail (``simplify``; ``triangles`` counts its)
+    debug_legend: str = ""  # a debug view's legend: what its colours mean (``debug_view``)
     binned: bool = False  # the lit pass looped over each screen bin's lights only
     messages: list = field(default_factory=list)  # what the user must be told about this frame

@@ -148,6 +148,7 @@ class Light:
     specular_factor: float = 1.0
     receivers: LinkSet | None = None  # light linking: what it lights (None: everything)
     blockers: LinkSet | None = None  # shadow linking: what casts its shadow (None: everything)
+    name: str = ""  # the light object's name (what the SHADOW_MAPS debug view labels its maps with)
 
     @property
     def spot_axes(self):
@@ -684,6 +685,7 @@ class SceneCache:
                     )
                 light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
                 if light is not None:
+                    light.name = ob.name
                     linking = getattr(ob, "light_linking", None)
                     if linking is not None:
                         light.receivers = linked(linking.receiver_collection)

@@ -45,6 +45,17 @@ int cube_face(vec3 d)
 /* Texels per side of the map being read (ShadowTile.size), set by shadow_visibility. */
 int tile_texels = 1;
 
+#if DEBUG_LIT
+/* What the lit debug views show (programs.lit_defines ``debug``), set as the lights are
+ * evaluated: lights evaluated, 1 + the cascade of the first cascaded sun looked up, and the
+ * map texels per screen pixel of the worst-sampled light (0: no map looked up). The pixel's
+ * footprint (world-space derivatives of P) comes from main, where derivatives are defined. */
+float debug_lights = 0.0;
+float debug_cascade = 0.0;
+float debug_density = 0.0;
+vec3 debug_dPdx = vec3(0.0), debug_dPdy = vec3(0.0);
+#endif
+
 /* 1 when ref is in front of the stored depth at integer texel st of the tile. Texels outside
  * the tile are lit: nothing was fitted to cast there. */
 float shadow_tap(ivec2 origin, ivec2 st, float ref)
@@ -141,6 +152,11 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
       }
     }
     tile = L.tiles[c];
+#if DEBUG_LIT
+    if (debug_cascade == 0.0 && tile >= 0) {
+      debug_cascade = float(c + 1);
+    }
+#endif
   }
   else {
     int face = cube_face(P - L.position);
@@ -171,6 +187,18 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
     return 1.0;
   }
   vec2 uv = t.xy / t.w;
+#if DEBUG_LIT
+  {
+    /* The map's texel coordinates st = size * t.xy / t.w, differentiated along the pixel's
+     * footprint: texels per pixel = sqrt(|det d(st)/d(x, y)|). */
+    mat4 M = T.proj_tex * T.view;
+    vec4 tx = M * vec4(debug_dPdx, 0.0), ty = M * vec4(debug_dPdy, 0.0);
+    vec2 sx = float(T.size) * (tx.xy * t.w - t.xy * tx.w) / (t.w * t.w);
+    vec2 sy = float(T.size) * (ty.xy * t.w - t.xy * ty.w) / (t.w * t.w);
+    float density = sqrt(abs(sx.x * sy.y - sx.y * sy.x));
+    debug_density = (debug_density > 0.0) ? min(debug_density, density) : density;
+  }
+#endif
   float receiver = -vp.z;
   float constant_bias = frame.constant_bias * bias_scale * texel;
   float slope_bias = frame.slope_bias * bias_scale * texel * tan_t;

@@ -105,6 +105,7 @@ def test_every_scene_setting_is_drawn_by_a_panel_section():
         settings.LIGHTING,
         settings.VIEWPORT,
         settings.SIMPLIFY,
+        settings.DEBUG,
     }
     assert {p.section for p in settings.SCENE_PARAMS} <= sections
     assert all(p.section is not None for p in settings.SCENE_PARAMS + settings.LIGHT_PARAMS)
