@@ -258,6 +258,11 @@ class PENUMBRA_OT_compare_cycles(bpy.types.Operator):
         scene.render.engine = engine
         if engine == "PENUMBRA":
             saved.set(scene.penumbra, "render_samples", self.samples)
+            saved.set(scene.penumbra, "debug_view", "NONE")  # the image, not a debug view of it
+            # Post layers change the image after the light is computed, where Cycles has none.
+            for layer in scene.penumbra.layers:
+                if layer.enabled:
+                    saved.set(layer, "enabled", False)
             return
         c = scene.cycles
         saved.set(c, "samples", self.samples)
@@ -313,14 +318,19 @@ class PENUMBRA_OT_compare_cycles(bpy.types.Operator):
             "penumbra_time": times["PENUMBRA"],
             "cycles_time": times["CYCLES"],
         }
-        out = np.ones((h, 3 * w, 4), np.float32)
-        out[:, :w, :3] = pen[..., :3]
-        out[:, w : 2 * w, :3] = cyc[..., :3]
-        out[:, 2 * w :, :3] = err_rgb
+        # Below the three parts, under the error part: its colour scale from 0 (left) to 1.
+        rows = legend_rows(h)
+        numbers["legend_rows"] = rows
+        out = np.ones((h + rows, 3 * w, 4), np.float32)
+        out[:rows, :, :3] = 0.0
+        out[:rows, 2 * w :, :3] = colormap((np.arange(w) + 0.5) / w)[None]
+        out[rows:, :w, :3] = pen[..., :3]
+        out[rows:, w : 2 * w, :3] = cyc[..., :3]
+        out[rows:, 2 * w :, :3] = err_rgb
         old = bpy.data.images.get(IMAGE_NAME)
         if old is not None:
             bpy.data.images.remove(old)
-        image = bpy.data.images.new(IMAGE_NAME, 3 * w, h, alpha=True, float_buffer=True)
+        image = bpy.data.images.new(IMAGE_NAME, 3 * w, h + rows, alpha=True, float_buffer=True)
         try:
             image.pixels.foreach_set(out.ravel())
             image.update()
@@ -338,6 +348,12 @@ class PENUMBRA_OT_compare_cycles(bpy.types.Operator):
             if area.type == "IMAGE_EDITOR":
                 area.spaces.active.image = image
                 return
+
+
+def legend_rows(height):
+    """Rows of the colour scale under a comparison of ``height`` rows (the image's
+    ``legend_rows`` property)."""
+    return max(4, height // 16)
 
 
 def menu_entry(self, context):

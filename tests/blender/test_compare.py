@@ -40,6 +40,8 @@ def touched(scene):
                    if hasattr(s, n)})
     values["penumbra.render_samples"] = scene.penumbra.render_samples
     values["penumbra.use_adaptive_sampling"] = scene.penumbra.use_adaptive_sampling
+    values["penumbra.debug_view"] = scene.penumbra.debug_view
+    values["penumbra.layers"] = [(layer.effect, layer.enabled) for layer in scene.penumbra.layers]
     values.update({"light." + ob.name: ob.data.use_shadow for ob in scene.objects if ob.type == "LIGHT"})
     values["passes"] = [scene.view_layers[0].use_pass_z, scene.view_layers[0].penumbra.use_pass_shadow]
     return values
@@ -51,6 +53,10 @@ def unusual(scene):
     c.use_denoising, c.use_adaptive_sampling = True, True
     c.caustics_reflective = c.caustics_refractive = True
     scene.penumbra.render_samples = 3
+    # A debug view and a post layer: the compare shows the image without either.
+    scene.penumbra.debug_view = "LIGHT_COST"
+    scene.penumbra.layers.clear()
+    scene.penumbra.layers.add().effect = "VIGNETTE"
     scene.render.image_settings.file_format = "PNG"
     scene.render.image_settings.color_depth = "16"
 
@@ -59,7 +65,12 @@ def parts(image):
     px = np.empty(w * h * 4, np.float32)
     image.pixels.foreach_get(px)
     px = px.reshape(h, w, 4)
+    rows = image["legend_rows"]
     third = w // 3
+    # The error part's colour scale runs under it, 0 to 1 from left to right.
+    legend = px[:rows, 2 * third:, :3]
+    assert np.allclose(legend, compare.colormap((np.arange(third) + 0.5) / third)[None], atol=1e-5)
+    px = px[rows:]
     return px[:, :third], px[:, third:2 * third], px[:, 2 * third:]
 
 def report(**values):
@@ -117,7 +128,7 @@ def test_box_over_plane_agrees_with_cycles_and_every_setting_comes_back():
         result["away_pixels"],
     )
     assert result["status"] == ["FINISHED"] and result["full"] == ["FINISHED"]
-    assert result["size"] == [3 * 96, 64]
+    assert result["size"] == [3 * 96, 64 + result["numbers"]["legend_rows"]]
     assert n["iou"] >= 0.98
     assert n["mean_shadow_error"] < 0.02 and n["mean_image_error"] < 0.02
     assert n["penumbra_time"] > 0 and n["cycles_time"] > 0 and n["samples"] == 16
