@@ -167,6 +167,12 @@ def finite(x):
     return np.where(np.isfinite(x), x, F(0.0)).astype(np.float32)
 
 
+def _scaled(x, scale):
+    """finite(x) * scale in float32; an overflow gives inf, as on the GPU."""
+    with np.errstate(over="ignore"):
+        return finite(x) * F(scale)
+
+
 # --- gradient noise -------------------------------------------------------------------------
 
 
@@ -386,7 +392,7 @@ def node_tex_noise(
     """The Noise Texture node: (n, 4) with Color in [:, :3] and Fac in [:, 3]."""
     detail = float(np.clip(F(detail), 0.0, 15.0))
     roughness = max(F(roughness), F(0.0))
-    p = _node_point(dimensions, finite(vector) * F(scale), finite(w) * F(scale))
+    p = _node_point(dimensions, _scaled(vector, scale), _scaled(w, scale))
     d = p.shape[1]
     if distortion != 0.0:
         first = 0
@@ -629,7 +635,8 @@ def voronoi_fractal(coord, feature, metric, exponent, randomness, smoothness, de
     position = np.zeros((n, 4), np.float32)
     zero_input = detail == 0 or roughness == 0
     for i in range(int(np.ceil(detail)) + 1):
-        c = finite(coord * octave_scale)
+        with np.errstate(over="ignore"):
+            c = finite(coord * octave_scale)
         if feature == VORONOI_F2:
             od, oc, op = voronoi_f2(c, metric, exponent, randomness, hash_mode)
         elif feature == VORONOI_SMOOTH_F1 and smoothness != 0:
@@ -667,7 +674,9 @@ def voronoi_fractal_edge(coord, randomness, detail, roughness, lacunarity, norma
     dist = np.full(len(coord), 8.0, np.float32)
     zero_input = detail == 0 or roughness == 0
     for i in range(int(np.ceil(detail)) + 1):
-        od = voronoi_distance_to_edge(finite(coord * octave_scale), randomness, hash_mode)
+        with np.errstate(over="ignore"):
+            c = finite(coord * octave_scale)
+        od = voronoi_distance_to_edge(c, randomness, hash_mode)
         if zero_input:
             dist = od
             break
@@ -708,7 +717,7 @@ def node_tex_voronoi(
     roughness = float(np.clip(F(roughness), 0.0, 1.0))
     randomness = float(np.clip(F(randomness), 0.0, 1.0))
     smoothness = float(np.clip(F(smoothness) / F(2.0), 0.0, 0.5))
-    p = _node_point(dimensions, finite(finite(vector) * F(scale)), finite(finite(w) * F(scale)))
+    p = _node_point(dimensions, finite(_scaled(vector, scale)), finite(_scaled(w, scale)))
     out = np.zeros((len(p), 8), np.float32)
     half = F(F(0.5) + F(0.5) * F(randomness))
     if feature == VORONOI_DISTANCE_TO_EDGE:
