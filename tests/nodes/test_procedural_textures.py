@@ -9,10 +9,10 @@ import bpy
 import numpy as np
 import pytest
 
-from devkit import engines, scenes
 from devkit import texture_reference as ref
 from devkit.render import render
 from devkit.texture_gpu import evaluate_many
+from devkit.texture_tiles import build_tiles, compare, gpu_scene, points, tile_errors
 
 HASH = ["texture_hash.glsl"]
 NOISE = HASH + ["texture_noise.glsl"]
@@ -22,29 +22,8 @@ SWIZZLE = {1: "a0.w", 2: "a0.xy", 3: "a0.xyz", 4: "a0"}
 HASH_MODE = ref.VORONOI_HASH_INT if bpy.app.version >= (5, 0, 0) else ref.VORONOI_HASH_FLOAT
 
 
-def _gpu_scene():
-    """Any scene with a camera: the GPU runner renders the current scene."""
-    scene = scenes.empty_scene(8, 8)
-    scenes.top_camera(scene)
-    return scene
-
-
-def _points(n=2048, seed=7):
-    """Random points in [-10, 10]^4, then the hard cases: lattice points (exact integers,
-    negative too), 1e4-scale coordinates, and non-finite and huge values in every slot."""
-    rng = np.random.default_rng(seed)
-    pts = rng.uniform(-10.0, 10.0, (n, 4))
-    pts[:128] = np.round(pts[:128])
-    pts[128:256] = rng.uniform(-1.0e4, 1.0e4, (128, 4))
-    pts[256:320] *= 1.0e5  # past the noise's 100000 period and its 1e6 half-cell shift
-    special = [np.nan, np.inf, -np.inf, 1.0e30, -1.0e30, 0.0, -0.0, 3.0e38]
-    for i, v in enumerate(special):
-        pts[320 + i * 4 : 324 + i * 4, i % 4] = v
-    return pts.astype(np.float32)
-
-
 def test_hashes_are_bit_exact_on_the_gpu(penumbra, gpu_call):
-    _gpu_scene()
+    gpu_scene()
     rng = np.random.default_rng(3)
     keys = rng.integers(0, 2**32, (4096, 4), dtype=np.uint64).astype(np.uint32)
     keys[(keys & 0x7F800000) == 0x7F800000] &= 0xBFFFFFFF  # no NaN/inf bit patterns in the upload
@@ -75,12 +54,6 @@ def test_hashes_are_bit_exact_on_the_gpu(penumbra, gpu_call):
         np.testing.assert_array_equal((got[:, 2] << 16) | got[:, 3], e1)
 
 
-def _compare(out, expected, rtol, atol, what):
-    assert np.all(np.isfinite(out)), what
-    err = np.abs(out.astype(np.float64) - expected)
-    assert np.all(err <= atol + rtol * np.abs(expected)), (what, float(err.max()), int(np.argmax(err.max(1))))
-
-
 NOISE_CASES = [
     # (dimensions, detail, roughness, lacunarity, offset, gain, distortion, type, normalize)
     (1, 2.0, 0.5, 2.0, 0.0, 1.0, 0.0, ref.NOISE_FBM, True),
@@ -96,8 +69,8 @@ NOISE_CASES = [
 
 
 def test_noise_glsl_matches_numpy(penumbra, gpu_call):
-    _gpu_scene()
-    pts = _points()
+    gpu_scene()
+    pts = points()
     scale = 1.7
     jobs = []
     for d, detail, rough, lac, offset, gain, dist, kind, norm in NOISE_CASES:
@@ -116,9 +89,9 @@ def test_noise_glsl_matches_numpy(penumbra, gpu_call):
         expected = ref.node_tex_noise(d, pts[:, :3], pts[:, 3], scale, *params)
         # float32 evaluation order (the GPU may fuse multiply-adds): measured up to 1.3e-5 on
         # the 4D colour, whose octaves and distortion compound the rounding.
-        _compare(out, expected, 1e-4, 5e-5, ("noise", d, params))
+        compare(out, expected, 1e-4, 5e-5, ("noise", d, params))
     signed = np.stack([ref.snoise(pts[:, :k]) for k in (1, 2, 3, 4)], -1)
-    _compare(outs[-1], signed, 0.0, 2e-6, "snoise")
+    compare(outs[-1], signed, 0.0, 2e-6, "snoise")
     # The reduction keeps far coordinates in range: noise at 1e5-scale points is not constant.
     assert np.std(signed[256:320]) > 0.05
 
@@ -141,8 +114,8 @@ VORONOI_CASES = [
 
 @pytest.mark.parametrize("hash_mode", [ref.VORONOI_HASH_FLOAT, ref.VORONOI_HASH_INT])
 def test_voronoi_glsl_matches_numpy(penumbra, gpu_call, hash_mode):
-    _gpu_scene()
-    pts = _points(1024)
+    gpu_scene()
+    pts = points(1024)
     scale = 2.3
     jobs = []
     for d, feature, metric, detail, smooth, exponent, rnd, norm in VORONOI_CASES:
@@ -184,8 +157,8 @@ def test_voronoi_glsl_matches_numpy(penumbra, gpu_call, hash_mode):
 
 
 def test_white_noise_glsl_matches_numpy_bit_for_bit(penumbra, gpu_call):
-    _gpu_scene()
-    pts = _points()
+    gpu_scene()
+    pts = points()
     pts = np.where(np.isnan(pts), 1.0, pts).astype(np.float32)  # NaN payloads do not survive the upload
     outs = evaluate_many(
         gpu_call, [(WHITE, f"result = node_tex_white_noise({d}, a0.xyz, a0.w);", [pts]) for d in (1, 2, 3, 4)]
@@ -195,8 +168,6 @@ def test_white_noise_glsl_matches_numpy_bit_for_bit(penumbra, gpu_call):
 
 
 # --- against Blender ------------------------------------------------------------------------
-
-TILE = 40  # pixels per tile side; each tile is a 2 x 2 plane, object coordinates in [-1, 1]^2
 
 
 def _tile_modes():
@@ -277,66 +248,10 @@ def _white_noise_mode(d):
     return (f"white noise {d}D", "ShaderNodeTexWhiteNoise", {"noise_dimensions": f"{d}D"}, {}, "Color", f)
 
 
-def _build_tiles(modes):
-    scene = scenes.empty_scene(TILE * len(modes), TILE, engine="CYCLES")
-    engines.configure(scene, "CYCLES", samples=1)
-    scenes.camera(scene, (len(modes) - 1.0, 0.0, 5.0), (0.0, 0.0, 0.0), ortho_scale=2.0 * len(modes), clip=(0.1, 10.0))
-    for k, (label, node_type, props, inputs, output, _f) in enumerate(modes):
-        mat = bpy.data.materials.new(label)
-        mat.use_nodes = True
-        nt = mat.node_tree
-        nt.nodes.clear()
-        coords = nt.nodes.new("ShaderNodeTexCoord")
-        tex = nt.nodes.new(node_type)
-        for name, value in props.items():
-            setattr(tex, name, value)
-        for name, value in inputs.items():
-            if name in tex.inputs:
-                tex.inputs[name].default_value = value
-        vector = coords.outputs["Object"]
-        if node_type == "ShaderNodeTexWhiteNoise":
-            mul = nt.nodes.new("ShaderNodeVectorMath")
-            mul.operation = "MULTIPLY"
-            mul.inputs[1].default_value = (4.0, 4.0, 4.0)
-            floor = nt.nodes.new("ShaderNodeVectorMath")
-            floor.operation = "FLOOR"
-            nt.links.new(vector, mul.inputs[0])
-            nt.links.new(mul.outputs[0], floor.inputs[0])
-            vector = floor.outputs[0]
-            if "W" in tex.inputs:  # 4D: W is the snapped x (a socket hidden in 2D and 3D)
-                sep = nt.nodes.new("ShaderNodeSeparateXYZ")
-                nt.links.new(vector, sep.inputs[0])
-                nt.links.new(sep.outputs[0], tex.inputs["W"])
-        nt.links.new(vector, tex.inputs["Vector"])
-        emit = nt.nodes.new("ShaderNodeEmission")
-        out = nt.nodes.new("ShaderNodeOutputMaterial")
-        nt.links.new(tex.outputs[output], emit.inputs["Color"])
-        nt.links.new(emit.outputs[0], out.inputs["Surface"])
-        scenes.plane(scene, label, size=2.0, mat=mat).location = (2.0 * k, 0.0, 0.0)
-    return scene
-
-
-def _pixel_points():
-    """Object coordinates of the pixel centres of one tile, (TILE * TILE, 3), row 0 at the bottom."""
-    c = -1.0 + 2.0 * (np.arange(TILE) + 0.5) / TILE
-    y, x = np.meshgrid(c, c, indexing="ij")
-    return np.stack([x.ravel(), y.ravel(), np.zeros(TILE * TILE)], -1).astype(np.float32)
-
-
 def test_textures_land_where_blender_puts_them(penumbra):
     modes = _tile_modes() + [_white_noise_mode(d) for d in (2, 3, 4)]
-    scene = _build_tiles(modes)
-    image = render(scene)["Combined"]
-    pts = _pixel_points()
-    report = []
-    for k, (label, *_rest, f) in enumerate(modes):
-        got = image[:, k * TILE : (k + 1) * TILE, :3].reshape(-1, 3).astype(np.float64)
-        expected = f(pts).astype(np.float64)
-        err = np.abs(got - expected).max(axis=1)
-        report.append((label, float(err.mean()), float(np.median(err)), float(np.mean(err > 1e-3)), float(err.max())))
-    print(
-        "\n".join(f"{r[0]:26s} mean {r[1]:.1e} median {r[2]:.1e} over 1e-3 {r[3]:.2%} max {r[4]:.1e}" for r in report)
-    )
+    scene = build_tiles(modes)
+    report = tile_errors(render(scene)["Combined"], modes)
     for label, mean, median, mismatched, worst in report:
         # Cycles' samples land within 0.005 pixel of the centre (pixel filter 0.01) and the hit
         # point carries float rounding: continuous patterns differ by that little shift only.
