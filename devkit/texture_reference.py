@@ -3,7 +3,8 @@ points: the same hashes on ``np.uint32`` / ``np.int32`` (wrapping), the same flo
 the same order, so GPU and numpy agree to float32 rounding and hashes agree bit for bit.
 
 Points are arrays of shape (n, d) (d = 1..4, float32); results are float32 arrays. Parameters are
-plain Python numbers. Enum values are the GLSL files' (``NOISE_*``, ``VORONOI_*``)."""
+plain Python numbers. Enum values are the GLSL files' (``NOISE_*``, ``VORONOI_*``, ``WAVE_*``,
+``MAGIC_*``, ``GRADIENT_*``)."""
 
 import numpy as np
 
@@ -13,6 +14,20 @@ NOISE_FBM, NOISE_MULTIFRACTAL, NOISE_HYBRID_MULTIFRACTAL, NOISE_RIDGED_MULTIFRAC
 VORONOI_F1, VORONOI_F2, VORONOI_SMOOTH_F1, VORONOI_DISTANCE_TO_EDGE, VORONOI_N_SPHERE_RADIUS = range(5)
 VORONOI_EUCLIDEAN, VORONOI_MANHATTAN, VORONOI_CHEBYCHEV, VORONOI_MINKOWSKI = range(4)
 VORONOI_HASH_FLOAT, VORONOI_HASH_INT = range(2)
+WAVE_BANDS, WAVE_RINGS = range(2)
+WAVE_X, WAVE_Y, WAVE_Z, WAVE_DIAGONAL = range(4)
+WAVE_SPHERICAL = WAVE_DIAGONAL
+WAVE_SINE, WAVE_SAW, WAVE_TRIANGLE = range(3)
+MAGIC_WRAP_UNSCALED, MAGIC_WRAP_SCALED = range(2)
+(
+    GRADIENT_LINEAR,
+    GRADIENT_QUADRATIC,
+    GRADIENT_EASING,
+    GRADIENT_DIAGONAL,
+    GRADIENT_SPHERICAL,
+    GRADIENT_QUADRATIC_SPHERE,
+    GRADIENT_RADIAL,
+) = range(7)
 
 
 def _f(x):
@@ -741,3 +756,219 @@ def node_tex_voronoi(
     out[:, 4:7] = pos[:, :3]
     out[:, 7] = pos[:, 3]
     return out
+
+
+# --- Wave, Magic, Brick, Checker, Gradient ---------------------------------------------------
+
+_TWO_PI = F(6.2831853071795864)
+_HALF_PI = F(1.5707963267948966)
+
+
+def float_to_int(f):
+    """C's (int)f as x86 converts it (INT_MIN out of range): the GLSL texture_float_to_int."""
+    return _cell_int(_f(f))
+
+
+def _nudge(p):
+    return ((p + F(0.000001)) * F(0.999999)).astype(np.float32)
+
+
+def texture_wave(p, distortion, detail, detail_scale, detail_roughness, phase, kind, direction, profile):
+    """The wave of already scaled points (n, 3)."""
+    p = _nudge(_f(p))
+    x, y, z = p[:, 0], p[:, 1], p[:, 2]
+    with np.errstate(over="ignore", invalid="ignore"):
+        if kind == WAVE_BANDS:
+            n = [x * F(20.0), y * F(20.0), z * F(20.0), (x + y + z) * F(10.0)][direction]
+        else:
+            r = [np.zeros_like(c) if direction == i else c for i, c in enumerate((x, y, z))]
+            n = np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) * F(20.0)
+        n = n + F(phase)
+        if distortion != 0.0:
+            f = noise_fbm(finite(p * F(detail_scale)), float(np.clip(F(detail), 0.0, 15.0)),
+                          max(F(detail_roughness), F(0.0)), 2.0, True)  # fmt: skip
+            n = n + F(distortion) * (f * F(2.0) - F(1.0))
+        n = finite(n)
+        if profile == WAVE_SINE:
+            return (F(0.5) + F(0.5) * np.sin(n - _HALF_PI)).astype(np.float32)
+        n = n / _TWO_PI
+        if profile == WAVE_SAW:
+            return (n - np.floor(n)).astype(np.float32)
+        return (np.abs(n - np.floor(n + F(0.5))) * F(2.0)).astype(np.float32)
+
+
+def node_tex_wave(
+    vector,
+    scale=5.0,
+    distortion=0.0,
+    detail=2.0,
+    detail_scale=1.0,
+    detail_roughness=0.5,
+    phase=0.0,
+    kind=WAVE_BANDS,
+    direction=WAVE_X,
+    profile=WAVE_SINE,
+):
+    """The Wave Texture node: (n, 4), Color in [:, :3], Fac in [:, 3]; ``direction`` is the
+    bands' or the rings' direction, whichever ``kind`` uses."""
+    p = finite(_scaled(vector, scale))
+    f = texture_wave(p, distortion, detail, detail_scale, detail_roughness, phase, kind, direction, profile)
+    return np.stack([f, f, f, f], -1)
+
+
+def node_tex_magic(vector, scale=5.0, distortion=1.0, depth=2, wrap=MAGIC_WRAP_SCALED):
+    """The Magic Texture node: (n, 4), Color in [:, :3], Fac in [:, 3]. ``wrap``: where the scale
+    enters (MAGIC_WRAP_UNSCALED: Blender 4.5, MAGIC_WRAP_SCALED: Blender 5)."""
+    p = finite(vector)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        if wrap == MAGIC_WRAP_SCALED:
+            p = finite(p * F(scale))
+        p = np.fmod(p, _TWO_PI).astype(np.float32)
+        px, py, pz = p[:, 0], p[:, 1], p[:, 2]
+        a = [(px + py + pz) * F(5.0), (-px + py - pz) * F(5.0), (-px - py + pz) * F(5.0)]
+        if wrap == MAGIC_WRAP_UNSCALED:
+            a = [finite(v * F(scale)) for v in a]
+        x, y, z = np.sin(a[0]), np.cos(a[1]), -np.cos(a[2])
+        d = F(distortion)
+        depth = int(np.clip(depth, 0, 10))
+        if depth > 0:
+            x, y, z = x * d, y * d, z * d
+            y = -np.cos(x - y + z) * d
+        if depth > 1:
+            x = np.cos(x - y - z) * d
+        if depth > 2:
+            z = np.sin(-x - y - z) * d
+        if depth > 3:
+            x = -np.cos(-x + y - z) * d
+        if depth > 4:
+            y = -np.sin(-x + y + z) * d
+        if depth > 5:
+            y = -np.cos(-x + y + z) * d
+        if depth > 6:
+            x = np.cos(x + y + z) * d
+        if depth > 7:
+            z = np.sin(x + y - z) * d
+        if depth > 8:
+            x = -np.cos(-x - y + z) * d
+        if depth > 9:
+            y = -np.sin(x - y + z) * d
+        if d != 0.0:
+            x, y, z = x / (d * F(2.0)), y / (d * F(2.0)), z / (d * F(2.0))
+        color = [F(0.5) - x, F(0.5) - y, F(0.5) - z]
+        fac = (color[0] + color[1] + color[2]) * F(1.0 / 3.0)
+    return np.stack(color + [fac], -1).astype(np.float32)
+
+
+def brick_noise(n):
+    """Blender's integer noise of the Brick texture, of uint32 n, in [0, 1)."""
+    n = np.asarray(n).astype(np.uint32)
+    with np.errstate(over="ignore"):
+        n = (n + np.uint32(1013)) & np.uint32(0x7FFFFFFF)
+        n = (n >> np.uint32(13)) ^ n
+        m = (n * (n * n * np.uint32(60493) + np.uint32(19990303)) + np.uint32(1376312589)) & np.uint32(0x7FFFFFFF)
+    return (F(0.5) * (m.astype(np.float32) / F(1073741824.0))).astype(np.float32)
+
+
+def _row_is_multiple(row, frequency):
+    magnitude = np.abs(row.astype(np.int64))
+    return magnitude % frequency == 0
+
+
+def _smoothstep01(t):
+    return np.where(t <= 0, F(0.0), np.where(t >= 1, F(1.0), (F(3.0) - F(2.0) * t) * t * t)).astype(np.float32)
+
+
+def texture_brick(p, mortar_size, mortar_smooth, bias, brick_width, row_height, offset_amount, offset_frequency,
+                  squash_amount, squash_frequency):  # fmt: skip
+    """(tint, mortar) of already scaled points (n, 3)."""
+    p = _f(p)
+    row_height = F(row_height)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        row = float_to_int(np.floor(p[:, 1] / row_height))
+        width = np.full(len(p), F(brick_width), np.float32)
+        offset = np.zeros(len(p), np.float32)
+        if offset_frequency != 0 and squash_frequency != 0:
+            width = np.where(_row_is_multiple(row, squash_frequency), width * F(squash_amount), width)
+            offset = np.where(_row_is_multiple(row, offset_frequency), width * F(offset_amount), offset)
+        shifted = (p[:, 0] + offset).astype(np.float32)
+        brick = float_to_int(np.floor(shifted / width))
+        x = shifted - width * brick.astype(np.float32)
+        y = p[:, 1] - row_height * row.astype(np.float32)
+        key = (row.astype(np.int64) << 16) + (brick.astype(np.int64) & 0xFFFF)
+        tint = np.clip(brick_noise((key & 0xFFFFFFFF).astype(np.uint32)) + F(bias), F(0.0), F(1.0))
+        min_dist = np.minimum(np.minimum(x, y), np.minimum(width - x, row_height - y))
+        if mortar_smooth == 0.0:
+            inside = F(1.0)
+        else:
+            inside = _smoothstep01((F(1.0) - min_dist / F(mortar_size)) / F(mortar_smooth))
+        mortar = np.where(min_dist >= F(mortar_size), F(0.0), inside)
+    return tint.astype(np.float32), mortar.astype(np.float32)
+
+
+def node_tex_brick(
+    vector,
+    color1=(0.8, 0.8, 0.8),
+    color2=(0.2, 0.2, 0.2),
+    mortar=(0.0, 0.0, 0.0),
+    scale=5.0,
+    mortar_size=0.02,
+    mortar_smooth=0.1,
+    bias=0.0,
+    brick_width=0.5,
+    row_height=0.25,
+    offset_amount=0.5,
+    offset_frequency=2,
+    squash_amount=1.0,
+    squash_frequency=2,
+):
+    """The Brick Texture node: (n, 4), Color in [:, :3], Fac in [:, 3]."""
+    p = finite(_scaled(vector, scale))
+    tint, f = texture_brick(p, mortar_size, mortar_smooth, bias, brick_width, row_height, offset_amount,
+                            offset_frequency, squash_amount, squash_frequency)  # fmt: skip
+    c1, c2, m = _f(color1), _f(color2), _f(mortar)
+    t = tint[:, None]
+    brick = np.where((f != F(1.0))[:, None], (F(1.0) - t) * c1 + t * c2, c1)
+    color = brick * (F(1.0) - f[:, None]) + m * f[:, None]
+    return np.concatenate([color, f[:, None]], 1).astype(np.float32)
+
+
+def node_tex_checker(vector, color1=(0.8, 0.8, 0.8), color2=(0.2, 0.2, 0.2), scale=5.0):
+    """The Checker Texture node: (n, 4), Color in [:, :3], Fac in [:, 3]."""
+    p = _nudge(finite(_scaled(vector, scale)))
+    with np.errstate(invalid="ignore"):
+        parity = [float_to_int(np.floor(p[:, i])) & 1 for i in range(3)]
+    f = np.where((parity[0] == parity[1]) == (parity[2] == 1), F(1.0), F(0.0)).astype(np.float32)
+    color = np.where((f == F(1.0))[:, None], _f(color1), _f(color2))
+    return np.concatenate([color, f[:, None]], 1).astype(np.float32)
+
+
+def texture_gradient(p, kind):
+    """The unclamped gradient of points (n, 3)."""
+    p = _f(p)
+    x, y, z = p[:, 0], p[:, 1], p[:, 2]
+    with np.errstate(over="ignore", invalid="ignore"):
+        if kind == GRADIENT_LINEAR:
+            return x
+        if kind == GRADIENT_QUADRATIC:
+            r = np.maximum(x, F(0.0))
+            return r * r
+        if kind == GRADIENT_EASING:
+            r = np.clip(x, F(0.0), F(1.0))
+            t = r * r
+            return F(3.0) * t - F(2.0) * t * r
+        if kind == GRADIENT_DIAGONAL:
+            return (x + y) * F(0.5)
+        if kind == GRADIENT_RADIAL:
+            return np.arctan2(y, x) / _TWO_PI + F(0.5)
+        r = np.maximum(F(0.999999) - np.sqrt(x * x + y * y + z * z), F(0.0))
+        if kind == GRADIENT_QUADRATIC_SPHERE:
+            return r * r
+        if kind == GRADIENT_SPHERICAL:
+            return r
+    return np.zeros_like(x)
+
+
+def node_tex_gradient(vector, kind=GRADIENT_LINEAR):
+    """The Gradient Texture node: (n, 4), Color in [:, :3] (Fac, grey), Fac in [:, 3]."""
+    f = np.clip(texture_gradient(finite(vector), kind), F(0.0), F(1.0)).astype(np.float32)
+    return np.stack([f, f, f, f], -1)

@@ -270,6 +270,12 @@ bool texture_is_finite(float x)
   return (floatBitsToUint(x) & 0x7f800000u) != 0x7f800000u;
 }
 
+/* C's (int)f as x86 converts it: truncation toward zero, INT_MIN when f is out of range. */
+int texture_float_to_int(float f)
+{
+  return (abs(f) < 2147483648.0) ? int(f) : (-2147483647 - 1);
+}
+
 /* A coordinate as the textures read it: NaN and +-inf become 0, so every output stays finite. */
 float texture_finite(float x)
 {
