@@ -48,12 +48,15 @@ def compare(out, expected, rtol, atol, what):
 
 
 def swizzle(p, s):
-    """The coordinate the texture reads: component c of ``s`` is x, y, z or 0."""
+    """The coordinate the texture reads: component c of ``s`` is x, y, z or 0; ``s`` may be a
+    pair (string, factor)."""
+    s, factor = s if isinstance(s, tuple) else (s, 1.0)
     cols = {"x": p[:, 0], "y": p[:, 1], "z": p[:, 2], "0": np.zeros(len(p), np.float32)}
-    return np.stack([cols[c] for c in s], -1).astype(np.float32)
+    return (np.stack([cols[c] for c in s], -1) * np.float32(factor)).astype(np.float32)
 
 
 def _vector(nt, vector, s, node_type):
+    s, factor = s if isinstance(s, tuple) else (s, 1.0)
     if s and s != "xyz":
         sep = nt.nodes.new("ShaderNodeSeparateXYZ")
         comb = nt.nodes.new("ShaderNodeCombineXYZ")
@@ -64,6 +67,12 @@ def _vector(nt, vector, s, node_type):
             else:
                 nt.links.new(sep.outputs["xyz".index(c)], comb.inputs[i])
         vector = comb.outputs[0]
+    if factor != 1.0:
+        mul = nt.nodes.new("ShaderNodeVectorMath")
+        mul.operation = "MULTIPLY"
+        mul.inputs[1].default_value = (factor, factor, factor)
+        nt.links.new(vector, mul.inputs[0])
+        vector = mul.outputs[0]
     if node_type == "ShaderNodeTexWhiteNoise":
         # White Noise of the coordinate snapped to a 1/4 lattice (Vector Math Multiply 4,
         # Floor): the hash reads exact float bits, which a ray-plane hit does not reproduce.
