@@ -9,6 +9,8 @@
  * a multiple of 2/5:
  * - MAGIC_WRAP_UNSCALED (Blender 4.5): fmod(coordinate, 2pi), then times 5 * Scale;
  * - MAGIC_WRAP_SCALED (Blender 5): fmod(coordinate * Scale, 2pi), then times 5.
+ * (EEVEE, on both lines, wraps after Scale with a floored modulo: a shift by 2pi, which the
+ * factor 5 turns into whole turns, so it draws Blender 5's pattern up to rounding.)
  *
  * Deviation, on purpose: a non-finite coordinate, or one that overflows with Scale, reads as 0
  * where Blender would return NaN. Depth is clamped to [0, 10] as Blender's property is. */
