@@ -39,9 +39,14 @@ class FrameData:
     bins: np.ndarray = None  # (rows, columns, LIGHT_WORDS) light masks of the screen bins, or None
 
 
-def disk_samples(settings):
-    """``shadow_samples`` rounded down to whole rings, within [RING, MAX_DISK_SAMPLES]."""
-    return int(np.clip(int(settings.shadow_samples) // RING * RING, RING, MAX_DISK_SAMPLES))
+def disk_samples(settings, sample_count=1):
+    """Disk taps per sample: ``shadow_samples`` rounded down to whole rings, within [RING,
+    MAX_DISK_SAMPLES]. A frame of ``sample_count`` samples spreads them over its samples (each
+    sample reads its own rotation of the per-pixel disk, ``shadow_filters.glsl``
+    ``disk_sample``), at least one ring per sample: the frame reads at least as many taps per
+    pixel as a one-sample frame, and a sample pays only for its share."""
+    per_sample = int(settings.shadow_samples) // max(1, int(sample_count))
+    return int(np.clip(per_sample // RING * RING, RING, MAX_DISK_SAMPLES))
 
 
 def select_lights(lights, camera_position, limit):
@@ -152,6 +157,7 @@ def build_frame_data(
     size=None,
     alpha_offset=0.5,
     origin=_ZERO,
+    sample_count=1,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -161,10 +167,11 @@ def build_frame_data(
     ``size`` (width, height) pixels, which bins the lights when several are local.
     ``world_color``: a ``materials.World`` (its SH light) or a constant colour;
     ``alpha_offset``: this sample's shift of the alpha-hash threshold ((s + 0.5) / N);
-    ``origin``: the frame origin: every position the GPU gets is relative to it."""
+    ``origin``: the frame origin: every position the GPU gets is relative to it;
+    ``sample_count``: the frame's samples, which share the disk filters' taps."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
-    disk = disk_samples(settings)
+    disk = disk_samples(settings, sample_count)
     order, sampled, shadowed = shading_order(lights, plan)
     sh = getattr(world_color, "sh", None)  # a materials.World, or a constant colour
     frame = frame_row(

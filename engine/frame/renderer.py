@@ -144,7 +144,17 @@ class Renderer:
             ]
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
             plan = self._sample(
-                draws, sample_lights, camera, view_camera, snapshot, settings, aux, emission, stats, alpha_offset
+                draws,
+                sample_lights,
+                camera,
+                view_camera,
+                snapshot,
+                settings,
+                aux,
+                emission,
+                stats,
+                alpha_offset,
+                sample_count if accumulate else 1,
             )
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
@@ -192,7 +202,20 @@ class Renderer:
             out.depth_data, out.normal_data = film.centre
         return out
 
-    def _sample(self, draws, lights, camera, view_camera, snapshot, settings, aux, emission, stats, alpha_offset=0.5):
+    def _sample(
+        self,
+        draws,
+        lights,
+        camera,
+        view_camera,
+        snapshot,
+        settings,
+        aux,
+        emission,
+        stats,
+        alpha_offset=0.5,
+        sample_count=1,
+    ):
         """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
         does not move between samples keeps its map), then the lit pass seen through
         ``view_camera``. Returns the shadow plan."""
@@ -238,6 +261,7 @@ class Renderer:
             size=(width, height),
             alpha_offset=alpha_offset,
             origin=self._origin,
+            sample_count=sample_count,
         )
         self._last_data = data
         stats.binned = data.bins is not None

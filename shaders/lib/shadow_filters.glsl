@@ -95,9 +95,13 @@ float shadow_bilinear(ivec2 origin, vec2 st, float ref, vec2 grad)
   return mix(mix(s00, s10, f.x), mix(s01, s11, f.x), f.y);
 }
 
+/* Disk offset i of this pixel. Each sample of a frame reads another pixel's disk (the pattern
+ * shifted by a hash of the sample's frame.alpha_offset), so a frame's samples average
+ * independent rotations and a sample needs only its share of the taps. */
 vec2 disk_sample(int i)
 {
-  ivec2 pix = ivec2(gl_FragCoord.xy) % JITTER_SIZE;
+  uint h = uint(frame.alpha_offset * 65536.0) * 0x9E3779B1u;
+  ivec2 pix = (ivec2(gl_FragCoord.xy) + ivec2(h >> 16u, h >> 8u)) % JITTER_SIZE;
   vec4 pair = texelFetch(jitter_tex, ivec3(pix, i / 2), 0);
   return ((i & 1) == 0) ? pair.xy : pair.zw;
 }
