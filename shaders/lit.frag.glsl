@@ -199,10 +199,22 @@ void main()
   float metal = material.metallic;
   float coverage = material.alpha;
   vec3 emission = material.emission;
+  float spec_level = material.specular;
+#if NODE_TREE
+  {
+    /* The material's compiled node tree (engine/scene/nodetree.py) gives every parameter. */
+    vec3 V = (frame.is_ortho != 0) ? -frame.camera_forward : normalize(frame.camera_position - v_world);
+    vec3 Nt = v_normal;
+    float l = length(Nt);
+    Nt = (l > 1e-20) ? Nt / l : vec3(0.0, 0.0, 1.0);
+    bool front = dot(Nt, V) >= 0.0;
+    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec_level, coverage, emission);
+  }
+#endif
 #if TEX_BASE_COLOR
   base *= SAMPLE_COLOR(base_color, v_uv);
 #endif
-#if HAS_VCOL
+#if HAS_VCOL && !NODE_TREE
   base *= v_color;
 #endif
 #if TEX_ROUGHNESS
@@ -284,7 +296,7 @@ void main()
   s.N = N;
 
   rough = clamp(rough, 0.0, 1.0);
-  float spec_level = max(material.specular, 0.0);
+  spec_level = max(spec_level, 0.0);
   metal = clamp(metal, 0.0, 1.0);
   s.albedo = base.rgb * (1.0 - metal);
   s.f0 = mix(vec3(0.08 * spec_level), base.rgb, metal);

@@ -36,6 +36,7 @@ class Draw:
     corners: np.ndarray  # (8, 3) world corners of the instance's bounds
     closed: bool = False  # a closed opaque surface: back faces hidden from outside its bounds
     geometry: object = None  # the extract.Geometry drawn whole (None: drawn at a level of detail)
+    bounds: np.ndarray = None  # (2, 3) object-space bounds (Generated texture coordinates)
     triangles: int = 0  # triangles of what it draws
     # () -> [(material index, GPUBatch)] with the Shadow Terminator's corner data, built on
     # first call; None where the geometry offset does not apply (offset 0, flat faces only).
@@ -93,6 +94,7 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
             model = Matrix(model.tolist())
             draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
             draw.geometry = geo if lod is None else None
+            draw.bounds = bounds[i]
             draw.triangles = (lod or geo).triangle_count
             if inst.terminator.geometry_offset > 0.0 and (lod or geo).smooth and facets[i] >= TERMINATOR_MIN_PIXELS:
                 draw.terminator_parts = functools.partial(batches.terminator, key, lod or geo)

@@ -10,6 +10,26 @@ from .draw_list import front_to_back
 from .programs import BACKGROUND, JITTER_SIZE, SHADOW_SAMPLER, lit_program, terminator_uniforms
 
 
+def texture_space(draw):
+    """Push constants of Blender's Generated coordinates for ``draw``: its object's bounds
+    mapped to [0, 1] (a flat axis, of zero extent, to 0.5), as Blender's automatic texture
+    space."""
+    bounds = getattr(draw, "bounds", None)
+    if bounds is None:
+        lo, hi = np.zeros(3), np.ones(3)
+    else:
+        lo, hi = np.asarray(bounds[0], np.float64), np.asarray(bounds[1], np.float64)
+    half = (hi - lo) * 0.5
+    half = np.where(half == 0.0, 1.0, np.maximum(half, 1e-5))
+    centre = (hi + lo) * 0.5
+    scale = 0.5 / half
+    offset = 0.5 - centre * scale
+    return {
+        "node_texspace_scale": tuple(float(x) for x in scale),
+        "node_texspace_offset": tuple(float(x) for x in offset),
+    }
+
+
 class LitPass:
     """The lit pass's GPU state of one renderer: its uniform blocks, the jittered-disk and
     light-bin textures. ``materials``: the renderer's ``MaterialBlocks``; ``textures``: its
@@ -76,13 +96,16 @@ class LitPass:
         width, height = film.size
         bound = {"shader": None, "counted": counted}
 
-        def bind(features, with_aux):
+        def bind(features, with_aux, tree):
             program = lit_program(
-                frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux
+                frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux, tree
             )
             shader = self.shaders.get(program, data.defines)
             if bound["shader"] is shader:
                 return shader
+            if tree is not None and "ORIGIN" in tree.needs:
+                shader.bind()
+                shader.uniform_float("node_origin", tuple(float(x) for x in origin))
             shader.bind()
             shader.uniform_block("frame", self._ubo("frame", data.frame))
             shader.uniform_block("lights", self._ubo("lights", data.lights))
@@ -114,7 +137,7 @@ class LitPass:
                     gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
                     gpu.state.front_facing_set(culling[1])
                     bound["culling"] = culling
-                shader = bind(features, with_aux)
+                shader = bind(features, with_aux, mat.tree)
                 if last is not d or bound.get("model_shader") is not shader:
                     shader.uniform_float("model", d.model)
                     if solid_uniform(shader):  # compiled out where no light reads it
@@ -124,9 +147,17 @@ class LitPass:
                     if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
                         set_uniforms(shader, terminators[id(d)])
                     last, bound["model_shader"] = d, shader
+                    bound["texspace"] = None
+                if mat.tree is not None and "GENERATED" in mat.tree.needs and bound.get("texspace") is not d:
+                    set_uniforms(shader, texture_space(d))
+                    bound["texspace"] = d
                 shader.uniform_block("material", self.materials.get(mat))
                 for channel, ref in mat.textures.items():
                     shader.uniform_sampler(f"tex_{channel}", self.textures.get(ref.image))
+                if mat.tree is not None:
+                    shader.uniform_block("node_constants", self.materials.constants(mat))
+                    for i, ref in enumerate(mat.tree.images):
+                        shader.uniform_sampler(f"node_image_{i}", self.textures.get(ref.image))
                 batch.draw(shader)
                 stats.draws += 1
 

@@ -59,15 +59,20 @@ class Material:
     holdout: bool = False  # a Holdout shader: a hole in the film where it shows (it still casts)
     transparent_shadow: bool = True  # Settings > Transparent Shadows: off, alpha casts as opaque
     messages: tuple = ()  # what could not be read, for the render report and the panel
+    tree: object = None  # nodetree.CompiledTree: the node tree drawn as generated GLSL
 
     @property
     def uv_maps(self):
         """UV maps the material's textures read ("" = the active render map)."""
-        return tuple(sorted({t.uv_map for t in self.textures.values()}))
+        maps = {t.uv_map for t in self.textures.values()}
+        if self.tree is not None and "UV" in self.tree.needs:
+            maps.add(self.tree.uv_map)
+        return tuple(sorted(maps))
 
     @property
     def uses_alpha(self):
-        return self.blend != "OPAQUE" and (self.alpha < 1.0 or "alpha" in self.textures)
+        transparent = self.tree is not None and self.tree.transparent
+        return self.blend != "OPAQUE" and (self.alpha < 1.0 or "alpha" in self.textures or transparent)
 
     @property
     def features(self):
@@ -79,6 +84,10 @@ class Material:
             out.add(f"ALPHA_{self.blend}")
         if self.holdout:
             out.add("HOLDOUT")
+        if self.tree is not None:
+            out.add(f"NODES_{self.tree.key}")
+            if "UV" in self.tree.needs:
+                out.add("TREE_UV")
         return frozenset(out)
 
 
@@ -257,15 +266,46 @@ def _material_surface(mat):
         )
         return out
     out = _shader(mat, _surface(mat), notes)
+    whole = out is None
     if out is None:
         out = _display(mat, notes, "its surface shader is drawn with the viewport display colour")
     elif "alpha" in out.textures or out.alpha < 1.0:
         out.blend = _blend_mode(mat)
+    if notes:
+        out, notes = _compiled(mat, out, notes, whole)
     for socket in ("Volume", "Displacement"):
         if _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", socket, {"ALL", "EEVEE"}):
             notes.append(f"its {socket} output is not drawn")
     out.messages = tuple(f"material '{mat.name}': {n}" for n in dict.fromkeys(notes))
     return out
+
+
+def _compiled(mat, read, notes, whole):
+    """The material drawn through its compiled node tree (``nodetree``) where that draws more
+    than the reader above: it compiled every input, or fewer inputs fell back than the reader
+    could not read, or the reader fell back for the whole surface. Materials the reader takes
+    whole keep its path (its image channels, shadow cut-outs and tests). -> (Material, notes)."""
+    from . import nodetree
+
+    tree, message = nodetree.compile_material(mat)
+    if tree is None or tree.surface_fallback:
+        return read, notes + ([message] if message else [])
+    unread = sum(1 for n in notes if " from a '" in n or n.endswith("' shader"))
+    if not (tree.fallbacks == 0 or whole or tree.fallbacks < unread):
+        return read, notes
+    out = Material(tree=tree)
+    if tree.transparent:
+        out.blend = _blend_mode(mat)
+    if "VCOL" in tree.needs:
+        out.color_attribute = tree.color_attribute
+    new_notes = list(tree.messages)
+    principled = [n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled"]
+    if len(principled) == 1:
+        _normal_map(None, principled[0], new_notes, out)
+        normal = out.textures.get("normal")
+        if normal is not None and "UV" in tree.needs and normal.uv_map != tree.uv_map:
+            new_notes.append("a normal map on another UV map than the tree's (the tree's map is used)")
+    return out, new_notes
 
 
 def _black():
