@@ -3,6 +3,7 @@ shader on a grid of planes (devkit/node_scenes.py, one plane per mode, 8x8 pixel
 Penumbra sample at pixel centres), compared with its numpy twin (devkit/node_reference.py)
 evaluated at each pixel's analytic UV; tolerances are stated at each assertion."""
 
+import bpy
 import numpy as np
 
 from devkit import engines, node_reference, node_scenes
@@ -297,3 +298,375 @@ def test_colour_adjustments_and_separate_combine(penumbra):
         return table[case]() if case in table else c
 
     _assert_close(image, _per_plane(grid, ref), grid, cases)
+
+
+def _planes_xy(grid):
+    """World (x, y) of every plane's centre."""
+    return [tuple(cell.ob.location[:2]) for cell in grid.cells]
+
+
+def test_coordinates_and_geometry(penumbra):
+    """Texture Coordinate (every output), Geometry, Object Info Location, UV Map and Mapping
+    (each type, rotated and scaled) on planes facing the camera: the analytic value at each
+    pixel within 2e-3 (Window: the pixel's place in the frame; Camera: camera space with +z
+    ahead, as Blender's)."""
+    coords = ["Generated", "Normal", "UV", "Object", "Camera", "Window", "Reflection"]
+    geometry = ["Position", "Normal", "True Normal", "Incoming", "Backfacing"]
+    cases = [("COORD", c) for c in coords] + [("GEOM", g) for g in geometry] + [("INFO", "Location"), ("UVMAP", "UV")]
+    cases += [("MAPPING", t) for t in ("POINT", "TEXTURE", "VECTOR", "NORMAL")]
+    grid = node_scenes.grid(len(cases))
+    loc, rot, scale = (0.1, -0.2, 0.3), (0.3, 0.5, 0.7), (1.5, 0.8, 2.0)
+    for cell, (kind, name) in zip(grid.cells, cases, strict=False):
+        if kind == "COORD":
+            out = _out(cell.nodes.new("ShaderNodeTexCoord"), name)
+        elif kind == "GEOM":
+            out = _out(cell.nodes.new("ShaderNodeNewGeometry"), name)
+        elif kind == "INFO":
+            out = _out(cell.nodes.new("ShaderNodeObjectInfo"), name)
+        elif kind == "UVMAP":
+            node = cell.nodes.new("ShaderNodeUVMap")
+            node.uv_map = "UVMap"
+            out = node.outputs[0]
+        else:
+            node = cell.nodes.new("ShaderNodeMapping")
+            node.vector_type = name
+            _in(node, "Location").default_value = loc
+            _in(node, "Rotation").default_value = rot
+            _in(node, "Scale").default_value = scale
+            cell.links.new(_out(cell.nodes.new("ShaderNodeTexCoord"), "UV"), _in(node, "Vector"))
+            out = node.outputs[0]
+        cell.links.new(out, _in(cell.emission, "Color"))
+    image = _penumbra(grid.scene)
+    centres = _planes_xy(grid)
+    width = float(max(grid.cols, grid.rows))
+    height = width * grid.rows / grid.cols
+
+    def ref(i, u, v):
+        kind, name = cases[i]
+        x, y = centres[i][0] + u - 0.5, centres[i][1] + v - 0.5
+        zero, one = np.zeros_like(u), np.ones_like(u)
+        up = np.stack([zero, zero, one], -1)
+        uv = np.stack([u, v, zero], -1)
+        if kind == "MAPPING":
+            return node_reference.mapping(name, uv, loc, rot, scale)
+        table = {
+            "Generated": np.stack([u, v, one * 0.5], -1),
+            "Normal": up,
+            "UV": uv,
+            "Object": np.stack([u - 0.5, v - 0.5, zero], -1),
+            "Camera": np.stack([x, y, one * 10.0], -1),
+            "Window": np.stack([x / width + 0.5, y / height + 0.5, zero], -1),
+            "Reflection": up,
+            "Position": np.stack([x, y, zero], -1),
+            "True Normal": up,
+            "Incoming": up,
+            "Backfacing": zero,
+            "Location": np.stack([one * centres[i][0], one * centres[i][1], zero], -1),
+        }
+        return table[name]
+
+    _assert_close(image, _per_plane(grid, ref), grid, [str(c) for c in cases])
+
+
+def test_checker_gradient_and_input_nodes(penumbra):
+    """Checker (Scale 3 on UV, and on Generated when its Vector is unlinked; Fac and Color) and
+    Gradient (every type, on 2 UV - 1); Fresnel and Layer Weight on a plane the camera faces
+    (N.V = 1): the numpy reference within 2e-3."""
+    from penumbra.engine.scene.nodetree import GRADIENT_TYPES
+
+    cases = [("CHECKER", "UV"), ("CHECKER", "GENERATED"), ("CHECKER", "COLOR")]
+    cases += [("GRADIENT", t) for t in GRADIENT_TYPES] + [("FRESNEL", 1.45), ("FRESNEL", 2.5)]
+    cases += [("LAYER", "Fresnel"), ("LAYER", "Facing")]
+    grid = node_scenes.grid(len(cases))
+    colours = ((0.9, 0.2, 0.1, 1.0), (0.1, 0.3, 0.8, 1.0))
+    for cell, (kind, option) in zip(grid.cells, cases, strict=False):
+        if kind == "CHECKER":
+            node = cell.nodes.new("ShaderNodeTexChecker")
+            _in(node, "Scale").default_value = 3.0
+            _in(node, "Color1").default_value = colours[0]
+            _in(node, "Color2").default_value = colours[1]
+            if option != "GENERATED":
+                cell.links.new(_out(cell.nodes.new("ShaderNodeTexCoord"), "UV"), _in(node, "Vector"))
+            out = _out(node, "Color" if option == "COLOR" else "Fac")
+        elif kind == "GRADIENT":
+            node = cell.nodes.new("ShaderNodeTexGradient")
+            node.gradient_type = option
+            cell.links.new(_uv_vector(cell, 2.0, -1.0, 2.0, -1.0, 0.0), _in(node, "Vector"))
+            out = _out(node, "Fac")
+        elif kind == "FRESNEL":
+            node = cell.nodes.new("ShaderNodeFresnel")
+            _in(node, "IOR").default_value = option
+            out = node.outputs[0]
+        else:
+            node = cell.nodes.new("ShaderNodeLayerWeight")
+            _in(node, "Blend").default_value = 0.3
+            out = _out(node, option)
+        cell.links.new(out, _in(cell.emission, "Color"))
+    image = _penumbra(grid.scene)
+
+    def ref(i, u, v):
+        kind, option = cases[i]
+        zero = np.zeros_like(u)
+        if kind == "CHECKER":
+            z = zero + (0.5 if option == "GENERATED" else 0.0)
+            fac = node_reference.checker(np.stack([u, v, z], -1), 3.0)
+            if option == "COLOR":
+                return np.where(fac[:, None] > 0.5, np.array(colours[0]), np.array(colours[1]))
+            return fac
+        if kind == "GRADIENT":
+            return node_reference.gradient(option, np.stack([2 * u - 1, 2 * v - 1, zero], -1))
+        if kind == "FRESNEL":
+            return node_reference.fresnel_dielectric(1.0, option) + zero
+        fresnel, facing = node_reference.layer_weight(0.3, 1.0)
+        return (fresnel if option == "Fresnel" else facing) + zero
+
+    _assert_close(image, _per_plane(grid, ref), grid, [str(c) for c in cases])
+
+
+def _group(name, build):
+    """A shader node group: ``build(tree, group_input, group_output)`` fills it."""
+    tree = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    gin, gout = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    build(tree, gin, gout)
+    return tree
+
+
+def _socket(tree, name, in_out, kind="NodeSocketFloat", default=None):
+    item = tree.interface.new_socket(name, in_out=in_out, socket_type=kind)
+    if default is not None:
+        item.default_value = default
+    return item
+
+
+def test_groups_reroutes_and_muted_nodes(penumbra):
+    """Nested node groups (an inner group's input left unlinked reads the value on its group
+    node), reroutes, a muted node (its first input passed through), a muted link (the socket's
+    own value): what Blender computes, within 2e-3."""
+
+    def inner(tree, gin, gout):
+        _socket(tree, "A", "INPUT")
+        _socket(tree, "B", "INPUT", default=0.5)
+        _socket(tree, "Out", "OUTPUT")
+        m = tree.nodes.new("ShaderNodeMath")
+        m.operation = "MULTIPLY"
+        tree.links.new(gin.outputs[0], m.inputs[0])
+        tree.links.new(gin.outputs[1], m.inputs[1])
+        tree.links.new(m.outputs[0], gout.inputs[0])
+
+    cases = ["GROUPS", "REROUTE", "MUTED_NODE", "MUTED_LINK"]
+    grid = node_scenes.grid(len(cases))  # a fresh file: the groups come after it
+    inner_tree = _group("Inner", inner)
+
+    def outer(tree, gin, gout):
+        _socket(tree, "X", "INPUT")
+        _socket(tree, "Y", "OUTPUT")
+        g = tree.nodes.new("ShaderNodeGroup")
+        g.node_tree = inner_tree
+        g.inputs[1].default_value = 0.25
+        add = tree.nodes.new("ShaderNodeMath")
+        add.inputs[1].default_value = 0.1
+        tree.links.new(gin.outputs[0], g.inputs[0])
+        tree.links.new(g.outputs[0], add.inputs[0])
+        tree.links.new(add.outputs[0], gout.inputs[0])
+
+    outer_tree = _group("Outer", outer)
+    for cell, case in zip(grid.cells, cases, strict=False):
+        u = node_scenes.uv_input(cell, 0)
+        target = _in(cell.emission, "Color")
+        if case == "GROUPS":
+            g = cell.nodes.new("ShaderNodeGroup")
+            g.node_tree = outer_tree
+            cell.links.new(u, g.inputs[0])
+            cell.links.new(g.outputs[0], target)
+        elif case == "REROUTE":
+            r1, r2 = cell.nodes.new("NodeReroute"), cell.nodes.new("NodeReroute")
+            cell.links.new(u, r1.inputs[0])
+            cell.links.new(r1.outputs[0], r2.inputs[0])
+            cell.links.new(r2.outputs[0], target)
+        elif case == "MUTED_NODE":
+            m = cell.nodes.new("ShaderNodeMath")
+            m.operation = "POWER"
+            cell.links.new(u, m.inputs[0])
+            m.mute = True
+            cell.links.new(m.outputs[0], target)
+        else:
+            target.default_value = (0.3, 0.6, 0.9, 1.0)
+            link = cell.links.new(u, target)
+            link.is_muted = True
+    image = _penumbra(grid.scene)
+
+    def ref(i, u, v):
+        return {
+            "GROUPS": u * 0.25 + 0.1,
+            "REROUTE": u,
+            "MUTED_NODE": u,
+            "MUTED_LINK": np.tile([0.3, 0.6, 0.9], (len(u), 1)),
+        }[cases[i]]
+
+    _assert_close(image, _per_plane(grid, ref), grid, cases)
+
+
+def _messages(mat):
+    from penumbra.engine.scene.materials import material_from_blender
+
+    return material_from_blender(mat)
+
+
+def test_bad_trees_fall_back_by_input_with_one_message(penumbra, capfd):
+    """An unknown node (Light Path) into a Mix Shader's factor falls back for that factor only;
+    a group node whose group is gone, a group that contains itself (a broken file) and a
+    2000-node chain each give one clear message and a finite frame."""
+    grid = node_scenes.grid(4)
+    light_path, missing, recursive, huge = (cell.mat for cell in grid.cells)
+
+    # 1: Light Path -> Mix Shader factor (default 0.5 used); the mixed sides still compile.
+    cell = grid.cells[0]
+    mix = cell.nodes.new("ShaderNodeMixShader")
+    _in(mix, "Fac").default_value = 0.5
+    red = cell.nodes.new("ShaderNodeEmission")
+    _in(red, "Color").default_value = (1.0, 0.0, 0.0, 1.0)
+    cell.links.new(_out(cell.nodes.new("ShaderNodeLightPath"), "Is Camera Ray"), _in(mix, "Fac"))
+    cell.links.new(red.outputs[0], mix.inputs[1])
+    cell.links.new(cell.emission.outputs[0], mix.inputs[2])
+    cell.links.new(node_scenes.uv_input(cell, 0), _in(cell.emission, "Color"))
+    cell.links.new(mix.outputs[0], _in(cell.output, "Surface"))
+    read = _messages(light_path)
+    assert read.tree is not None and read.tree.fallbacks == 1
+    assert len(read.messages) == 1 and "Light Path" in read.messages[0] and "'Node000'" in read.messages[0]
+
+    # 2: a group node without its group.
+    cell = grid.cells[1]
+    gone = _group("Gone", lambda t, i, o: _socket(t, "V", "OUTPUT"))
+    g = cell.nodes.new("ShaderNodeGroup")
+    g.node_tree = gone
+    cell.links.new(g.outputs[0], _in(cell.emission, "Color"))
+    cell.links.new(node_scenes.uv_input(cell, 1), _in(cell.emission, "Strength"))
+    bpy.data.node_groups.remove(gone)
+    read = _messages(missing)
+    if g.outputs and g.outputs[0].is_linked:  # Blender drops the sockets (and links) with the group
+        assert any("without its node group" in m for m in read.messages), read.messages
+
+    # 3: a group containing itself. Blender's own API refuses to build one, as a broken file
+    # may hold it: where it refuses, a group of a group of itself is tried the same way.
+    cell = grid.cells[2]
+    loop = _group("Loop", lambda t, i, o: _socket(t, "V", "OUTPUT"))
+    inside = loop.nodes.new("ShaderNodeGroup")
+    try:
+        inside.node_tree = loop
+        built = inside.node_tree == loop
+    except (TypeError, RuntimeError, ValueError):
+        built = False
+    if built:
+        loop.links.new(inside.outputs[0], loop.nodes["Group Output"].inputs[0])
+    g = cell.nodes.new("ShaderNodeGroup")
+    g.node_tree = loop
+    cell.links.new(g.outputs[0], _in(cell.emission, "Color"))
+    cell.links.new(node_scenes.uv_input(cell, 1), _in(cell.emission, "Strength"))
+    read = _messages(recursive)
+    if built:
+        assert any("contains itself" in m for m in read.messages), read.messages
+
+    # 4: 2000 Math nodes in a row: 50 group nodes in a chain, each a group of 40 (Blender
+    # itself takes half a minute to build 2000 nodes in one tree).
+    cell = grid.cells[3]
+
+    def forty(tree, gin, gout):
+        _socket(tree, "V", "INPUT")
+        _socket(tree, "V", "OUTPUT")
+        src = gin.outputs[0]
+        for _ in range(40):
+            m = tree.nodes.new("ShaderNodeMath")
+            m.inputs[1].default_value = 0.0001
+            tree.links.new(src, m.inputs[0])
+            src = m.outputs[0]
+        tree.links.new(src, gout.inputs[0])
+
+    block = _group("Forty", forty)
+    src = node_scenes.uv_input(cell, 0)
+    for _ in range(50):
+        g = cell.nodes.new("ShaderNodeGroup")
+        g.node_tree = block
+        cell.links.new(src, g.inputs[0])
+        src = g.outputs[0]
+    cell.links.new(src, _in(cell.emission, "Color"))
+    read = _messages(huge)
+    assert any("too large to compile" in m for m in read.messages), read.messages
+
+    image = _penumbra(grid.scene)
+    assert np.isfinite(image).all()
+    out = capfd.readouterr().out
+    assert out.count("Light Path") == 1, out
+
+
+def test_extreme_inputs_draw_finite(penumbra):
+    """NaN, +-1e30 and zero or negative scales through Math, Vector Math, Mapping, Color Ramp
+    and Map Range: every pixel finite."""
+    cases = ["DIV0", "HUGE", "NEGHUGE", "NAN", "MAPZERO", "MAPNEG", "RAMP", "RANGE"]
+    grid = node_scenes.grid(len(cases))
+    for cell, case in zip(grid.cells, cases, strict=False):
+        target = _in(cell.emission, "Color")
+        if case in {"DIV0", "HUGE", "NEGHUGE", "NAN"}:
+            m = cell.nodes.new("ShaderNodeMath")
+            m.operation = {"DIV0": "DIVIDE", "HUGE": "POWER", "NEGHUGE": "MULTIPLY", "NAN": "SQRT"}[case]
+            m.inputs[0].default_value = {"DIV0": 1.0, "HUGE": 1e30, "NEGHUGE": -1e30, "NAN": -1.0}[case]
+            m.inputs[1].default_value = {"DIV0": 0.0, "HUGE": 1e30, "NEGHUGE": 1e30, "NAN": 0.0}[case]
+            out = m.outputs[0]
+        elif case.startswith("MAP"):
+            node = cell.nodes.new("ShaderNodeMapping")
+            node.vector_type = "TEXTURE" if case == "MAPZERO" else "NORMAL"
+            _in(node, "Scale").default_value = (0.0, 0.0, 0.0) if case == "MAPZERO" else (-1e30, -2.0, 0.0)
+            cell.links.new(_out(cell.nodes.new("ShaderNodeTexCoord"), "UV"), _in(node, "Vector"))
+            out = node.outputs[0]
+        elif case == "RAMP":
+            node = cell.nodes.new("ShaderNodeValToRGB")
+            node.inputs[0].default_value = float("nan")
+            out = node.outputs[0]
+        else:
+            node = cell.nodes.new("ShaderNodeMapRange")
+            node.inputs[1].default_value = 1e30
+            node.inputs[2].default_value = -1e30
+            cell.links.new(node_scenes.uv_input(cell, 0), node.inputs[0])
+            out = node.outputs[0]
+        cell.links.new(out, target)
+    image = _penumbra(grid.scene)
+    assert np.isfinite(image).all()
+
+
+def test_trees_differing_in_values_share_one_program(penumbra, gpu_call):
+    """1000 materials of one structure and different values compile to one key; drawn, a
+    second scene of other values compiles no program, while another operation compiles one."""
+    from penumbra.engine.scene.nodetree import compile_material
+
+    mats = []
+    for k in range(1000):
+        mat, nodes, links, emission, _output = node_scenes.emission_material(f"Same{k:04d}")
+        m = nodes.new("ShaderNodeMath")
+        m.operation = "MULTIPLY"
+        m.inputs[1].default_value = k / 1000.0
+        links.new(_out(nodes.new("ShaderNodeTexCoord"), "UV"), m.inputs[0])
+        links.new(m.outputs[0], _in(emission, "Color"))
+        mats.append(mat)
+    trees = [compile_material(m)[0] for m in mats]
+    assert len({t.key for t in trees}) == 1
+    assert len({float(t.constants[0, 0]) for t in trees}) == 1000  # the values differ, as constants
+
+    from devkit.render import engine_frame
+
+    def scene_of(values, ops=("MULTIPLY",)):
+        grid = node_scenes.grid(len(values))
+        for k, (cell, value) in enumerate(zip(grid.cells, values, strict=False)):
+            m = cell.nodes.new("ShaderNodeMath")
+            m.operation = ops[k % len(ops)]
+            m.inputs[1].default_value = value
+            cell.links.new(node_scenes.uv_input(cell, 0), m.inputs[0])
+            cell.links.new(m.outputs[0], _in(cell.emission, "Color"))
+        engines.configure(grid.scene, "PENUMBRA")
+        return grid.scene
+
+    one, _ = engine_frame(gpu_call, scene_of([0.5]), 16, 16)
+    many, image = engine_frame(gpu_call, scene_of([0.1 * k for k in range(16)]), 32, 32)
+    assert many.shaders_compiled == one.shaders_compiled, (one.shaders_compiled, many.shaders_compiled)
+    assert len(np.unique(np.round(image[..., 0], 3))) > 16  # the values did reach the planes
+    two, _ = engine_frame(gpu_call, scene_of([0.5, 0.5], ("MULTIPLY", "ADD")), 16, 16)
+    assert two.shaders_compiled == one.shaders_compiled + 1
+    assert two.compile_seconds > 0.0
