@@ -90,3 +90,27 @@ def uv_input(cell, axis, scale=1.0, offset=0.0):
     mad.inputs[1].default_value = scale
     mad.inputs[2].default_value = offset
     return mad.outputs[0]
+
+
+def sphere(width, height, build, name="Asset"):
+    """``material_scenes.sphere_view`` (a smooth unit sphere, a sun from the upper left, the
+    dim grey world) with a material whose tree ``build(mat, nodes, links, bsdf, output)``
+    makes from the default Principled BSDF and Material Output."""
+    scene = material_scenes.base(width, height)
+    mat, bsdf, output = material_scenes.node_material(name)
+    build(mat, mat.node_tree.nodes, mat.node_tree.links, bsdf, output)
+    return material_scenes.sphere_view(scene, mat)
+
+
+def shader_group(name, inputs, build):
+    """A node group with float/colour ``inputs`` ((name, socket type, default)) and one Shader
+    output, which ``build(tree, group_input, group_output)`` fills."""
+    tree = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    for sock_name, kind, default in inputs:
+        item = tree.interface.new_socket(sock_name, in_out="INPUT", socket_type=kind)
+        if default is not None:
+            item.default_value = default
+    tree.interface.new_socket("Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+    gin, gout = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    build(tree, gin, gout)
+    return tree

@@ -553,6 +553,13 @@ def _diffuse(c, node, socket, ctx):
     return c.temp("closure", f"node_diffuse({color.expr})")
 
 
+@node("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic")
+def _glossy(c, node, socket, ctx):
+    color = c.shader_input(node, "Color", ctx, "vec4")
+    rough = c.shader_input(node, "Roughness", ctx, "float")
+    return c.temp("closure", f"node_principled({color.expr}, 1.0, {rough.expr}, 0.5, 1.0, vec3(0.0))")
+
+
 @node("ShaderNodeBsdfTransparent")
 def _transparent(c, node, socket, ctx):
     c.transparent = True

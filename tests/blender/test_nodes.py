@@ -5,6 +5,7 @@ evaluated at each pixel's analytic UV; tolerances are stated at each assertion."
 
 import bpy
 import numpy as np
+import pytest
 
 from devkit import engines, node_reference, node_scenes
 from devkit.render import render
@@ -670,3 +671,113 @@ def test_trees_differing_in_values_share_one_program(penumbra, gpu_call):
     two, _ = engine_frame(gpu_call, scene_of([0.5, 0.5], ("MULTIPLY", "ADD")), 16, 16)
     assert two.shaders_compiled == one.shaders_compiled + 1
     assert two.compile_seconds > 0.0
+
+
+# --- asset-like trees against EEVEE -------------------------------------------------------
+
+
+def _principled_in_group(mat, nodes, links, bsdf, output):
+    """A Principled BSDF inside a node group (inside another group), its Base Color and
+    Roughness group inputs: one linked from an RGB node, one left at the group node's value."""
+
+    def inner(tree, gin, gout):
+        p = tree.nodes.new("ShaderNodeBsdfPrincipled")
+        tree.links.new(gin.outputs[0], _in(p, "Base Color"))
+        tree.links.new(gin.outputs[1], _in(p, "Roughness"))
+        _in(p, "Specular IOR Level").default_value = 0.5
+        tree.links.new(p.outputs[0], gout.inputs[0])
+
+    inner_tree = node_scenes.shader_group(
+        "PBR", [("Color", "NodeSocketColor", (0.8, 0.8, 0.8, 1.0)), ("Rough", "NodeSocketFloat", 0.5)], inner
+    )
+
+    def outer(tree, gin, gout):
+        g = tree.nodes.new("ShaderNodeGroup")
+        g.node_tree = inner_tree
+        g.inputs[1].default_value = 0.35
+        tree.links.new(gin.outputs[0], g.inputs[0])
+        tree.links.new(g.outputs[0], gout.inputs[0])
+
+    outer_tree = node_scenes.shader_group("Wrapper", [("Color", "NodeSocketColor", None)], outer)
+    g = nodes.new("ShaderNodeGroup")
+    g.node_tree = outer_tree
+    rgb = nodes.new("ShaderNodeRGB")
+    rgb.outputs[0].default_value = (0.7, 0.25, 0.1, 1.0)
+    links.new(rgb.outputs[0], g.inputs[0])
+    links.new(g.outputs[0], _in(output, "Surface"))
+
+
+def _ramp_on_gradient_into_roughness(mat, nodes, links, bsdf, output):
+    """Gradient (Generated, linear along x) -> Color Ramp -> Roughness, and a second ramp
+    (Ease) of the same gradient -> Base Color; Metallic 0.6 so roughness shows."""
+    grad = nodes.new("ShaderNodeTexGradient")
+    rough = nodes.new("ShaderNodeValToRGB")
+    rough.color_ramp.elements[0].color = (0.05, 0.05, 0.05, 1.0)
+    rough.color_ramp.elements[1].color = (0.9, 0.9, 0.9, 1.0)
+    color = nodes.new("ShaderNodeValToRGB")
+    color.color_ramp.interpolation = "EASE"
+    color.color_ramp.elements[0].color = (0.8, 0.1, 0.1, 1.0)
+    color.color_ramp.elements[1].color = (0.1, 0.3, 0.9, 1.0)
+    links.new(_out(grad, "Fac"), rough.inputs[0])
+    links.new(_out(grad, "Fac"), color.inputs[0])
+    links.new(rough.outputs[0], _in(bsdf, "Roughness"))
+    links.new(color.outputs[0], _in(bsdf, "Base Color"))
+    _in(bsdf, "Metallic").default_value = 0.6
+
+
+def _mix_shader_by_checker(mat, nodes, links, bsdf, output):
+    """Mix Shader whose factor is a Checker (Generated, scale 4): a red Principled and a blue
+    Diffuse BSDF."""
+    _in(bsdf, "Base Color").default_value = (0.8, 0.15, 0.1, 1.0)
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    _in(diffuse, "Color").default_value = (0.1, 0.3, 0.8, 1.0)
+    checker = nodes.new("ShaderNodeTexChecker")
+    _in(checker, "Scale").default_value = 4.0
+    mix = nodes.new("ShaderNodeMixShader")
+    links.new(_out(checker, "Fac"), mix.inputs[0])
+    links.new(bsdf.outputs[0], mix.inputs[1])
+    links.new(diffuse.outputs[0], mix.inputs[2])
+    links.new(mix.outputs[0], _in(output, "Surface"))
+
+
+def _add_shader_rim(mat, nodes, links, bsdf, output):
+    """Add Shader of a Principled BSDF and an Emission whose strength is Layer Weight's
+    Facing: a glowing rim."""
+    _in(bsdf, "Base Color").default_value = (0.3, 0.5, 0.3, 1.0)
+    emission = nodes.new("ShaderNodeEmission")
+    _in(emission, "Color").default_value = (1.0, 0.6, 0.2, 1.0)
+    weight = nodes.new("ShaderNodeLayerWeight")
+    _in(weight, "Blend").default_value = 0.4
+    links.new(_out(weight, "Facing"), _in(emission, "Strength"))
+    add = nodes.new("ShaderNodeAddShader")
+    links.new(bsdf.outputs[0], add.inputs[0])
+    links.new(emission.outputs[0], add.inputs[1])
+    links.new(add.outputs[0], _in(output, "Surface"))
+
+
+# name -> (builder, bound on the mean |difference| from EEVEE); measured on 5.2 and 4.5:
+# 0.0017, 0.0035, 0.0080, 0.0067 (the bounds sit 2-3x above; the issue asks for 0.05).
+ASSETS = {
+    "principled_in_group": (_principled_in_group, 0.005),
+    "ramp_into_roughness": (_ramp_on_gradient_into_roughness, 0.01),
+    "mix_shader_by_checker": (_mix_shader_by_checker, 0.02),
+    "add_shader_rim": (_add_shader_rim, 0.015),
+}
+
+
+@pytest.mark.parametrize("name", list(ASSETS))
+def test_asset_like_trees_match_eevee(penumbra, name):
+    """Trees as asset libraries build them, on a sphere under a sun (48x48): Penumbra at 8
+    samples within the bound of ASSETS (mean |difference|) of EEVEE (16 samples), and the
+    tree compiled whole."""
+    from penumbra.engine.scene.materials import material_from_blender
+
+    build, bound = ASSETS[name]
+    scene = node_scenes.sphere(48, 48, build)
+    read = material_from_blender(bpy.data.materials["Asset"])
+    assert read.tree is not None and read.tree.fallbacks == 0, read.messages
+    ours = _penumbra(scene, samples=8)
+    engines.configure(scene, "EEVEE")
+    ref = render(scene)["Combined"]
+    diff = np.abs(ours[..., :3] - ref[..., :3]).mean()
+    assert diff < bound, diff
