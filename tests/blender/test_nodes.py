@@ -781,3 +781,71 @@ def test_asset_like_trees_match_eevee(penumbra, name):
     ref = render(scene)["Combined"]
     diff = np.abs(ours[..., :3] - ref[..., :3]).mean()
     assert diff < bound, diff
+
+
+def test_an_image_feeds_any_node(penumbra):
+    """An Image Texture (the 4x4 sRGB checker of material_scenes, its alpha 1 / 0.25 by cell)
+    through Invert, and its Alpha through Math Multiply 0.5, both into Emission; and through a
+    Mapping node (scale 2) read by its Vector: each checker cell's centre is the decoded texel
+    so transformed, within 1e-3."""
+    from devkit import material_scenes as ms
+
+    grid = node_scenes.grid(3, block=32)
+    pixels = ms.checker(4, 4, (*ms.CHECKER_A, 1.0), (*ms.CHECKER_B, 0.25))
+    img = ms.image("NodeChecker", pixels)
+    for k, cell in enumerate(grid.cells):
+        tex = cell.nodes.new("ShaderNodeTexImage")
+        tex.image = img
+        tex.interpolation = "Closest"
+        if k == 0:
+            inv = cell.nodes.new("ShaderNodeInvert")
+            cell.links.new(_out(tex, "Color"), _in(inv, "Color"))
+            cell.links.new(inv.outputs[0], _in(cell.emission, "Color"))
+        elif k == 1:
+            m = cell.nodes.new("ShaderNodeMath")
+            m.operation = "MULTIPLY"
+            m.inputs[1].default_value = 0.5
+            cell.links.new(_out(tex, "Alpha"), m.inputs[0])
+            cell.links.new(m.outputs[0], _in(cell.emission, "Color"))
+        else:
+            mapping = cell.nodes.new("ShaderNodeMapping")
+            _in(mapping, "Scale").default_value = (2.0, 2.0, 1.0)
+            cell.links.new(_out(cell.nodes.new("ShaderNodeTexCoord"), "UV"), _in(mapping, "Vector"))
+            cell.links.new(mapping.outputs[0], _in(tex, "Vector"))
+            cell.links.new(_out(tex, "Color"), _in(cell.emission, "Color"))
+    image = _penumbra(grid.scene)
+    a = np.array([((c + 0.055) / 1.055) ** 2.4 for c in np.floor(np.array(ms.CHECKER_A) * 255 + 0.5) / 255])
+    b = np.array([((c + 0.055) / 1.055) ** 2.4 for c in np.floor(np.array(ms.CHECKER_B) * 255 + 0.5) / 255])
+    for i in range(4):
+        for j in range(4):
+            first = (i + j) % 2 == 0
+            row, col = j * 8 + 4, i * 8 + 4
+            np.testing.assert_allclose(image[row, col, :3], 1.0 - (a if first else b), atol=1e-3)
+            np.testing.assert_allclose(image[row, 32 + col, :3], 0.5 * (1.0 if first else 0.25), atol=1e-3)
+            # Mapping scales UV by 2: this cell's centre reads cell (2i, 2j) mod 4, always the first colour
+            np.testing.assert_allclose(image[32 + row, col, :3], a, atol=1e-3)
+
+
+def test_a_normal_map_stays_on_a_compiled_tree(penumbra):
+    """material_scenes' normal_map with a Math node (Add 0) between a Value and Roughness, which
+    only the compiler reads: the tree compiles and the normal map still tilts the normal as
+    the reader's path draws it (within 1e-3)."""
+    from devkit import material_scenes as ms
+    from penumbra.engine.scene.materials import material_from_blender
+
+    def plane(compiled):
+        scene = ms.normal_map(32, 32)
+        mat = next(ob for ob in scene.objects if ob.type == "MESH").material_slots[0].material
+        if compiled:
+            nodes, links = mat.node_tree.nodes, mat.node_tree.links
+            bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+            value, add = nodes.new("ShaderNodeValue"), nodes.new("ShaderNodeMath")
+            value.outputs[0].default_value = _in(bsdf, "Roughness").default_value
+            add.inputs[1].default_value = 0.0
+            links.new(value.outputs[0], add.inputs[0])
+            links.new(add.outputs[0], _in(bsdf, "Roughness"))
+            read = material_from_blender(mat)
+            assert read.tree is not None and "normal" in read.textures, read.messages
+        return _penumbra(scene, samples=1)
+
+    np.testing.assert_allclose(plane(True), plane(False), atol=1e-3)
