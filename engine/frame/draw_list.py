@@ -56,6 +56,23 @@ class Draw:
             out.add("TERMINATOR_SHADING")
         return frozenset(out)
 
+    def texture_space(self):
+        """Push constants of Blender's Generated coordinates (a compiled node tree's
+        ``node_texspace_*``): the object's bounds mapped to [0, 1], a flat axis (of zero
+        extent) to 0.5, as Blender's automatic texture space."""
+        if self.bounds is None:
+            lo, hi = np.zeros(3), np.ones(3)
+        else:
+            lo, hi = np.asarray(self.bounds[0], np.float64), np.asarray(self.bounds[1], np.float64)
+        half = (hi - lo) * 0.5
+        half = np.where(half == 0.0, 1.0, np.maximum(half, 1e-5))
+        scale = 0.5 / half
+        offset = 0.5 - (hi + lo) * 0.5 * scale
+        return {
+            "node_texspace_scale": tuple(float(x) for x in scale),
+            "node_texspace_offset": tuple(float(x) for x in offset),
+        }
+
     def material(self, index):
         materials = self.instance.materials
         mat = materials[index] if 0 <= index < len(materials) else None

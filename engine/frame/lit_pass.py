@@ -10,26 +10,6 @@ from .draw_list import front_to_back
 from .programs import BACKGROUND, JITTER_SIZE, SHADOW_SAMPLER, lit_program, terminator_uniforms
 
 
-def texture_space(draw):
-    """Push constants of Blender's Generated coordinates for ``draw``: its object's bounds
-    mapped to [0, 1] (a flat axis, of zero extent, to 0.5), as Blender's automatic texture
-    space."""
-    bounds = getattr(draw, "bounds", None)
-    if bounds is None:
-        lo, hi = np.zeros(3), np.ones(3)
-    else:
-        lo, hi = np.asarray(bounds[0], np.float64), np.asarray(bounds[1], np.float64)
-    half = (hi - lo) * 0.5
-    half = np.where(half == 0.0, 1.0, np.maximum(half, 1e-5))
-    centre = (hi + lo) * 0.5
-    scale = 0.5 / half
-    offset = 0.5 - centre * scale
-    return {
-        "node_texspace_scale": tuple(float(x) for x in scale),
-        "node_texspace_offset": tuple(float(x) for x in offset),
-    }
-
-
 class LitPass:
     """The lit pass's GPU state of one renderer: its uniform blocks, the jittered-disk and
     light-bin textures. ``materials``: the renderer's ``MaterialBlocks``; ``textures``: its
@@ -149,7 +129,7 @@ class LitPass:
                     last, bound["model_shader"] = d, shader
                     bound["texspace"] = None
                 if mat.tree is not None and "GENERATED" in mat.tree.needs and bound.get("texspace") is not d:
-                    set_uniforms(shader, texture_space(d))
+                    set_uniforms(shader, d.texture_space())
                     bound["texspace"] = d
                 shader.uniform_block("material", self.materials.get(mat))
                 for channel, ref in mat.textures.items():

@@ -469,6 +469,26 @@ def shadow_cutout_program(depth_format, textured, raster_depth=False):
     return _with_features(program, features, f"{base.name}_alpha_tex")
 
 
+def shadow_tree_program(depth_format, tree, raster_depth=False):
+    """The alpha cut-out of a caster whose alpha a compiled node tree gives (``tree``:
+    ``nodetree.CompiledTree`` without FRAME in its needs): the tree runs in the depth pass,
+    with the surface data it reads, so a procedural alpha casts the shadow it draws."""
+    base = shadow_program(depth_format, raster_depth)
+    program = replace(
+        base,
+        libs=base.libs + ("lib/material.glsl",),
+        vertex_in=MESH_VERTEX_IN,
+        varyings=base.varyings + (("smooth", "VEC3", "v_world"), ("smooth", "VEC3", "v_normal")),
+        push_constants=base.push_constants + (("FLOAT", "alpha_offset"),),
+        uniform_blocks=base.uniform_blocks + ((MATERIAL_STRUCT, "material", 0),),
+        defines=base.defines + (("ALPHA_CUTOUT", True),),
+    )
+    features = {f"NODES_{tree.key}"} | ({"TREE_UV"} if "UV" in tree.needs else set())
+    features |= {"VCOL"} if "VCOL" in tree.needs else set()
+    program = _with_features(program, frozenset(features), f"{base.name}_alpha_{'_'.join(sorted(features)).lower()}")
+    return with_tree(program, tree)
+
+
 # The world's Environment Texture behind everything (materials.World.image).
 BACKGROUND = Program(
     name="background",

@@ -121,7 +121,7 @@ class CompiledTree:
     families: tuple  # shaders/nodes/*.glsl files, in include order
     constants: np.ndarray  # (n, 4) float32: the node_constants rows
     images: tuple  # NodeImage per sampler node_image_<i>
-    needs: frozenset  # surface data read: UV, VCOL, GENERATED, ORIGIN
+    needs: frozenset  # surface data read: UV, VCOL, GENERATED, ORIGIN, FRAME (the camera)
     uv_map: str = ""  # the UV map UV reads ("" = the active render map)
     color_attribute: str = ""  # the colour attribute VCOL reads ("" = the active one)
     transparent: bool = False  # alpha can be below 1
@@ -469,11 +469,14 @@ class Compiler:
 def _prelude(needs):
     """Surface data the node functions read, as GLSL (per-draw push constants where needed)."""
     out = [
-        "vec3 node_window()\n{\n  vec4 c = frame.view_proj * vec4(v_world, 1.0);\n"
-        "  return (abs(c.w) > 1e-30) ? vec3(c.xy / c.w * 0.5 + 0.5, 0.0) : vec3(0.0);\n}\n",
         "vec3 node_true_normal(vec3 V)\n{\n  vec3 f = node_safe_normalize(cross(dFdx(v_world), dFdy(v_world)));\n"
         "  return (dot(f, V) < 0.0) ? -f : f;\n}\n",
     ]
+    if "FRAME" in needs:  # the camera's matrices: the lit pass only
+        out.append(
+            "vec3 node_window()\n{\n  vec4 c = frame.view_proj * vec4(v_world, 1.0);\n"
+            "  return (abs(c.w) > 1e-30) ? vec3(c.xy / c.w * 0.5 + 0.5, 0.0) : vec3(0.0);\n}\n"
+        )
     if "GENERATED" in needs:
         out.append(
             "vec3 node_generated()\n{\n  vec3 p = (inverse(model) * vec4(v_world, 1.0)).xyz;\n"
@@ -608,8 +611,10 @@ def _tex_coord(c, node, socket, ctx):
             raise Fallback("a 'Texture Coordinate' node's Object output of another object")
         return c.temp("vec3", "(inverse(model) * vec4(v_world, 1.0)).xyz")
     if out == "Camera":
+        c.needs.add("FRAME")
         return c.temp("vec3", "(frame.view * vec4(v_world, 1.0)).xyz * vec3(1.0, 1.0, -1.0)")
     if out == "Window":
+        c.needs.add("FRAME")
         return c.temp("vec3", "node_window()")
     if out == "Reflection":
         return c.temp("vec3", "reflect(-V, N)")

@@ -849,3 +849,40 @@ def test_a_normal_map_stays_on_a_compiled_tree(penumbra):
         return _penumbra(scene, samples=1)
 
     np.testing.assert_allclose(plane(True), plane(False), atol=1e-3)
+
+
+def test_a_procedural_alpha_casts_the_shadow_it_draws(penumbra):
+    """material_scenes' alpha_checker_shadow with its alpha from a Checker texture (UV, Scale
+    4: the same 4x4 cells, opaque where i + j is odd) instead of the image: the compiled tree
+    runs in the shadow pass, so the ground is shadowed exactly under the opaque cells (pixels
+    more than 1.5 pixels from a cell edge)."""
+    from devkit import material_scenes as ms
+    from penumbra.engine.scene.materials import material_from_blender
+
+    size = 64
+    scene = ms.alpha_checker_shadow(size, size)
+    mat = scene.objects["Checker"].material_slots[0].material
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    checker = nodes.new("ShaderNodeTexChecker")
+    _in(checker, "Scale").default_value = 4.0
+    links.new(_out(nodes.new("ShaderNodeTexCoord"), "UV"), _in(checker, "Vector"))
+    links.new(_out(checker, "Fac"), _in(bsdf, "Alpha"))
+    read = material_from_blender(mat)
+    assert read.tree is not None and read.tree.transparent and read.uses_alpha, read.messages
+    image = _penumbra(scene, samples=1)[..., :3].mean(axis=-1)
+    view, cells, side = scene["view_size"], scene["checker_cells"], scene["checker_size"]
+    centres = ((np.arange(size) + 0.5) / size - 0.5) * view
+    gx, gy = np.meshgrid(centres, centres)
+    inside = (np.abs(gx) < side / 2) & (np.abs(gy) < side / 2)
+    i = np.floor((gx + side / 2) / (side / cells)).astype(int)
+    j = np.floor((gy + side / 2) / (side / cells)).astype(int)
+    shadowed = inside & ((i + j) % 2 == 1)
+    cell, pixel = side / cells, view / size
+    fx, fy = np.mod(gx + side / 2, cell), np.mod(gy + side / 2, cell)
+    near_edge = (np.minimum(fx, cell - fx) < 1.5 * pixel) | (np.minimum(fy, cell - fy) < 1.5 * pixel)
+    near_edge |= (np.abs(np.abs(gx) - side / 2) < 1.5 * pixel) | (np.abs(np.abs(gy) - side / 2) < 1.5 * pixel)
+    lit_level = image[~shadowed & ~near_edge].mean()
+    dark = image < 0.5 * lit_level
+    assert shadowed.sum() > 200 and (~shadowed & ~near_edge).sum() > 200
+    assert np.array_equal(dark[~near_edge], shadowed[~near_edge])
