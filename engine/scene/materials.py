@@ -7,10 +7,11 @@ its UV map and Mapping node. Besides what the wrapper follows, an input may come
 Color Attribute / Attribute node (vertex colours), an RGB or Value node, or through reroutes.
 Emission and Diffuse BSDF surfaces are read directly.
 
-Anything else (a Mix Shader, a procedural texture into Base Color, ...) falls back to the
-material's viewport display values, and the material carries a message that says so: the
-engine reports it once per render and the Material panel shows it. Nothing is dropped
-silently.
+Anything else is compiled (``nodetree``: the tree as generated GLSL, ``Material.tree``)
+where that draws more than this reader; what neither reads falls back to the material's
+viewport display values (or the input's own value), and the material carries a message
+that says so: the engine reports it once per render and the Material panel shows it.
+Nothing is dropped silently.
 
 No gpu here: the result is plain data (``Material``, ``TextureRef``) the renderer turns
 into shader variants and uniforms.
@@ -551,6 +552,8 @@ def summary(read):
     last (the same words as the render report, without the material's name)."""
     textures = ", ".join(c.replace("_", " ") for c in read.textures) or "none"
     lines = [("TEXTURE", f"Textures: {textures}")]
+    if read.tree is not None:
+        lines.insert(0, ("NODETREE", f"Node tree: compiled to GLSL ({len(read.tree.constants)} constants)"))
     if read.color_attribute is not None:
         lines.append(("GROUP_VCOL", f"Colour attribute: {read.color_attribute or 'the active one'}"))
     alpha = {"OPAQUE": "opaque", "HASHED": "dithered (hashed over samples)", "BLEND": "blended"}[read.blend]

@@ -774,8 +774,11 @@ def test_asset_like_trees_match_eevee(penumbra, name):
 
     build, bound = ASSETS[name]
     scene = node_scenes.sphere(48, 48, build)
+    from penumbra.engine.scene.materials import summary
+
     read = material_from_blender(bpy.data.materials["Asset"])
     assert read.tree is not None and read.tree.fallbacks == 0, read.messages
+    assert summary(read)[0][0] == "NODETREE"  # the Material panel says it is compiled
     ours = _penumbra(scene, samples=8)
     engines.configure(scene, "EEVEE")
     ref = render(scene)["Combined"]
