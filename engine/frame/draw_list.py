@@ -73,6 +73,14 @@ class Draw:
             "node_texspace_offset": tuple(float(x) for x in offset),
         }
 
+    def tree_uniforms(self, tree):
+        """The per-draw push constants compiled node tree ``tree`` reads of this instance."""
+        out = self.texture_space() if "GENERATED" in tree.needs else {}
+        if "OBJECT_INFO" in tree.needs:
+            out["node_object_color"] = tuple(float(c) for c in self.instance.color)
+            out["node_object_random"] = float(self.instance.random)
+        return out
+
     def material(self, index):
         materials = self.instance.materials
         mat = materials[index] if 0 <= index < len(materials) else None

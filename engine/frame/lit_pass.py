@@ -127,10 +127,8 @@ class LitPass:
                     if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
                         set_uniforms(shader, terminators[id(d)])
                     last, bound["model_shader"] = d, shader
-                    bound["texspace"] = None
-                if mat.tree is not None and "GENERATED" in mat.tree.needs and bound.get("texspace") is not d:
-                    set_uniforms(shader, d.texture_space())
-                    bound["texspace"] = d
+                if mat.tree is not None and mat.tree.needs & {"GENERATED", "OBJECT_INFO"}:
+                    set_uniforms(shader, d.tree_uniforms(mat.tree))
                 shader.uniform_block("material", self.materials.get(mat))
                 for channel, ref in mat.textures.items():
                     shader.uniform_sampler(f"tex_{channel}", self.textures.get(ref.image))

@@ -307,10 +307,12 @@ def lit_program(features=frozenset(), aux=True, emission=False, counted=False, t
 
 
 # Per-draw values a compiled tree may read (set like ``model``): the object's texture space
-# (Generated = object position * scale + offset) and the world origin the positions are
-# drawn relative to (``draw_list``: positions are shifted by the frame's origin).
+# (Generated = object position * scale + offset), the world origin the positions are drawn
+# relative to (``draw_list``: positions are shifted by the frame's origin), and the Object
+# Info node's colour and random number.
 TREE_UNIFORMS = {"GENERATED": (("VEC3", "node_texspace_scale"), ("VEC3", "node_texspace_offset"))}
 TREE_UNIFORMS["ORIGIN"] = (("VEC3", "node_origin"),)
+TREE_UNIFORMS["OBJECT_INFO"] = (("VEC4", "node_object_color"), ("FLOAT", "node_object_random"))
 
 
 def with_tree(program, tree):

@@ -132,7 +132,7 @@ def caster(d, materials, textures):
 def _tree_cutout(d, mat, materials, textures):
     """What a caster's compiled node tree needs in the depth pass (``shadow_maps.TreeCutout``)."""
     tree = mat.tree
-    uniforms = d.texture_space() if "GENERATED" in tree.needs else {}
+    uniforms = d.tree_uniforms(tree)
     images = tuple(textures.get(ref.image) for ref in tree.images)
     return TreeCutout(tree, materials.constants(mat), images, uniforms)
 

@@ -121,7 +121,7 @@ class CompiledTree:
     families: tuple  # shaders/nodes/*.glsl files, in include order
     constants: np.ndarray  # (n, 4) float32: the node_constants rows
     images: tuple  # NodeImage per sampler node_image_<i>
-    needs: frozenset  # surface data read: UV, VCOL, GENERATED, ORIGIN, FRAME (the camera)
+    needs: frozenset  # surface data read: UV, VCOL, GENERATED, ORIGIN, OBJECT_INFO, FRAME (the camera)
     uv_map: str = ""  # the UV map UV reads ("" = the active render map)
     color_attribute: str = ""  # the colour attribute VCOL reads ("" = the active one)
     transparent: bool = False  # alpha can be below 1
@@ -669,6 +669,13 @@ def _object_info(c, node, socket, ctx):
     if socket.identifier == "Location":
         c.needs.add("ORIGIN")
         return Value("(model[3].xyz + node_origin)", "vec3")
+    if socket.identifier in {"Color", "Alpha", "Random"}:
+        c.needs.add("OBJECT_INFO")
+        return {
+            "Color": Value("vec4(node_object_color.rgb, 1.0)", "vec4"),
+            "Alpha": Value("node_object_color.a", "float"),
+            "Random": Value("node_object_random", "float"),
+        }[socket.identifier]
     raise Fallback(f"an 'Object Info' node's {socket.name} output")
 
 
