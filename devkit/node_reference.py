@@ -504,3 +504,11 @@ def mapping(kind, v, location, rotation, scale):
     if kind == "VECTOR":
         return (v * scale) @ r.T
     return safe_normalize(safe_divide(v, scale) @ r.T)
+
+
+def curve(mapping, curve_, x):
+    """A CurveMapping curve evaluated by Blender itself at every ``x`` (the reference the
+    tabulated node_curve is held to)."""
+    mapping.initialize()
+    flat = np.ravel(_f(x))
+    return np.array([mapping.evaluate(curve_, float(v)) for v in flat]).reshape(np.shape(x))

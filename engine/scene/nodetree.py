@@ -57,6 +57,7 @@ MAX_NODES = 1500  # node outputs compiled (after inlining groups)
 MAX_DEPTH = 120  # links followed from the output to the farthest node
 MAX_GROUP_DEPTH = 16  # node groups inside node groups
 MAX_IMAGES = 8  # image textures one tree samples
+CURVE_SAMPLES = 128  # points an RGB Curves / Float Curve curve is tabulated at
 
 GLSL_TYPES = {"float": "float", "vec3": "vec3", "vec4": "vec4", "closure": "NodeClosure"}
 SOCKET_TYPES = {"VALUE": "float", "INT": "float", "BOOLEAN": "float", "VECTOR": "vec3", "RGBA": "vec4"}
@@ -786,6 +787,56 @@ def _color_ramp(c, node, socket, ctx):
     )
     v = c.temp("vec4", f"node_color_ramp({fac.expr}, {args})")
     return Value(f"{v.expr}.a", "float") if socket.identifier == "Alpha" else v
+
+
+def _curve(c, mapping, curve, x):
+    """GLSL of curve ``curve`` of CurveMapping ``mapping`` at float expression ``x``: the curve
+    tabulated with Blender's own evaluation (constants), read by node_curve."""
+    xs = [float(p.location[0]) for p in curve.points]
+    lo, hi = min(xs), max(xs)
+    if hi - lo < 1e-6:
+        hi = lo + 1e-6
+    samples = lo + (hi - lo) * np.arange(CURVE_SAMPLES) / (CURVE_SAMPLES - 1)
+    ys = [float(mapping.evaluate(curve, float(s))) for s in samples]
+    before = ys[0] - float(mapping.evaluate(curve, lo - 1.0))
+    after = float(mapping.evaluate(curve, hi + 1.0)) - ys[-1]
+    first = len(c.constants)
+    for k in range(0, CURVE_SAMPLES, 4):
+        c.const(tuple(ys[k : k + 4]), "vec4")
+    head = c.const((lo, 1.0 / (hi - lo), before, after), "vec4")
+    return f"node_curve({x}, {first}, {CURVE_SAMPLES}, {head.expr})"
+
+
+@node("ShaderNodeFloatCurve", family="converter")
+def _float_curve(c, node, socket, ctx):
+    mapping = node.mapping
+    mapping.initialize()
+    fac, value = c.input(node, "Factor", ctx, "float"), c.input(node, "Value", ctx, "float")
+    v = c.temp("float", value.expr)
+    curved = c.temp("float", _curve(c, mapping, mapping.curves[0], v.expr))
+    return c.temp("float", f"mix({v.expr}, {curved.expr}, {fac.expr})")
+
+
+@node("ShaderNodeRGBCurve", family="converter")
+def _rgb_curve(c, node, socket, ctx):
+    """Each channel through the combined curve (C), then its own (R, G, B), after the black
+    and white levels, mixed with the input by Fac; alpha kept."""
+    mapping = node.mapping
+    mapping.initialize()
+    fac, col = c.input(node, "Fac", ctx, "float"), c.input(node, "Color", ctx, "vec4")
+    black, white = tuple(mapping.black_level), tuple(mapping.white_level)
+    src = c.temp("vec4", col.expr)
+    x = src
+    if black != (0.0, 0.0, 0.0) or white != (1.0, 1.0, 1.0):
+        b = c.const(black, "vec3")
+        scale = c.const(tuple(1.0 / (w - k) if w != k else 0.0 for w, k in zip(white, black, strict=True)), "vec3")
+        x = c.temp("vec4", f"vec4(({src.expr}.rgb - {b.expr}) * {scale.expr}, {src.expr}.a)")
+    channels = []
+    for i, comp in enumerate("rgb"):
+        combined = c.temp("float", _curve(c, mapping, mapping.curves[3], f"{x.expr}.{comp}"))
+        channels.append(c.temp("float", _curve(c, mapping, mapping.curves[i], combined.expr)).expr)
+    curved = f"vec4({', '.join(channels)}, {src.expr}.a)"
+    return c.temp("vec4", f"mix({src.expr}, {curved}, {fac.expr})")
 
 
 @node("ShaderNodeHueSaturation", family="color")

@@ -126,4 +126,28 @@ vec4 node_color_ramp(float x, const int first, const int count, const int interp
 #undef NODE_RAMP_COLOR
 #undef NODE_RAMP_POS
 
+#define NODE_CURVE_Y(k) node_constants[first + (k) / 4].v[(k) % 4]
+
+/* A curve of RGB Curves / Float Curve, tabulated at ``count`` points over the x range of its
+ * control points (constants from ``first``, four a row), read linearly between them; past
+ * the range it continues along the curve's end slopes (head: x of the first point, 1 / the
+ * range, slope before, slope after), as Blender's curves extrapolate. */
+float node_curve(float x, const int first, const int count, vec4 head)
+{
+  float t = (x - head.x) * head.y * float(count - 1);
+  if (isnan(t)) {
+    return NODE_CURVE_Y(0);
+  }
+  if (t <= 0.0) {
+    return NODE_CURVE_Y(0) + head.z * (x - head.x);
+  }
+  if (t >= float(count - 1)) {
+    return NODE_CURVE_Y(count - 1) + head.w * (x - (head.x + 1.0 / head.y));
+  }
+  int i = int(floor(t));
+  return mix(NODE_CURVE_Y(i), NODE_CURVE_Y(i + 1), t - float(i));
+}
+
+#undef NODE_CURVE_Y
+
 #endif

@@ -916,3 +916,45 @@ def test_object_info_colour_alpha_and_random(penumbra):
     u, v, index = grid.uv()
     randoms = [float(cycles[index == i].mean()) for i in (2, 5)]
     assert len({round(r, 3) for r in randoms}) == 2 and all(0.0 < r < 1.0 for r in randoms)
+
+
+def test_rgb_curves_and_float_curve(penumbra):
+    """Float Curve (an S-curve, Factor 0.8) and RGB Curves (a combined curve, a red curve, Fac
+    1) on x = 1.6u - 0.3 (past both ends of the curves): Blender's own curve evaluation at
+    each pixel within 2e-3 (combined curve first, then the channel's; past the ends along
+    the end slopes, as CurveMapping.evaluate), and EEVEE within 0.005 mean (measured 0.0008, 0.0010 on 4.5)
+    inside the curves' range, away from the planes' edges."""
+    grid = node_scenes.grid(2, block=32)
+    float_cell, rgb_cell = grid.cells
+    fc = float_cell.nodes.new("ShaderNodeFloatCurve")
+    points = fc.mapping.curves[0].points
+    points.new(0.3, 0.1)
+    points.new(0.7, 0.9)
+    _in(fc, "Factor").default_value = 0.8
+    float_cell.links.new(node_scenes.uv_input(float_cell, 0, 1.6, -0.3), _in(fc, "Value"))
+    float_cell.links.new(fc.outputs[0], _in(float_cell.emission, "Color"))
+    rc = rgb_cell.nodes.new("ShaderNodeRGBCurve")
+    rc.mapping.curves[3].points.new(0.5, 0.7)
+    rc.mapping.curves[0].points.new(0.4, 0.2)
+    x = node_scenes.uv_input(rgb_cell, 0, 1.6, -0.3)
+    rgb_cell.links.new(_combine(rgb_cell, x, x, 0.5, color=True), _in(rc, "Color"))
+    rgb_cell.links.new(rc.outputs[0], _in(rgb_cell.emission, "Color"))
+    ours = _penumbra(grid.scene)
+    r = node_reference
+    fm, rm = fc.mapping, rc.mapping
+
+    def ref(i, u, v):
+        x = 1.6 * u - 0.3
+        if i == 0:
+            return x + 0.8 * (r.curve(fm, fm.curves[0], x) - x)
+        comb = [r.curve(rm, rm.curves[3], ch) for ch in (x, x, np.full_like(x, 0.5))]
+        return np.stack([r.curve(rm, rm.curves[k], comb[k]) for k in range(3)], -1)
+
+    _assert_close(ours, _per_plane(grid, ref), grid, ["FLOAT_CURVE", "RGB_CURVES"])
+    engines.configure(grid.scene, "EEVEE")
+    eevee = render(grid.scene)["Combined"]
+    u, v, _index = grid.uv()
+    inner = (np.abs(u - 0.5) < 0.4) & (np.abs(v - 0.5) < 0.4)  # EEVEE's pixel filter blurs the planes' edges
+    inner &= (1.6 * u - 0.3 > 0.0) & (1.6 * u - 0.3 < 1.0)  # past the curves' ends EEVEE extrapolates otherwise
+    diff = np.abs(ours[..., :3] - eevee[..., :3])[inner]
+    assert diff.mean() < 0.005, diff.mean()
