@@ -115,7 +115,7 @@ class NodeImage:
     extension: str = "REPEAT"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # compared by identity (it holds an array)
 class CompiledTree:
     key: str  # hash of the code and what it reads: equal trees share one program
     code: str  # the GLSL function node_tree(...)
