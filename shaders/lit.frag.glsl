@@ -200,6 +200,7 @@ void main()
   float coverage = material.alpha;
   vec3 emission = material.emission;
   float spec_level = material.specular;
+  vec3 tree_normal = vec3(0.0); /* the tree's shading normal (NODE_NORMAL) */
 #if NODE_TREE
   {
     /* The material's compiled node tree (engine/scene/nodetree.py) gives every parameter. */
@@ -208,7 +209,7 @@ void main()
     float l = length(Nt);
     Nt = (l > 1e-20) ? Nt / l : vec3(0.0, 0.0, 1.0);
     bool front = dot(Nt, V) >= 0.0;
-    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec_level, coverage, emission);
+    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec_level, coverage, emission, tree_normal);
   }
 #endif
 #if TEX_BASE_COLOR
@@ -264,6 +265,9 @@ void main()
   }
 #if TERMINATOR_OFFSET
   s.smooth_offset = smooth_surface_offset(s.Nv);
+#endif
+#if NODE_NORMAL
+  N = (dot(tree_normal, tree_normal) > 0.0) ? normalize(tree_normal) : N; /* a Bump, ... */
 #endif
 #if TEX_NORMAL
   {

@@ -17,8 +17,8 @@ void main()
     bool front = dot(Nt, V) >= 0.0;
     vec4 base = vec4(0.8, 0.8, 0.8, 1.0);
     float rough = 0.5, metal = 0.0, spec = 0.5;
-    vec3 emission = vec3(0.0);
-    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec, coverage, emission);
+    vec3 emission = vec3(0.0), normal = vec3(0.0);
+    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec, coverage, emission, normal);
   }
 #  endif
 #  if TEX_ALPHA

@@ -147,6 +147,7 @@ def material_defines(features):
     uv = any(out.values()) or "TREE_UV" in features
     out["HAS_UV"] = uv
     out["NODE_TREE"] = any(f.startswith("NODES_") for f in features)
+    out["NODE_NORMAL"] = "TREE_NORMAL" in features  # the tree gives the shading normal
     out["HAS_VCOL"] = "VCOL" in features
     out["HAS_TANGENT"] = "TEX_NORMAL" in features
     mode = next((m for m in ALPHA_MODES if f"ALPHA_{m}" in features), "OPAQUE")

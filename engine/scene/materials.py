@@ -89,6 +89,8 @@ class Material:
             out.add(f"NODES_{self.tree.key}")
             if "UV" in self.tree.needs:
                 out.add("TREE_UV")
+            if self.tree.normal:
+                out.add("TREE_NORMAL")
         return frozenset(out)
 
 
@@ -301,7 +303,7 @@ def _compiled(mat, read, notes, whole):
         out.color_attribute = tree.color_attribute
     new_notes = list(tree.messages)
     principled = [n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled"]
-    if len(principled) == 1:
+    if len(principled) == 1 and not tree.normal:
         _normal_map(None, principled[0], new_notes, out)
         normal = out.textures.get("normal")
         if normal is not None and "UV" in tree.needs and normal.uv_map != tree.uv_map:

@@ -7,10 +7,11 @@ function of our own (``shaders/nodes/<family>.glsl``, every one with a numpy twi
 
     void node_tree(vec3 N, vec3 V, bool front, inout vec4 base, inout float roughness,
                    inout float metallic, inout float specular, inout float alpha,
-                   inout vec3 emission)
+                   inout vec3 emission, inout vec3 normal)
 
 which the lit pass calls where it reads the material (``shaders/lit.frag.glsl``, under
-``NODE_TREE``), the GLSL families it needs, the surface data it reads (UV map, colour
+``NODE_TREE``; ``normal`` only where a shader's Normal input is compiled, a Bump say:
+``NODE_NORMAL``), the GLSL families it needs, the surface data it reads (UV map, colour
 attribute, texture space, world origin), its image textures, and its **constants**.
 
 Constants are not in the code: every unlinked socket value and every plain number of a node
@@ -129,6 +130,7 @@ class CompiledTree:
     messages: tuple = ()  # what fell back (without the material's name)
     fallbacks: int = 0  # shader inputs that fell back
     surface_fallback: bool = False  # the whole surface fell back (nothing compiled)
+    normal: bool = False  # it computes the shading normal (a Bump, ...): NODE_NORMAL
 
 
 # --- the registry -------------------------------------------------------------------------
@@ -210,6 +212,7 @@ class Compiler:
         self.transparent = False
         self.fallbacks = 0
         self.surface_fallback = False
+        self.normal = False
 
     # -- emitting --
 
@@ -412,13 +415,31 @@ class Compiler:
                 return self.const(fallback, typ) if typ != "float" else self.const(float(fallback), "float")
             return self.default(socket, typ)
 
+    def normal_input(self, node, ctx):
+        """A shader's Normal input: N where unlinked or fed by a Normal Map (the reader's
+        normal-map path draws that one), else the compiled vector (a Bump, ...)."""
+        socket = next((s for s in node.inputs if s.identifier == "Normal"), None)
+        link = _link(socket) if socket is not None else None
+        if link is None:
+            return Value("N", "vec3")
+        src = link.from_node
+        while src.bl_idname == "NodeReroute" and _link(src.inputs[0]) is not None:
+            src = _link(src.inputs[0]).from_node
+        if src.bl_idname == "ShaderNodeNormalMap":
+            return Value("N", "vec3")
+        value = self.shader_input(node, "Normal", ctx, "vec3")
+        if value.expr.startswith("node_constants"):  # fell back to the socket's value: no normal
+            return Value("N", "vec3")
+        self.normal = True
+        return value
+
     def display_closure(self):
         """The material's viewport display values as a surface."""
         m = self.mat
         base = self.const(tuple(m.diffuse_color), "vec4")
         r = self.const(float(m.roughness), "float")
         metal = self.const(float(m.metallic), "float")
-        return Value(f"node_principled({base.expr}, {metal.expr}, {r.expr}, 0.5, 1.0, vec3(0.0))", "closure")
+        return Value(f"node_principled({base.expr}, {metal.expr}, {r.expr}, 0.5, 1.0, vec3(0.0), N)", "closure")
 
     # -- the whole tree --
 
@@ -427,10 +448,11 @@ class Compiler:
         body = "\n".join(self.lines)
         code = _prelude(self.needs) + (
             "void node_tree(vec3 N, vec3 V, bool front, inout vec4 base, inout float roughness,\n"
-            "               inout float metallic, inout float specular, inout float alpha, inout vec3 emission)\n"
+            "               inout float metallic, inout float specular, inout float alpha, inout vec3 emission,\n"
+            "               inout vec3 normal)\n"
             "{\n"
             f"{body}\n"
-            f"  node_closure_resolve({v.expr}, base, roughness, metallic, specular, alpha, emission);\n"
+            f"  node_closure_resolve({v.expr}, base, roughness, metallic, specular, alpha, emission, normal);\n"
             "}\n"
         )
         families = tuple(f for f in FAMILY_ORDER if f in self.families) + tuple(
@@ -454,6 +476,7 @@ class Compiler:
             messages=tuple(dict.fromkeys(self.messages)),
             fallbacks=self.fallbacks,
             surface_fallback=self.surface_fallback,
+            normal=self.normal,
         )
 
     def shader_input_root(self, socket):
@@ -533,13 +556,14 @@ def _principled(c, node, socket, ctx):
     strength = "1.0"
     if _first(node, "Emission Strength"):
         strength = c.shader_input(node, "Emission Strength", ctx, "float", 1.0).expr
+    normal = c.normal_input(node, ctx)
     for name in ("Transmission Weight", "Transmission", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
         sock = node.inputs.get(name)
         if sock is not None and (sock.is_linked or float(sock.default_value) > 0.0):
             c.messages.append(f"{name} is not drawn")
     expr = (
         f"node_principled({base.expr}, {metal.expr}, {rough.expr}, {spec.expr}, {alpha.expr}, "
-        f"({emission.expr}).rgb * {strength})"
+        f"({emission.expr}).rgb * {strength}, {normal.expr})"
     )
     return c.temp("closure", expr)
 
@@ -554,14 +578,15 @@ def _emission(c, node, socket, ctx):
 @node("ShaderNodeBsdfDiffuse")
 def _diffuse(c, node, socket, ctx):
     color = c.shader_input(node, "Color", ctx, "vec4")
-    return c.temp("closure", f"node_diffuse({color.expr})")
+    return c.temp("closure", f"node_diffuse({color.expr}, {c.normal_input(node, ctx).expr})")
 
 
 @node("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic")
 def _glossy(c, node, socket, ctx):
     color = c.shader_input(node, "Color", ctx, "vec4")
     rough = c.shader_input(node, "Roughness", ctx, "float")
-    return c.temp("closure", f"node_principled({color.expr}, 1.0, {rough.expr}, 0.5, 1.0, vec3(0.0))")
+    normal = c.normal_input(node, ctx)
+    return c.temp("closure", f"node_principled({color.expr}, 1.0, {rough.expr}, 0.5, 1.0, vec3(0.0), {normal.expr})")
 
 
 @node("ShaderNodeBsdfTransparent")
@@ -904,6 +929,16 @@ def _combine_xyz(c, node, socket, ctx):
 
 
 # --- vectors ------------------------------------------------------------------------------
+
+
+@node("ShaderNodeBump", family="input")
+def _bump(c, node, socket, ctx):
+    strength, dist = c.input(node, "Strength", ctx, "float"), c.input(node, "Distance", ctx, "float")
+    height = c.input(node, "Height", ctx, "float")
+    n = c.input(node, "Normal", ctx, "vec3") if c.linked(node, "Normal") else Value("N", "vec3")
+    invert = "true" if node.invert else "false"
+    h = c.temp("float", height.expr)
+    return c.temp("vec3", f"node_bump({strength.expr}, {dist.expr}, {h.expr}, {n.expr}, front, {invert})")
 
 
 @node("ShaderNodeMapping", family="vector")

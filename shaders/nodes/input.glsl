@@ -39,4 +39,22 @@ vec2 node_layer_weight(float blend, vec3 N, vec3 V, bool front)
   return vec2(fresnel, 1.0 - facing);
 }
 
+/* Bump: the shading normal tilted by the screen-space gradient of ``height`` over the surface
+ * (the surface-gradient form of bump mapping on unparametrised surfaces), Distance scaling the
+ * height, Invert and the side seen flipping it, Strength mixing from N. */
+vec3 node_bump(float strength, float dist, float height, vec3 N, bool front, bool invert)
+{
+  N = node_safe_normalize(N);
+  float d = dist * (invert ? -1.0 : 1.0) * (front ? 1.0 : -1.0);
+  vec3 dpx = dFdx(v_world), dpy = dFdy(v_world);
+  vec3 rx = cross(dpy, N), ry = cross(N, dpx);
+  float det = dot(dpx, rx);
+  vec3 grad = dFdx(height) * rx + dFdy(height) * ry;
+  vec3 bumped = node_safe_normalize(abs(det) * N - d * sign(det) * grad);
+  if (dot(bumped, bumped) == 0.0) {
+    return N;
+  }
+  return node_safe_normalize(mix(N, bumped, max(strength, 0.0)));
+}
+
 #endif
