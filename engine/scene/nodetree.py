@@ -783,12 +783,19 @@ def _mix_rgb(c, node, socket, ctx):
 
 @node("ShaderNodeMapRange", family="converter")
 def _map_range(c, node, socket, ctx):
-    if node.data_type != "FLOAT":
-        raise Fallback("a 'Map Range' node of type vector")
-    args = ", ".join(c.input(node, i, ctx, "float").expr for i in range(6))
     kind = MAP_RANGE_TYPES.index(node.interpolation_type)
     clamp = "true" if node.clamp else "false"
-    return c.temp("float", f"node_map_range({kind}, {clamp}, {args})")
+    if node.data_type == "FLOAT":
+        args = ", ".join(c.input(node, i, ctx, "float").expr for i in range(6))
+        return c.temp("float", f"node_map_range({kind}, {clamp}, {args})")
+    # FLOAT_VECTOR: each component mapped alone (Blender's vector Map Range).
+    ins = [c.input(node, k, ctx, "vec3") for k in ("Vector", "From_Min_FLOAT3", "From_Max_FLOAT3")]
+    ins += [c.input(node, k, ctx, "vec3") for k in ("To_Min_FLOAT3", "To_Max_FLOAT3", "Steps_FLOAT3")]
+    parts = []
+    for comp in "xyz":
+        args = ", ".join(f"{v.expr}.{comp}" for v in ins)
+        parts.append(f"node_map_range({kind}, {clamp}, {args})")
+    return c.temp("vec3", f"vec3({', '.join(parts)})")
 
 
 @node("ShaderNodeClamp", family="converter")

@@ -141,11 +141,13 @@ def test_mix_color_every_blend_mode(penumbra):
 def test_map_range_clamp_and_float_mix(penumbra):
     """Map Range (each interpolation, clamped and not, from [0.2, 0.8] to [-1, 2], 3 steps), and
     the reversed source range; Clamp (Min Max and Range with min > max); Mix (Float) and Mix
-    (Vector, non-uniform factor): the numpy reference within 2e-3, value = 1.4u - 0.2."""
+    (Vector, non-uniform factor); Map Range (Vector, each interpolation, clamped): the numpy
+    reference within 2e-3, value = 1.4u - 0.2."""
     from penumbra.engine.scene.nodetree import MAP_RANGE_TYPES
 
     cases = [(t, c, False) for t in MAP_RANGE_TYPES for c in (False, True)] + [(t, True, True) for t in MAP_RANGE_TYPES]
     cases += [("CLAMP", "MINMAX", False), ("CLAMP", "RANGE", False), ("MIX", "FLOAT", False), ("MIX", "VECTOR", False)]
+    cases += [("VECTOR_RANGE", t, False) for t in MAP_RANGE_TYPES]
     grid = node_scenes.grid(len(cases))
     for cell, (kind, option, reverse) in zip(grid.cells, cases, strict=False):
         value = node_scenes.uv_input(cell, 0, 1.4, -0.2)
@@ -156,6 +158,18 @@ def test_map_range_clamp_and_float_mix(penumbra):
             _in(node, "Max").default_value = 0.3
             cell.links.new(value, _in(node, "Value"))
             out = node.outputs[0]
+        elif kind == "VECTOR_RANGE":
+            node = cell.nodes.new("ShaderNodeMapRange")
+            node.data_type = "FLOAT_VECTOR"
+            node.interpolation_type = option
+            node.clamp = True
+            _in(node, "From_Min_FLOAT3").default_value = (0.2, 0.8, 0.0)
+            _in(node, "From_Max_FLOAT3").default_value = (0.8, 0.2, 1.0)
+            _in(node, "To_Min_FLOAT3").default_value = (-1.0, 0.0, 2.0)
+            _in(node, "To_Max_FLOAT3").default_value = (2.0, 1.0, 1.0)
+            _in(node, "Steps_FLOAT3").default_value = (3.0, 2.0, 4.0)
+            cell.links.new(_combine(cell, value, value, value), _in(node, "Vector"))
+            out = _out(node, "Vector")
         elif kind == "MIX":
             node = cell.nodes.new("ShaderNodeMix")
             node.data_type = option
@@ -190,6 +204,9 @@ def test_map_range_clamp_and_float_mix(penumbra):
         x = 1.4 * u - 0.2
         if kind == "CLAMP":
             return node_reference.clamp(option, x, 0.7, 0.3)
+        if kind == "VECTOR_RANGE":
+            rows = ((0.2, 0.8, -1.0, 2.0, 3.0), (0.8, 0.2, 0.0, 1.0, 2.0), (0.0, 1.0, 2.0, 1.0, 4.0))
+            return np.stack([node_reference.map_range(option, x, *row, True) for row in rows], -1)
         if kind == "MIX":
             if option == "FLOAT":
                 return 0.2 + x * (0.9 - 0.2)
