@@ -114,3 +114,26 @@ def shader_group(name, inputs, build):
     gin, gout = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
     build(tree, gin, gout)
     return tree
+
+
+def compiled_sphere(width, height):
+    """``sphere`` with a tree only the compiler reads: a Mix Shader whose factor is a Checker
+    (Generated, Scale 4) of the Principled BSDF (Base Color from a Color Ramp of a Gradient)
+    and an Emission whose strength is Layer Weight's Facing."""
+
+    def build(mat, nodes, links, bsdf, output):
+        grad, ramp = nodes.new("ShaderNodeTexGradient"), nodes.new("ShaderNodeValToRGB")
+        ramp.color_ramp.elements[0].color = (0.8, 0.2, 0.1, 1.0)
+        ramp.color_ramp.elements[1].color = (0.1, 0.4, 0.9, 1.0)
+        links.new(grad.outputs["Fac"], ramp.inputs[0])
+        links.new(ramp.outputs[0], bsdf.inputs["Base Color"])
+        emission, weight = nodes.new("ShaderNodeEmission"), nodes.new("ShaderNodeLayerWeight")
+        links.new(weight.outputs["Facing"], emission.inputs["Strength"])
+        checker, mix = nodes.new("ShaderNodeTexChecker"), nodes.new("ShaderNodeMixShader")
+        checker.inputs["Scale"].default_value = 4.0
+        links.new(checker.outputs["Fac"], mix.inputs[0])
+        links.new(bsdf.outputs[0], mix.inputs[1])
+        links.new(emission.outputs[0], mix.inputs[2])
+        links.new(mix.outputs[0], output.inputs["Surface"])
+
+    return sphere(width, height, build, name="Compiled")
