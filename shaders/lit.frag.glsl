@@ -206,10 +206,23 @@ void main()
   float metal = material.metallic;
   float coverage = material.alpha;
   vec3 emission = material.emission;
+  float spec_level = material.specular;
+  vec3 tree_normal = vec3(0.0); /* the tree's shading normal (NODE_NORMAL) */
+#if NODE_TREE
+  {
+    /* The material's compiled node tree (engine/scene/nodetree.py) gives every parameter. */
+    vec3 V = (frame.is_ortho != 0) ? -frame.camera_forward : normalize(frame.camera_position - v_world);
+    vec3 Nt = v_normal;
+    float l = length(Nt);
+    Nt = (l > 1e-20) ? Nt / l : vec3(0.0, 0.0, 1.0);
+    bool front = dot(Nt, V) >= 0.0;
+    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec_level, coverage, emission, tree_normal);
+  }
+#endif
 #if TEX_BASE_COLOR
   base *= SAMPLE_COLOR(base_color, v_uv);
 #endif
-#if HAS_VCOL
+#if HAS_VCOL && !NODE_TREE
   base *= v_color;
 #endif
 #if TEX_ROUGHNESS
@@ -260,6 +273,9 @@ void main()
 #if TERMINATOR_OFFSET
   s.smooth_offset = smooth_surface_offset(s.Nv);
 #endif
+#if NODE_NORMAL
+  N = (dot(tree_normal, tree_normal) > 0.0) ? normalize(tree_normal) : N; /* a Bump, ... */
+#endif
 #if TEX_NORMAL
   {
     /* Tangent-space normal map (Blender's Normal Map node): MikkTSpace tangent and sign from
@@ -291,7 +307,7 @@ void main()
   s.N = N;
 
   rough = clamp(rough, 0.0, 1.0);
-  float spec_level = max(material.specular, 0.0);
+  spec_level = max(spec_level, 0.0);
   metal = clamp(metal, 0.0, 1.0);
   s.albedo = base.rgb * (1.0 - metal);
   s.f0 = mix(vec3(0.08 * spec_level), base.rgb, metal);

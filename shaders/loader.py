@@ -6,6 +6,7 @@ interface into a ``GPUShaderCreateInfo`` and compiles. Variants differ only by t
 and are compiled the first time a frame needs them, then cached by (program, defines).
 """
 
+import time
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -127,6 +128,7 @@ class Program:
     outputs: tuple = (("VEC4", "out_color"),)
     defines: tuple = ()  # (name, value) every variant gets: enum values, fixed sizes
     depth_write: str = ""  # 'ANY' etc. when the fragment stage writes gl_FragDepth
+    generated: str = ""  # fragment-stage GLSL written by Python (a compiled node tree), after the libs
 
 
 def _read(rel):
@@ -137,7 +139,7 @@ def program_sources(program):
     """The (vertex, fragment) GLSL text, libraries first, in the order the program lists them."""
     vlibs = "".join(_read(p) + "\n" for p in program.vertex_libs)
     flibs = "".join(_read(p) + "\n" for p in program.libs)
-    return vlibs + _read(program.vertex), flibs + _read(program.fragment)
+    return vlibs + _read(program.vertex), flibs + program.generated + "\n" + _read(program.fragment)
 
 
 def _format_define(value):
@@ -155,6 +157,7 @@ class ShaderCache:
     def __init__(self):
         self._cache = {}
         self.compiled = 0
+        self.compile_seconds = 0.0  # spent compiling, over the cache's life
 
     def __len__(self):
         return len(self._cache)
@@ -164,7 +167,9 @@ class ShaderCache:
         key = (program.name, defines)
         shader = self._cache.get(key)
         if shader is None:
+            start = time.perf_counter()
             shader = self._compile(program, defines)
+            self.compile_seconds += time.perf_counter() - start
             self._cache[key] = shader
             self.compiled += 1
         return shader

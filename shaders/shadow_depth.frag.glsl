@@ -8,6 +8,19 @@ void main()
 {
 #if ALPHA_CUTOUT
   float coverage = material.alpha;
+#  if NODE_TREE
+  {
+    /* The compiled node tree's alpha (engine/scene/nodetree.py), seen from the light. */
+    vec3 V = normalize(vec3(tile.view[0][2], tile.view[1][2], tile.view[2][2]));
+    float l = length(v_normal);
+    vec3 Nt = (l > 1e-20) ? v_normal / l : V;
+    bool front = dot(Nt, V) >= 0.0;
+    vec4 base = vec4(0.8, 0.8, 0.8, 1.0);
+    float rough = 0.5, metal = 0.0, spec = 0.5;
+    vec3 emission = vec3(0.0), normal = vec3(0.0);
+    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec, coverage, emission, normal);
+  }
+#  endif
 #  if TEX_ALPHA
   coverage *= SAMPLE_VALUE(alpha, v_uv);
 #  endif

@@ -36,6 +36,7 @@ class Draw:
     corners: np.ndarray  # (8, 3) world corners of the instance's bounds
     closed: bool = False  # a closed opaque surface: back faces hidden from outside its bounds
     geometry: object = None  # the extract.Geometry drawn whole (None: drawn at a level of detail)
+    bounds: np.ndarray = None  # (2, 3) object-space bounds (Generated texture coordinates)
     triangles: int = 0  # triangles of what it draws
     # () -> [(material index, GPUBatch)] with the Shadow Terminator's corner data, built on
     # first call; None where the geometry offset does not apply (offset 0, flat faces only).
@@ -54,6 +55,31 @@ class Draw:
         if term.shading_offset > 0.0:
             out.add("TERMINATOR_SHADING")
         return frozenset(out)
+
+    def texture_space(self):
+        """Push constants of Blender's Generated coordinates (a compiled node tree's
+        ``node_texspace_*``): the object's bounds mapped to [0, 1], a flat axis (of zero
+        extent) to 0.5, as Blender's automatic texture space."""
+        if self.bounds is None:
+            lo, hi = np.zeros(3), np.ones(3)
+        else:
+            lo, hi = np.asarray(self.bounds[0], np.float64), np.asarray(self.bounds[1], np.float64)
+        half = (hi - lo) * 0.5
+        half = np.where(half == 0.0, 1.0, np.maximum(half, 1e-5))
+        scale = 0.5 / half
+        offset = 0.5 - (hi + lo) * 0.5 * scale
+        return {
+            "node_texspace_scale": tuple(float(x) for x in scale),
+            "node_texspace_offset": tuple(float(x) for x in offset),
+        }
+
+    def tree_uniforms(self, tree):
+        """The per-draw push constants compiled node tree ``tree`` reads of this instance."""
+        out = self.texture_space() if "GENERATED" in tree.needs else {}
+        if "OBJECT_INFO" in tree.needs:
+            out["node_object_color"] = tuple(float(c) for c in self.instance.color)
+            out["node_object_random"] = float(self.instance.random)
+        return out
 
     def material(self, index):
         materials = self.instance.materials
@@ -93,6 +119,7 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
             model = Matrix(model.tolist())
             draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
             draw.geometry = geo if lod is None else None
+            draw.bounds = bounds[i]
             draw.triangles = (lod or geo).triangle_count
             if inst.terminator.geometry_offset > 0.0 and (lod or geo).smooth and facets[i] >= TERMINATOR_MIN_PIXELS:
                 draw.terminator_parts = functools.partial(batches.terminator, key, lod or geo)

@@ -79,13 +79,16 @@ class LitPass:
         width, height = film.size
         bound = {"shader": None, "counted": counted}
 
-        def bind(features, with_aux):
+        def bind(features, with_aux, tree):
             program = lit_program(
-                frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux
+                frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux, tree
             )
             shader = self.shaders.get(program, data.defines)
             if bound["shader"] is shader:
                 return shader
+            if tree is not None and "ORIGIN" in tree.needs:
+                shader.bind()
+                shader.uniform_float("node_origin", tuple(float(x) for x in origin))
             shader.bind()
             shader.uniform_block("frame", self._ubo("frame", data.frame))
             shader.uniform_block("lights", self._ubo("lights", data.lights))
@@ -117,7 +120,7 @@ class LitPass:
                     gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
                     gpu.state.front_facing_set(culling[1])
                     bound["culling"] = culling
-                shader = bind(features, with_aux)
+                shader = bind(features, with_aux, mat.tree)
                 if last is not d or bound.get("model_shader") is not shader:
                     shader.uniform_float("model", d.model)
                     if solid_uniform(shader):  # compiled out where no light reads it
@@ -127,9 +130,15 @@ class LitPass:
                     if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
                         set_uniforms(shader, terminators[id(d)])
                     last, bound["model_shader"] = d, shader
+                if mat.tree is not None and mat.tree.needs & {"GENERATED", "OBJECT_INFO"}:
+                    set_uniforms(shader, d.tree_uniforms(mat.tree))
                 shader.uniform_block("material", self.materials.get(mat))
                 for channel, ref in mat.textures.items():
                     shader.uniform_sampler(f"tex_{channel}", self.textures.get(ref.image))
+                if mat.tree is not None:
+                    shader.uniform_block("node_constants", self.materials.constants(mat))
+                    for i, ref in enumerate(mat.tree.images):
+                        shader.uniform_sampler(f"node_image_{i}", self.textures.get(ref.image))
                 batch.draw(shader)
                 stats.draws += 1
 

@@ -1,8 +1,10 @@
 """Each material's uniform block (``programs.MATERIAL_STRUCT``), built once per Material read:
 the lit pass and the shadow pass's alpha cutouts bind the same block."""
 
+import numpy as np
+
 from ..scene.materials import CHANNELS, EXTENSION, INTERPOLATION
-from .programs import MATERIAL_STRUCT
+from .programs import MATERIAL_STRUCT, NODE_CONSTANT_STRUCT
 
 MAX_BLOCKS = 4096  # blocks kept before the cache starts afresh (materials of past snapshots)
 
@@ -10,6 +12,7 @@ MAX_BLOCKS = 4096  # blocks kept before the cache starts afresh (materials of pa
 class MaterialBlocks:
     def __init__(self):
         self._blocks = {}  # id(Material) -> (Material, GPUUniformBuf)
+        self._constants = {}  # id(Material) -> (Material, GPUUniformBuf) of its node tree
 
     def __len__(self):
         return len(self._blocks)
@@ -48,4 +51,19 @@ class MaterialBlocks:
         if len(self._blocks) > MAX_BLOCKS:
             self._blocks.clear()
         self._blocks[id(mat)] = (mat, ubo)
+        return ubo
+
+    def constants(self, mat):
+        """The node_constants block of ``mat``'s compiled node tree (``Material.tree``)."""
+        import gpu
+
+        cached = self._constants.get(id(mat))
+        if cached is not None and cached[0] is mat:
+            return cached[1]
+        rows = mat.tree.constants if len(mat.tree.constants) else np.zeros((1, 4), np.float32)
+        data = NODE_CONSTANT_STRUCT.pack([{"v": row} for row in rows])
+        ubo = gpu.types.GPUUniformBuf(data.tobytes())
+        if len(self._constants) > MAX_BLOCKS:
+            self._constants.clear()
+        self._constants[id(mat)] = (mat, ubo)
         return ubo

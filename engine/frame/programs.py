@@ -125,6 +125,10 @@ MATERIAL_STRUCT = Struct(
 )
 ALPHA_MODES = {"OPAQUE": 0, "HASHED": 1, "BLEND": 2}
 
+# A compiled node tree's constants (engine/scene/nodetree.py): one vec4 row each, bound per
+# material as the block ``node_constants`` (as many rows as the tree has, at least one).
+NODE_CONSTANT_STRUCT = Struct("NodeConstant", (("VEC4", "v"),))
+
 
 # An object's Object > Shading > Shadow Terminator (``scene.terminator``) as lit-pass features:
 # TERMINATOR_OFFSET  Cycles' Geometry Offset: the shadow point lifted towards the smooth
@@ -140,8 +144,10 @@ def material_defines(features):
     vertex data exist (HAS_UV, HAS_VCOL, HAS_TANGENT), the alpha mode, holdout, and the
     object's Shadow Terminator features (TERMINATOR_FEATURES)."""
     out = {f"TEX_{c.upper()}": f"TEX_{c.upper()}" in features for c in CHANNELS}
-    uv = any(out.values())
+    uv = any(out.values()) or "TREE_UV" in features
     out["HAS_UV"] = uv
+    out["NODE_TREE"] = any(f.startswith("NODES_") for f in features)
+    out["NODE_NORMAL"] = "TREE_NORMAL" in features  # the tree gives the shading normal
     out["HAS_VCOL"] = "VCOL" in features
     out["HAS_TANGENT"] = "TEX_NORMAL" in features
     mode = next((m for m in ALPHA_MODES if f"ALPHA_{m}" in features), "OPAQUE")
@@ -289,14 +295,41 @@ LIT_COLOR_COUNTED = replace(
 )
 
 
-def lit_program(features=frozenset(), aux=True, emission=False, counted=False):
+def lit_program(features=frozenset(), aux=True, emission=False, counted=False, tree=None):
     """The lit pass program of a material variant (``Material.features``, plus "HOLDOUT");
     ``emission``: the variant also writes the Emission pass's target; ``counted`` (colour
-    only): it also writes the shading count (``LIT_COLOR_COUNTED``)."""
+    only): it also writes the shading count (``LIT_COLOR_COUNTED``); ``tree``: the
+    material's ``nodetree.CompiledTree`` (its feature NODES_<key> names the variant)."""
     base = LIT_EMIT if emission else (LIT if aux else (LIT_COLOR_COUNTED if counted else LIT_COLOR))
     if not features:
         return base
-    return _with_features(base, features, f"{base.name}_{'_'.join(sorted(features)).lower()}")
+    program = _with_features(base, features, f"{base.name}_{'_'.join(sorted(features)).lower()}")
+    return with_tree(program, tree) if tree is not None else program
+
+
+# Per-draw values a compiled tree may read (set like ``model``): the object's texture space
+# (Generated = object position * scale + offset), the world origin the positions are drawn
+# relative to (``draw_list``: positions are shifted by the frame's origin), and the Object
+# Info node's colour and random number.
+TREE_UNIFORMS = {"GENERATED": (("VEC3", "node_texspace_scale"), ("VEC3", "node_texspace_offset"))}
+TREE_UNIFORMS["ORIGIN"] = (("VEC3", "node_origin"),)
+TREE_UNIFORMS["OBJECT_INFO"] = (("VEC4", "node_object_color"), ("FLOAT", "node_object_random"))
+
+
+def with_tree(program, tree):
+    """``program`` with compiled node tree ``tree``: its GLSL families, its generated code,
+    its constants block and image samplers, and the per-draw values it reads."""
+    libs = tuple(f"nodes/{f}.glsl" for f in tree.families if f"nodes/{f}.glsl" not in program.libs)
+    pushes = tuple(p for need in sorted(tree.needs) for p in TREE_UNIFORMS.get(need, ()))
+    return replace(
+        program,
+        libs=program.libs + libs,
+        generated=tree.code,
+        uniform_blocks=program.uniform_blocks
+        + ((NODE_CONSTANT_STRUCT, "node_constants", max(len(tree.constants), 1)),),
+        samplers=program.samplers + tuple(("FLOAT_2D", f"node_image_{i}") for i in range(len(tree.images))),
+        push_constants=program.push_constants + pushes,
+    )
 
 
 SHADOW_DEPTH = Program(
@@ -440,6 +473,26 @@ def shadow_cutout_program(depth_format, textured, raster_depth=False):
     if not textured:
         return replace(program, name=f"{base.name}_alpha")
     return _with_features(program, features, f"{base.name}_alpha_tex")
+
+
+def shadow_tree_program(depth_format, tree, raster_depth=False):
+    """The alpha cut-out of a caster whose alpha a compiled node tree gives (``tree``:
+    ``nodetree.CompiledTree`` without FRAME in its needs): the tree runs in the depth pass,
+    with the surface data it reads, so a procedural alpha casts the shadow it draws."""
+    base = shadow_program(depth_format, raster_depth)
+    program = replace(
+        base,
+        libs=base.libs + ("lib/material.glsl",),
+        vertex_in=MESH_VERTEX_IN,
+        varyings=base.varyings + (("smooth", "VEC3", "v_world"), ("smooth", "VEC3", "v_normal")),
+        push_constants=base.push_constants + (("FLOAT", "alpha_offset"),),
+        uniform_blocks=base.uniform_blocks + ((MATERIAL_STRUCT, "material", 0),),
+        defines=base.defines + (("ALPHA_CUTOUT", True),),
+    )
+    features = {f"NODES_{tree.key}"} | ({"TREE_UV"} if "UV" in tree.needs else set())
+    features |= {"VCOL"} if "VCOL" in tree.needs else set()
+    program = _with_features(program, frozenset(features), f"{base.name}_alpha_{'_'.join(sorted(features)).lower()}")
+    return with_tree(program, tree)
 
 
 # The world's Environment Texture behind everything (materials.World.image).

@@ -87,6 +87,7 @@ class Renderer:
         when there is no time limit: a frame stays a function of the scene and its settings."""
         stats = FrameStats()
         compiled_before = self.shaders.compiled
+        seconds_before = self.shaders.compile_seconds
         self.shadow_pass.begin_frame()
         emission = bool(emission and aux)
         film = self.film
@@ -191,6 +192,7 @@ class Renderer:
             film.target_bytes(aux, accumulate) + stats.shadow_bytes + film.post_ctx.memory_bytes + self.textures.bytes
         )
         stats.shaders_compiled = self.shaders.compiled - compiled_before
+        stats.compile_seconds = self.shaders.compile_seconds - seconds_before
         if not aux:
             out = FrameOutput(color, None, None, stats, width, height, lit=film.color)
             out.debug = debug_image

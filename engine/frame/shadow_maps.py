@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...shaders.loader import set_uniforms
 from ..enums import DEPTH_FORMAT
 from ..gpu_pool import new_texture
 from ..shadows.planning import pack_tiles
@@ -17,7 +18,19 @@ from .programs import (
     depth_defines,
     shadow_cutout_program,
     shadow_program,
+    shadow_tree_program,
 )
+
+
+@dataclass
+class TreeCutout:
+    """A caster part whose alpha a compiled node tree gives (``programs.shadow_tree_program``):
+    the tree, its node_constants block, its images' textures and per-draw push constants."""
+
+    tree: object
+    constants: object
+    images: tuple
+    uniforms: dict
 
 
 @dataclass
@@ -28,7 +41,9 @@ class Caster:
     model: object  # mathutils.Matrix
     det: float  # sign of the model matrix (winding under negative scale)
     identity: tuple  # what a tile's content depends on
-    cutouts: list = field(default_factory=list)  # (batch, material UBO, alpha texture): alpha >= 0.5 casts
+    # (batch, material UBO, alpha texture or None, TreeCutout or None): covers a texel in a
+    # fraction alpha of the samples
+    cutouts: list = field(default_factory=list)
     cull_back: bool = False  # every material asks for shadow back-face culling: faces away from the light cast nothing
     closed: bool = False  # a closed opaque surface (renderer.CULL_CLOSED): its back faces are hidden from outside
     corners: object = None  # (8, 3) world corners of its bounds, with ``closed``
@@ -234,9 +249,21 @@ class ShadowAtlas:
                     stats.shadow_triangles += caster.triangles
                 gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
                 for caster in casters:
-                    for batch, material_ubo, texture in caster.cutouts:
-                        cut = cutout(texture is not None, raster)
-                        cut.bind()
+                    for batch, material_ubo, texture, tree in caster.cutouts:
+                        if tree is not None:
+                            cut = shaders.get(shadow_tree_program(self.depth_format, tree.tree, raster), defines)
+                            cut.bind()
+                            cut.uniform_block("node_constants", tree.constants)
+                            for i, image in enumerate(tree.images):
+                                cut.uniform_sampler(f"node_image_{i}", image)
+                            uniforms = dict(tree.uniforms)
+                            if "ORIGIN" in tree.tree.needs:
+                                o = origin if origin is not None else (0.0, 0.0, 0.0)
+                                uniforms["node_origin"] = tuple(float(x) for x in o)
+                            set_uniforms(cut, uniforms)
+                        else:
+                            cut = cutout(texture is not None, raster)
+                            cut.bind()
                         cut.uniform_block("tile", tile_ubo)
                         cut.uniform_float("alpha_offset", alpha_offset)
                         cut.uniform_float("model", caster.model)

@@ -8,7 +8,7 @@ from ..scene import simplify
 from ..shadows import lightspace
 from ..shadows.planning import MAX_SHADOW_TILES, Density, plan_shadows
 from .draw_list import corners_of
-from .shadow_maps import Caster, ShadowAtlas
+from .shadow_maps import Caster, ShadowAtlas, TreeCutout
 
 UNSET = object()  # ``ShadowPass.depth_range`` before this frame's first plan
 
@@ -119,12 +119,22 @@ def caster(d, materials, textures):
     for _index, batch, mat in mats:
         if not (mat.uses_alpha and mat.transparent_shadow):
             solid.append(batch)
+        elif mat.tree is not None and "FRAME" not in mat.tree.needs:
+            cutouts.append((batch, materials.get(mat), None, _tree_cutout(d, mat, materials, textures)))
         elif "alpha" in mat.textures:
-            cutouts.append((batch, materials.get(mat), textures.get(mat.textures["alpha"].image)))
+            cutouts.append((batch, materials.get(mat), textures.get(mat.textures["alpha"].image), None))
         elif mat.alpha > 0.0:
-            cutouts.append((batch, materials.get(mat), None))
+            cutouts.append((batch, materials.get(mat), None, None))
     identity = (*d.identity, tuple(id(m) for _i, _b, m in mats))
     return Caster(solid, d.model, d.det, identity, cutouts, cull_back=cull, triangles=d.triangles)
+
+
+def _tree_cutout(d, mat, materials, textures):
+    """What a caster's compiled node tree needs in the depth pass (``shadow_maps.TreeCutout``)."""
+    tree = mat.tree
+    uniforms = d.tree_uniforms(tree)
+    images = tuple(textures.get(ref.image) for ref in tree.images)
+    return TreeCutout(tree, materials.constants(mat), images, uniforms)
 
 
 def map_levels(plan, draws, casters, batches, cell_texels):

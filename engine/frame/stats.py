@@ -20,6 +20,7 @@ class FrameStats:
     texture_bytes: int = 0
     shadow_bytes: int = 0  # the shadow atlas (and its one-tile scratch target, if any)
     shaders_compiled: int = 0
+    compile_seconds: float = 0.0  # spent compiling those programs (compiled node trees included)
     samples: int = 0  # samples rendered by this call
     lights_sampled: int = 0  # lights that moved between samples (the others kept one map)
     cancelled: bool = False  # on_sample asked to stop before the last sample

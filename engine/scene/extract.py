@@ -89,6 +89,8 @@ class MeshInstance:
     holdout: bool = False  # Object > Visibility > Holdout: alpha 0 where it covers
     names: tuple = ()  # the object's name and its instancer's: what light linking matches
     terminator: Terminator = Terminator()  # Object > Shading > Shadow Terminator
+    color: tuple = (1.0, 1.0, 1.0, 1.0)  # Object > Viewport Display > Color (the Object Info node's)
+    random: float = 0.0  # the Object Info node's Random: Blender's per-object (or per-instance) hash
 
 
 @dataclass(frozen=True)
@@ -104,6 +106,50 @@ class LinkSet:
         if any(n in self.exclude for n in names):
             return False
         return not self.include or any(n in self.include for n in names)
+
+
+def _hash_string(text):
+    """The string hash Cycles seeds an object's random number with (h = 37 h + byte), 32-bit."""
+    h = 0
+    for b in text.encode("utf-8"):
+        h = (h * 37 + b) & 0xFFFFFFFF
+    return h
+
+
+def _hash_int_2d(kx, ky):
+    """Bob Jenkins' final mix of two 32-bit integers (Blender's BLI_hash_int_2d)."""
+    m = 0xFFFFFFFF
+
+    def rot(x, k):
+        return ((x << k) | (x >> (32 - k))) & m
+
+    a = b = c = (0xDEADBEEF + (2 << 2) + 13) & m
+    a = (a + kx) & m
+    b = (b + ky) & m
+    c ^= b
+    c = (c - rot(b, 14)) & m
+    a ^= c
+    a = (a - rot(c, 11)) & m
+    b ^= a
+    b = (b - rot(a, 25)) & m
+    c ^= b
+    c = (c - rot(b, 16)) & m
+    a ^= c
+    a = (a - rot(c, 4)) & m
+    b ^= a
+    b = (b - rot(a, 14)) & m
+    c ^= b
+    c = (c - rot(b, 24)) & m
+    return c
+
+
+def object_random(name, inst=None):
+    """The Object Info node's Random of object ``name``, or of depsgraph instance ``inst``
+    when it is an instance (its random_id), in [0, 1], as Cycles gives it (a hash of the
+    name mixed by Bob Jenkins' final mix; EEVEE's differs from it by up to 0.015)."""
+    if inst is not None and inst.is_instance:
+        return (int(inst.random_id) & 0xFFFFFFFF) / float(0xFFFFFFFF)
+    return _hash_int_2d(_hash_string(name), 0) / float(0xFFFFFFFF)
 
 
 def link_set(collection):
@@ -739,6 +785,8 @@ class SceneCache:
                     camera=camera,
                     holdout=holdout(orig, inst),
                     terminator=terminator(ob),
+                    color=tuple(float(c) for c in orig.color),
+                    random=object_random(orig.name, inst),
                     names=(orig.name_full, inst.parent.original.name_full)
                     if inst.is_instance and inst.parent is not None
                     else (orig.name_full,),

@@ -7,10 +7,11 @@ its UV map and Mapping node. Besides what the wrapper follows, an input may come
 Color Attribute / Attribute node (vertex colours), an RGB or Value node, or through reroutes.
 Emission and Diffuse BSDF surfaces are read directly.
 
-Anything else (a Mix Shader, a procedural texture into Base Color, ...) falls back to the
-material's viewport display values, and the material carries a message that says so: the
-engine reports it once per render and the Material panel shows it. Nothing is dropped
-silently.
+Anything else is compiled (``nodetree``: the tree as generated GLSL, ``Material.tree``)
+where that draws more than this reader; what neither reads falls back to the material's
+viewport display values (or the input's own value), and the material carries a message
+that says so: the engine reports it once per render and the Material panel shows it.
+Nothing is dropped silently.
 
 No gpu here: the result is plain data (``Material``, ``TextureRef``) the renderer turns
 into shader variants and uniforms.
@@ -59,15 +60,20 @@ class Material:
     holdout: bool = False  # a Holdout shader: a hole in the film where it shows (it still casts)
     transparent_shadow: bool = True  # Settings > Transparent Shadows: off, alpha casts as opaque
     messages: tuple = ()  # what could not be read, for the render report and the panel
+    tree: object = None  # nodetree.CompiledTree: the node tree drawn as generated GLSL
 
     @property
     def uv_maps(self):
         """UV maps the material's textures read ("" = the active render map)."""
-        return tuple(sorted({t.uv_map for t in self.textures.values()}))
+        maps = {t.uv_map for t in self.textures.values()}
+        if self.tree is not None and "UV" in self.tree.needs:
+            maps.add(self.tree.uv_map)
+        return tuple(sorted(maps))
 
     @property
     def uses_alpha(self):
-        return self.blend != "OPAQUE" and (self.alpha < 1.0 or "alpha" in self.textures)
+        transparent = self.tree is not None and self.tree.transparent
+        return self.blend != "OPAQUE" and (self.alpha < 1.0 or "alpha" in self.textures or transparent)
 
     @property
     def features(self):
@@ -79,6 +85,12 @@ class Material:
             out.add(f"ALPHA_{self.blend}")
         if self.holdout:
             out.add("HOLDOUT")
+        if self.tree is not None:
+            out.add(f"NODES_{self.tree.key}")
+            if "UV" in self.tree.needs:
+                out.add("TREE_UV")
+            if self.tree.normal:
+                out.add("TREE_NORMAL")
         return frozenset(out)
 
 
@@ -257,15 +269,46 @@ def _material_surface(mat):
         )
         return out
     out = _shader(mat, _surface(mat), notes)
+    whole = out is None
     if out is None:
         out = _display(mat, notes, "its surface shader is drawn with the viewport display colour")
     elif "alpha" in out.textures or out.alpha < 1.0:
         out.blend = _blend_mode(mat)
+    if notes:
+        out, notes = _compiled(mat, out, notes, whole)
     for socket in ("Volume", "Displacement"):
         if _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", socket, {"ALL", "EEVEE"}):
             notes.append(f"its {socket} output is not drawn")
     out.messages = tuple(f"material '{mat.name}': {n}" for n in dict.fromkeys(notes))
     return out
+
+
+def _compiled(mat, read, notes, whole):
+    """The material drawn through its compiled node tree (``nodetree``) where that draws more
+    than the reader above: it compiled every input, or fewer inputs fell back than the reader
+    could not read, or the reader fell back for the whole surface. Materials the reader takes
+    whole keep its path (its image channels, shadow cut-outs and tests). -> (Material, notes)."""
+    from . import nodetree
+
+    tree, message = nodetree.compile_material(mat)
+    if tree is None or tree.surface_fallback:
+        return read, notes + ([message] if message else [])
+    unread = sum(1 for n in notes if " from a '" in n or n.endswith("' shader"))
+    if not (tree.fallbacks == 0 or whole or tree.fallbacks < unread):
+        return read, notes
+    out = Material(tree=tree)
+    if tree.transparent:
+        out.blend = _blend_mode(mat)
+    if "VCOL" in tree.needs:
+        out.color_attribute = tree.color_attribute
+    new_notes = list(tree.messages)
+    principled = [n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled"]
+    if len(principled) == 1 and not tree.normal:
+        _normal_map(None, principled[0], new_notes, out)
+        normal = out.textures.get("normal")
+        if normal is not None and "UV" in tree.needs and normal.uv_map != tree.uv_map:
+            new_notes.append("a normal map on another UV map than the tree's (the tree's map is used)")
+    return out, new_notes
 
 
 def _black():
@@ -511,6 +554,8 @@ def summary(read):
     last (the same words as the render report, without the material's name)."""
     textures = ", ".join(c.replace("_", " ") for c in read.textures) or "none"
     lines = [("TEXTURE", f"Textures: {textures}")]
+    if read.tree is not None:
+        lines.insert(0, ("NODETREE", f"Node tree: compiled to GLSL ({len(read.tree.constants)} constants)"))
     if read.color_attribute is not None:
         lines.append(("GROUP_VCOL", f"Colour attribute: {read.color_attribute or 'the active one'}"))
     alpha = {"OPAQUE": "opaque", "HASHED": "dithered (hashed over samples)", "BLEND": "blended"}[read.blend]

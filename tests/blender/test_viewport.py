@@ -56,12 +56,14 @@ def _viewport_frame(gpu_call, scene, window=None, frame=None):
 
 
 @pytest.mark.parametrize(
-    "stack", ["demo", "every effect", "normal map", "environment world", "alpha", "colour attribute"]
+    "stack",
+    ["demo", "every effect", "normal map", "environment world", "alpha", "colour attribute", "compiled node tree"],
 )
 def test_viewport_matches_final_render(penumbra, gpu_call, stack):
-    from devkit import material_scenes
+    from devkit import material_scenes, node_scenes
 
     builders = {
+        "compiled node tree": node_scenes.compiled_sphere,
         "normal map": material_scenes.normal_map,
         "environment world": material_scenes.world_hdri,
         "alpha": material_scenes.alpha_quarter,

@@ -1,0 +1,1001 @@
+"""A material's shader node tree compiled to one GLSL function.
+
+``compile_material(mat)`` walks back from the active Material Output's Surface socket and
+writes the tree as GLSL statements, one temporary per node output, each a call of a node
+function of our own (``shaders/nodes/<family>.glsl``, every one with a numpy twin in
+``devkit/node_reference.py``). The result (``CompiledTree``) is plain data: the code of
+
+    void node_tree(vec3 N, vec3 V, bool front, inout vec4 base, inout float roughness,
+                   inout float metallic, inout float specular, inout float alpha,
+                   inout vec3 emission, inout vec3 normal)
+
+which the lit pass calls where it reads the material (``shaders/lit.frag.glsl``, under
+``NODE_TREE``; ``normal`` only where a shader's Normal input is compiled, a Bump say:
+``NODE_NORMAL``), the GLSL families it needs, the surface data it reads (UV map, colour
+attribute, texture space, world origin), its image textures, and its **constants**.
+
+Constants are not in the code: every unlinked socket value and every plain number of a node
+(a Value or RGB node, a Color Ramp's stops) is a row of the material's ``node_constants``
+uniform block, so two trees that differ only in values give the same code and share one
+program. The program key (``CompiledTree.key``) is a hash of the code and what it reads;
+node names never reach the code. Enum properties (a Math operation, a blend mode, an
+interpolation) are structure: compiled in as literals.
+
+How Blender's rules are followed:
+- node groups are inlined (nested; a group input left unlinked reads its value on the group
+  node), reroutes followed, a muted link reads the socket's own value, a muted node passes
+  its first input of the matching type through (``Node.internal_links``), else gives 0;
+- implicit conversions as Blender's: colour to value is Rec.709 luminance, vector to value
+  the mean of its components, a value to a colour is grey, a colour into a shader socket
+  emits it;
+- Mix Shader and Add Shader combine the Principled parameters per pixel with their factor,
+  which may come from any node (``shaders/nodes/shader.glsl``: a mix of two lobes is drawn
+  as one Principled surface with mixed parameters).
+
+What cannot compile (an unknown node, a Script node, Light Path, an output Penumbra has no
+data for) falls back for the shader input it feeds only: that input takes the value the
+earlier reader (``materials.py``) would use (the viewport display colour, roughness and
+metallic for the Principled BSDF's inputs; the socket's own value otherwise), and the
+material's messages name the node once. A group that contains itself, a group node without
+its group, a tree deeper than ``MAX_DEPTH`` links or larger than ``MAX_NODES`` node outputs,
+more than ``MAX_CONSTANTS`` constants: a message, never a crash.
+
+Adding a node is one registry entry: a function decorated ``@node("ShaderNodeX", family)``
+that takes (compiler, node, output socket, context) and returns a ``Value`` (GLSL expression,
+type), reading its inputs with ``c.input(node, name, ctx, type)`` (constants become uniforms
+by themselves) and naming its ``family`` file under ``shaders/nodes/`` (e.g. ``texture_noise``
+for a ``shaders/nodes/texture_noise.glsl``). Procedural textures read their coordinates with
+``c.texture_vector(node, ctx)`` (Generated when unlinked, as Blender does).
+"""
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+
+MAX_CONSTANTS = 1024  # vec4 rows of node_constants (16 KiB: the smallest uniform block GL allows)
+MAX_NODES = 1500  # node outputs compiled (after inlining groups)
+MAX_DEPTH = 120  # links followed from the output to the farthest node
+MAX_GROUP_DEPTH = 16  # node groups inside node groups
+MAX_IMAGES = 8  # image textures one tree samples
+CURVE_SAMPLES = 128  # points an RGB Curves / Float Curve curve is tabulated at
+
+GLSL_TYPES = {"float": "float", "vec3": "vec3", "vec4": "vec4", "closure": "NodeClosure"}
+SOCKET_TYPES = {"VALUE": "float", "INT": "float", "BOOLEAN": "float", "VECTOR": "vec3", "RGBA": "vec4"}
+SOCKET_TYPES["SHADER"] = "closure"
+
+# Literal codes of the enums compiled into the GLSL (the switch cases of shaders/nodes/*.glsl).
+MATH_OPS = (
+    "ADD SUBTRACT MULTIPLY DIVIDE MULTIPLY_ADD POWER LOGARITHM SQRT INVERSE_SQRT ABSOLUTE EXPONENT "
+    "MINIMUM MAXIMUM LESS_THAN GREATER_THAN SIGN COMPARE SMOOTH_MIN SMOOTH_MAX ROUND FLOOR CEIL TRUNC "
+    "FRACT MODULO FLOORED_MODULO WRAP SNAP PINGPONG SINE COSINE TANGENT ARCSINE ARCCOSINE ARCTANGENT "
+    "ARCTAN2 SINH COSH TANH RADIANS DEGREES"
+).split()
+VECTOR_MATH_OPS = (
+    "ADD SUBTRACT MULTIPLY DIVIDE MULTIPLY_ADD CROSS_PRODUCT PROJECT REFLECT REFRACT FACEFORWARD "
+    "DOT_PRODUCT DISTANCE LENGTH SCALE NORMALIZE ABSOLUTE POWER SIGN MINIMUM MAXIMUM FLOOR CEIL "
+    "FRACTION MODULO WRAP SNAP SINE COSINE TANGENT"
+).split()
+VECTOR_MATH_VALUE = {"DOT_PRODUCT", "DISTANCE", "LENGTH"}  # the operations whose output is the Value
+BLEND_MODES = (
+    "MIX DARKEN MULTIPLY BURN LIGHTEN SCREEN DODGE ADD OVERLAY SOFT_LIGHT LINEAR_LIGHT DIFFERENCE "
+    "EXCLUSION SUBTRACT DIVIDE HUE SATURATION VALUE COLOR"
+).split()
+MAP_RANGE_TYPES = ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")
+CLAMP_TYPES = ("MINMAX", "RANGE")
+RAMP_INTERPOLATIONS = ("CONSTANT", "LINEAR", "EASE", "CARDINAL", "B_SPLINE")
+RAMP_MODES = ("RGB", "HSV", "HSL")
+RAMP_HUE = ("NEAR", "FAR", "CW", "CCW")
+COLOR_MODES = ("RGB", "HSV", "HSL")
+MAPPING_TYPES = ("POINT", "TEXTURE", "VECTOR", "NORMAL")
+GRADIENT_TYPES = ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "RADIAL", "QUADRATIC_SPHERE", "SPHERICAL")
+IMAGE_INTERPOLATION = {"Closest": 0, "Linear": 1, "Cubic": 1, "Smart": 1}
+IMAGE_EXTENSION = {"REPEAT": 0, "EXTEND": 1, "CLIP": 2, "MIRROR": 3}
+
+
+class Fallback(Exception):
+    """This input cannot be compiled: ``str(self)`` says which node and why."""
+
+
+class TreeTooLarge(Exception):
+    """The whole tree is beyond the compiler's bounds."""
+
+
+@dataclass(frozen=True)
+class Value:
+    expr: str
+    type: str  # float, vec3, vec4 or closure
+
+
+@dataclass(frozen=True)
+class NodeImage:
+    """An image a compiled tree samples (sampler ``node_image_<index>``)."""
+
+    image: str
+    interpolation: str = "Linear"
+    extension: str = "REPEAT"
+
+
+@dataclass(frozen=True, eq=False)  # compared by identity (it holds an array)
+class CompiledTree:
+    key: str  # hash of the code and what it reads: equal trees share one program
+    code: str  # the GLSL function node_tree(...)
+    families: tuple  # shaders/nodes/*.glsl files, in include order
+    constants: np.ndarray  # (n, 4) float32: the node_constants rows
+    images: tuple  # NodeImage per sampler node_image_<i>
+    needs: frozenset  # surface data read: UV, VCOL, GENERATED, ORIGIN, OBJECT_INFO, FRAME (the camera)
+    uv_map: str = ""  # the UV map UV reads ("" = the active render map)
+    color_attribute: str = ""  # the colour attribute VCOL reads ("" = the active one)
+    transparent: bool = False  # alpha can be below 1
+    messages: tuple = ()  # what fell back (without the material's name)
+    fallbacks: int = 0  # shader inputs that fell back
+    surface_fallback: bool = False  # the whole surface fell back (nothing compiled)
+    normal: bool = False  # it computes the shading normal (a Bump, ...): NODE_NORMAL
+
+
+# --- the registry -------------------------------------------------------------------------
+
+NODES = {}  # bl_idname -> (function, family)
+
+
+def node(*idnames, family=None):
+    """Register a node compiler for ``idnames``; ``family``: its shaders/nodes file (stem)."""
+
+    def register(fn):
+        for idname in idnames:
+            NODES[idname] = (fn, family)
+        return fn
+
+    return register
+
+
+FAMILY_ORDER = ("common", "math", "vector", "color", "converter", "input", "texture", "shader")
+
+
+# --- the compiler -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Context:
+    """Where in the tree evaluation is: the top-level tree, or inside a group node."""
+
+    path: tuple = ()  # names of the group nodes entered
+    group_node: object = None
+    parent: object = None
+    trees: tuple = ()  # node groups entered (a group inside itself is a broken file)
+
+
+def _label(node):
+    return node.bl_label or node.name or node.bl_idname
+
+
+def _link(socket):
+    """The link into ``socket`` Blender evaluates, or None (unlinked, muted or invalid)."""
+    if not socket.is_linked:
+        return None
+    for link in socket.links:
+        if getattr(link, "is_muted", False) or not getattr(link, "is_valid", True):
+            return None
+        return link
+    return None
+
+
+def _socket(sockets, key):
+    """A socket by identifier, then name, then index."""
+    if isinstance(key, int):
+        return sockets[key]
+    for s in sockets:
+        if s.identifier == key:
+            return s
+    for s in sockets:
+        if s.name == key and s.enabled:
+            return s
+    for s in sockets:
+        if s.name == key:
+            return s
+    raise Fallback(f"no socket '{key}'")
+
+
+class Compiler:
+    def __init__(self, mat):
+        self.mat = mat
+        self.lines = []
+        self.constants = []
+        self.cache = {}
+        self.messages = []
+        self.images = []
+        self.needs = set()
+        self.families = {"common", "shader"}
+        self.uv_maps = []
+        self.attributes = []
+        self.depth = 0
+        self.transparent = False
+        self.fallbacks = 0
+        self.surface_fallback = False
+        self.normal = False
+
+    # -- emitting --
+
+    def temp(self, typ, expr):
+        name = f"t{len(self.lines)}"
+        self.lines.append(f"  {GLSL_TYPES[typ]} {name} = {expr};")
+        if len(self.lines) > MAX_NODES:
+            raise TreeTooLarge(f"more than {MAX_NODES} node outputs")
+        return Value(name, typ)
+
+    def const(self, value, typ):
+        """A constant as a row of node_constants (never a literal in the code)."""
+        if len(self.constants) >= MAX_CONSTANTS:
+            raise TreeTooLarge(f"more than {MAX_CONSTANTS} constants")
+        v = np.zeros(4, np.float64)
+        if typ == "float":
+            v[0] = float(value)
+        else:
+            seq = [float(x) for x in value]
+            v[: min(len(seq), 4)] = seq[:4]
+            if typ == "vec4" and len(seq) < 4:
+                v[3] = 1.0
+        v = np.nan_to_num(v, nan=0.0, posinf=3.0e38, neginf=-3.0e38)
+        i = len(self.constants)
+        self.constants.append(v)
+        swizzle = {"float": ".x", "vec3": ".xyz", "vec4": ""}[typ]
+        return Value(f"node_constants[{i}].v{swizzle}", typ)
+
+    @staticmethod
+    def zero(typ):
+        return Value(
+            {"float": "0.0", "vec3": "vec3(0.0)", "vec4": "vec4(0.0, 0.0, 0.0, 1.0)"}.get(typ, "node_closure_empty()"),
+            typ,
+        )
+
+    def convert(self, v, typ):
+        if v.type == typ:
+            return v
+        if typ == "closure":
+            if v.type == "float":
+                return Value(f"node_emission(vec4(vec3({v.expr}), 1.0), 1.0)", typ)
+            return Value(f"node_emission({self.convert(v, 'vec4').expr}, 1.0)", typ)
+        if v.type == "closure":
+            raise Fallback("a shader linked into a value socket")
+        table = {
+            ("float", "vec3"): "vec3({})",
+            ("float", "vec4"): "vec4(vec3({}), 1.0)",
+            ("vec3", "float"): "node_vector_to_float({})",
+            ("vec3", "vec4"): "vec4({}, 1.0)",
+            ("vec4", "float"): "node_color_to_float({})",
+            ("vec4", "vec3"): "({}).rgb",
+        }
+        return Value(table[(v.type, typ)].format(v.expr), typ)
+
+    # -- reading sockets --
+
+    def default(self, socket, typ):
+        """An unlinked socket's own value, as a constant."""
+        if not hasattr(socket, "default_value"):
+            return self.zero(typ)
+        value = socket.default_value
+        own = SOCKET_TYPES.get(socket.type, "float")
+        if own == "float":
+            return self.convert(self.const(float(value), "float"), typ)
+        if own == "closure":
+            return self.zero(typ)
+        return self.convert(self.const(tuple(value), own), typ)
+
+    def input(self, node, key, ctx, typ):
+        """Input ``key`` of ``node`` as a Value of GLSL type ``typ``."""
+        return self.socket_value(_socket(node.inputs, key), ctx, typ)
+
+    def linked(self, node, key):
+        return _link(_socket(node.inputs, key)) is not None
+
+    def socket_value(self, socket, ctx, typ):
+        link = _link(socket)
+        if link is None:
+            return self.default(socket, typ)
+        return self.convert(self.output(link.from_node, link.from_socket, ctx), typ)
+
+    def output(self, node, socket, ctx):
+        """What output ``socket`` of ``node`` gives (its own type)."""
+        key = (ctx.path, node.name, socket.identifier)
+        if key in self.cache:
+            return self.cache[key]
+        self.depth += 1
+        try:
+            if self.depth > MAX_DEPTH:
+                raise TreeTooLarge(f"more than {MAX_DEPTH} nodes in a row")
+            value = self._output(node, socket, ctx)
+        finally:
+            self.depth -= 1
+        self.cache[key] = value
+        return value
+
+    def _output(self, node, socket, ctx):
+        typ = SOCKET_TYPES.get(socket.type)
+        idname = node.bl_idname
+        if idname == "NodeReroute":
+            link = _link(node.inputs[0])
+            if link is None:
+                return self.zero(typ or "float")
+            return self.output(link.from_node, link.from_socket, ctx)
+        if idname == "NodeGroupInput":
+            return self._group_input(socket, ctx, typ)
+        if typ is None:
+            raise Fallback(f"a '{_label(node)}' node's {socket.name} output ({socket.type.lower()})")
+        if node.mute:
+            for link in node.internal_links:
+                if link.to_socket.identifier == socket.identifier:
+                    return self.socket_value(link.from_socket, ctx, typ)
+            return self.zero(typ)
+        if idname == "ShaderNodeGroup":
+            return self._group(node, socket, ctx, typ)
+        entry = NODES.get(idname)
+        if entry is None:
+            raise Fallback(f"a '{_label(node)}' node")
+        fn, family = entry
+        if family:
+            self.families.add(family)
+        try:
+            value = fn(self, node, socket, ctx)
+        except (Fallback, TreeTooLarge):
+            raise
+        except (AttributeError, KeyError, IndexError, TypeError, ValueError) as exc:
+            raise Fallback(f"a '{_label(node)}' node ({exc})") from exc
+        return self.convert(value, typ) if value.type != typ and typ != "closure" else value
+
+    def _group_input(self, socket, ctx, typ):
+        if ctx.group_node is None:
+            return self.zero(typ or "float")
+        outer = next((s for s in ctx.group_node.inputs if s.identifier == socket.identifier), None)
+        if outer is None:
+            return self.zero(typ or "float")
+        return self.socket_value(outer, ctx.parent, typ or SOCKET_TYPES.get(outer.type, "float"))
+
+    def _group(self, group, socket, ctx, typ):
+        tree = group.node_tree
+        if tree is None:
+            raise Fallback(f"a group node '{group.name}' without its node group")
+        if tree in ctx.trees:
+            raise Fallback(f"node group '{tree.name}' contains itself")
+        if len(ctx.trees) >= MAX_GROUP_DEPTH:
+            raise Fallback(f"node groups nested more than {MAX_GROUP_DEPTH} deep")
+        outputs = [n for n in tree.nodes if n.bl_idname == "NodeGroupOutput"]
+        out = next((n for n in outputs if getattr(n, "is_active_output", False)), outputs[0] if outputs else None)
+        if out is None:
+            return self.zero(typ)
+        inner = next((s for s in out.inputs if s.identifier == socket.identifier), None)
+        if inner is None:
+            return self.zero(typ)
+        sub = Context(ctx.path + (group.name,), group, ctx, ctx.trees + (tree,))
+        return self.socket_value(inner, sub, typ)
+
+    # -- surface data --
+
+    def uv(self, name=""):
+        """The UV coordinates of map ``name`` ("" = the active render map) as a vec3."""
+        if name not in self.uv_maps:
+            self.uv_maps.append(name)
+            if len(self.uv_maps) == 2:
+                self.messages.append(f"a second UV map '{name}' (UV map '{self.uv_maps[0] or 'active'}' is used)")
+        self.needs.add("UV")
+        return Value("vec3(v_uv, 0.0)", "vec3")
+
+    def attribute(self, name=""):
+        """Colour attribute ``name`` ("" = the active one) as a vec4."""
+        if name not in self.attributes:
+            self.attributes.append(name)
+            if len(self.attributes) == 2:
+                self.messages.append(f"a second colour attribute '{name}' ('{self.attributes[0] or 'active'}' is used)")
+        self.needs.add("VCOL")
+        return Value("v_color", "vec4")
+
+    def generated(self):
+        self.needs.add("GENERATED")
+        return Value("node_generated()", "vec3")
+
+    def texture_vector(self, node, ctx, key="Vector"):
+        """A texture node's coordinates: its Vector input, Generated where unlinked."""
+        if self.linked(node, key):
+            return self.input(node, key, ctx, "vec3")
+        return self.generated()
+
+    # -- shader inputs with their fallback --
+
+    def shader_input(self, node, key, ctx, typ, fallback=None, label=None):
+        """An input of a shader node; what cannot compile falls back to ``fallback`` (or the
+        socket's own value) and is named."""
+        socket = _socket(node.inputs, key)
+        try:
+            return self.socket_value(socket, ctx, typ)
+        except Fallback as exc:
+            self.fallbacks += 1
+            self.messages.append(f"{label or socket.name} from {exc}")
+            if typ == "closure":
+                return self.display_closure()
+            if fallback is not None:
+                return self.const(fallback, typ) if typ != "float" else self.const(float(fallback), "float")
+            return self.default(socket, typ)
+
+    def normal_input(self, node, ctx):
+        """A shader's Normal input: N where unlinked or fed by a Normal Map (the reader's
+        normal-map path draws that one), else the compiled vector (a Bump, ...)."""
+        socket = next((s for s in node.inputs if s.identifier == "Normal"), None)
+        link = _link(socket) if socket is not None else None
+        if link is None:
+            return Value("N", "vec3")
+        src = link.from_node
+        while src.bl_idname == "NodeReroute" and _link(src.inputs[0]) is not None:
+            src = _link(src.inputs[0]).from_node
+        if src.bl_idname == "ShaderNodeNormalMap":
+            return Value("N", "vec3")
+        value = self.shader_input(node, "Normal", ctx, "vec3")
+        if value.expr.startswith("node_constants"):  # fell back to the socket's value: no normal
+            return Value("N", "vec3")
+        self.normal = True
+        return value
+
+    def display_closure(self):
+        """The material's viewport display values as a surface."""
+        m = self.mat
+        base = self.const(tuple(m.diffuse_color), "vec4")
+        r = self.const(float(m.roughness), "float")
+        metal = self.const(float(m.metallic), "float")
+        return Value(f"node_principled({base.expr}, {metal.expr}, {r.expr}, 0.5, 1.0, vec3(0.0), N)", "closure")
+
+    # -- the whole tree --
+
+    def compile(self, surface_socket):
+        v = self.shader_input_root(surface_socket)
+        body = "\n".join(self.lines)
+        code = _prelude(self.needs) + (
+            "void node_tree(vec3 N, vec3 V, bool front, inout vec4 base, inout float roughness,\n"
+            "               inout float metallic, inout float specular, inout float alpha, inout vec3 emission,\n"
+            "               inout vec3 normal)\n"
+            "{\n"
+            f"{body}\n"
+            f"  node_closure_resolve({v.expr}, base, roughness, metallic, specular, alpha, emission, normal);\n"
+            "}\n"
+        )
+        families = tuple(f for f in FAMILY_ORDER if f in self.families) + tuple(
+            sorted(self.families - set(FAMILY_ORDER))
+        )
+        needs = frozenset(self.needs)
+        images = tuple(self.images)
+        modes = ",".join(f"{i.interpolation}/{i.extension}" for i in images)
+        digest = hashlib.sha1(f"{code}|{families}|{sorted(needs)}|{modes}|{len(self.constants)}".encode()).hexdigest()
+        constants = np.array(self.constants, np.float32).reshape(-1, 4)
+        return CompiledTree(
+            key=digest[:12],
+            code=code,
+            families=families,
+            constants=constants,
+            images=images,
+            needs=needs,
+            uv_map=self.uv_maps[0] if self.uv_maps else "",
+            color_attribute=self.attributes[0] if self.attributes else "",
+            transparent=self.transparent,
+            messages=tuple(dict.fromkeys(self.messages)),
+            fallbacks=self.fallbacks,
+            surface_fallback=self.surface_fallback,
+            normal=self.normal,
+        )
+
+    def shader_input_root(self, socket):
+        ctx = Context()
+        try:
+            return self.socket_value(socket, ctx, "closure")
+        except Fallback as exc:
+            self.fallbacks += 1
+            self.surface_fallback = True
+            self.messages.append(f"the surface from {exc} (drawn with the viewport display colour)")
+            return self.display_closure()
+
+
+def _prelude(needs):
+    """Surface data the node functions read, as GLSL (per-draw push constants where needed)."""
+    out = [
+        "vec3 node_true_normal(vec3 V)\n{\n  vec3 f = node_safe_normalize(cross(dFdx(v_world), dFdy(v_world)));\n"
+        "  return (dot(f, V) < 0.0) ? -f : f;\n}\n",
+    ]
+    if "FRAME" in needs:  # the camera's matrices: the lit pass only
+        out.append(
+            "vec3 node_window()\n{\n  vec4 c = frame.view_proj * vec4(v_world, 1.0);\n"
+            "  return (abs(c.w) > 1e-30) ? vec3(c.xy / c.w * 0.5 + 0.5, 0.0) : vec3(0.0);\n}\n"
+        )
+    if "GENERATED" in needs:
+        out.append(
+            "vec3 node_generated()\n{\n  vec3 p = (inverse(model) * vec4(v_world, 1.0)).xyz;\n"
+            "  return p * node_texspace_scale + node_texspace_offset;\n}\n"
+        )
+    return "".join(out)
+
+
+def compile_material(mat):
+    """``CompiledTree`` of ``mat``'s surface, or (None, message) when the tree is beyond the
+    compiler's bounds or has no surface: returns (tree, message)."""
+    tree = getattr(mat, "node_tree", None)
+    if tree is None:
+        return None, None
+    outputs = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"]
+    active = [n for n in outputs if n.is_active_output and n.target in {"ALL", "EEVEE"}] or outputs
+    surface = next((o.inputs["Surface"] for o in active if _link(o.inputs["Surface"]) is not None), None)
+    if surface is None:
+        return None, None
+    compiler = Compiler(mat)
+    try:
+        return compiler.compile(surface), None
+    except TreeTooLarge as exc:
+        return None, f"its node tree is too large to compile ({exc})"
+    except RecursionError:
+        return None, "its node tree is too large to compile (too deep)"
+
+
+# --- shaders ------------------------------------------------------------------------------
+
+
+def _first(node, *names):
+    for n in names:
+        for s in node.inputs:
+            if s.name == n or s.identifier == n:
+                return n
+    return None
+
+
+@node("ShaderNodeBsdfPrincipled")
+def _principled(c, node, socket, ctx):
+    m = c.mat
+    base = c.shader_input(node, "Base Color", ctx, "vec4", tuple(m.diffuse_color))
+    metal = c.shader_input(node, "Metallic", ctx, "float", float(m.metallic))
+    rough = c.shader_input(node, "Roughness", ctx, "float", float(m.roughness))
+    spec = c.shader_input(node, _first(node, "Specular IOR Level", "Specular"), ctx, "float", 0.5)
+    alpha_socket = _socket(node.inputs, "Alpha")
+    if _link(alpha_socket) is not None or float(alpha_socket.default_value) < 1.0:
+        c.transparent = True
+    alpha = c.shader_input(node, "Alpha", ctx, "float", 1.0)
+    emit_name = _first(node, "Emission Color", "Emission")
+    emission = c.shader_input(node, emit_name, ctx, "vec4", (0.0, 0.0, 0.0, 1.0), "Emission Color")
+    strength = "1.0"
+    if _first(node, "Emission Strength"):
+        strength = c.shader_input(node, "Emission Strength", ctx, "float", 1.0).expr
+    normal = c.normal_input(node, ctx)
+    for name in ("Transmission Weight", "Transmission", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
+        sock = node.inputs.get(name)
+        if sock is not None and (sock.is_linked or float(sock.default_value) > 0.0):
+            c.messages.append(f"{name} is not drawn")
+    expr = (
+        f"node_principled({base.expr}, {metal.expr}, {rough.expr}, {spec.expr}, {alpha.expr}, "
+        f"({emission.expr}).rgb * {strength}, {normal.expr})"
+    )
+    return c.temp("closure", expr)
+
+
+@node("ShaderNodeEmission")
+def _emission(c, node, socket, ctx):
+    color = c.shader_input(node, "Color", ctx, "vec4", None, "Emission Color")
+    strength = c.shader_input(node, "Strength", ctx, "float", None, "Emission Strength")
+    return c.temp("closure", f"node_emission({color.expr}, {strength.expr})")
+
+
+@node("ShaderNodeBsdfDiffuse")
+def _diffuse(c, node, socket, ctx):
+    color = c.shader_input(node, "Color", ctx, "vec4")
+    return c.temp("closure", f"node_diffuse({color.expr}, {c.normal_input(node, ctx).expr})")
+
+
+@node("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic")
+def _glossy(c, node, socket, ctx):
+    color = c.shader_input(node, "Color", ctx, "vec4")
+    rough = c.shader_input(node, "Roughness", ctx, "float")
+    normal = c.normal_input(node, ctx)
+    return c.temp("closure", f"node_principled({color.expr}, 1.0, {rough.expr}, 0.5, 1.0, vec3(0.0), {normal.expr})")
+
+
+@node("ShaderNodeBsdfTransparent")
+def _transparent(c, node, socket, ctx):
+    c.transparent = True
+    return Value("node_transparent()", "closure")
+
+
+@node("ShaderNodeMixShader")
+def _mix_shader(c, node, socket, ctx):
+    fac = c.shader_input(node, 0, ctx, "float", None, "Mix Shader Fac")
+    a = c.shader_input(node, 1, ctx, "closure")
+    b = c.shader_input(node, 2, ctx, "closure")
+    return c.temp("closure", f"node_mix_shader({fac.expr}, {a.expr}, {b.expr})")
+
+
+@node("ShaderNodeAddShader")
+def _add_shader(c, node, socket, ctx):
+    a = c.shader_input(node, 0, ctx, "closure")
+    b = c.shader_input(node, 1, ctx, "closure")
+    return c.temp("closure", f"node_add_shader({a.expr}, {b.expr})")
+
+
+# --- inputs -------------------------------------------------------------------------------
+
+
+@node("ShaderNodeValue")
+def _value(c, node, socket, ctx):
+    return c.const(float(node.outputs[0].default_value), "float")
+
+
+@node("ShaderNodeRGB")
+def _rgb(c, node, socket, ctx):
+    return c.const(tuple(node.outputs[0].default_value), "vec4")
+
+
+@node("ShaderNodeTexCoord")
+def _tex_coord(c, node, socket, ctx):
+    out = socket.identifier
+    if out == "Generated":
+        return c.generated()
+    if out == "Normal":
+        return c.temp("vec3", "node_safe_normalize(transpose(mat3(model)) * N)")
+    if out == "UV":
+        return c.uv(getattr(node, "uv_map", "") or "") if hasattr(node, "uv_map") else c.uv("")
+    if out == "Object":
+        if getattr(node, "object", None) is not None:
+            raise Fallback("a 'Texture Coordinate' node's Object output of another object")
+        return c.temp("vec3", "(inverse(model) * vec4(v_world, 1.0)).xyz")
+    if out == "Camera":
+        c.needs.add("FRAME")
+        return c.temp("vec3", "(frame.view * vec4(v_world, 1.0)).xyz * vec3(1.0, 1.0, -1.0)")
+    if out == "Window":
+        c.needs.add("FRAME")
+        return c.temp("vec3", "node_window()")
+    if out == "Reflection":
+        return c.temp("vec3", "reflect(-V, N)")
+    raise Fallback(f"a 'Texture Coordinate' node's {socket.name} output")
+
+
+@node("ShaderNodeUVMap")
+def _uv_map(c, node, socket, ctx):
+    return c.uv(node.uv_map)
+
+
+@node("ShaderNodeVertexColor")
+def _vertex_color(c, node, socket, ctx):
+    v = c.attribute(node.layer_name)
+    return Value("v_color.a", "float") if socket.identifier == "Alpha" else v
+
+
+@node("ShaderNodeAttribute")
+def _attribute(c, node, socket, ctx):
+    if node.attribute_type != "GEOMETRY":
+        raise Fallback(f"an 'Attribute' node of type {node.attribute_type.lower()}")
+    c.attribute(node.attribute_name)
+    out = socket.identifier
+    if out == "Color":
+        return Value("vec4(v_color.rgb, 1.0)", "vec4")
+    if out == "Vector":
+        return Value("v_color.rgb", "vec3")
+    if out == "Fac":
+        return Value("((v_color.r + v_color.g + v_color.b) / 3.0)", "float")
+    return Value("v_color.a", "float")
+
+
+@node("ShaderNodeNewGeometry")
+def _geometry(c, node, socket, ctx):
+    out = socket.identifier
+    if out == "Position":
+        c.needs.add("ORIGIN")
+        return Value("(v_world + node_origin)", "vec3")
+    if out == "Normal":
+        return Value("N", "vec3")
+    if out == "True Normal":
+        return c.temp("vec3", "node_true_normal(V)")
+    if out == "Incoming":
+        return Value("V", "vec3")
+    if out == "Backfacing":
+        return Value("(front ? 0.0 : 1.0)", "float")
+    raise Fallback(f"a 'Geometry' node's {socket.name} output")
+
+
+@node("ShaderNodeObjectInfo")
+def _object_info(c, node, socket, ctx):
+    if socket.identifier == "Location":
+        c.needs.add("ORIGIN")
+        return Value("(model[3].xyz + node_origin)", "vec3")
+    if socket.identifier in {"Color", "Alpha", "Random"}:
+        c.needs.add("OBJECT_INFO")
+        return {
+            "Color": Value("vec4(node_object_color.rgb, 1.0)", "vec4"),
+            "Alpha": Value("node_object_color.a", "float"),
+            "Random": Value("node_object_random", "float"),
+        }[socket.identifier]
+    raise Fallback(f"an 'Object Info' node's {socket.name} output")
+
+
+@node("ShaderNodeFresnel", family="input")
+def _fresnel(c, node, socket, ctx):
+    ior = c.input(node, "IOR", ctx, "float")
+    n = c.input(node, "Normal", ctx, "vec3") if c.linked(node, "Normal") else Value("N", "vec3")
+    return c.temp("float", f"node_fresnel({ior.expr}, {n.expr}, V, front)")
+
+
+@node("ShaderNodeLayerWeight", family="input")
+def _layer_weight(c, node, socket, ctx):
+    blend = c.input(node, "Blend", ctx, "float")
+    n = c.input(node, "Normal", ctx, "vec3") if c.linked(node, "Normal") else Value("N", "vec3")
+    lw = c.temp("vec3", f"vec3(node_layer_weight({blend.expr}, {n.expr}, V, front), 0.0)")
+    return Value(f"{lw.expr}.{'x' if socket.identifier == 'Fresnel' else 'y'}", "float")
+
+
+# --- converters ---------------------------------------------------------------------------
+
+
+@node("ShaderNodeMath", family="math")
+def _math(c, node, socket, ctx):
+    op = MATH_OPS.index(node.operation)
+    a, b, d = (c.input(node, i, ctx, "float") for i in range(3))
+    v = c.temp("float", f"node_math({op}, {a.expr}, {b.expr}, {d.expr})")
+    return c.temp("float", f"clamp({v.expr}, 0.0, 1.0)") if node.use_clamp else v
+
+
+@node("ShaderNodeVectorMath", family="vector")
+def _vector_math(c, node, socket, ctx):
+    c.families.add("math")
+    op = VECTOR_MATH_OPS.index(node.operation)
+    a, b, d = (c.input(node, i, ctx, "vec3") for i in range(3))
+    s = c.input(node, "Scale", ctx, "float")
+    v = c.temp("vec3", "vec3(0.0)")
+    f = c.temp("float", "0.0")
+    c.lines.append(f"  node_vector_math({op}, {a.expr}, {b.expr}, {d.expr}, {s.expr}, {v.expr}, {f.expr});")
+    return f if socket.identifier == "Value" else v
+
+
+@node("ShaderNodeMix", family="color")
+def _mix(c, node, socket, ctx):
+    kind = node.data_type
+    if kind == "FLOAT":
+        fac = c.input(node, "Factor_Float", ctx, "float")
+        if node.clamp_factor:
+            fac = Value(f"clamp({fac.expr}, 0.0, 1.0)", "float")
+        a, b = c.input(node, "A_Float", ctx, "float"), c.input(node, "B_Float", ctx, "float")
+        return c.temp("float", f"mix({a.expr}, {b.expr}, {fac.expr})")
+    if kind == "VECTOR":
+        uniform = node.factor_mode == "UNIFORM"
+        fac = c.input(node, "Factor_Float" if uniform else "Factor_Vector", ctx, "float" if uniform else "vec3")
+        if node.clamp_factor:
+            fac = Value(f"clamp({fac.expr}, 0.0, 1.0)", fac.type)
+        a, b = c.input(node, "A_Vector", ctx, "vec3"), c.input(node, "B_Vector", ctx, "vec3")
+        return c.temp("vec3", f"mix({a.expr}, {b.expr}, {fac.expr})")
+    if kind == "RGBA":
+        fac = c.input(node, "Factor_Float", ctx, "float")
+        if node.clamp_factor:
+            fac = Value(f"clamp({fac.expr}, 0.0, 1.0)", "float")
+        a, b = c.input(node, "A_Color", ctx, "vec4"), c.input(node, "B_Color", ctx, "vec4")
+        v = c.temp("vec4", f"node_mix_color({BLEND_MODES.index(node.blend_type)}, {fac.expr}, {a.expr}, {b.expr})")
+        if node.clamp_result:
+            v = c.temp("vec4", f"vec4(clamp({v.expr}.rgb, 0.0, 1.0), {v.expr}.a)")
+        return v
+    raise Fallback(f"a 'Mix' node of type {kind.lower()}")
+
+
+@node("ShaderNodeMixRGB", family="color")
+def _mix_rgb(c, node, socket, ctx):
+    fac = c.input(node, "Fac", ctx, "float")
+    a, b = c.input(node, "Color1", ctx, "vec4"), c.input(node, "Color2", ctx, "vec4")
+    v = c.temp("vec4", f"node_mix_color({BLEND_MODES.index(node.blend_type)}, {fac.expr}, {a.expr}, {b.expr})")
+    if node.use_clamp:
+        v = c.temp("vec4", f"vec4(clamp({v.expr}.rgb, 0.0, 1.0), {v.expr}.a)")
+    return v
+
+
+@node("ShaderNodeMapRange", family="converter")
+def _map_range(c, node, socket, ctx):
+    kind = MAP_RANGE_TYPES.index(node.interpolation_type)
+    clamp = "true" if node.clamp else "false"
+    if node.data_type == "FLOAT":
+        args = ", ".join(c.input(node, i, ctx, "float").expr for i in range(6))
+        return c.temp("float", f"node_map_range({kind}, {clamp}, {args})")
+    # FLOAT_VECTOR: each component mapped alone (Blender's vector Map Range).
+    ins = [c.input(node, k, ctx, "vec3") for k in ("Vector", "From_Min_FLOAT3", "From_Max_FLOAT3")]
+    ins += [c.input(node, k, ctx, "vec3") for k in ("To_Min_FLOAT3", "To_Max_FLOAT3", "Steps_FLOAT3")]
+    parts = []
+    for comp in "xyz":
+        args = ", ".join(f"{v.expr}.{comp}" for v in ins)
+        parts.append(f"node_map_range({kind}, {clamp}, {args})")
+    return c.temp("vec3", f"vec3({', '.join(parts)})")
+
+
+@node("ShaderNodeClamp", family="converter")
+def _clamp(c, node, socket, ctx):
+    v, lo, hi = (c.input(node, k, ctx, "float") for k in ("Value", "Min", "Max"))
+    return c.temp("float", f"node_clamp({CLAMP_TYPES.index(node.clamp_type)}, {v.expr}, {lo.expr}, {hi.expr})")
+
+
+@node("ShaderNodeValToRGB", family="converter")
+def _color_ramp(c, node, socket, ctx):
+    ramp = node.color_ramp
+    fac = c.input(node, "Fac", ctx, "float")
+    elements = list(ramp.elements)
+    first = len(c.constants)
+    for e in elements:
+        c.const(tuple(e.color), "vec4")
+        c.const(float(e.position), "float")
+    args = (
+        f"{first}, {len(elements)}, {RAMP_INTERPOLATIONS.index(ramp.interpolation)}, "
+        f"{RAMP_MODES.index(ramp.color_mode)}, {RAMP_HUE.index(ramp.hue_interpolation)}"
+    )
+    v = c.temp("vec4", f"node_color_ramp({fac.expr}, {args})")
+    return Value(f"{v.expr}.a", "float") if socket.identifier == "Alpha" else v
+
+
+def _curve(c, mapping, curve, x):
+    """GLSL of curve ``curve`` of CurveMapping ``mapping`` at float expression ``x``: the curve
+    tabulated with Blender's own evaluation (constants), read by node_curve."""
+    xs = [float(p.location[0]) for p in curve.points]
+    lo, hi = min(xs), max(xs)
+    if hi - lo < 1e-6:
+        hi = lo + 1e-6
+    samples = lo + (hi - lo) * np.arange(CURVE_SAMPLES) / (CURVE_SAMPLES - 1)
+    ys = [float(mapping.evaluate(curve, float(s))) for s in samples]
+    before = ys[0] - float(mapping.evaluate(curve, lo - 1.0))
+    after = float(mapping.evaluate(curve, hi + 1.0)) - ys[-1]
+    first = len(c.constants)
+    for k in range(0, CURVE_SAMPLES, 4):
+        c.const(tuple(ys[k : k + 4]), "vec4")
+    head = c.const((lo, 1.0 / (hi - lo), before, after), "vec4")
+    return f"node_curve({x}, {first}, {CURVE_SAMPLES}, {head.expr})"
+
+
+@node("ShaderNodeFloatCurve", family="converter")
+def _float_curve(c, node, socket, ctx):
+    mapping = node.mapping
+    mapping.initialize()
+    fac, value = c.input(node, "Factor", ctx, "float"), c.input(node, "Value", ctx, "float")
+    v = c.temp("float", value.expr)
+    curved = c.temp("float", _curve(c, mapping, mapping.curves[0], v.expr))
+    return c.temp("float", f"mix({v.expr}, {curved.expr}, {fac.expr})")
+
+
+@node("ShaderNodeRGBCurve", family="converter")
+def _rgb_curve(c, node, socket, ctx):
+    """Each channel through the combined curve (C), then its own (R, G, B), after the black
+    and white levels, mixed with the input by Fac; alpha kept."""
+    mapping = node.mapping
+    mapping.initialize()
+    fac, col = c.input(node, "Fac", ctx, "float"), c.input(node, "Color", ctx, "vec4")
+    black, white = tuple(mapping.black_level), tuple(mapping.white_level)
+    src = c.temp("vec4", col.expr)
+    x = src
+    if black != (0.0, 0.0, 0.0) or white != (1.0, 1.0, 1.0):
+        b = c.const(black, "vec3")
+        scale = c.const(tuple(1.0 / (w - k) if w != k else 0.0 for w, k in zip(white, black, strict=True)), "vec3")
+        x = c.temp("vec4", f"vec4(({src.expr}.rgb - {b.expr}) * {scale.expr}, {src.expr}.a)")
+    channels = []
+    for i, comp in enumerate("rgb"):
+        combined = c.temp("float", _curve(c, mapping, mapping.curves[3], f"{x.expr}.{comp}"))
+        channels.append(c.temp("float", _curve(c, mapping, mapping.curves[i], combined.expr)).expr)
+    curved = f"vec4({', '.join(channels)}, {src.expr}.a)"
+    return c.temp("vec4", f"mix({src.expr}, {curved}, {fac.expr})")
+
+
+@node("ShaderNodeHueSaturation", family="color")
+def _hue_sat(c, node, socket, ctx):
+    h, s, v, f = (c.input(node, k, ctx, "float") for k in ("Hue", "Saturation", "Value", "Fac"))
+    col = c.input(node, "Color", ctx, "vec4")
+    return c.temp("vec4", f"node_hue_saturation({h.expr}, {s.expr}, {v.expr}, {f.expr}, {col.expr})")
+
+
+@node("ShaderNodeInvert", family="color")
+def _invert(c, node, socket, ctx):
+    f, col = c.input(node, "Fac", ctx, "float"), c.input(node, "Color", ctx, "vec4")
+    return c.temp("vec4", f"node_invert({f.expr}, {col.expr})")
+
+
+@node("ShaderNodeGamma", family="color")
+def _gamma(c, node, socket, ctx):
+    col, g = c.input(node, "Color", ctx, "vec4"), c.input(node, "Gamma", ctx, "float")
+    return c.temp("vec4", f"node_gamma({col.expr}, {g.expr})")
+
+
+@node("ShaderNodeBrightContrast", family="color")
+def _bright_contrast(c, node, socket, ctx):
+    col = c.input(node, "Color", ctx, "vec4")
+    b, k = c.input(node, "Bright", ctx, "float"), c.input(node, "Contrast", ctx, "float")
+    return c.temp("vec4", f"node_bright_contrast({col.expr}, {b.expr}, {k.expr})")
+
+
+@node("ShaderNodeSeparateColor", family="color")
+def _separate_color(c, node, socket, ctx):
+    col = c.input(node, "Color", ctx, "vec4")
+    v = c.temp("vec4", f"node_separate_color({COLOR_MODES.index(node.mode)}, {col.expr})")
+    index = [s.identifier for s in node.outputs].index(socket.identifier)
+    return Value(f"{v.expr}.{'xyzw'[index]}", "float")
+
+
+@node("ShaderNodeCombineColor", family="color")
+def _combine_color(c, node, socket, ctx):
+    x, y, z = (c.input(node, i, ctx, "float") for i in range(3))
+    return c.temp("vec4", f"node_combine_color({COLOR_MODES.index(node.mode)}, {x.expr}, {y.expr}, {z.expr})")
+
+
+@node("ShaderNodeSeparateRGB")
+def _separate_rgb(c, node, socket, ctx):
+    col = c.input(node, "Image", ctx, "vec4")
+    return Value(f"({col.expr}).{'rgb'[['R', 'G', 'B'].index(socket.identifier)]}", "float")
+
+
+@node("ShaderNodeCombineRGB")
+def _combine_rgb(c, node, socket, ctx):
+    x, y, z = (c.input(node, i, ctx, "float") for i in range(3))
+    return c.temp("vec4", f"vec4({x.expr}, {y.expr}, {z.expr}, 1.0)")
+
+
+@node("ShaderNodeSeparateXYZ")
+def _separate_xyz(c, node, socket, ctx):
+    v = c.input(node, "Vector", ctx, "vec3")
+    return Value(f"({v.expr}).{'xyz'[['X', 'Y', 'Z'].index(socket.identifier)]}", "float")
+
+
+@node("ShaderNodeCombineXYZ")
+def _combine_xyz(c, node, socket, ctx):
+    x, y, z = (c.input(node, i, ctx, "float") for i in range(3))
+    return c.temp("vec3", f"vec3({x.expr}, {y.expr}, {z.expr})")
+
+
+# --- vectors ------------------------------------------------------------------------------
+
+
+@node("ShaderNodeBump", family="input")
+def _bump(c, node, socket, ctx):
+    strength, dist = c.input(node, "Strength", ctx, "float"), c.input(node, "Distance", ctx, "float")
+    height = c.input(node, "Height", ctx, "float")
+    n = c.input(node, "Normal", ctx, "vec3") if c.linked(node, "Normal") else Value("N", "vec3")
+    invert = "true" if node.invert else "false"
+    h = c.temp("float", height.expr)
+    return c.temp("vec3", f"node_bump({strength.expr}, {dist.expr}, {h.expr}, {n.expr}, front, {invert})")
+
+
+@node("ShaderNodeMapping", family="vector")
+def _mapping(c, node, socket, ctx):
+    c.families.add("math")
+    v = c.input(node, "Vector", ctx, "vec3")
+    kind = MAPPING_TYPES.index(node.vector_type)
+    loc = c.input(node, "Location", ctx, "vec3") if kind < 2 else Value("vec3(0.0)", "vec3")
+    rot, scale = c.input(node, "Rotation", ctx, "vec3"), c.input(node, "Scale", ctx, "vec3")
+    return c.temp("vec3", f"node_mapping({kind}, {v.expr}, {loc.expr}, {rot.expr}, {scale.expr})")
+
+
+# --- textures -----------------------------------------------------------------------------
+
+
+@node("ShaderNodeTexChecker", family="texture")
+def _checker(c, node, socket, ctx):
+    p = c.texture_vector(node, ctx)
+    scale = c.input(node, "Scale", ctx, "float")
+    f = c.temp("float", f"node_checker({p.expr}, {scale.expr})")
+    if socket.identifier == "Fac":
+        return f
+    a, b = c.input(node, "Color1", ctx, "vec4"), c.input(node, "Color2", ctx, "vec4")
+    return c.temp("vec4", f"(({f.expr}) > 0.5 ? {a.expr} : {b.expr})")
+
+
+@node("ShaderNodeTexGradient", family="texture")
+def _gradient(c, node, socket, ctx):
+    p = c.texture_vector(node, ctx)
+    f = c.temp("float", f"node_gradient({GRADIENT_TYPES.index(node.gradient_type)}, {p.expr})")
+    return f if socket.identifier == "Fac" else Value(f"vec4(vec3({f.expr}), 1.0)", "vec4")
+
+
+@node("ShaderNodeTexImage")
+def _image(c, node, socket, ctx):
+    image = node.image
+    if image is None:
+        c.messages.append("an Image Texture node without an image")
+        return Value("vec4(0.0, 0.0, 0.0, 1.0)" if socket.identifier == "Color" else "0.0", SOCKET_TYPES[socket.type])
+    if node.projection != "FLAT":
+        c.messages.append(f"image projection {node.projection} (flat UV is used)")
+    if node.interpolation in {"Cubic", "Smart"}:
+        c.messages.append(f"{node.interpolation} interpolation (drawn as Linear)")
+    ref = NodeImage(image.name_full, node.interpolation, node.extension)
+    if ref not in c.images:
+        if len(c.images) >= MAX_IMAGES:
+            raise Fallback(f"more than {MAX_IMAGES} image textures")
+        c.images.append(ref)
+    index = c.images.index(ref)
+    uv = c.input(node, "Vector", ctx, "vec3") if c.linked(node, "Vector") else c.uv("")
+    mode = f"ivec4({IMAGE_INTERPOLATION.get(ref.interpolation, 1)}, {IMAGE_EXTENSION.get(ref.extension, 0)}, 0, 0)"
+    texel = c.temp("vec4", f"sample_image(node_image_{index}, ({uv.expr}).xy, {mode})")
+    return Value(f"{texel.expr}.a", "float") if socket.identifier == "Alpha" else texel
