@@ -91,6 +91,8 @@ class Material:
                 out.add("TREE_UV")
             if self.tree.normal:
                 out.add("TREE_NORMAL")
+            if self.tree.lobes == 2:
+                out.add("TREE_LOBES")
         return frozenset(out)
 
 
@@ -364,6 +366,9 @@ def _mix_shader(mat, node, notes, depth):
     a, b = sides
     if fac in (0.0, 1.0):
         return b if fac == 1.0 else a
+    if a.alpha > 0.0 and b.alpha > 0.0 and not (a.holdout or b.holdout or _emits_only(a) or _emits_only(b)):
+        notes.append("a Mix Shader of two surfaces (drawn as two lobes by the compiled node tree)")
+        return None
     if a.holdout or b.holdout:
         notes.append("a Holdout shader mixed with another (the side with the larger factor is drawn)")
         return b if fac >= 0.5 else a
@@ -389,6 +394,11 @@ def _mix_shader(mat, node, notes, depth):
     out.alpha = total
     out.emission = tuple((1.0 - fac) * x + fac * y for x, y in zip(a.emission, b.emission, strict=True))
     return out
+
+
+def _emits_only(m):
+    """A shader read with no reflecting surface (an Emission, an unlinked socket)."""
+    return not m.textures and m.specular == 0.0 and m.metallic == 0.0 and max(m.base_color[:3]) == 0.0
 
 
 def _fed_and_constant(a, b, constant_node):
