@@ -1207,3 +1207,42 @@ def test_single_lobe_trees_keep_their_program(penumbra):
     node_scenes.sphere(16, 16, _mixed(_checker_factor))
     double = _read()
     assert double.tree.lobes == 2 and material_defines(double.features)["NODE_LOBES"] == 2
+
+
+def test_two_lobes_keep_the_passes_and_debug_views(penumbra):
+    """Add Shader of the metal / matte Mix (0.5) and an Emission (0.3, 0.2, 0.1): the Normal,
+    Shadow and Emission passes and the LIGHT_COST debug view equal those of the metal alone
+    plus that Emission (one lobe; the lobes share the mesh normal here), within 1e-4."""
+    from penumbra.engine.scene.materials import material_from_blender
+
+    def glowing(build):
+        def full(mat, nodes, links, bsdf, output):
+            build(mat, nodes, links, bsdf, output)
+            surface = _in(output, "Surface").links[0].from_socket
+            emission = nodes.new("ShaderNodeEmission")
+            _in(emission, "Color").default_value = (0.3, 0.2, 0.1, 1.0)
+            add = nodes.new("ShaderNodeAddShader")
+            links.new(surface, add.inputs[0])
+            links.new(emission.outputs[0], add.inputs[1])
+            links.new(add.outputs[0], _in(output, "Surface"))
+
+        return full
+
+    def passes(build, name):
+        scene = node_scenes.sphere(32, 32, glowing(build), name=name)
+        engines.configure(scene, "PENUMBRA")
+        scene.view_layers[0].use_pass_normal = True
+        out = render(scene, passes=("Combined", "Shadow", "Emission"))
+        scene.penumbra.debug_view = "LIGHT_COST"
+        out["debug"] = render(scene)["Combined"]
+        scene.penumbra.debug_view = "NONE"
+        return out, material_from_blender(bpy.data.materials[name])
+
+    two, read_two = passes(_mixed(0.5), "TwoLobes")
+    one, read_one = passes(lambda m, n, links, bsdf, o: links.new(_metal(n, bsdf).outputs[0], _in(o, "Surface")), "One")
+    assert read_two.tree.lobes == 2 and read_one.tree.lobes == 1
+    for name in ("Normal", "Shadow", "Emission", "debug"):
+        assert np.abs(two[name] - one[name]).max() < 1e-4, name
+    assert two["debug"][16, 16, 0] > 0.0 and two["Normal"][16, 16, :3].any()  # lights counted, normals written
+    assert np.abs(two["Emission"][16, 16, :3] - (0.3, 0.2, 0.1)).max() < 1e-4
+    assert not np.allclose(two["Combined"], one["Combined"], atol=1e-2)  # the lobes differ
