@@ -333,6 +333,7 @@ def _shader(mat, node, notes, depth=0):
         out = Material(metallic=1.0)
         out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
         out.roughness = _value_channel(node.inputs["Roughness"], notes, "Roughness", out, "roughness", 0.5)
+        _normal_map(None, node, notes, out)
         return out
     if idname == "ShaderNodeBsdfTransparent":
         out = _black()
@@ -556,6 +557,7 @@ def _emission_shader(node, notes):
 def _diffuse_shader(node, notes):
     out = Material(specular=0.0, roughness=1.0)
     out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
+    _normal_map(None, node, notes, out)  # a Bump, ...: named, so the compiled tree draws it
     return out
 
 
