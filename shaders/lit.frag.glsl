@@ -21,9 +21,21 @@
  * Normal Offset), TERMINATOR_SHADING raises the cosine term's frequency (Cycles' Shading
  * Offset).
  *
+ * NODE_LOBES == 2 (a compiled node tree whose Mix / Add Shader joins two surfaces,
+ * engine/scene/nodetree.py): the surface is two lobes, each its own Principled parameters and
+ * shading normal, weighted per pixel (shaders/nodes/shader.glsl). Each light's shadow is
+ * looked up once, then both lobes' BSDFs are evaluated; the world lights both; the colour is
+ * the lobes' light summed by their weights. The Shadow pass weights each light by the heavier
+ * lobe's cosine, the Normal pass writes the heavier lobe's normal. Other materials compile
+ * one lobe, as before.
+ *
  * DEBUG_LIT (the TEXEL_DENSITY, CASCADES and LIGHT_COST debug views, engine/frame/debug_view.py):
  * the pixel writes the lights it evaluated, the cascade it read and its worst texel density
  * instead of colour. */
+
+#ifndef NODE_LOBES
+#  define NODE_LOBES 1
+#endif
 
 struct Surface {
   vec3 P, N, V;
@@ -36,6 +48,14 @@ struct Surface {
   vec3 albedo, f0;
   float shininess;
   float alpha; /* GGX roughness (Principled roughness squared) */
+#if NODE_LOBES == 2
+  /* The second lobe (N, albedo, f0, shininess, alpha above are the first), and the lobes'
+   * weights. */
+  vec3 N_b;
+  vec3 albedo_b, f0_b;
+  float shininess_b, alpha_b;
+  vec2 w;
+#endif
 };
 
 #define NO_SHADOW -1
@@ -73,6 +93,50 @@ float smooth_offset_amount(float NL, float NgL)
 }
 #endif
 
+/* The cosine term; Cycles' Shading Offset replaces cos(theta) by max(cos(f theta), 0). */
+float cosine_term(float NdotL)
+{
+#if TERMINATOR_SHADING
+  return max(cos(acos(min(NdotL, 1.0)) * terminator_shading_frequency), 0.0);
+#else
+  return NdotL;
+#endif
+}
+
+/* One lobe's BSDF for light from ``to_light`` (N.L > 0): its diffuse and specular parts, each
+ * scaled by the light's factors. */
+vec3 lobe_brdf(vec3 N, vec3 V, vec3 albedo, vec3 f0, float shininess, float alpha, vec3 to_light, float NdotL,
+               LightData L)
+{
+#if SPECULAR_MODEL == SPECULAR_GGX
+  vec3 H = normalize(to_light + V);
+  float NdotH = max(dot(N, H), 0.0);
+  float NdotV = max(dot(N, V), 1e-4);
+  float a2 = alpha * alpha;
+  float dd = NdotH * NdotH * (a2 - 1.0) + 1.0;
+  float D = a2 / (M_PI * dd * dd);
+  /* Height-correlated Smith visibility G / (4 N.L N.V). */
+  float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
+  float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
+  float Vis = 0.5 / max(gv + gl, 1e-8);
+  float fw = pow(clamp(1.0 - dot(to_light, H), 0.0, 1.0), 5.0);
+  /* Schlick Fresnel towards f90; a surface without specular (f0 ~ 0) has none at grazing
+   * angles either, as the Principled BSDF at Specular 0. */
+  float f90 = clamp(50.0 * dot(f0, vec3(0.3333)), 0.0, 1.0);
+  vec3 spec = (f0 + (f90 - f0) * fw) * (D * Vis);
+  return albedo / M_PI * L.diffuse_factor + spec * L.specular_factor;
+#else
+#  if SPECULAR_MODEL == SPECULAR_BLINN
+  vec3 H = normalize(to_light + V);
+  float spec = (shininess + 8.0) / (8.0 * M_PI) * pow(max(dot(N, H), 0.0), shininess);
+#  else
+  vec3 R = reflect(-to_light, N);
+  float spec = (shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, V), 0.0), shininess);
+#  endif
+  return albedo / M_PI * L.diffuse_factor + f0 * spec * L.specular_factor;
+#endif
+}
+
 /* Add light i's contribution. ``filter_id`` is a literal at each call (FILTER_* or NO_SHADOW), so
  * the compiler keeps a shadow filter only where a light has a map, and only that one. */
 void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout float arriving,
@@ -92,14 +156,19 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   float irradiance;
   light_incident(L, s.P, to_light, irradiance);
   float NdotL = dot(s.N, to_light);
+#if NODE_LOBES == 2
+  float NdotL_b = dot(s.N_b, to_light);
+  if ((NdotL <= 0.0 && NdotL_b <= 0.0) || irradiance <= 0.0) {
+    return;
+  }
+  float cosine_a = (NdotL > 0.0) ? cosine_term(NdotL) : 0.0;
+  float cosine_b = (NdotL_b > 0.0) ? cosine_term(NdotL_b) : 0.0;
+  float cosine = (s.w.y > s.w.x) ? cosine_b : cosine_a; /* the Shadow pass's: the heavier lobe's */
+#else
   if (NdotL <= 0.0 || irradiance <= 0.0) {
     return;
   }
-  /* The cosine term; Cycles' Shading Offset replaces cos(theta) by max(cos(f theta), 0). */
-#if TERMINATOR_SHADING
-  float cosine = max(cos(acos(min(NdotL, 1.0)) * terminator_shading_frequency), 0.0);
-#else
-  float cosine = NdotL;
+  float cosine = cosine_term(NdotL);
 #endif
   /* Shadow pass: direct light that arrives over direct light that would arrive unshadowed,
    * each light weighted by the luminance of its irradiance here (1 where no light reaches). */
@@ -129,34 +198,20 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
                                                  shadow_visibility(L, shadow_P, s.Ng, s.Nf, NgdotL, dot(s.Nf, to_light), filter_id);
   unshadowed += weight;
   arriving += weight * visibility;
-#if SPECULAR_MODEL == SPECULAR_GGX
-  vec3 H = normalize(to_light + s.V);
-  float NdotH = max(dot(s.N, H), 0.0);
-  float NdotV = max(dot(s.N, s.V), 1e-4);
-  float a2 = s.alpha * s.alpha;
-  float dd = NdotH * NdotH * (a2 - 1.0) + 1.0;
-  float D = a2 / (M_PI * dd * dd);
-  /* Height-correlated Smith visibility G / (4 N.L N.V). */
-  float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
-  float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
-  float Vis = 0.5 / max(gv + gl, 1e-8);
-  float fw = pow(clamp(1.0 - dot(to_light, H), 0.0, 1.0), 5.0);
-  /* Schlick Fresnel towards f90; a surface without specular (f0 ~ 0) has none at grazing
-   * angles either, as the Principled BSDF at Specular 0. */
-  float f90 = clamp(50.0 * dot(s.f0, vec3(0.3333)), 0.0, 1.0);
-  vec3 spec = (s.f0 + (f90 - s.f0) * fw) * (D * Vis);
-  vec3 E = L.color * (irradiance * cosine * visibility);
-  color += E * (s.albedo / M_PI * L.diffuse_factor + spec * L.specular_factor);
+#if NODE_LOBES == 2
+  /* Both lobes under the one shadow lookup, summed by their weights. */
+  vec3 reflected = vec3(0.0);
+  if (NdotL > 0.0) {
+    reflected += (s.w.x * cosine_a) * lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
+  }
+  if (NdotL_b > 0.0) {
+    reflected += (s.w.y * cosine_b) *
+                 lobe_brdf(s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b, s.alpha_b, to_light, NdotL_b, L);
+  }
+  color += L.color * (irradiance * visibility) * reflected;
 #else
-#  if SPECULAR_MODEL == SPECULAR_BLINN
-  vec3 H = normalize(to_light + s.V);
-  float spec = (s.shininess + 8.0) / (8.0 * M_PI) * pow(max(dot(s.N, H), 0.0), s.shininess);
-#  else
-  vec3 R = reflect(-to_light, s.N);
-  float spec = (s.shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, s.V), 0.0), s.shininess);
-#  endif
   vec3 E = L.color * (irradiance * cosine * visibility);
-  color += E * (s.albedo / M_PI * L.diffuse_factor + s.f0 * spec * L.specular_factor);
+  color += E * lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
 #endif
 }
 
@@ -189,13 +244,39 @@ vec2 env_brdf(vec3 f0, float rough, float NdotV)
 
 /* Light from the world: diffuse irradiance, and specular radiance around the reflected
  * direction, wider with roughness, weighted by the environment BRDF ``ab``. */
-vec3 world_light(Surface s, float rough, vec2 ab)
+vec3 world_light(vec3 N, vec3 V, vec3 albedo, vec3 f0, float rough, vec2 ab)
 {
-  vec3 diffuse = s.albedo * world_sh(s.N, vec2(2.0 / 3.0, 0.25));
-  vec3 R = reflect(-s.V, s.N);
+  vec3 diffuse = albedo * world_sh(N, vec2(2.0 / 3.0, 0.25));
+  vec3 R = reflect(-V, N);
   float t = rough * rough;
   vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
-  return diffuse + radiance * (s.f0 * ab.x + ab.y);
+  return diffuse + radiance * (f0 * ab.x + ab.y);
+}
+
+/* One lobe's shading values from its Principled parameters (``albedo`` with the specular
+ * layer's energy taken out), and the light the world gives it. */
+vec3 lobe_setup(vec3 base, float rough, float metal, float spec_level, vec3 N, vec3 V, out vec3 albedo,
+                out vec3 f0, out float shininess, out float alpha)
+{
+  rough = clamp(rough, 0.0, 1.0);
+  spec_level = max(spec_level, 0.0);
+  metal = clamp(metal, 0.0, 1.0);
+  albedo = base * (1.0 - metal);
+  f0 = mix(vec3(0.08 * spec_level), base, metal);
+  float a = max(rough * rough, 0.02);
+  shininess = 2.0 / (a * a) - 2.0;
+  alpha = max(rough * rough, 0.002);
+
+  /* Energy: light reflected by the specular layer does not reach the diffuse one below (the
+   * Principled BSDF's layering), estimated per pixel from the directional albedo. */
+  float NdotV = max(dot(N, V), 1e-4);
+  vec2 ab = env_brdf(f0, rough, NdotV);
+  /* Metallic mixes a metal and a dielectric; only the dielectric's own specular (f0 from the
+   * Specular level) sits over its diffuse. */
+  float f0_dielectric = 0.08 * spec_level;
+  vec2 ab_dielectric = env_brdf(vec3(f0_dielectric), rough, NdotV);
+  albedo *= clamp(1.0 - (f0_dielectric * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
+  return world_light(N, V, albedo, f0, rough, ab);
 }
 
 void main()
@@ -208,6 +289,13 @@ void main()
   vec3 emission = material.emission;
   float spec_level = material.specular;
   vec3 tree_normal = vec3(0.0); /* the tree's shading normal (NODE_NORMAL) */
+#if NODE_LOBES == 2
+  /* The second lobe's parameters and the lobes' weights (shaders/nodes/shader.glsl). */
+  vec4 base_b = base;
+  float rough_b = rough, metal_b = metal, spec_level_b = spec_level;
+  vec3 tree_normal_b = vec3(0.0);
+  vec2 lobe_weights = vec2(1.0, 0.0);
+#endif
 #if NODE_TREE
   {
     /* The material's compiled node tree (engine/scene/nodetree.py) gives every parameter. */
@@ -216,7 +304,13 @@ void main()
     float l = length(Nt);
     Nt = (l > 1e-20) ? Nt / l : vec3(0.0, 0.0, 1.0);
     bool front = dot(Nt, V) >= 0.0;
+#  if NODE_LOBES == 2
+    node_closure_resolve_lobes(node_tree_closure(front ? Nt : -Nt, V, front), base, rough, metal, spec_level,
+                               coverage, emission, tree_normal, base_b, rough_b, metal_b, spec_level_b, tree_normal_b,
+                               lobe_weights);
+#  else
     node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec_level, coverage, emission, tree_normal);
+#  endif
   }
 #endif
 #if TEX_BASE_COLOR
@@ -305,26 +399,20 @@ void main()
     N = -N; /* two-sided, as Blender draws meshes */
   }
   s.N = N;
-
-  rough = clamp(rough, 0.0, 1.0);
-  spec_level = max(spec_level, 0.0);
-  metal = clamp(metal, 0.0, 1.0);
-  s.albedo = base.rgb * (1.0 - metal);
-  s.f0 = mix(vec3(0.08 * spec_level), base.rgb, metal);
-  float alpha = max(rough * rough, 0.02);
-  s.shininess = 2.0 / (alpha * alpha) - 2.0;
-  s.alpha = max(rough * rough, 0.002);
-
-  /* Energy: light reflected by the specular layer does not reach the diffuse one below (the
-   * Principled BSDF's layering), estimated per pixel from the directional albedo. */
-  float NdotV = max(dot(s.N, s.V), 1e-4);
-  vec2 ab = env_brdf(s.f0, rough, NdotV);
-  /* Metallic mixes a metal and a dielectric; only the dielectric's own specular (f0 from the
-   * Specular level) sits over its diffuse. */
-  float f0_dielectric = 0.08 * spec_level;
-  vec2 ab_dielectric = env_brdf(vec3(f0_dielectric), rough, NdotV);
-  s.albedo *= clamp(1.0 - (f0_dielectric * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
-  vec3 color = world_light(s, rough, ab);
+  vec3 color = lobe_setup(base.rgb, rough, metal, spec_level, s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha);
+#if NODE_LOBES == 2
+  /* The second lobe: its own normal where the tree gives one, else the first lobe's. */
+#  if NODE_NORMAL
+  vec3 N_b = (dot(tree_normal_b, tree_normal_b) > 0.0) ? normalize(tree_normal_b) : N;
+#  else
+  vec3 N_b = N;
+#  endif
+  s.N_b = (dot(N_b, s.V) < 0.0) ? -N_b : N_b;
+  vec3 color_b = lobe_setup(base_b.rgb, rough_b, metal_b, spec_level_b, s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b,
+                            s.alpha_b);
+  s.w = lobe_weights;
+  color = lobe_weights.x * color + lobe_weights.y * color_b;
+#endif
   float arriving = 0.0, unshadowed = 0.0;
 #if DEBUG_LIT
   debug_dPdx = dFdx(s.P);
@@ -413,7 +501,11 @@ void main()
 #if AUX_OUTPUTS
   out_depth = v_view_depth;
   out_shadow = (unshadowed > 0.0) ? arriving / unshadowed : 1.0;
+#  if NODE_LOBES == 2
+  out_normal = vec4((s.w.y > s.w.x) ? s.N_b : N, 0.0); /* the heavier lobe's */
+#  else
   out_normal = vec4(N, 0.0); /* world-space shading normal, facing the camera (Normal pass) */
+#  endif
 #endif
 #if EMISSION_OUTPUT
 #  if HOLDOUT

@@ -148,6 +148,8 @@ def material_defines(features):
     out["HAS_UV"] = uv
     out["NODE_TREE"] = any(f.startswith("NODES_") for f in features)
     out["NODE_NORMAL"] = "TREE_NORMAL" in features  # the tree gives the shading normal
+    if "TREE_LOBES" in features:  # the tree gives two lobes (one-lobe variants keep their defines)
+        out["NODE_LOBES"] = 2
     out["HAS_VCOL"] = "VCOL" in features
     out["HAS_TANGENT"] = "TEX_NORMAL" in features
     mode = next((m for m in ALPHA_MODES if f"ALPHA_{m}" in features), "OPAQUE")

@@ -91,6 +91,8 @@ class Material:
                 out.add("TREE_UV")
             if self.tree.normal:
                 out.add("TREE_NORMAL")
+            if self.tree.lobes == 2:
+                out.add("TREE_LOBES")
         return frozenset(out)
 
 
@@ -331,6 +333,7 @@ def _shader(mat, node, notes, depth=0):
         out = Material(metallic=1.0)
         out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
         out.roughness = _value_channel(node.inputs["Roughness"], notes, "Roughness", out, "roughness", 0.5)
+        _normal_map(None, node, notes, out)
         return out
     if idname == "ShaderNodeBsdfTransparent":
         out = _black()
@@ -364,6 +367,9 @@ def _mix_shader(mat, node, notes, depth):
     a, b = sides
     if fac in (0.0, 1.0):
         return b if fac == 1.0 else a
+    if a.alpha > 0.0 and b.alpha > 0.0 and not (a.holdout or b.holdout or _emits_only(a) or _emits_only(b)):
+        notes.append("a Mix Shader of two surfaces (drawn as two lobes by the compiled node tree)")
+        return None
     if a.holdout or b.holdout:
         notes.append("a Holdout shader mixed with another (the side with the larger factor is drawn)")
         return b if fac >= 0.5 else a
@@ -389,6 +395,11 @@ def _mix_shader(mat, node, notes, depth):
     out.alpha = total
     out.emission = tuple((1.0 - fac) * x + fac * y for x, y in zip(a.emission, b.emission, strict=True))
     return out
+
+
+def _emits_only(m):
+    """A shader read with no reflecting surface (an Emission, an unlinked socket)."""
+    return not m.textures and m.specular == 0.0 and m.metallic == 0.0 and max(m.base_color[:3]) == 0.0
 
 
 def _fed_and_constant(a, b, constant_node):
@@ -546,6 +557,7 @@ def _emission_shader(node, notes):
 def _diffuse_shader(node, notes):
     out = Material(specular=0.0, roughness=1.0)
     out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
+    _normal_map(None, node, notes, out)  # a Bump, ...: named, so the compiled tree draws it
     return out
 
 

@@ -28,9 +28,16 @@ How Blender's rules are followed:
 - implicit conversions as Blender's: colour to value is Rec.709 luminance, vector to value
   the mean of its components, a value to a colour is grey, a colour into a shader socket
   emits it;
-- Mix Shader and Add Shader combine the Principled parameters per pixel with their factor,
-  which may come from any node (``shaders/nodes/shader.glsl``: a mix of two lobes is drawn
-  as one Principled surface with mixed parameters).
+- Mix Shader and Add Shader combine shaders per pixel with their factor, which may come from
+  any node, as a weighted set of lobes (``shaders/nodes/shader.glsl``): each lobe a full set
+  of Principled parameters with its own normal, shaded separately and summed by weight (Add:
+  both weight 1, so energy can exceed 1, as in Blender). Penumbra shades at most two lobes
+  per pixel; where more would result (nested mixes) the two most similar merge, per pixel,
+  into one with their weighted parameters. Every closure ``Value`` says how many lobes it can
+  hold (``Value.lobes``); a tree whose surface can hold two (``CompiledTree.lobes``) also
+  defines ``node_tree_closure`` for the lit pass (``NODE_LOBES == 2``), and trees of one lobe
+  (a shader alone, mixed with Emission or Transparent) compile the code and program they
+  did before.
 
 What cannot compile (an unknown node, a Script node, Light Path, an output Penumbra has no
 data for) falls back for the shader input it feeds only: that input takes the value the
@@ -105,6 +112,7 @@ class TreeTooLarge(Exception):
 class Value:
     expr: str
     type: str  # float, vec3, vec4 or closure
+    lobes: int = 0  # a closure: how many lobes it can hold (0, 1 or 2; shaders/nodes/shader.glsl)
 
 
 @dataclass(frozen=True)
@@ -131,6 +139,7 @@ class CompiledTree:
     fallbacks: int = 0  # shader inputs that fell back
     surface_fallback: bool = False  # the whole surface fell back (nothing compiled)
     normal: bool = False  # it computes the shading normal (a Bump, ...): NODE_NORMAL
+    lobes: int = 1  # 2: a Mix / Add Shader of two surfaces, shaded as two lobes (NODE_LOBES == 2)
 
 
 # --- the registry -------------------------------------------------------------------------
@@ -216,12 +225,12 @@ class Compiler:
 
     # -- emitting --
 
-    def temp(self, typ, expr):
+    def temp(self, typ, expr, lobes=0):
         name = f"t{len(self.lines)}"
         self.lines.append(f"  {GLSL_TYPES[typ]} {name} = {expr};")
         if len(self.lines) > MAX_NODES:
             raise TreeTooLarge(f"more than {MAX_NODES} node outputs")
-        return Value(name, typ)
+        return Value(name, typ, lobes)
 
     def const(self, value, typ):
         """A constant as a row of node_constants (never a literal in the code)."""
@@ -439,22 +448,34 @@ class Compiler:
         base = self.const(tuple(m.diffuse_color), "vec4")
         r = self.const(float(m.roughness), "float")
         metal = self.const(float(m.metallic), "float")
-        return Value(f"node_principled({base.expr}, {metal.expr}, {r.expr}, 0.5, 1.0, vec3(0.0), N)", "closure")
+        return Value(f"node_principled({base.expr}, {metal.expr}, {r.expr}, 0.5, 1.0, vec3(0.0), N)", "closure", 1)
 
     # -- the whole tree --
 
     def compile(self, surface_socket):
         v = self.shader_input_root(surface_socket)
         body = "\n".join(self.lines)
-        code = _prelude(self.needs) + (
+        signature = (
             "void node_tree(vec3 N, vec3 V, bool front, inout vec4 base, inout float roughness,\n"
             "               inout float metallic, inout float specular, inout float alpha, inout vec3 emission,\n"
             "               inout vec3 normal)\n"
-            "{\n"
-            f"{body}\n"
-            f"  node_closure_resolve({v.expr}, base, roughness, metallic, specular, alpha, emission, normal);\n"
-            "}\n"
         )
+        if v.lobes < 2:
+            code = _prelude(self.needs) + (
+                f"{signature}{{\n{body}\n"
+                f"  node_closure_resolve({v.expr}, base, roughness, metallic, specular, alpha, emission, normal);\n"
+                "}\n"
+            )
+        else:
+            # Two lobes: the closure itself for the lit pass (NODE_LOBES == 2), and node_tree
+            # (the lobes summed) for the passes that read one set of parameters (shadow alpha).
+            code = _prelude(self.needs) + (
+                f"NodeClosure node_tree_closure(vec3 N, vec3 V, bool front)\n{{\n{body}\n  return {v.expr};\n}}\n"
+                f"{signature}{{\n"
+                "  node_closure_resolve(node_tree_closure(N, V, front), base, roughness, metallic, specular, alpha,\n"
+                "                       emission, normal);\n"
+                "}\n"
+            )
         families = tuple(f for f in FAMILY_ORDER if f in self.families) + tuple(
             sorted(self.families - set(FAMILY_ORDER))
         )
@@ -477,6 +498,7 @@ class Compiler:
             fallbacks=self.fallbacks,
             surface_fallback=self.surface_fallback,
             normal=self.normal,
+            lobes=max(1, v.lobes),
         )
 
     def shader_input_root(self, socket):
@@ -565,7 +587,7 @@ def _principled(c, node, socket, ctx):
         f"node_principled({base.expr}, {metal.expr}, {rough.expr}, {spec.expr}, {alpha.expr}, "
         f"({emission.expr}).rgb * {strength}, {normal.expr})"
     )
-    return c.temp("closure", expr)
+    return c.temp("closure", expr, 1)
 
 
 @node("ShaderNodeEmission")
@@ -578,7 +600,7 @@ def _emission(c, node, socket, ctx):
 @node("ShaderNodeBsdfDiffuse")
 def _diffuse(c, node, socket, ctx):
     color = c.shader_input(node, "Color", ctx, "vec4")
-    return c.temp("closure", f"node_diffuse({color.expr}, {c.normal_input(node, ctx).expr})")
+    return c.temp("closure", f"node_diffuse({color.expr}, {c.normal_input(node, ctx).expr})", 1)
 
 
 @node("ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic")
@@ -586,7 +608,8 @@ def _glossy(c, node, socket, ctx):
     color = c.shader_input(node, "Color", ctx, "vec4")
     rough = c.shader_input(node, "Roughness", ctx, "float")
     normal = c.normal_input(node, ctx)
-    return c.temp("closure", f"node_principled({color.expr}, 1.0, {rough.expr}, 0.5, 1.0, vec3(0.0), {normal.expr})")
+    expr = f"node_principled({color.expr}, 1.0, {rough.expr}, 0.5, 1.0, vec3(0.0), {normal.expr})"
+    return c.temp("closure", expr, 1)
 
 
 @node("ShaderNodeBsdfTransparent")
@@ -595,19 +618,33 @@ def _transparent(c, node, socket, ctx):
     return Value("node_transparent()", "closure")
 
 
+def _combine(a, b):
+    """How Mix / Add Shader combine closures of ``a.lobes`` and ``b.lobes`` lobes: (GLSL
+    function suffix, lobes of the result). One lobe in all stays one (summed: ``_shader``);
+    two single lobes become two (``_split``); more are merged per pixel down to two, the two
+    most similar first (``_merge``): Penumbra shades at most two lobes per pixel."""
+    if a.lobes == 0 or b.lobes == 0:
+        return "_shader", a.lobes + b.lobes
+    if a.lobes == 1 and b.lobes == 1:
+        return "_split", 2
+    return "_merge", 2
+
+
 @node("ShaderNodeMixShader")
 def _mix_shader(c, node, socket, ctx):
     fac = c.shader_input(node, 0, ctx, "float", None, "Mix Shader Fac")
     a = c.shader_input(node, 1, ctx, "closure")
     b = c.shader_input(node, 2, ctx, "closure")
-    return c.temp("closure", f"node_mix_shader({fac.expr}, {a.expr}, {b.expr})")
+    how, lobes = _combine(a, b)
+    return c.temp("closure", f"node_mix{how}({fac.expr}, {a.expr}, {b.expr})", lobes)
 
 
 @node("ShaderNodeAddShader")
 def _add_shader(c, node, socket, ctx):
     a = c.shader_input(node, 0, ctx, "closure")
     b = c.shader_input(node, 1, ctx, "closure")
-    return c.temp("closure", f"node_add_shader({a.expr}, {b.expr})")
+    how, lobes = _combine(a, b)
+    return c.temp("closure", f"node_add{how}({a.expr}, {b.expr})", lobes)
 
 
 # --- inputs -------------------------------------------------------------------------------

@@ -1,47 +1,66 @@
-/* Shader sockets of a compiled node tree (engine/scene/nodetree.py): a closure is the
- * Principled parameters Penumbra shades with, summed with weights so Mix Shader and Add
- * Shader combine them per pixel (the factor may come from any node):
- *   color, specular, emission   weighted by coverage (a Transparent BSDF adds none)
- *   roughness, metallic         weighted by ``weight``, how much reflecting surface there is
- *   alpha                       coverage (Transparent adds 0, every other shader 1 x its alpha)
- *   normal                      weighted by ``weight`` (a surface's shading normal)
- * node_closure_resolve divides the sums back into one set of parameters. This is Penumbra's
- * limit: a mix of two lobes is one Principled surface with mixed parameters, per pixel. */
+/* Shader sockets of a compiled node tree (engine/scene/nodetree.py): a closure is up to TWO
+ * lobes, each the Principled parameters Penumbra shades with as sums weighted by how much of
+ * that surface there is, plus the coverage and emission the lobes share:
+ *   lobe a, lobe b   color, roughness, metallic, specular, normal: each x ``weight``
+ *                    (a Transparent BSDF or an Emission adds no lobe)
+ *   alpha            coverage (Transparent adds 0, every other shader 1 x its alpha)
+ *   emission         weighted by coverage
+ * A lone shader is lobe a. Mix Shader and Add Shader combine two closures with their factor,
+ * which may come from any node: the compiler (which knows how many lobes each side can hold)
+ * calls node_mix_shader / node_add_shader where the result holds one lobe (lobes summed:
+ * one Principled surface with mixed parameters, as before), node_mix_split / node_add_split
+ * where two single lobes become a and b, and node_mix_merge / node_add_merge beyond that:
+ * Penumbra shades at most two lobes per pixel, so of three or four lobes the two most similar
+ * (node_lobe_distance) merge, per pixel, into one with their weighted parameters, until two
+ * are left. node_closure_resolve gives one set of parameters (the lobes summed: trees of one
+ * lobe, and the shadow pass's alpha); node_closure_resolve_lobes the two lobes and their
+ * weights (the lit pass under NODE_LOBES == 2). */
 
 #ifndef NODE_SHADER_GLSL
 #define NODE_SHADER_GLSL
 
-struct NodeClosure {
+struct NodeLobe {
   vec3 color;
   float roughness;
   float metallic;
   float specular;
   float weight;
-  float alpha;
-  vec3 emission;
   vec3 normal;
 };
 
+struct NodeClosure {
+  NodeLobe a;
+  NodeLobe b;
+  float alpha;
+  vec3 emission;
+};
+
+NodeLobe node_lobe_empty()
+{
+  return NodeLobe(vec3(0.0), 0.0, 0.0, 0.0, 0.0, vec3(0.0));
+}
+
 NodeClosure node_closure_empty()
 {
-  return NodeClosure(vec3(0.0), 0.0, 0.0, 0.0, 0.0, 0.0, vec3(0.0), vec3(0.0));
+  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0));
 }
 
 NodeClosure node_principled(vec4 base, float metallic, float roughness, float specular, float alpha,
                             vec3 emission, vec3 normal)
 {
   float a = clamp(alpha, 0.0, 1.0);
-  return NodeClosure(base.rgb * a, roughness * a, metallic * a, specular * a, a, a, emission * a, normal * a);
+  return NodeClosure(NodeLobe(base.rgb * a, roughness * a, metallic * a, specular * a, a, normal * a),
+                     node_lobe_empty(), a, emission * a);
 }
 
 NodeClosure node_emission(vec4 color, float strength)
 {
-  return NodeClosure(vec3(0.0), 0.0, 0.0, 0.0, 0.0, 1.0, color.rgb * strength, vec3(0.0));
+  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 1.0, color.rgb * strength);
 }
 
 NodeClosure node_diffuse(vec4 color, vec3 normal)
 {
-  return NodeClosure(color.rgb, 1.0, 0.0, 0.0, 1.0, 1.0, vec3(0.0), normal);
+  return NodeClosure(NodeLobe(color.rgb, 1.0, 0.0, 0.0, 1.0, normal), node_lobe_empty(), 1.0, vec3(0.0));
 }
 
 NodeClosure node_transparent()
@@ -49,21 +68,133 @@ NodeClosure node_transparent()
   return node_closure_empty();
 }
 
+/* g x + f y, lobe by lobe (the weighted-parameter rule: merging two lobes adds their sums). */
+NodeLobe node_lobe_mix(float g, NodeLobe x, float f, NodeLobe y)
+{
+  return NodeLobe(g * x.color + f * y.color, g * x.roughness + f * y.roughness, g * x.metallic + f * y.metallic,
+                  g * x.specular + f * y.specular, g * x.weight + f * y.weight, g * x.normal + f * y.normal);
+}
+
+NodeLobe node_lobe_sum(NodeLobe x, NodeLobe y)
+{
+  return node_lobe_mix(1.0, x, 1.0, y);
+}
+
+/* Closures whose lobes stay where they are: a with a, b with b. */
+NodeClosure node_mix_shader_weights(float g, NodeClosure a, float f, NodeClosure b)
+{
+  return NodeClosure(node_lobe_mix(g, a.a, f, b.a), node_lobe_mix(g, a.b, f, b.b), g * a.alpha + f * b.alpha,
+                     g * a.emission + f * b.emission);
+}
+
 NodeClosure node_mix_shader(float f, NodeClosure a, NodeClosure b)
 {
   f = clamp(f, 0.0, 1.0);
-  float g = 1.0 - f;
-  return NodeClosure(g * a.color + f * b.color, g * a.roughness + f * b.roughness,
-                     g * a.metallic + f * b.metallic, g * a.specular + f * b.specular,
-                     g * a.weight + f * b.weight, g * a.alpha + f * b.alpha,
-                     g * a.emission + f * b.emission, g * a.normal + f * b.normal);
+  return node_mix_shader_weights(1.0 - f, a, f, b);
 }
 
 NodeClosure node_add_shader(NodeClosure a, NodeClosure b)
 {
-  return NodeClosure(a.color + b.color, a.roughness + b.roughness, a.metallic + b.metallic,
-                     a.specular + b.specular, a.weight + b.weight, a.alpha + b.alpha,
-                     a.emission + b.emission, a.normal + b.normal);
+  return node_mix_shader_weights(1.0, a, 1.0, b);
+}
+
+/* Two closures of one lobe each: a's lobe becomes lobe a, b's lobe b. */
+NodeClosure node_mix_split_weights(float g, NodeClosure a, float f, NodeClosure b)
+{
+  NodeLobe none = node_lobe_empty();
+  return NodeClosure(node_lobe_mix(g, a.a, 0.0, none), node_lobe_mix(f, b.a, 0.0, none),
+                     g * a.alpha + f * b.alpha, g * a.emission + f * b.emission);
+}
+
+NodeClosure node_mix_split(float f, NodeClosure a, NodeClosure b)
+{
+  f = clamp(f, 0.0, 1.0);
+  return node_mix_split_weights(1.0 - f, a, f, b);
+}
+
+NodeClosure node_add_split(NodeClosure a, NodeClosure b)
+{
+  return node_mix_split_weights(1.0, a, 1.0, b);
+}
+
+/* How unlike two lobes are: their parameters' differences (an empty lobe is like any). */
+float node_lobe_distance(NodeLobe x, NodeLobe y)
+{
+  if (!(x.weight > 1e-6) || !(y.weight > 1e-6)) {
+    return -1.0;
+  }
+  float ix = 1.0 / x.weight, iy = 1.0 / y.weight;
+  float nx = length(x.normal), ny = length(y.normal);
+  float bend = (nx > 1e-12 && ny > 1e-12) ? 0.5 * (1.0 - dot(x.normal, y.normal) / (nx * ny)) : 0.0;
+  vec3 dc = abs(x.color * ix - y.color * iy);
+  float d = abs(x.roughness * ix - y.roughness * iy) + abs(x.metallic * ix - y.metallic * iy) +
+            abs(x.specular * ix - y.specular * iy) + (dc.r + dc.g + dc.b) / 3.0 + bend;
+  return isnan(d) ? 0.0 : d;
+}
+
+/* Three lobes to two: the two most similar merge. */
+void node_lobes_reduce3(NodeLobe x, NodeLobe y, NodeLobe z, out NodeLobe a, out NodeLobe b)
+{
+  float dxy = node_lobe_distance(x, y), dxz = node_lobe_distance(x, z), dyz = node_lobe_distance(y, z);
+  if (dxy <= dxz && dxy <= dyz) {
+    a = node_lobe_sum(x, y);
+    b = z;
+  }
+  else if (dxz <= dyz) {
+    a = node_lobe_sum(x, z);
+    b = y;
+  }
+  else {
+    a = x;
+    b = node_lobe_sum(y, z);
+  }
+}
+
+/* The four lobes of two two-lobe closures (weighted g and f) merged, most similar first,
+ * down to two. */
+NodeClosure node_mix_merge_weights(float g, NodeClosure a, float f, NodeClosure b)
+{
+  NodeLobe none = node_lobe_empty();
+  NodeLobe w = node_lobe_mix(g, a.a, 0.0, none), x = node_lobe_mix(g, a.b, 0.0, none);
+  NodeLobe y = node_lobe_mix(f, b.a, 0.0, none), z = node_lobe_mix(f, b.b, 0.0, none);
+  float dwx = node_lobe_distance(w, x), dwy = node_lobe_distance(w, y), dwz = node_lobe_distance(w, z);
+  float dxy = node_lobe_distance(x, y), dxz = node_lobe_distance(x, z), dyz = node_lobe_distance(y, z);
+  float m = min(min(min(dwx, dwy), min(dwz, dxy)), min(dxz, dyz));
+  NodeLobe p, q, r;
+  if (m == dwx) {
+    p = node_lobe_sum(w, x), q = y, r = z;
+  }
+  else if (m == dwy) {
+    p = node_lobe_sum(w, y), q = x, r = z;
+  }
+  else if (m == dwz) {
+    p = node_lobe_sum(w, z), q = x, r = y;
+  }
+  else if (m == dxy) {
+    p = node_lobe_sum(x, y), q = w, r = z;
+  }
+  else if (m == dxz) {
+    p = node_lobe_sum(x, z), q = w, r = y;
+  }
+  else {
+    p = node_lobe_sum(y, z), q = w, r = x;
+  }
+  NodeClosure c;
+  node_lobes_reduce3(p, q, r, c.a, c.b);
+  c.alpha = g * a.alpha + f * b.alpha;
+  c.emission = g * a.emission + f * b.emission;
+  return c;
+}
+
+NodeClosure node_mix_merge(float f, NodeClosure a, NodeClosure b)
+{
+  f = clamp(f, 0.0, 1.0);
+  return node_mix_merge_weights(1.0 - f, a, f, b);
+}
+
+NodeClosure node_add_merge(NodeClosure a, NodeClosure b)
+{
+  return node_mix_merge_weights(1.0, a, 1.0, b);
 }
 
 vec3 node_finite3(vec3 v, float limit)
@@ -72,28 +203,49 @@ vec3 node_finite3(vec3 v, float limit)
               isnan(v.z) ? 0.0 : clamp(v.z, -limit, limit));
 }
 
-/* The sums back as parameters (a surface with no reflecting part: black, rough, no specular). */
-void node_closure_resolve(NodeClosure c, inout vec4 base, inout float roughness, inout float metallic,
-                          inout float specular, inout float alpha, inout vec3 emission, inout vec3 normal)
+/* The sums back as parameters: ``weight`` divides roughness and metallic, ``coverage`` colour
+ * and specular (a surface with no reflecting part: black, rough, no specular); NaN or
+ * infinite inputs (a division the tree did, an absurd constant) draw finite. */
+void node_lobe_resolve(NodeLobe c, float coverage, inout vec4 base, inout float roughness, inout float metallic,
+                       inout float specular, inout vec3 normal)
 {
   float nl = length(c.normal);
   normal = (nl > 1e-12 && !isinf(nl)) ? c.normal / nl : normal;
-  float coverage = clamp(c.alpha, 0.0, 1.0);
   float inv = (coverage > 1e-6) ? 1.0 / coverage : 0.0;
   float winv = (c.weight > 1e-6) ? 1.0 / c.weight : 0.0;
-  base = vec4(c.color * inv, 1.0);
-  specular = c.specular * inv;
-  emission = c.emission * inv;
-  roughness = (c.weight > 1e-6) ? c.roughness * winv : 1.0;
-  metallic = c.metallic * winv;
-  alpha = coverage;
-  /* NaN or infinite inputs (a division the tree did, an absurd constant) draw finite. */
-  base = vec4(node_finite3(base.rgb, 1e6), 1.0);
-  specular = node_finite3(vec3(specular), 1e6).x;
-  emission = node_finite3(emission, 1e20);
-  roughness = node_finite3(vec3(roughness), 1.0).x;
-  metallic = node_finite3(vec3(metallic), 1.0).x;
-  alpha = node_finite3(vec3(alpha), 1.0).x;
+  base = vec4(node_finite3(c.color * inv, 1e6), 1.0);
+  specular = node_finite3(vec3(c.specular * inv), 1e6).x;
+  roughness = node_finite3(vec3((c.weight > 1e-6) ? c.roughness * winv : 1.0), 1.0).x;
+  metallic = node_finite3(vec3(c.metallic * winv), 1.0).x;
+}
+
+/* One set of parameters: the lobes summed. */
+void node_closure_resolve(NodeClosure c, inout vec4 base, inout float roughness, inout float metallic,
+                          inout float specular, inout float alpha, inout vec3 emission, inout vec3 normal)
+{
+  float coverage = clamp(c.alpha, 0.0, 1.0);
+  node_lobe_resolve(node_lobe_sum(c.a, c.b), coverage, base, roughness, metallic, specular, normal);
+  float inv = (coverage > 1e-6) ? 1.0 / coverage : 0.0;
+  emission = node_finite3(c.emission * inv, 1e20);
+  alpha = node_finite3(vec3(coverage), 1.0).x;
+}
+
+/* Two lobes, each its own parameters (divided by its own weight), and their weights over the
+ * coverage (the lit pass's colour is the lobes' shading summed by these; an Add Shader's
+ * lobes may sum above 1, as in Blender). */
+void node_closure_resolve_lobes(NodeClosure c, inout vec4 base, inout float roughness, inout float metallic,
+                                inout float specular, inout float alpha, inout vec3 emission, inout vec3 normal,
+                                inout vec4 base_b, inout float roughness_b, inout float metallic_b,
+                                inout float specular_b, inout vec3 normal_b, out vec2 weights)
+{
+  float coverage = clamp(c.alpha, 0.0, 1.0);
+  node_lobe_resolve(c.a, c.a.weight, base, roughness, metallic, specular, normal);
+  node_lobe_resolve(c.b, c.b.weight, base_b, roughness_b, metallic_b, specular_b, normal_b);
+  float inv = (coverage > 1e-6) ? 1.0 / coverage : 0.0;
+  weights = node_finite3(vec3(c.a.weight * inv, c.b.weight * inv, 0.0), 1e6).xy;
+  weights = max(weights, vec2(0.0));
+  emission = node_finite3(c.emission * inv, 1e20);
+  alpha = node_finite3(vec3(coverage), 1.0).x;
 }
 
 #endif
