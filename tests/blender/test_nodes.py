@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 import pytest
 
-from devkit import engines, node_reference, node_scenes
+from devkit import engines, node_reference, node_scenes, texture_reference
 from devkit.render import render
 
 
@@ -429,12 +429,11 @@ def test_checker_gradient_and_input_nodes(penumbra):
         zero = np.zeros_like(u)
         if kind == "CHECKER":
             z = zero + (0.5 if option == "GENERATED" else 0.0)
-            fac = node_reference.checker(np.stack([u, v, z], -1), 3.0)
-            if option == "COLOR":
-                return np.where(fac[:, None] > 0.5, np.array(colours[0]), np.array(colours[1]))
-            return fac
+            t = texture_reference.node_tex_checker(np.stack([u, v, z], -1), colours[0][:3], colours[1][:3], 3.0)
+            return t[:, :3] if option == "COLOR" else t[:, 3]
         if kind == "GRADIENT":
-            return node_reference.gradient(option, np.stack([2 * u - 1, 2 * v - 1, zero], -1))
+            p = np.stack([2 * u - 1, 2 * v - 1, zero], -1)
+            return texture_reference.node_tex_gradient(p, GRADIENT_TYPES.index(option))[:, 3]
         if kind == "FRESNEL":
             return node_reference.fresnel_dielectric(1.0, option) + zero
         fresnel, facing = node_reference.layer_weight(0.3, 1.0)
