@@ -44,8 +44,11 @@ Adding a node is one registry entry: a function decorated ``@node("ShaderNodeX",
 that takes (compiler, node, output socket, context) and returns a ``Value`` (GLSL expression,
 type), reading its inputs with ``c.input(node, name, ctx, type)`` (constants become uniforms
 by themselves) and naming its ``family`` file under ``shaders/nodes/`` (e.g. ``texture_noise``
-for a ``shaders/nodes/texture_noise.glsl``). Procedural textures read their coordinates with
-``c.texture_vector(node, ctx)`` (Generated when unlinked, as Blender does).
+for a ``shaders/nodes/texture_noise.glsl``); a new family takes its place in ``FAMILY_ORDER``
+(after the families it calls) and names them in ``FAMILY_NEEDS``, which includes them with it.
+Procedural textures read their coordinates with ``c.texture_vector(node, ctx)`` (Generated when
+unlinked, as Blender does) and call the per-dimension entry points (``node_tex_noise_at``,
+``node_tex_voronoi_at``): the all-dimension functions compile several times slower.
 """
 
 import hashlib
