@@ -55,6 +55,13 @@ visibility            four things over a ground under a slanted sun: "NoCamera" 
                       instances show)
 hair                  sphere with a HAIR particle system (300 strands), and next to it a
                       Curves (hair) object of 49 strands where ``bpy.data.hair_curves`` exists
+noise_texture,        the sphere (as emission_shader: a sun from the upper left, the dim
+voronoi_texture,      world) with a compiled procedural tree on Generated coordinates: Noise
+wave_texture,         Color (Scale 4, Detail 4) -> Base Color; Voronoi F1 Color -> Base Color and
+brick_texture,        its Distance -> Roughness; Wave bands (Scale 3, Distortion 4) Color -> Base
+magic_texture,        Color; Brick (Scale 4) -> Base Color; Magic (Depth 3) -> Base Color; a
+noise_ramp            Color Ramp (Constant, three stops) of a Noise -> Base Color and a second
+                      ramp of it -> Roughness
 
 ``BUILDERS`` maps each name to its builder, in this order.
 """
@@ -515,6 +522,61 @@ def hair(width=SIZE, height=SIZE):
     return scene
 
 
+def _procedural_sphere(width, height, name, node_type, output="Color", props=None, **inputs):
+    """The sphere whose Principled Base Color is output ``output`` of texture ``node_type``
+    (Generated coordinates) with node properties ``props`` and ``inputs``: (scene, material,
+    texture node, Principled BSDF)."""
+    scene = base(width, height)
+    mat, bsdf, _ = node_material(name)
+    tex = mat.node_tree.nodes.new(node_type)
+    for key, value in (props or {}).items():
+        setattr(tex, key, value)
+    for key, value in inputs.items():
+        tex.inputs[key.replace("_", " ")].default_value = value
+    out = next(s for s in tex.outputs if s.identifier == output)
+    mat.node_tree.links.new(out, bsdf.inputs["Base Color"])
+    return sphere_view(scene, mat), mat, tex, bsdf
+
+
+def noise_texture(width=SIZE, height=SIZE):
+    return _procedural_sphere(width, height, "Noise", "ShaderNodeTexNoise", Scale=4.0, Detail=4.0)[0]
+
+
+def voronoi_texture(width=SIZE, height=SIZE):
+    scene, mat, tex, bsdf = _procedural_sphere(width, height, "Voronoi", "ShaderNodeTexVoronoi", Scale=5.0)
+    mat.node_tree.links.new(tex.outputs["Distance"], bsdf.inputs["Roughness"])
+    return scene
+
+
+def wave_texture(width=SIZE, height=SIZE):
+    return _procedural_sphere(width, height, "Wave", "ShaderNodeTexWave", Scale=3.0, Distortion=4.0)[0]
+
+
+def brick_texture(width=SIZE, height=SIZE):
+    return _procedural_sphere(width, height, "Brick", "ShaderNodeTexBrick", Scale=4.0)[0]
+
+
+def magic_texture(width=SIZE, height=SIZE):
+    return _procedural_sphere(width, height, "Magic", "ShaderNodeTexMagic", props={"turbulence_depth": 3})[0]
+
+
+def noise_ramp(width=SIZE, height=SIZE):
+    scene, mat, tex, bsdf = _procedural_sphere(width, height, "NoiseRamp", "ShaderNodeTexNoise", "Fac", Scale=3.0)
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    color, rough = nodes.new("ShaderNodeValToRGB"), nodes.new("ShaderNodeValToRGB")
+    color.color_ramp.interpolation = "CONSTANT"
+    stops = ((0.0, (0.05, 0.15, 0.5, 1.0)), (0.45, (0.8, 0.7, 0.3, 1.0)), (0.55, (0.1, 0.5, 0.1, 1.0)))
+    color.color_ramp.elements.new(0.5)
+    for element, (position, rgba) in zip(color.color_ramp.elements, stops, strict=True):
+        element.position, element.color = position, rgba
+    rough.color_ramp.elements[0].color = (0.1, 0.1, 0.1, 1.0)
+    for ramp in (color, rough):
+        links.new(tex.outputs["Fac"], ramp.inputs["Fac"])
+    links.new(color.outputs["Color"], bsdf.inputs["Base Color"])
+    links.new(rough.outputs["Color"], bsdf.inputs["Roughness"])
+    return scene
+
+
 BUILDERS = {
     "texture_base_color": texture_base_color,
     "texture_closest_clip": texture_closest_clip,
@@ -533,4 +595,10 @@ BUILDERS = {
     "light_temperature": light_temperature,
     "visibility": visibility,
     "hair": hair,
+    "noise_texture": noise_texture,
+    "voronoi_texture": voronoi_texture,
+    "wave_texture": wave_texture,
+    "brick_texture": brick_texture,
+    "magic_texture": magic_texture,
+    "noise_ramp": noise_ramp,
 }

@@ -458,28 +458,6 @@ def layer_weight(blend, cos_nv, front=True):
     return fresnel, 1.0 - facing
 
 
-def checker(p, scale):
-    p = (_f(p) * scale + 0.000001) * 0.999999
-    i = np.abs(np.floor(p)).astype(np.int64)
-    return ((i[..., 0] % 2 == i[..., 1] % 2) == (i[..., 2] % 2 == 1)).astype(float)
-
-
-def gradient(kind, p):
-    p = _f(p)
-    x, y = p[..., 0], p[..., 1]
-    r = np.linalg.norm(p, axis=-1)
-    g = {
-        "LINEAR": lambda: x,
-        "QUADRATIC": lambda: np.maximum(x, 0) ** 2,
-        "EASING": lambda: (lambda t: 3 * t * t - 2 * t * t * t)(np.clip(x, 0, 1)),
-        "DIAGONAL": lambda: (x + y) * 0.5,
-        "RADIAL": lambda: np.arctan2(y, x) / (2 * np.pi) + 0.5,
-        "QUADRATIC_SPHERE": lambda: np.maximum(0.999999 - r, 0) ** 2,
-        "SPHERICAL": lambda: np.maximum(0.999999 - r, 0),
-    }[kind]()
-    return np.clip(g, 0, 1)
-
-
 def euler_to_matrix(e):
     cx, cy, cz = np.cos(e)
     sx, sy, sz = np.sin(e)

@@ -3,7 +3,8 @@ evaluate, and a Cycles scene of tiled planes, one per texture mode, whose Emissi
 texture of the Object coordinate.
 
 A mode is ``(label, node type, node properties, input values, output socket, f)``: Blender's own
-names for properties and sockets, and ``f`` the numpy of (n, 3) Object coordinates giving the
+names for properties and sockets (an input value "x", "y" or "z" links that component of the
+coordinate, a texture's W say), and ``f`` the numpy of (n, 3) Object coordinates giving the
 (n, 3) emitted colour. ``swizzle`` (optional, one string per mode such as ``"xzy"`` or ``"xy0"``)
 feeds the texture a permutation of the coordinate (Separate and Combine XYZ, exact) so planes at
 z = 0 exercise every axis."""
@@ -102,15 +103,20 @@ def build_tiles(modes, swizzles=None):
         for name, value in props.items():
             setattr(tex, name, value)
         for name, value in inputs.items():
-            if name in tex.inputs:
+            if name in tex.inputs and not isinstance(value, str):
                 tex.inputs[name].default_value = value
         vector = _vector(nt, coords.outputs["Object"], swizzles[k] if swizzles else None, node_type)
+        for name, value in inputs.items():
+            if isinstance(value, str):  # "x", "y" or "z": that component of the coordinate, linked
+                sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+                nt.links.new(vector, sep.inputs[0])
+                nt.links.new(sep.outputs["xyz".index(value)], tex.inputs[name])
         if node_type == "ShaderNodeTexWhiteNoise" and "W" in tex.inputs:
             # 4D: W is the snapped x (a socket hidden in 2D and 3D)
             sep = nt.nodes.new("ShaderNodeSeparateXYZ")
             nt.links.new(vector, sep.inputs[0])
             nt.links.new(sep.outputs[0], tex.inputs["W"])
-        nt.links.new(vector, tex.inputs["Vector"])
+        nt.links.new(vector, next(s for s in tex.inputs if s.identifier == "Vector"))
         emit = nt.nodes.new("ShaderNodeEmission")
         out = nt.nodes.new("ShaderNodeOutputMaterial")
         nt.links.new(tex.outputs[output], emit.inputs["Color"])

@@ -51,8 +51,11 @@ Adding a node is one registry entry: a function decorated ``@node("ShaderNodeX",
 that takes (compiler, node, output socket, context) and returns a ``Value`` (GLSL expression,
 type), reading its inputs with ``c.input(node, name, ctx, type)`` (constants become uniforms
 by themselves) and naming its ``family`` file under ``shaders/nodes/`` (e.g. ``texture_noise``
-for a ``shaders/nodes/texture_noise.glsl``). Procedural textures read their coordinates with
-``c.texture_vector(node, ctx)`` (Generated when unlinked, as Blender does).
+for a ``shaders/nodes/texture_noise.glsl``); a new family takes its place in ``FAMILY_ORDER``
+(after the families it calls) and names them in ``FAMILY_NEEDS``, which includes them with it.
+Procedural textures read their coordinates with ``c.texture_vector(node, ctx)`` (Generated when
+unlinked, as Blender does) and call the per-dimension entry points (``node_tex_noise_at``,
+``node_tex_voronoi_at``): the all-dimension functions compile several times slower.
 """
 
 import hashlib
@@ -67,7 +70,7 @@ MAX_GROUP_DEPTH = 16  # node groups inside node groups
 MAX_IMAGES = 8  # image textures one tree samples
 CURVE_SAMPLES = 128  # points an RGB Curves / Float Curve curve is tabulated at
 
-GLSL_TYPES = {"float": "float", "vec3": "vec3", "vec4": "vec4", "closure": "NodeClosure"}
+GLSL_TYPES = {"float": "float", "vec2": "vec2", "vec3": "vec3", "vec4": "vec4", "closure": "NodeClosure"}
 SOCKET_TYPES = {"VALUE": "float", "INT": "float", "BOOLEAN": "float", "VECTOR": "vec3", "RGBA": "vec4"}
 SOCKET_TYPES["SHADER"] = "closure"
 
@@ -95,7 +98,14 @@ RAMP_MODES = ("RGB", "HSV", "HSL")
 RAMP_HUE = ("NEAR", "FAR", "CW", "CCW")
 COLOR_MODES = ("RGB", "HSV", "HSL")
 MAPPING_TYPES = ("POINT", "TEXTURE", "VECTOR", "NORMAL")
-GRADIENT_TYPES = ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "RADIAL", "QUADRATIC_SPHERE", "SPHERICAL")
+GRADIENT_TYPES = ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "SPHERICAL", "QUADRATIC_SPHERE", "RADIAL")
+NOISE_TYPES = ("FBM", "MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HETERO_TERRAIN")
+VORONOI_FEATURES = ("F1", "F2", "SMOOTH_F1", "DISTANCE_TO_EDGE", "N_SPHERE_RADIUS")
+VORONOI_METRICS = ("EUCLIDEAN", "MANHATTAN", "CHEBYCHEV", "MINKOWSKI")
+WAVE_TYPES = ("BANDS", "RINGS")
+WAVE_BANDS = ("X", "Y", "Z", "DIAGONAL")
+WAVE_RINGS = ("X", "Y", "Z", "SPHERICAL")
+WAVE_PROFILES = ("SIN", "SAW", "TRI")
 IMAGE_INTERPOLATION = {"Closest": 0, "Linear": 1, "Cubic": 1, "Smart": 1}
 IMAGE_EXTENSION = {"REPEAT": 0, "EXTEND": 1, "CLIP": 2, "MIRROR": 3}
 
@@ -158,7 +168,47 @@ def node(*idnames, family=None):
     return register
 
 
-FAMILY_ORDER = ("common", "math", "vector", "color", "converter", "input", "texture", "shader")
+# The GLSL families in include order: each after the families it calls (FAMILY_NEEDS).
+FAMILY_ORDER = (
+    "common",
+    "math",
+    "vector",
+    "color",
+    "converter",
+    "input",
+    "texture_hash",
+    "texture_noise",
+    "texture_voronoi",
+    "texture_white_noise",
+    "texture_wave",
+    "texture_magic",
+    "texture_brick",
+    "texture_checker",
+    "texture_gradient",
+    "shader",
+)
+# family -> the families its functions call (included with it, earlier in FAMILY_ORDER).
+FAMILY_NEEDS = {
+    "texture_noise": ("texture_hash",),  # lattice hashes, texture_finite
+    "texture_voronoi": ("texture_hash",),
+    "texture_white_noise": ("texture_hash",),
+    "texture_wave": ("texture_noise",),  # fBM of the distortion
+    "texture_magic": ("texture_noise",),  # texture_fmod
+    "texture_brick": ("texture_hash",),
+    "texture_checker": ("texture_hash",),
+    "texture_gradient": ("texture_hash",),
+}
+
+
+def family_closure(families):
+    """``families`` with every family they need, in FAMILY_ORDER (unknown ones last, sorted)."""
+    found, todo = set(), list(families)
+    while todo:
+        f = todo.pop()
+        if f not in found:
+            found.add(f)
+            todo.extend(FAMILY_NEEDS.get(f, ()))
+    return tuple(f for f in FAMILY_ORDER if f in found) + tuple(sorted(found - set(FAMILY_ORDER)))
 
 
 # --- the compiler -------------------------------------------------------------------------
@@ -476,9 +526,7 @@ class Compiler:
                 "                       emission, normal);\n"
                 "}\n"
             )
-        families = tuple(f for f in FAMILY_ORDER if f in self.families) + tuple(
-            sorted(self.families - set(FAMILY_ORDER))
-        )
+        families = family_closure(self.families)
         needs = frozenset(self.needs)
         images = tuple(self.images)
         modes = ",".join(f"{i.interpolation}/{i.extension}" for i in images)
@@ -998,22 +1046,158 @@ def _mapping(c, node, socket, ctx):
 # --- textures -----------------------------------------------------------------------------
 
 
-@node("ShaderNodeTexChecker", family="texture")
+def _blender_5():
+    """The running Blender is 5.x or later (Voronoi and Magic changed there)."""
+    import bpy
+
+    return tuple(bpy.app.version) >= (5, 0, 0)
+
+
+def _dimensions(node, prop):
+    """A texture node's dimensions property ('1D' .. '4D') as 1 .. 4."""
+    return int(str(getattr(node, prop, "3D"))[0])
+
+
+def _glsl_bool(value):
+    return "true" if value else "false"
+
+
+def _texture_point(c, node, ctx, dims, scale, finite_after=False):
+    """The scaled coordinate a hashed texture reads for ``dims`` dimensions (1D: W; 2D: Vector.xy;
+    3D: Vector; 4D: Vector and W), non-finite inputs as 0, as Blender's node functions take it."""
+    parts = []
+    if dims >= 2:
+        v = c.texture_vector(node, ctx)
+        parts.append(f"texture_finite({v.expr}) * {scale.expr}")
+    if dims in (1, 4):
+        w = c.input(node, "W", ctx, "float")
+        parts.append(f"texture_finite({w.expr}) * {scale.expr}")
+    if finite_after:
+        parts = [f"texture_finite({p})" for p in parts]
+    if dims == 1:
+        return c.temp("float", parts[0])
+    if dims == 2:
+        return c.temp("vec2", f"({parts[0]}).xy")
+    if dims == 3:
+        return c.temp("vec3", parts[0])
+    return c.temp("vec4", f"vec4({parts[0]}, {parts[1]})")
+
+
+def _rgba(value):
+    """A vec4 expression's colour with alpha 1 (the texture functions pack Fac in .a)."""
+    return Value(f"vec4({value.expr}.rgb, 1.0)", "vec4")
+
+
+@node("ShaderNodeTexNoise", family="texture_noise")
+def _noise(c, node, socket, ctx):
+    dims = _dimensions(node, "noise_dimensions")
+    kind = NOISE_TYPES.index(getattr(node, "noise_type", "FBM"))
+    normalize = _glsl_bool(getattr(node, "normalize", True))
+    scale = c.input(node, "Scale", ctx, "float")
+    p = _texture_point(c, node, ctx, dims, scale)
+    args = [c.input(node, k, ctx, "float").expr for k in ("Detail", "Roughness", "Lacunarity")]
+    args += [
+        c.input(node, k, ctx, "float").expr if _has(node, k) else d for k, d in (("Offset", "0.0"), ("Gain", "1.0"))
+    ]
+    args.append(c.input(node, "Distortion", ctx, "float").expr)
+    v = c.temp("vec4", f"node_tex_noise_at({p.expr}, {', '.join(args)}, {kind}, {normalize})")
+    return Value(f"{v.expr}.a", "float") if socket.identifier == "Fac" else _rgba(v)
+
+
+def _has(node, key):
+    return any(s.identifier == key or s.name == key for s in node.inputs)
+
+
+@node("ShaderNodeTexVoronoi", family="texture_voronoi")
+def _voronoi(c, node, socket, ctx):
+    dims = _dimensions(node, "voronoi_dimensions")
+    feature = VORONOI_FEATURES.index(node.feature)
+    metric = VORONOI_METRICS.index(getattr(node, "distance", "EUCLIDEAN"))
+    normalize = _glsl_bool(getattr(node, "normalize", False))
+    scale = c.input(node, "Scale", ctx, "float")
+    p = _texture_point(c, node, ctx, dims, scale, finite_after=True)
+    keys = ("Detail", "Roughness", "Lacunarity", "Smoothness", "Exponent", "Randomness")
+    defaults = {"Detail": "0.0", "Roughness": "0.5", "Lacunarity": "2.0"}  # sockets Blender 3.x lacks
+    args = [c.input(node, k, ctx, "float").expr if _has(node, k) else defaults[k] for k in keys]
+    hash_mode = 1 if _blender_5() else 0  # VORONOI_HASH_INT on Blender 5, VORONOI_HASH_FLOAT before
+    dist, col = c.temp("float", "0.0"), c.temp("vec3", "vec3(0.0)")
+    pos, rad = c.temp("vec4", "vec4(0.0)"), c.temp("float", "0.0")
+    c.lines.append(
+        f"  node_tex_voronoi_at({p.expr}, {feature}, {metric}, {scale.expr}, {', '.join(args)}, {normalize}, "
+        f"{hash_mode}, {dist.expr}, {col.expr}, {pos.expr}, {rad.expr});"
+    )
+    out = socket.identifier
+    if out == "Color":
+        return Value(f"vec4({col.expr}, 1.0)", "vec4")
+    if out == "Position":
+        return Value(f"{pos.expr}.xyz", "vec3")
+    if out == "W":
+        return Value(f"{pos.expr}.w", "float")
+    if out == "Radius":
+        return rad
+    return dist
+
+
+@node("ShaderNodeTexWhiteNoise", family="texture_white_noise")
+def _white_noise(c, node, socket, ctx):
+    dims = _dimensions(node, "noise_dimensions")
+    v = c.texture_vector(node, ctx) if dims >= 2 else Value("vec3(0.0)", "vec3")
+    w = c.input(node, "W", ctx, "float") if dims in (1, 4) else Value("0.0", "float")
+    t = c.temp("vec4", f"node_tex_white_noise({dims}, {v.expr}, {w.expr})")
+    return Value(f"{t.expr}.a", "float") if socket.identifier == "Value" else _rgba(t)
+
+
+@node("ShaderNodeTexWave", family="texture_wave")
+def _wave(c, node, socket, ctx):
+    kind = WAVE_TYPES.index(node.wave_type)
+    direction = WAVE_BANDS.index(node.bands_direction) if kind == 0 else WAVE_RINGS.index(node.rings_direction)
+    profile = WAVE_PROFILES.index(node.wave_profile)
+    p = c.texture_vector(node, ctx)
+    keys = ("Scale", "Distortion", "Detail", "Detail Scale", "Detail Roughness", "Phase Offset")
+    args = ", ".join(c.input(node, k, ctx, "float").expr for k in keys)
+    v = c.temp("vec4", f"node_tex_wave({p.expr}, {args}, {kind}, {direction}, {profile})")
+    return Value(f"{v.expr}.a", "float") if socket.identifier == "Fac" else _rgba(v)
+
+
+@node("ShaderNodeTexMagic", family="texture_magic")
+def _magic(c, node, socket, ctx):
+    p = c.texture_vector(node, ctx)
+    scale, dist = c.input(node, "Scale", ctx, "float"), c.input(node, "Distortion", ctx, "float")
+    depth = c.const(float(node.turbulence_depth), "float")
+    wrap = 1 if _blender_5() else 0  # MAGIC_WRAP_SCALED on Blender 5, MAGIC_WRAP_UNSCALED before
+    v = c.temp("vec4", f"node_tex_magic({p.expr}, {scale.expr}, {dist.expr}, int({depth.expr}), {wrap})")
+    return Value(f"{v.expr}.a", "float") if socket.identifier == "Fac" else _rgba(v)
+
+
+@node("ShaderNodeTexBrick", family="texture_brick")
+def _brick(c, node, socket, ctx):
+    p = c.texture_vector(node, ctx)
+    colours = ", ".join(c.input(node, k, ctx, "vec4").expr + ".rgb" for k in ("Color1", "Color2", "Mortar"))
+    keys = ("Scale", "Mortar Size", "Mortar Smooth", "Bias", "Brick Width", "Row Height")
+    values = ", ".join(c.input(node, k, ctx, "float").expr for k in keys)
+    props = c.const((node.offset, node.offset_frequency, node.squash, node.squash_frequency), "vec4")
+    v = c.temp(
+        "vec4",
+        f"node_tex_brick({p.expr}, {colours}, {values}, {props.expr}.x, int({props.expr}.y), "
+        f"{props.expr}.z, int({props.expr}.w))",
+    )
+    return Value(f"{v.expr}.a", "float") if socket.identifier == "Fac" else _rgba(v)
+
+
+@node("ShaderNodeTexChecker", family="texture_checker")
 def _checker(c, node, socket, ctx):
     p = c.texture_vector(node, ctx)
-    scale = c.input(node, "Scale", ctx, "float")
-    f = c.temp("float", f"node_checker({p.expr}, {scale.expr})")
-    if socket.identifier == "Fac":
-        return f
     a, b = c.input(node, "Color1", ctx, "vec4"), c.input(node, "Color2", ctx, "vec4")
-    return c.temp("vec4", f"(({f.expr}) > 0.5 ? {a.expr} : {b.expr})")
+    scale = c.input(node, "Scale", ctx, "float")
+    v = c.temp("vec4", f"node_tex_checker({p.expr}, {a.expr}.rgb, {b.expr}.rgb, {scale.expr})")
+    return Value(f"{v.expr}.a", "float") if socket.identifier == "Fac" else _rgba(v)
 
 
-@node("ShaderNodeTexGradient", family="texture")
+@node("ShaderNodeTexGradient", family="texture_gradient")
 def _gradient(c, node, socket, ctx):
     p = c.texture_vector(node, ctx)
-    f = c.temp("float", f"node_gradient({GRADIENT_TYPES.index(node.gradient_type)}, {p.expr})")
-    return f if socket.identifier == "Fac" else Value(f"vec4(vec3({f.expr}), 1.0)", "vec4")
+    v = c.temp("vec4", f"node_tex_gradient({p.expr}, {GRADIENT_TYPES.index(node.gradient_type)})")
+    return Value(f"{v.expr}.a", "float") if socket.identifier == "Fac" else _rgba(v)
 
 
 @node("ShaderNodeTexImage")

@@ -114,11 +114,11 @@ def test_unsupported_input_falls_back_to_the_viewport_colour_and_says_so(penumbr
 
     mat, bsdf, _output = material_scenes.node_material("Noisy")
     mat.diffuse_color = (0.1, 0.7, 0.2, 1.0)
-    noise = mat.node_tree.nodes.new("ShaderNodeTexNoise")
-    mat.node_tree.links.new(noise.outputs["Color"], bsdf.inputs["Base Color"])
+    sky = mat.node_tree.nodes.new("ShaderNodeTexSky")
+    mat.node_tree.links.new(sky.outputs["Color"], bsdf.inputs["Base Color"])
     read = material_from_blender(mat)
     assert read.base_color[:3] == pytest.approx((0.1, 0.7, 0.2))
-    assert len(read.messages) == 1 and "Noise Texture" in read.messages[0] and "Noisy" in read.messages[0]
+    assert len(read.messages) == 1 and "Sky Texture" in read.messages[0] and "Noisy" in read.messages[0]
 
     glass, _bsdf, _output = material_scenes.node_material("Glass")
     glass.diffuse_color = (0.3, 0.3, 0.9, 1.0)
@@ -136,13 +136,13 @@ def test_material_panel_lists_what_is_drawn_and_what_is_not(penumbra):
     scene = _builder("alpha_checker_shadow")
     checker = next(ob for ob in scene.objects if ob.name == "Checker")
     mat = checker.material_slots[0].material
-    noise = mat.node_tree.nodes.new("ShaderNodeTexNoise")
+    path = mat.node_tree.nodes.new("ShaderNodeLightPath")
     bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
-    mat.node_tree.links.new(noise.outputs["Fac"], bsdf.inputs["Roughness"])
+    mat.node_tree.links.new(path.outputs["Is Camera Ray"], bsdf.inputs["Roughness"])
     lines = summary(material_from_blender(mat))
     assert ("TEXTURE", "Textures: base color, alpha") in lines
     assert ("IMAGE_ALPHA", "Alpha: dithered (hashed over samples)") in lines
-    assert [text for icon, text in lines if icon == "ERROR"] == ["Roughness from a 'Noise Texture' node"]
+    assert [text for icon, text in lines if icon == "ERROR"] == ["Roughness from a 'Light Path' node"]
 
 
 def test_render_reports_each_unsupported_case_once(penumbra, capfd):

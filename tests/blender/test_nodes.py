@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 import pytest
 
-from devkit import engines, node_reference, node_scenes
+from devkit import engines, node_reference, node_scenes, texture_reference
 from devkit.render import render
 
 
@@ -429,12 +429,11 @@ def test_checker_gradient_and_input_nodes(penumbra):
         zero = np.zeros_like(u)
         if kind == "CHECKER":
             z = zero + (0.5 if option == "GENERATED" else 0.0)
-            fac = node_reference.checker(np.stack([u, v, z], -1), 3.0)
-            if option == "COLOR":
-                return np.where(fac[:, None] > 0.5, np.array(colours[0]), np.array(colours[1]))
-            return fac
+            t = texture_reference.node_tex_checker(np.stack([u, v, z], -1), colours[0][:3], colours[1][:3], 3.0)
+            return t[:, :3] if option == "COLOR" else t[:, 3]
         if kind == "GRADIENT":
-            return node_reference.gradient(option, np.stack([2 * u - 1, 2 * v - 1, zero], -1))
+            p = np.stack([2 * u - 1, 2 * v - 1, zero], -1)
+            return texture_reference.node_tex_gradient(p, GRADIENT_TYPES.index(option))[:, 3]
         if kind == "FRESNEL":
             return node_reference.fresnel_dielectric(1.0, option) + zero
         fresnel, facing = node_reference.layer_weight(0.3, 1.0)
@@ -653,8 +652,9 @@ def test_extreme_inputs_draw_finite(penumbra):
 
 
 def test_trees_differing_in_values_share_one_program(penumbra, gpu_call):
-    """1000 materials of one structure and different values compile to one key; drawn, a
-    second scene of other values compiles no program, while another operation compiles one."""
+    """1000 materials of one structure and different values compile to one key (a Math node's
+    value; a Noise texture's Scale); drawn, a second scene of other values compiles no program,
+    while another operation compiles one."""
     from penumbra.engine.scene.nodetree import compile_material
 
     mats = []
@@ -669,6 +669,16 @@ def test_trees_differing_in_values_share_one_program(penumbra, gpu_call):
     trees = [compile_material(m)[0] for m in mats]
     assert len({t.key for t in trees}) == 1
     assert len({float(t.constants[0, 0]) for t in trees}) == 1000  # the values differ, as constants
+    noise = []
+    for k in range(1000):  # a Noise texture (4D, so Vector and W) differing only in Scale
+        mat, nodes, links, emission, _output = node_scenes.emission_material(f"Noise{k:04d}")
+        n = nodes.new("ShaderNodeTexNoise")
+        n.noise_dimensions = "4D"
+        _in(n, "Scale").default_value = 1.0 + k / 100.0
+        links.new(_out(n, "Color"), _in(emission, "Color"))
+        noise.append(compile_material(mat)[0])
+    assert len({t.key for t in noise}) == 1 and noise[0].key != trees[0].key
+    assert len({t.constants.tobytes() for t in noise}) == 1000
 
     from devkit.render import engine_frame
 
@@ -774,13 +784,50 @@ def _add_shader_rim(mat, nodes, links, bsdf, output):
     links.new(add.outputs[0], _in(output, "Surface"))
 
 
+def _ramp_on_noise(mat, nodes, links, bsdf, output):
+    """Noise (Generated, Scale 4, Detail 3) -> Color Ramp -> Roughness, and a second ramp of
+    the same noise -> Base Color; Metallic 0.5 so roughness shows."""
+    noise = nodes.new("ShaderNodeTexNoise")
+    _in(noise, "Scale").default_value = 4.0
+    _in(noise, "Detail").default_value = 3.0
+    rough, color = nodes.new("ShaderNodeValToRGB"), nodes.new("ShaderNodeValToRGB")
+    rough.color_ramp.elements[0].position = 0.35
+    rough.color_ramp.elements[1].position = 0.65
+    rough.color_ramp.elements[0].color = (0.1, 0.1, 0.1, 1.0)
+    color.color_ramp.elements[0].position = 0.3
+    color.color_ramp.elements[1].position = 0.7
+    color.color_ramp.elements[0].color = (0.8, 0.25, 0.05, 1.0)
+    color.color_ramp.elements[1].color = (0.1, 0.5, 0.3, 1.0)
+    links.new(_out(noise, "Fac"), rough.inputs[0])
+    links.new(_out(noise, "Fac"), color.inputs[0])
+    links.new(rough.outputs[0], _in(bsdf, "Roughness"))
+    links.new(color.outputs[0], _in(bsdf, "Base Color"))
+    _in(bsdf, "Metallic").default_value = 0.5
+
+
+def _bump_from_voronoi(mat, nodes, links, bsdf, output):
+    """Voronoi (Generated, Scale 6, F1 Distance) -> Bump (Strength 0.6, Distance 0.05) -> the
+    Principled Normal; Base Color its Color."""
+    voronoi = nodes.new("ShaderNodeTexVoronoi")
+    _in(voronoi, "Scale").default_value = 6.0
+    bump = nodes.new("ShaderNodeBump")
+    _in(bump, "Strength").default_value = 0.6
+    _in(bump, "Distance").default_value = 0.05
+    links.new(_out(voronoi, "Distance"), _in(bump, "Height"))
+    links.new(_out(bump, "Normal"), _in(bsdf, "Normal"))
+    links.new(_out(voronoi, "Color"), _in(bsdf, "Base Color"))
+
+
 # name -> (builder, bound on the mean |difference| from EEVEE); measured on 5.2 and 4.5:
-# 0.0017, 0.0035, 0.0080, 0.0067 (the bounds sit 2-3x above; the issue asks for 0.05).
+# 0.0017, 0.0035, 0.0080, 0.0067, 0.0063, 0.0092 (the bounds sit 2-3x above; the issue asks
+# for 0.05).
 ASSETS = {
     "principled_in_group": (_principled_in_group, 0.005),
     "ramp_into_roughness": (_ramp_on_gradient_into_roughness, 0.01),
     "mix_shader_by_checker": (_mix_shader_by_checker, 0.02),
     "add_shader_rim": (_add_shader_rim, 0.015),
+    "ramp_on_noise": (_ramp_on_noise, 0.015),
+    "bump_from_voronoi": (_bump_from_voronoi, 0.02),
 }
 
 
