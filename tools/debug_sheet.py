@@ -17,6 +17,7 @@ from pathlib import Path
 import bpy
 
 from devkit import imageio, scenes, session
+from tools.contact_sheet import render_png
 
 VIEWS = ("SHADOW_MAPS", "TEXEL_DENSITY", "CASCADES", "LIGHT_COST", "SAMPLES", "NOISE")
 
@@ -31,14 +32,6 @@ def demo(width, height):
     p.adaptive_min_samples = 4
     p.shadow_cascades = 3
     return scene
-
-
-def render_png(scene, path):
-    imageio.set_format(scene.render.image_settings, "PNG", color_depth="8")
-    scene.render.filepath = str(path)
-    scene.render.use_file_extension = False
-    bpy.ops.render.render(write_still=True)
-    return imageio.read_image(path)
 
 
 def main(argv=None):
