@@ -12,6 +12,8 @@ Sections (``--sections``, all by default):
   passes      the demo scene at 960x540, F12, timed pass by pass (the GPU waited for with a
               one-pixel read-back before and after each pass): the depth pass and the lit pass
               with PCF 5x5, with a single-tap filter (NONE) and with shadows off
+  samples     the demo at 960x540, F12 at 1 and 16 samples against Workbench: one further
+              sample's cost against the first, the 16-sample frame's lit and shadow passes
   viewport    the viewport path at 960x540 (demo scene with its post layers), one engine
               instance: display only, redraw with nothing changed, camera moving, scene edited
   lights      N shadowed spot lights over a field of boxes (N = 1, 8, 32, 64): F12, and the
@@ -49,6 +51,7 @@ HELP = "frame cost and scaling as ratios to Workbench (AA off, shadows on)"
 SECTIONS = (
     "resolution",
     "passes",
+    "samples",
     "viewport",
     "lights",
     "objects",
@@ -255,55 +258,45 @@ def section_resolution(plan):
     return rows
 
 
-def section_passes(plan):
-    """The demo at 960x540 pass by pass: the shadow (depth) pass and the lit pass, each timed
-    to a one-pixel read-back of its targets before and after it (so each pass's GPU work is
-    its own), for PCF 5x5, a single tap (NONE) and shadows off, interleaved."""
+def _wait(renderer):
+    """Return once the GPU has finished what was drawn into the frame's targets."""
+    fb = renderer.film.fb or renderer.film.fb_color
+    if fb is not None:
+        with fb.bind():
+            fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+    atlas = renderer.shadows._framebuffer
+    if atlas is not None:
+        with atlas.bind():
+            if renderer.shadows.depth_format == "FLOAT32":
+                atlas.read_depth(0, 0, 1, 1)
+            else:
+                atlas.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+
+
+def _time_passes(times, current):
+    """Time every shadow (depth) pass and lit pass of the renders that follow, each to a
+    one-pixel read-back of the frame's targets before and after it: seconds are appended to
+    ``times[current["case"], "depth pass" | "lit pass"]`` while ``current`` names a case.
+    Returns what ``_restore`` puts back."""
     from penumbra.engine.frame.lit_pass import LitPass
     from penumbra.engine.frame.renderer import Renderer
     from penumbra.engine.frame.shadow_pass import ShadowPass
 
-    scene = demo(960, 540)
-    lights = [ob for ob in scene.objects if ob.type == "LIGHT"]
-    cases = {"PCF 5x5": ("PCF", True), "one tap (NONE)": ("NONE", True), "shadows off": ("PCF", False)}
-    times = {(case, part): [] for case in cases for part in ("depth pass", "lit pass")}
-    current = {}
-
-    def wait(renderer):
-        """Return once the GPU has finished what was drawn into the frame's targets."""
-        fb = renderer.film.fb or renderer.film.fb_color
-        if fb is not None:
-            with fb.bind():
-                fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
-        atlas = renderer.shadows._framebuffer
-        if atlas is not None:
-            with atlas.bind():
-                if renderer.shadows.depth_format == "FLOAT32":
-                    atlas.read_depth(0, 0, 1, 1)
-                else:
-                    atlas.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
-
     def timed(method, part):
         def run(self, *args, **kwargs):
-            wait(current["renderer"])
+            _wait(current["renderer"])
             start = time.perf_counter()
             out = method(self, *args, **kwargs)
-            wait(current["renderer"])
+            _wait(current["renderer"])
             if "case" in current:
-                times[current["case"], part].append(time.perf_counter() - start)
+                times.setdefault((current["case"], part), []).append(time.perf_counter() - start)
             return out
 
         return run
 
-    def setup(case):
-        _penumbra(scene)
-        scene.penumbra.shadow_filter, shadowed = cases[case]
-        for ob in lights:
-            ob.data.use_shadow = shadowed
-
     def recorded(method):
         def run(self, *args, **kwargs):
-            current["renderer"] = self  # the renderer whose targets ``wait`` reads
+            current["renderer"] = self  # the renderer whose targets ``_wait`` reads
             return method(self, *args, **kwargs)
 
         return run
@@ -316,6 +309,85 @@ def section_passes(plan):
     ShadowPass.draw = timed(ShadowPass.draw, "depth pass")
     LitPass.draw = timed(LitPass.draw, "lit pass")
     Renderer.render = recorded(Renderer.render)
+    return originals
+
+
+def _restore(originals):
+    for (owner, name), method in originals.items():
+        setattr(owner, name, method)
+
+
+def section_samples(plan):
+    """The demo at 960x540, F12 at 1 and 16 render samples against Workbench, interleaved: what
+    one further sample costs against the first, and how the 16-sample frame's time splits into
+    shadow (depth) passes and lit passes (summed over its samples, each timed as in
+    ``passes``)."""
+    scene = demo(960, 540)
+    times, current = {}, {}
+    frames = {1: [], 16: []}
+    workbench = []
+    originals = _time_passes(times, current)
+    try:
+        for n in frames:  # warm-up
+            _penumbra(scene)
+            scene.penumbra.render_samples = n
+            _render()
+        _workbench(scene)
+        _render()
+        for run in range(plan["runs"]):
+            for n in frames:
+                _penumbra(scene)
+                scene.penumbra.render_samples = n
+                current["case"] = (n, run)
+                start = time.perf_counter()
+                _render()
+                frames[n].append(time.perf_counter() - start)
+                current.pop("case")
+            _workbench(scene)
+            start = time.perf_counter()
+            _render()
+            workbench.append(time.perf_counter() - start)
+    finally:
+        _restore(originals)
+        _penumbra(scene)
+    w = statistics.median(workbench)
+    one, sixteen = statistics.median(frames[1]), statistics.median(frames[16])
+
+    def part(name):
+        return statistics.median(sum(times.get(((16, r), name), [0.0])) for r in range(plan["runs"]))
+
+    lit, depth = part("lit pass"), part("depth pass")
+    extra = (sixteen - one) / 15.0 / one
+    return [
+        _row("samples", "1 sample", {"PENUMBRA": one, "WORKBENCH": w}, runs=plan["runs"]),
+        _row(
+            "samples",
+            "16 samples",
+            {"PENUMBRA": sixteen, "WORKBENCH": w},
+            f"samples 2-16: {extra:.2f}x the first each; lit passes {lit * 1e3:.0f} ms ({lit / sixteen:.0%}), "
+            f"shadow passes {depth * 1e3:.0f} ms ({depth / sixteen:.0%})",
+            plan["runs"],
+        ),
+    ]
+
+
+def section_passes(plan):
+    """The demo at 960x540 pass by pass: the shadow (depth) pass and the lit pass, each timed
+    to a one-pixel read-back of its targets before and after it (so each pass's GPU work is
+    its own), for PCF 5x5, a single tap (NONE) and shadows off, interleaved."""
+    scene = demo(960, 540)
+    lights = [ob for ob in scene.objects if ob.type == "LIGHT"]
+    cases = {"PCF 5x5": ("PCF", True), "one tap (NONE)": ("NONE", True), "shadows off": ("PCF", False)}
+    times = {(case, part): [] for case in cases for part in ("depth pass", "lit pass")}
+    current = {}
+
+    def setup(case):
+        _penumbra(scene)
+        scene.penumbra.shadow_filter, shadowed = cases[case]
+        for ob in lights:
+            ob.data.use_shadow = shadowed
+
+    originals = _time_passes(times, current)
     try:
         for case in cases:  # warm-up
             setup(case)
@@ -327,8 +399,7 @@ def section_passes(plan):
                 _render()
                 current.pop("case")
     finally:
-        for (owner, name), method in originals.items():
-            setattr(owner, name, method)
+        _restore(originals)
         for ob in lights:
             ob.data.use_shadow = True
     rows = []
