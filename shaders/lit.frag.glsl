@@ -31,7 +31,14 @@
  *
  * DEBUG_LIT (the TEXEL_DENSITY, CASCADES and LIGHT_COST debug views, engine/frame/debug_view.py):
  * the pixel writes the lights it evaluated, the cascade it read and its worst texel density
- * instead of colour. */
+ * instead of colour.
+ *
+ * SETTLE_TEST (engine/frame/settle.py, after a frame's pilot sample, lights at their centres):
+ * the pixel writes whether any later sample could change it through a light (1 in red where
+ * none can: every moving light's visibility is the same from all of the light,
+ * lib/shadow_filters.glsl, and no facet turns across it; a dithered or blended surface never
+ * settles) and, in green, how far the light it reflects is from its average over each
+ * light's extent. */
 
 #ifndef NODE_LOBES
 #  define NODE_LOBES 1
@@ -137,6 +144,75 @@ vec3 lobe_brdf(vec3 N, vec3 V, vec3 albedo, vec3 f0, float shininess, float alph
 #endif
 }
 
+#if SETTLE_TEST
+bool settle_unstable = false;
+float settle_spread = 0.0;
+
+/* The light L reflects towards the viewer from ``to_light`` delivering ``irradiance``,
+ * unshadowed (both lobes with NODE_LOBES == 2). */
+vec3 reflected_light(LightData L, Surface s, vec3 to_light, float irradiance)
+{
+  vec3 r = vec3(0.0);
+  float NdotL = dot(s.N, to_light);
+#  if NODE_LOBES == 2
+  if (NdotL > 0.0) {
+    r += (s.w.x * cosine_term(NdotL)) * lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
+  }
+  float NdotL_b = dot(s.N_b, to_light);
+  if (NdotL_b > 0.0) {
+    r += (s.w.y * cosine_term(NdotL_b)) *
+         lobe_brdf(s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b, s.alpha_b, to_light, NdotL_b, L);
+  }
+#  else
+  if (NdotL > 0.0) {
+    r += cosine_term(NdotL) * lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
+  }
+#  endif
+  return L.color * irradiance * r;
+}
+
+/* How the light L reflects here differs from its average over the light's extent: the light
+ * sits at its centre in this pass, so the first-order change cancels over the extent and
+ * what remains is the curvature, from the light moved by its radius (a sun: tilted by its
+ * half angle) both ways along two axes across ``to_light``: the mean of those four minus the
+ * centre's, halved (a uniform disc's second moment is half theirs). A highlight narrower
+ * than the light, or a light close to the surface, does not settle. Also whether a facet
+ * turns across the light. */
+void settle_light(LightData L, Surface s, vec3 to_light, float irradiance, float NgdotL)
+{
+  bool sun = L.type == LIGHT_SUN;
+  float extent = sun ? L.sun_tan_half_angle : L.shadow_radius;
+  if (!(extent > 0.0)) {
+    return;
+  }
+  float angle = sun ? extent : extent / max(length(L.position - s.P), 1e-30);
+  if (abs(NgdotL) < 1.5 * angle || abs(dot(s.Nf, to_light)) < 1.5 * angle) {
+    settle_unstable = true; /* a facet (or the smooth normal) turns across the light */
+    return;
+  }
+  vec3 a = normalize(cross(to_light, (abs(to_light.z) < 0.9) ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0)));
+  vec3 b = cross(to_light, a);
+  vec3 c0 = reflected_light(L, s, to_light, irradiance);
+  vec3 mean = vec3(0.0);
+  for (int k = 0; k < 4; k++) {
+    vec3 o = (k == 0) ? a : (k == 1) ? -a : (k == 2) ? b : -b;
+    vec3 l;
+    float e;
+    if (sun) {
+      l = normalize(to_light + extent * o);
+      e = 1.0;
+    }
+    else {
+      LightData M = L;
+      M.position = L.position + extent * o;
+      light_incident(M, s.P, l, e);
+    }
+    mean += 0.25 * reflected_light(L, s, l, e);
+  }
+  settle_spread += 0.5 * dot(abs(mean - c0), vec3(1.0));
+}
+#endif
+
 /* Add light i's contribution. ``filter_id`` is a literal at each call (FILTER_* or NO_SHADOW), so
  * the compiler keeps a shadow filter only where a light has a map, and only that one. */
 void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout float arriving,
@@ -196,6 +272,17 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   float visibility = (filter_id == NO_SHADOW) ? 1.0 :
                      (NgdotL <= 0.0 || turned) ? 0.0 :
                                                  shadow_visibility(L, shadow_P, s.Ng, s.Nf, NgdotL, dot(s.Nf, to_light), filter_id);
+#if SETTLE_TEST
+  /* Lights that move between samples are the sampled ones (FILTER_PCSS) and, without a map,
+   * any with an extent; the scene's filter serves lights that stay put. */
+  if (visibility < 0.0) {
+    settle_unstable = true;
+    visibility = 1.0;
+  }
+  if (visibility > 0.0 && (filter_id == FILTER_PCSS || filter_id == NO_SHADOW)) {
+    settle_light(L, s, to_light, irradiance, NgdotL);
+  }
+#endif
   unshadowed += weight;
   arriving += weight * visibility;
 #if NODE_LOBES == 2
@@ -331,7 +418,11 @@ void main()
 #if TEX_EMISSION
   emission *= SAMPLE_COLOR(emission, v_uv).rgb;
 #endif
-#if ALPHA_MODE == 1
+#if ALPHA_MODE == 1 && SETTLE_TEST
+  if (coverage <= 0.0) {
+    discard; /* never drawn; where it covers some samples, it marks the pixel unsettled */
+  }
+#elif ALPHA_MODE == 1
   /* Hashed (EEVEE's Dithered): the surface covers a pixel in a fraction alpha of the samples
    * (stratified over the frame's samples by frame.alpha_offset). */
   if (coverage <= fract(pixel_hash(gl_FragCoord.xy) + frame.alpha_offset)) {
@@ -497,6 +588,13 @@ void main()
 #endif
 #if DEBUG_LIT
   out_color = vec4(debug_lights, debug_cascade, debug_density, 1.0); /* a lit debug view's values */
+#endif
+#if SETTLE_TEST
+  bool settled = !settle_unstable;
+#  if ALPHA_MODE == 1 || ALPHA_MODE == 2
+  settled = settled && coverage >= 1.0; /* what is behind shows in some samples */
+#  endif
+  out_color = vec4(settled ? 1.0 : 0.0, settle_spread, 0.0, 1.0);
 #endif
 #if AUX_OUTPUTS
   out_depth = v_view_depth;

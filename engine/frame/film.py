@@ -13,11 +13,13 @@ from .programs import (
     CONVERGED_DEPTH,
     CONVERGENCE,
     CONVERGENCE_ERROR,
+    MASK_SCALE,
     MASKED_COPY,
     MASKED_COPY_SHADOW_WEIGHT,
     MASKED_COPY_WEIGHT,
     SCALED_COPY,
     SCALED_COPY_SHADOW,
+    SETTLE,
     WEIGHTED_RESOLVE,
     WEIGHTED_RESOLVE_SHADOW,
 )
@@ -112,6 +114,7 @@ class Film:
         self._mask_index = 0
         self._weight = None
         self._masked_fbs = {}
+        self._settle = None  # (size, the settle test's flags, their framebuffer over the z-buffer)
         # The shading count of tests (``count_shaded``): the lit pass writes 1 into ``shaded``
         # for every pixel it shades; ``shaded_total`` adds them over the frame's samples.
         self.count_shaded = False
@@ -175,18 +178,23 @@ class Film:
         if accumulate:
             per_pixel += 16 + (4 if aux else 0)
             if self.tracking:
-                per_pixel += 16 + 4 + 4 + (4 if self._weight is not None else 0)
+                per_pixel += 16
+            if self._masks is not None:
+                per_pixel += 4 + 4 + (4 if self._weight is not None else 0)
+            if self._settle is not None:
+                per_pixel += 16
         return per_pixel * self.size[0] * self.size[1]
 
     # --- samples --------------------------------------------------------------------------
 
-    def begin(self, aux, emission, fresh, adaptive=False):
+    def begin(self, aux, emission, fresh, adaptive=False, settle=False):
         """Before a multi-sample frame's samples: the accumulation targets, cleared when the
         frame starts afresh (``fresh``); ``adaptive``: the frame estimates each pixel's error
-        (from a fresh start on)."""
+        (from a fresh start on); ``settle``: pixels may settle (``settle``), so the converged
+        masks exist."""
         self._ensure_accumulation(aux)
         if fresh:
-            self._begin_adaptive(adaptive)
+            self._begin_adaptive(adaptive, settle)
             if self.shaded_total is not None:
                 self.shaded_total.clear(format="FLOAT", value=(0.0,))
             self._accum_color.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
@@ -268,9 +276,9 @@ class Film:
         """The converged mask (R32F, 1 where a pixel converged), or None while no pixel has."""
         return self._masks[self._mask_index] if self.converged and self._masks is not None else None
 
-    def _begin_adaptive(self, adaptive):
-        """A fresh frame: no pixel converged; with ``adaptive`` the second accumulation and
-        the masks exist (at this size) and are cleared."""
+    def _begin_adaptive(self, adaptive, settle=False):
+        """A fresh frame: no pixel converged; with ``adaptive`` the second accumulation, with
+        it or ``settle`` the masks exist (at this size) and are cleared."""
         import gpu
 
         self.tracking = bool(adaptive)
@@ -278,19 +286,68 @@ class Film:
         self._give([self._weight])
         self._weight = None
         self._masked_fbs = {}
-        if not self.tracking:
+        if not (self.tracking or settle):
             return
         size = self.size
-        if self._half is None or (self._half.width, self._half.height) != size:
+        if self._masks is None or (self._masks[0].width, self._masks[0].height) != size:
             self._give([self._half, *(self._masks or ())])
-            self._half = new_texture(self.pool, size, "RGBA32F")
-            self._half_fb = gpu.types.GPUFrameBuffer(color_slots=(self._half,))
+            self._half = self._half_fb = None
             self._masks = [new_texture(self.pool, size, "R32F") for _ in range(2)]
             self._mask_fbs = [gpu.types.GPUFrameBuffer(color_slots=(m,)) for m in self._masks]
-        self._half.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+        if self.tracking and self._half is None:
+            self._half = new_texture(self.pool, size, "RGBA32F")
+            self._half_fb = gpu.types.GPUFrameBuffer(color_slots=(self._half,))
+        if self.tracking:
+            self._half.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
         for m in self._masks:
             m.clear(format="FLOAT", value=(0.0,))
         self._mask_index = 0
+
+    def settle_framebuffer(self):
+        """The settle test's target (RGBA32F flags, ``settle.py``) over the lit pass's z-buffer,
+        cleared to settled (1) with no change: where no surface is drawn, only the image
+        decides."""
+        import gpu
+
+        if self._settle is None or self._settle[0] != self.size:
+            self._give([self._settle[1]] if self._settle else [])
+            flags = new_texture(self.pool, self.size, "RGBA32F")
+            self._settle = (self.size, flags, gpu.types.GPUFrameBuffer(depth_slot=self.zbuffer, color_slots=(flags,)))
+        self._settle[1].clear(format="FLOAT", value=(1.0, 0.0, 0.0, 0.0))
+        return self._settle[2]
+
+    def settle(self, threshold, shifts):
+        """After the pilot sample (accumulated with weight 1): settle the pixels no later
+        sample can change by ``threshold`` (the flags in ``settle_framebuffer`` and the image
+        so far; ``shifts``: ``settle.settle_shifts``): they join the converged pixels with
+        the pilot as their value; every other pixel starts afresh, as if the pilot had not
+        been taken. Returns the number of converged pixels."""
+        import gpu
+
+        (mx, my), (sxx, syy, sxy) = shifts
+        src, dst = self._mask_index, 1 - self._mask_index
+        samplers = {"accum": self._accum_color, "flags": self._settle[1], "converged": self._masks[src]}
+        uniforms = {
+            "threshold": float(threshold),
+            "weight_sum": float(self._weight_sum),
+            "mean_shift": (float(mx), float(my)),
+            "moment_shift": (float(sxx), float(syy), float(sxy)),
+        }
+        self.fullscreen(SETTLE, self._mask_fbs[dst], samplers, uniforms)
+        count = self._take_mask(dst)
+        # The pilot stays only where it settled (with its weight, 1); the other pixels start
+        # their samples afresh.
+        mask = self._masks[dst]
+        emission = self._emission_targets[0] if self._emission_targets is not None else None
+        for target in (self._accum_color, self._accum_shadow, emission, self._weight):
+            if target is not None:
+                framebuffer = gpu.types.GPUFrameBuffer(color_slots=(target,))
+                self.fullscreen(MASK_SCALE, framebuffer, {"converged": mask}, {}, "MULTIPLY")
+        if self._half is not None:
+            self._half.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+        self._weight_sum = 0.0
+        self.sample_weights = []
+        return count
 
     def check(self, threshold):
         """The convergence check after an even number of samples: a pixel converges when the
@@ -310,6 +367,11 @@ class Film:
             "per_pixel": 1.0 if self._weight is not None else 0.0,
         }
         self.fullscreen(CONVERGENCE, self._mask_fbs[dst], samplers, uniforms)
+        return self._take_mask(dst)
+
+    def _take_mask(self, dst):
+        """Mask ``dst`` becomes the converged mask; returns its count (and from the first
+        converged pixel on, each pixel keeps its own weight)."""
         self._mask_index = dst
         count = int(np.count_nonzero(texture_array(self._masks[dst], 1) > 0.5))
         if count and self._weight is None:
@@ -504,8 +566,10 @@ class Film:
                 self._weight,
                 self.shaded,
                 self.shaded_total,
+                self._settle[1] if self._settle else None,
             ]
         )
+        self._settle = None
         self.fb = self.fb_color = self.fb_emit = self._accum_fb = self._resolve_fb = None
         self._half = self._half_fb = self._masks = self._mask_fbs = self._weight = None
         self._masked_fbs = {}

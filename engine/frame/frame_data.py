@@ -158,6 +158,8 @@ def build_frame_data(
     alpha_offset=0.5,
     origin=_ZERO,
     sample_count=1,
+    settle=False,
+    pilot=False,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -168,7 +170,8 @@ def build_frame_data(
     ``world_color``: a ``materials.World`` (its SH light) or a constant colour;
     ``alpha_offset``: this sample's shift of the alpha-hash threshold ((s + 0.5) / N);
     ``origin``: the frame origin: every position the GPU gets is relative to it;
-    ``sample_count``: the frame's samples, which share the disk filters' taps."""
+    ``sample_count``: the frame's samples, which share the disk filters' taps; ``settle``:
+    for the settle test's variant (``settle.py``); ``pilot``: for a frame's pilot sample."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings, sample_count)
@@ -211,7 +214,9 @@ def build_frame_data(
             sampled > 0,
             (sampled, shadowed, len(lights)),
             any(light.receivers is not None for light in lights),
-            DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].lit,
+            DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].lit and not settle,
+            settle,
+            pilot,
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

@@ -25,14 +25,22 @@ class LitPass:
         self._bins_tex = None
         self._dummy_shadow = None
 
-    def draw(self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None):
+    def draw(
+        self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None, target=None
+    ):
         """Every visible part of ``draws``, grouped by material variant: opaque and
         alpha-hashed parts nearest first, then alpha-blended parts farthest first, blended over
         them (their depth, normal and shadow stay those of what is behind; EEVEE too keeps
         blended surfaces out of its depth). ``atlas``: the shadow atlas, or None when no map
-        was planned; ``world``: the snapshot's World (or None) and ``world_color``."""
+        was planned; ``world``: the snapshot's World (or None) and ``world_color``.
+        ``target``: the settle test's framebuffer (``Film.settle_framebuffer``; ``data`` built
+        with ``settle``): the surfaces the last sample drew (its z-buffer, kept) and any
+        dithered or blended one in front of them write their flags, the dithered and blended
+        last, nothing blended."""
         import gpu
 
+        if target is not None:
+            aux = emission = False
         world_data, world_color = world
         shadow_tex = atlas.texture if atlas is not None else self._shadow_dummy()
         # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
@@ -41,15 +49,20 @@ class LitPass:
         transparent = settings.film_transparent or debug
         bg = (0.0, 0.0, 0.0, 0.0) if transparent else (*map(float, world_color[:3]), 1.0)
         emission = aux and emission
-        counted = film.fb_counted is not None and not aux  # the shading count of tests
+        counted = film.fb_counted is not None and not aux and target is None  # the shading count of tests
         fb = film.fb_emit if emission else (film.fb if aux else (film.fb_counted if counted else film.fb_color))
-        film.clear(bg, aux, emission)
+        if target is not None:
+            fb = target
+        else:
+            film.clear(bg, aux, emission)
         # Adaptive sampling: where a pixel converged the nearest depth goes first, so nothing
         # (surface or world) is drawn there; the pixel is not shaded again.
-        converged = film.mask is not None
+        converged = film.mask is not None and target is None
         if converged:
             film.mask_depth(fb)
-        if world_data is not None and world_data.image is not None and not transparent:
+        if target is not None:
+            pass  # the settle test: surfaces only
+        elif world_data is not None and world_data.image is not None and not transparent:
             self._background(film, world_data, camera, origin, "LESS_EQUAL" if converged else "NONE")
         # Closed instances wholly beyond the near plane: from there no back face shows.
         outside = set()
@@ -74,7 +87,7 @@ class LitPass:
                 features = mat.features | ({"HOLDOUT"} if d.instance.holdout else set()) | term
                 entry = (features, rank, d, batch, mat)
                 (blended if "ALPHA_BLEND" in features and not d.instance.holdout else opaque).append(entry)
-        opaque.sort(key=lambda e: (sorted(e[0]), e[1]))
+        opaque.sort(key=lambda e: (target is not None and "ALPHA_HASHED" in e[0], sorted(e[0]), e[1]))
         blended.sort(key=lambda e: -e[1])
         width, height = film.size
         bound = {"shader": None, "counted": counted}
@@ -144,19 +157,19 @@ class LitPass:
 
         with fb.bind():
             gpu.state.viewport_set(0, 0, width, height)
-            if not converged:
+            if not converged and target is None:
                 fb.clear(depth=1.0)
             gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(True)
+            gpu.state.depth_mask_set(target is None)
             draw(opaque, aux)
         if blended:
             bound["shader"] = None
             bound["counted"] = False  # blended surfaces draw into the colour target alone
-            with film.fb_color.bind():
+            with (film.fb_color if target is None else target).bind():
                 gpu.state.viewport_set(0, 0, width, height)
                 gpu.state.depth_test_set("LESS_EQUAL")
                 gpu.state.depth_mask_set(False)
-                gpu.state.blend_set("ALPHA_PREMULT")
+                gpu.state.blend_set("ALPHA_PREMULT" if target is None else "NONE")
                 draw(blended, False)
                 gpu.state.blend_set("NONE")
         gpu.state.face_culling_set("NONE")

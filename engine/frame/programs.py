@@ -447,6 +447,30 @@ CONVERGENCE = Program(
 CONVERGENCE = replace(CONVERGENCE, defines=(("ERROR_OUTPUT", False),))
 # The NOISE debug view: each pixel's error estimate as the check reads it (``Film.error_array``).
 CONVERGENCE_ERROR = replace(CONVERGENCE, name="convergence_error", defines=(("ERROR_OUTPUT", True),))
+# Settling (``engine/frame/settle.py``): the settle test's flags and the image so far give the
+# pixels no later sample can change; they join the converged mask.
+SETTLE = Program(
+    name="settle",
+    vertex="fullscreen.vert.glsl",
+    fragment="settle.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(
+        ("FLOAT", "threshold"),
+        ("FLOAT", "weight_sum"),
+        ("VEC2", "mean_shift"),
+        ("VEC3", "moment_shift"),
+    ),
+    samplers=(("FLOAT_2D", "accum"), ("FLOAT_2D", "flags"), ("FLOAT_2D", "converged")),
+    outputs=(("VEC4", "out_color"),),
+)
+MASK_SCALE = Program(
+    name="mask_scale",
+    vertex="fullscreen.vert.glsl",
+    fragment="mask_scale.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    samplers=(("FLOAT_2D", "converged"),),
+    outputs=(("VEC4", "out_color"),),
+)
 CONVERGED_DEPTH = Program(
     name="converged_depth",
     vertex="fullscreen.vert.glsl",
@@ -532,6 +556,13 @@ def depth_defines(depth_format):
 UNROLLED_LIGHTS = 4
 
 
+# The settle test reads a map's region up to SETTLE_REACH texels around a point (the light's
+# half width seen from there); a wider region (a large light far from its casters) may change.
+# It reads every texel up to SETTLE_GRID texels away, beyond that (2 SETTLE_GRID + 1)^2 taps.
+SETTLE_REACH = 128
+SETTLE_GRID = 4
+
+
 def lit_defines(
     shadow_filter,
     pcf_weights,
@@ -546,6 +577,8 @@ def lit_defines(
     light_counts=None,
     light_linking=False,
     debug=False,
+    settle=False,
+    pilot=False,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -561,7 +594,10 @@ def lit_defines(
     masked pass on llvmpipe even when it runs zero times). ``light_linking``: some light
     lights only some objects; each object's ``light_mask`` says which. ``debug``: the variant
     writes what a lit debug view shows instead of colour (``DEBUG_LIT``: lights evaluated,
-    sun cascade + 1, texel density of the worst-sampled light, coverage)."""
+    sun cascade + 1, texel density of the worst-sampled light, coverage). ``settle``: the
+    variant writes the settle test's flags instead (``SETTLE_TEST``, ``settle.py``), looking
+    at most SETTLE_REACH texels around a point in a map; ``pilot``: a frame's pilot sample
+    (``PILOT_SAMPLE``), which reads moving lights' maps with one bilinear lookup."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -590,4 +626,8 @@ def lit_defines(
         "LIGHT_COUNT": counts[2],
         "LIGHT_LINKING": bool(light_linking),
         "DEBUG_LIT": bool(debug),
+        "SETTLE_TEST": bool(settle),
+        "PILOT_SAMPLE": bool(pilot),
+        "SETTLE_REACH": SETTLE_REACH,
+        "SETTLE_GRID": SETTLE_GRID,
     }

@@ -24,6 +24,7 @@ from .frame_data import build_frame_data, select_lights
 from .lit_pass import LitPass
 from .material_blocks import MaterialBlocks
 from .programs import MAX_LIGHTS
+from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats
 
@@ -49,6 +50,7 @@ class Renderer:
         self._last_plan = None  # the last sample's shadow plan (the SHADOW_MAPS view)
         self._last_data = None  # and its frame data (light bins, light order)
         self._last_lights = []  # the lights of the last sample (what its shadow plan indexes)
+        self._last_cameras = None  # the last sample's raster and view cameras, its lights' screen rects
         self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
 
     @property
@@ -113,9 +115,12 @@ class Renderer:
         # A lit debug view's values are not colour: no noise estimate of theirs ends a frame.
         adaptive = adaptive if accumulate and not debug.lit else None
         noise = adaptive is not None and adaptive.threshold > 0.0
+        settle = adaptive is not None and adaptive.settle > 0.0
+        if not accumulate:
+            film.converged = 0  # a single sample shades every pixel, whatever an earlier frame left
         if accumulate:
             # The NOISE view shows the estimate even where no threshold uses it.
-            film.begin(aux, emission, fresh=start == 0, adaptive=noise or debug.id == "NOISE")
+            film.begin(aux, emission, fresh=start == 0, adaptive=noise or debug.id == "NOISE", settle=settle)
         plan = None
         moving = set()
         # With map jitter every shadowed light changes from sample to sample (its maps' texel
@@ -130,6 +135,19 @@ class Renderer:
         if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + adaptive.time_limit
         pixels = width * height
+        pilot = settle and start == 0 and start < stop
+        if pilot:
+            # The pilot sample (settle.py): the centred pixel with every light at its centre,
+            # whose maps the settle test reads; it stays only in the pixels that settle.
+            centred = [
+                dataclasses.replace(lt, sampled=True, jittered=jitter) if i in moving else lt
+                for i, lt in enumerate(lights)
+            ]
+            plan = self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True)
+            film.accumulate(1.0, aux, emission, 0)
+            if aux:
+                film.keep_centre()  # the Depth and Normal passes, for settled pixels too
+            stats.pixels_settled = settle_pixels(self, draws, snapshot, settings, adaptive, sample_count)
         for s in range(start, stop):
             if accumulate and film.converged >= pixels:
                 stats.stopped = "converged"  # (a later call of a frame that has converged)
@@ -160,7 +178,7 @@ class Renderer:
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
                 film.accumulate(weight, aux, emission, s)
-            if aux and accumulate and s == 0:  # the centred sample's depth and normal
+            if aux and accumulate and s == 0 and not pilot:  # the centred sample's depth and normal
                 film.keep_centre()
             stats.samples += 1
             # (No check after a frame's last sample: it ends there anyway.)
@@ -177,7 +195,7 @@ class Renderer:
             if stats.stopped:
                 break
         stats.pixels_converged = film.converged if accumulate else 0
-        if accumulate and stats.samples:
+        if accumulate and (stats.samples or pilot):
             film.resolve(aux, emission)
         self.batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()})
         debug_image = None
@@ -217,6 +235,7 @@ class Renderer:
         stats,
         alpha_offset=0.5,
         sample_count=1,
+        pilot=False,
     ):
         """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
         does not move between samples keeps its map), then the lit pass seen through
@@ -264,8 +283,10 @@ class Renderer:
             alpha_offset=alpha_offset,
             origin=self._origin,
             sample_count=sample_count,
+            pilot=pilot,
         )
         self._last_data = data
+        self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
         stats.binned = data.bins is not None
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None

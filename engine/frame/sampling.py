@@ -390,12 +390,16 @@ class Adaptive:
     """What may end a frame's sampling before its last sample. ``threshold``: Cycles' Noise
     Threshold (0: every pixel takes every sample); a pixel whose error estimate (and its
     neighbours') is below it after ``min_samples`` takes no more samples, checked every
-    ``step`` samples. ``time_limit``: seconds the samples may take (0: none)."""
+    ``step`` samples. ``time_limit``: seconds the samples may take (0: none).
+    ``settle``: the Noise Threshold a pixel settles by after the frame's pilot sample (0:
+    none; ``settle.py``): no sample could change it by as much (no moving shadow edge,
+    highlight or facet, no edge or detail under the pixel filter), so it takes no other."""
 
     threshold: float = 0.0
     min_samples: int = ADAPTIVE_STEP
     time_limit: float = 0.0
     step: int = ADAPTIVE_STEP
+    settle: float = 0.0
 
     def checks_at(self, done):
         """Whether the convergence check runs after ``done`` samples (an even count, so half of
@@ -405,9 +409,12 @@ class Adaptive:
 
 def adaptive_settings(use, threshold, min_samples, time_limit, sample_count):
     """The ``Adaptive`` of a frame of ``sample_count`` samples (0: without end) from its
-    settings, or None when nothing can end it early: adaptive sampling off, a threshold of 0,
-    or a first check that would come after the last sample; and no time limit."""
+    settings, or None when nothing can end it early: adaptive sampling off or a threshold of
+    0, and no time limit. Pixels settle after a pilot sample unless Min Samples asks for
+    more than one sample a pixel; the noise check starts at Min Samples (automatic: Cycles'
+    rule), and is left out when it would come after the last sample."""
     threshold = float(threshold) if use else 0.0
+    settle = threshold if threshold > 0.0 and int(min_samples) <= 1 and sample_count != 1 else 0.0
     if threshold > 0.0:
         first = max(ADAPTIVE_STEP, int(min_samples)) if min_samples > 0 else auto_min_samples(threshold)
         first = -(-first // ADAPTIVE_STEP) * ADAPTIVE_STEP  # checks fall on multiples of the step
@@ -415,6 +422,11 @@ def adaptive_settings(use, threshold, min_samples, time_limit, sample_count):
             threshold = 0.0  # the last sample comes before any check: the frame is the plain one
     else:
         first = ADAPTIVE_STEP
-    if threshold <= 0.0 and time_limit <= 0.0:
+    if threshold <= 0.0 and time_limit <= 0.0 and settle <= 0.0:
         return None
-    return Adaptive(threshold=threshold, min_samples=first if threshold > 0.0 else 0, time_limit=float(time_limit))
+    return Adaptive(
+        threshold=threshold,
+        min_samples=first if threshold > 0.0 else 0,
+        time_limit=float(time_limit),
+        settle=settle,
+    )

@@ -292,6 +292,46 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
   float search_world = sun ? (receiver - near) * 2.0 * L.sun_tan_half_angle :
                              2.0 * L.shadow_radius * (receiver - near) / max(receiver, 1e-30);
   float search = clamp(0.5 * search_world / texel, 1.0, max_r);
+#if PILOT_SAMPLE
+  /* A frame's pilot sample (engine/frame/settle.py) is kept only where every moving light's
+   * visibility is the same from all of the light: there one bilinear lookup reads it. */
+  return shadow_bilinear(origin, st, SHADOW_REF(1.0), grad);
+#endif
+#if SETTLE_TEST
+  {
+    /* The settle test (engine/frame/settle.py), with the light at its whole size: whether
+     * every point of the light, on every shift of the map, sees P the same. The map was drawn
+     * from the light's centre, so the region it must show is the light's half width
+     * (PCSS's blocker search region) around P, plus a texel and a half for the maps'
+     * sub-texel shifts and the bilinear lookup. 1: no texel of it occludes P (lit from
+     * everywhere), 0: every texel does (the casters cover every way to the light), -1: it
+     * may change. A region past SETTLE_REACH texels, or leaving a local light's map, may
+     * change; beyond SETTLE_GRID texels the grid samples it every reach / SETTLE_GRID
+     * texels. */
+    float reach = 0.5 * search_world / texel + 1.5;
+    if (!(reach <= float(SETTLE_REACH))) {
+      return -1.0;
+    }
+    int n = int(ceil(min(reach, float(SETTLE_GRID))));
+    float spacing = reach / float(n);
+    float ref = SHADOW_REF(reach);
+    float lit = 0.0, taps = 0.0;
+    for (int y = -n; y <= n; y++) {
+      for (int x = -n; x <= n; x++) {
+        ivec2 t = ivec2(floor(st + vec2(x, y) * spacing));
+        if (!sun && (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, ivec2(size))))) {
+          return -1.0;
+        }
+        lit += shadow_tap(origin, t, plane_ref(t, st, ref, grad));
+        taps += 1.0;
+        if (lit > 0.0 && lit < taps) {
+          return -1.0; /* some of it occludes, some does not */
+        }
+      }
+    }
+    return (lit == taps) ? 1.0 : (lit == 0.0) ? 0.0 : -1.0;
+  }
+#endif
   if (L.jittered != 0 && 0.5 * search_world <= texel) {
     /* This sample's penumbra is under two texels wide here (a light without size: none):
      * one bilinear lookup, which the frame's jittered maps average into the edge filtered

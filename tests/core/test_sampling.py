@@ -128,10 +128,18 @@ def test_adaptive_settings_off_cases_and_check_schedule():
     settings = sampling.adaptive_settings
     assert settings(False, 0.01, 8, 0.0, 64) is None  # off
     assert settings(True, 0.0, 8, 0.0, 64) is None  # threshold 0: off too
-    assert settings(True, 0.01, 0, 0.0, 64) is None  # automatic 64: no check before the last sample
-    assert settings(True, 0.01, 0, 0.0, 16) is None
-    limited = settings(True, 0.01, 0, 2.5, 16)  # the time limit alone
-    assert limited.threshold == 0.0 and limited.time_limit == 2.5 and not limited.checks_at(8)
+    # Automatic Min Samples 64: no noise check before the last sample, but pixels settle
+    # after the pilot sample; an explicit Min Samples above 1, or a one-sample frame, no settling.
+    for count in (16, 64):
+        only = settings(True, 0.01, 0, 0.0, count)
+        assert only.threshold == 0.0 and only.settle == 0.01 and not any(only.checks_at(n) for n in range(1, 65))
+    assert settings(True, 0.01, 0, 0.0, 1) is None
+    assert settings(True, 0.01, 8, 0.0, 8) is None  # Min Samples 8: no settling, no check before the end
+    assert settings(True, 0.01, 1, 0.0, 8).settle == 0.01
+    assert settings(True, 0.01, 8, 0.0, 64).settle == 0.0
+    limited = settings(True, 0.01, 4, 2.5, 4)  # the time limit alone
+    assert limited.threshold == 0.0 and limited.settle == 0.0 and limited.time_limit == 2.5
+    assert not limited.checks_at(8)
     a = settings(True, 0.01, 6, 0.0, 64)  # checks on multiples of the step from Min Samples on
     assert a.min_samples == 8 and [n for n in range(1, 21) if a.checks_at(n)] == [8, 12, 16, 20]
     endless = settings(True, 0.1, 0, 0.0, 0)  # the viewport refining without end

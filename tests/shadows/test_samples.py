@@ -289,6 +289,8 @@ def test_viewport_after_n_redraws_shows_the_final_render_of_n_samples(penumbra, 
     scene = scenes.demo_scene(64, 36)
     scene.objects["Spot"].data.shadow_soft_size = 0.4
     scene.penumbra.render_samples = scene.penumbra.viewport_samples = 6
+    # Pixels settle by the Noise Threshold (render 0.01, viewport 0.1 by default): the same here.
+    scene.penumbra.preview_adaptive_threshold = scene.penumbra.adaptive_threshold
     final = render(scene)["Combined"]
 
     def job(engine, depsgraph):

@@ -1,0 +1,96 @@
+"""Settling: a pixel that no later sample of its frame can change takes no more samples.
+
+A frame's samples differ in three ways (``sampling``): where in the pixel they look (the pixel
+filter's offsets), where each light with an extent shines from, and how each map's texel grid
+is shifted. After the first sample (or Min Samples, when set), one pass asks of every pixel
+whether any of these could move it by the Noise Threshold, in Cycles' error units:
+
+* **Lights.** The settle test's variant of the lit pass (``SETTLE_TEST``,
+  ``lit.frag.glsl`` and ``lib/shadow_filters.glsl``) runs over the surfaces the sample drew,
+  with each light at its whole size: a moving light's visibility must be the same from every
+  point of it and on every map shift (the map's region the light's whole width around the
+  point shows no occluder at all, or occluders everywhere), no facet may turn across the
+  light, and the light the surface reflects may change only a little over the light's
+  extent (it moves the light by its radius each way: highlights and close lights do not
+  settle). Dithered and blended surfaces never settle (what is behind them shows in some
+  samples). A pixel needs its 3x3 neighbourhood settled, as far as the pixel filter reaches.
+* **The pixel filter.** For an image smooth over the pixel, the samples taken so far average
+  to the whole frame's filtered value up to gradient . (mean offset difference) + 1/2 Hessian :
+  (second-moment difference) (``settle_shifts``, exact for the frame's own offsets); the
+  gradient and Hessian come from central differences of the image so far. Edges, thin lines,
+  texture detail and noise give large values and keep sampling.
+
+Settled pixels join adaptive sampling's converged pixels (``Film``): later samples do not shade
+or add them, and the resolve divides by their own weight. With Noise Threshold 0 (or adaptive
+sampling off) nothing settles and every sample is the plain one.
+
+Not caught (named in docs/design.md): an occluder thinner than the test's grid spacing in a map
+region wider than 8 texels (a large light far from its casters), and detail under a pixel that
+the first sample missed entirely (a sub-pixel wire between pixel centres).
+"""
+
+import numpy as np
+
+from . import sampling
+from .draw_list import light_masks
+from .frame_data import build_frame_data
+from .stats import FrameStats
+
+ENDLESS_MOMENTS = 1024  # the samples a frame without end is taken to have (its filter's moments)
+
+
+def settle_shifts(kept, count, filter_size):
+    """How the pixel offsets of samples 0 .. ``kept`` - 1 differ from those of all ``count``
+    samples of the frame (0: without end): (mean dx, mean dy), (mean dx^2, mean dy^2,
+    mean dx dy), the kept ones' minus the whole frame's. A smooth image's kept average
+    differs from the frame's by gradient . mean + 1/2 Hessian : moments (``settle.frag.glsl``)."""
+
+    def moments(n):
+        offsets = np.array([sampling.pixel_offset(s, filter_size)[:2] for s in range(n)], np.float64)
+        dx, dy = offsets[:, 0], offsets[:, 1]
+        return np.array([dx.mean(), dy.mean()]), np.array([(dx * dx).mean(), (dy * dy).mean(), (dx * dy).mean()])
+
+    total = int(count) if count > 0 else ENDLESS_MOMENTS
+    mean_k, second_k = moments(max(1, int(kept)))
+    mean_n, second_n = moments(max(total, int(kept)))
+    return tuple(mean_k - mean_n), tuple(second_k - second_n)
+
+
+def settle(renderer, draws, snapshot, settings, adaptive, sample_count):
+    """Settle the pixels of ``renderer``'s film no later sample can change by
+    ``adaptive.settle``: the settle test's variant of the lit pass over the last sample's
+    surfaces, maps and lights (each light at its whole size), then the film's settle pass.
+    Returns the number of pixels settled."""
+    film = renderer.film
+    width, height = film.size
+    plan = renderer._last_plan
+    camera, view_camera, rects = renderer._last_cameras
+    lights = renderer._last_lights
+    atlas = renderer.shadows if plan is not None and plan.tiles else None
+    data = build_frame_data(
+        lights,
+        camera,
+        snapshot.world if snapshot.world is not None else snapshot.world_color,
+        settings,
+        plan,
+        tile_size=atlas.size if atlas else 1,
+        atlas_columns=atlas.columns if atlas else 1,
+        depth_format=atlas.depth_format if atlas else "FLOAT32",
+        aux_outputs=False,
+        rects=rects,
+        size=(width, height),
+        origin=renderer._origin,
+        sample_count=sample_count,
+        settle=True,
+    )
+    seen = [d for d in draws if d.instance.camera]
+    masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
+    world = (snapshot.world, snapshot.world_color)
+    target = film.settle_framebuffer()
+    stats = FrameStats()  # the test's draws are not the frame's
+    renderer.lit_pass.draw(
+        film, seen, view_camera, data, atlas, world, settings, False, False, stats, renderer._origin, masks, target
+    )
+    before = film.converged
+    film.settle(adaptive.settle, settle_shifts(1, sample_count, settings.filter_size))
+    return film.converged - before

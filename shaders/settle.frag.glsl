@@ -1,0 +1,45 @@
+/* The settle mask (programs.SETTLE, engine/frame/settle.py), once after a frame's first
+ * sample(s): a pixel settles, taking no further samples, when no later sample can move it
+ * by the Noise Threshold. Two causes could:
+ *   - a light: the settle test's flags (``flags``: red 1 where no moving light's visibility
+ *     or facet can change, green the change of reflected light over the lights' extents),
+ *     needed settled over the pixel's 3x3 neighbourhood (the pixel filter reaches into it);
+ *   - the pixel filter: later samples look elsewhere in the pixel. For an image f smooth
+ *     over the filter, the samples kept (their offsets' mean m_k and second moments S_k)
+ *     differ from the whole frame's (m, S) by
+ *       grad f . (m_k - m) + 1/2 tr(H (S_k - S)),
+ *     bounded here by |f_x dm_x| + |f_y dm_y| + 1/2 K (|dS_xx| + |dS_yy| + 2 |dS_xy|), with
+ *     central differences of the image so far (``accum`` / ``weight_sum``) and K the largest
+ *     second difference along the four lines through the pixel (rows, columns, diagonals):
+ *     an edge within the filter's reach (0.75 px) has a neighbour on its other side, which
+ *     one of them sees, as it sees a thin line or a texture's detail.
+ * Both in Cycles' error units (sum over RGBA of |change| over sqrt of the pixel's RGB),
+ * against ``threshold``. A pixel already converged stays so. */
+void main()
+{
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  if (texelFetch(converged, p, 0).r > 0.5) {
+    out_color = vec4(1.0);
+    return;
+  }
+  ivec2 size = textureSize(accum, 0);
+  float inv = (weight_sum > 0.0) ? 1.0 / weight_sum : 0.0;
+  bool settled = true;
+  vec4 c[9];
+  for (int y = -1; y <= 1; y++) {
+    for (int x = -1; x <= 1; x++) {
+      ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
+      settled = settled && texelFetch(flags, q, 0).r > 0.5;
+      c[(y + 1) * 3 + (x + 1)] = texelFetch(accum, q, 0) * inv;
+    }
+  }
+  vec4 fx = 0.5 * (c[5] - c[3]), fy = 0.5 * (c[7] - c[1]);
+  vec4 k = max(max(abs(c[5] - 2.0 * c[4] + c[3]), abs(c[7] - 2.0 * c[4] + c[1])),
+               max(abs(c[8] - 2.0 * c[4] + c[0]), abs(c[6] - 2.0 * c[4] + c[2])));
+  vec3 m2 = abs(moment_shift);
+  vec4 change = abs(fx * mean_shift.x) + abs(fy * mean_shift.y) + 0.5 * k * (m2.x + m2.y + 2.0 * m2.z);
+  vec4 I = c[4];
+  float spread = texelFetch(flags, p, 0).g;
+  float error = (dot(change, vec4(1.0)) + spread) / (0.0001 + sqrt(max(I.r + I.g + I.b, 0.0)));
+  out_color = vec4((settled && error < threshold) ? 1.0 : 0.0);
+}
