@@ -96,7 +96,11 @@ class LitPass:
             program = lit_program(
                 frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux, tree
             )
-            shader = self.shaders.get(program, data.defines)
+            defines = data.defines
+            if bool(defines.get("AUX_OUTPUTS")) != with_aux:
+                # Blended surfaces of a frame with passes draw into the colour target alone.
+                defines = {**defines, "AUX_OUTPUTS": with_aux}
+            shader = self.shaders.get(program, defines)
             if bound["shader"] is shader:
                 return shader
             if tree is not None and "ORIGIN" in tree.needs:

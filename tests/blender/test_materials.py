@@ -252,6 +252,19 @@ def test_alpha_covers_a_quarter_and_its_shadow_lets_three_quarters_through(penum
     assert ours.std(axis=(0, 1)).max() < 0.06, ours.std(axis=(0, 1))
 
 
+def test_a_blended_surface_renders_beside_the_passes(penumbra):
+    """A blended surface in a final render with Depth and Shadow passes: its variant writes
+    the colour target alone (it failed to compile asking for the passes' outputs), Combined
+    is the render's without passes, and Depth is the ground's under it (blended surfaces stay
+    out of the depth, as in EEVEE): the top view looks down from 10 m."""
+    scene = _builder("alpha_blend")
+    scene.penumbra.render_samples = 4
+    alone = render(scene)["Combined"]
+    passes = render(scene, passes=("Combined", "Depth", "Shadow"))
+    np.testing.assert_allclose(passes["Combined"], alone, atol=1e-5)
+    np.testing.assert_allclose(_alpha_region(passes["Depth"], scene)[..., 0], 10.0, atol=1e-3)
+
+
 @pytest.mark.parametrize("transparent", [True, False])
 def test_alpha_textured_plane_casts_the_analytic_checker_shadow(penumbra, transparent):
     """The ground seen from between it and the checker plane: shadowed exactly under opaque
