@@ -43,6 +43,9 @@
 #ifndef NODE_LOBES
 #  define NODE_LOBES 1
 #endif
+#ifndef NODE_PROCEDURAL
+#  define NODE_PROCEDURAL 0 /* a compiled node tree with procedural textures (programs.with_tree) */
+#endif
 
 struct Surface {
   vec3 P, N, V;
@@ -178,17 +181,17 @@ vec3 reflected_light(LightData L, Surface s, vec3 to_light, float irradiance)
  * centre's, halved (a uniform disc's second moment is half theirs). A highlight narrower
  * than the light, or a light close to the surface, does not settle. Also whether a facet
  * turns across the light. */
-void settle_light(LightData L, Surface s, vec3 to_light, float irradiance, float NgdotL)
+bool settle_light(LightData L, Surface s, vec3 to_light, float irradiance, float NgdotL)
 {
   bool sun = L.type == LIGHT_SUN;
   float extent = sun ? L.sun_tan_half_angle : L.shadow_radius;
   if (!(extent > 0.0)) {
-    return;
+    return false;
   }
   float angle = sun ? extent : extent / max(length(L.position - s.P), 1e-30);
   if (abs(NgdotL) < 1.5 * angle || abs(dot(s.Nf, to_light)) < 1.5 * angle) {
     settle_unstable = true; /* a facet (or the smooth normal) turns across the light */
-    return;
+    return true;
   }
   vec3 a = normalize(cross(to_light, (abs(to_light.z) < 0.9) ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0)));
   vec3 b = cross(to_light, a);
@@ -210,6 +213,22 @@ void settle_light(LightData L, Surface s, vec3 to_light, float irradiance, float
     mean += 0.25 * reflected_light(L, s, l, e);
   }
   settle_spread += 0.5 * dot(abs(mean - c0), vec3(1.0));
+  return dot(mean, vec3(1.0)) > 0.0;
+}
+
+/* A light that does not reach P from its centre (outside a spot's cone, behind the surface)
+ * but may from other points of it: the pixel settles only if those points see P, for the
+ * Shadow pass counts the light wherever it arrives. */
+void settle_unreached(LightData L, Surface s, vec3 to_light, float irradiance, const int filter_id)
+{
+  if (!settle_light(L, s, to_light, irradiance, dot(s.Ng, to_light)) || filter_id == NO_SHADOW) {
+    return;
+  }
+  float NgdotL = dot(s.Ng, to_light);
+  float v = (NgdotL <= 0.0) ? 0.0 : shadow_visibility(L, s.P, s.Ng, s.Nf, NgdotL, dot(s.Nf, to_light), filter_id);
+  if (v != 1.0) {
+    settle_unstable = true;
+  }
 }
 #endif
 
@@ -235,6 +254,11 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
 #if NODE_LOBES == 2
   float NdotL_b = dot(s.N_b, to_light);
   if ((NdotL <= 0.0 && NdotL_b <= 0.0) || irradiance <= 0.0) {
+#  if SETTLE_TEST
+    if (filter_id == FILTER_PCSS || filter_id == NO_SHADOW) {
+      settle_unreached(L, s, to_light, irradiance, filter_id); /* other points may reach it */
+    }
+#  endif
     return;
   }
   float cosine_a = (NdotL > 0.0) ? cosine_term(NdotL) : 0.0;
@@ -242,6 +266,11 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   float cosine = (s.w.y > s.w.x) ? cosine_b : cosine_a; /* the Shadow pass's: the heavier lobe's */
 #else
   if (NdotL <= 0.0 || irradiance <= 0.0) {
+#  if SETTLE_TEST
+    if (filter_id == FILTER_PCSS || filter_id == NO_SHADOW) {
+      settle_unreached(L, s, to_light, irradiance, filter_id); /* other points may reach it */
+    }
+#  endif
     return;
   }
   float cosine = cosine_term(NdotL);
@@ -591,6 +620,12 @@ void main()
 #endif
 #if SETTLE_TEST
   bool settled = !settle_unstable;
+#  if NODE_PROCEDURAL
+  /* Procedural textures are evaluated at each sample's point, unfiltered: one sample cannot
+   * tell their detail under the pixel (mortar lines between pixel centres), so they keep
+   * sampling. Image textures are filtered (mipmaps) and settle. */
+  settled = false;
+#  endif
 #  if ALPHA_MODE == 1 || ALPHA_MODE == 2
   settled = settled && coverage >= 1.0; /* what is behind shows in some samples */
 #  endif

@@ -8,13 +8,18 @@
  *     over the filter, the samples kept (their offsets' mean m_k and second moments S_k)
  *     differ from the whole frame's (m, S) by
  *       grad f . (m_k - m) + 1/2 tr(H (S_k - S)),
- *     bounded here by |f_x dm_x| + |f_y dm_y| + 1/2 K (|dS_xx| + |dS_yy| + 2 |dS_xy|), with
- *     central differences of the image so far (``accum`` / ``weight_sum``) and K the largest
- *     second difference along the four lines through the pixel (rows, columns, diagonals):
- *     an edge within the filter's reach (0.75 px) has a neighbour on its other side, which
- *     one of them sees, as it sees a thin line or a texture's detail.
+ *     with central differences of the image so far (``accum`` / ``weight_sum``) and K the
+ *     largest second difference along the four lines through the pixel (rows, columns,
+ *     diagonals). That holds where f is smooth; an edge within the filter's reach (0.75 px)
+ *     moves the filtered value by up to half its step, and has a neighbour on its other side:
+ *     so the change is bounded by the larger of the smooth estimate and half of R, the
+ *     largest departure of a neighbour from the plane through the pixel (its gradient), which
+ *     is a step's size at an edge, a thin line or a texture's detail, and small where the
+ *     image is smooth.
  * Both in Cycles' error units (sum over RGBA of |change| over sqrt of the pixel's RGB),
- * against ``threshold``. A pixel already converged stays so. */
+ * against ``threshold``; WITH_SHADOW, the Shadow pass's change too (in visibility), so a
+ * silhouette between two surfaces of the same colour, one lit and one in shadow, samples on.
+ * A pixel already converged stays so. */
 void main()
 {
   ivec2 p = ivec2(gl_FragCoord.xy);
@@ -38,6 +43,33 @@ void main()
                max(abs(c[8] - 2.0 * c[4] + c[0]), abs(c[6] - 2.0 * c[4] + c[2])));
   vec3 m2 = abs(moment_shift);
   vec4 change = abs(fx * mean_shift.x) + abs(fy * mean_shift.y) + 0.5 * k * (m2.x + m2.y + 2.0 * m2.z);
+  vec4 r = vec4(0.0);
+  for (int y = -1; y <= 1; y++) {
+    for (int x = -1; x <= 1; x++) {
+      r = max(r, abs(c[(y + 1) * 3 + (x + 1)] - c[4] - fx * float(x) - fy * float(y)));
+    }
+  }
+  change = max(change, 0.5 * r);
+#if WITH_SHADOW
+  {
+    float v[9];
+    for (int y = -1; y <= 1; y++) {
+      for (int x = -1; x <= 1; x++) {
+        v[(y + 1) * 3 + (x + 1)] = texelFetch(accum_shadow, clamp(p + ivec2(x, y), ivec2(0), size - 1), 0).r * inv;
+      }
+    }
+    float ks = max(max(abs(v[5] - 2.0 * v[4] + v[3]), abs(v[7] - 2.0 * v[4] + v[1])),
+                   max(abs(v[8] - 2.0 * v[4] + v[0]), abs(v[6] - 2.0 * v[4] + v[2])));
+    float sx = 0.5 * (v[5] - v[3]), sy = 0.5 * (v[7] - v[1]);
+    float shadow_change = abs(sx * mean_shift.x) + abs(sy * mean_shift.y) + 0.5 * ks * (m2.x + m2.y + 2.0 * m2.z);
+    for (int y = -1; y <= 1; y++) {
+      for (int x = -1; x <= 1; x++) {
+        shadow_change = max(shadow_change, 0.5 * abs(v[(y + 1) * 3 + (x + 1)] - v[4] - sx * float(x) - sy * float(y)));
+      }
+    }
+    settled = settled && shadow_change < threshold;
+  }
+#endif
   vec4 I = c[4];
   float spread = texelFetch(flags, p, 0).g;
   float error = (dot(change, vec4(1.0)) + spread) / (0.0001 + sqrt(max(I.r + I.g + I.b, 0.0)));

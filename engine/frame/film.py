@@ -20,6 +20,7 @@ from .programs import (
     SCALED_COPY,
     SCALED_COPY_SHADOW,
     SETTLE,
+    SETTLE_SHADOW,
     WEIGHTED_RESOLVE,
     WEIGHTED_RESOLVE_SHADOW,
 )
@@ -316,7 +317,7 @@ class Film:
         self._settle[1].clear(format="FLOAT", value=(1.0, 0.0, 0.0, 0.0))
         return self._settle[2]
 
-    def settle(self, threshold, shifts):
+    def settle(self, threshold, shifts, aux=False):
         """After the pilot sample (accumulated with weight 1): settle the pixels no later
         sample can change by ``threshold`` (the flags in ``settle_framebuffer`` and the image
         so far; ``shifts``: ``settle.settle_shifts``): they join the converged pixels with
@@ -327,13 +328,17 @@ class Film:
         (mx, my), (sxx, syy, sxy) = shifts
         src, dst = self._mask_index, 1 - self._mask_index
         samplers = {"accum": self._accum_color, "flags": self._settle[1], "converged": self._masks[src]}
+        with_shadow = aux and self._accum_shadow is not None  # (``aux``: the frame has the Shadow pass)
+        if with_shadow:
+            samplers["accum_shadow"] = self._accum_shadow
         uniforms = {
             "threshold": float(threshold),
             "weight_sum": float(self._weight_sum),
             "mean_shift": (float(mx), float(my)),
             "moment_shift": (float(sxx), float(syy), float(sxy)),
         }
-        self.fullscreen(SETTLE, self._mask_fbs[dst], samplers, uniforms)
+        program = SETTLE_SHADOW if with_shadow else SETTLE
+        self.fullscreen(program, self._mask_fbs[dst], samplers, uniforms)
         count = self._take_mask(dst)
         # The pilot stays only where it settled (with its weight, 1); the other pixels start
         # their samples afresh.

@@ -323,8 +323,10 @@ def with_tree(program, tree):
     its constants block and image samplers, and the per-draw values it reads."""
     libs = tuple(f"nodes/{f}.glsl" for f in tree.families if f"nodes/{f}.glsl" not in program.libs)
     pushes = tuple(p for need in sorted(tree.needs) for p in TREE_UNIFORMS.get(need, ()))
+    procedural = any(f.startswith("texture_") for f in tree.families)
     return replace(
         program,
+        defines=program.defines + (("NODE_PROCEDURAL", procedural),),
         libs=program.libs + libs,
         generated=tree.code,
         uniform_blocks=program.uniform_blocks
@@ -462,6 +464,13 @@ SETTLE = Program(
     ),
     samplers=(("FLOAT_2D", "accum"), ("FLOAT_2D", "flags"), ("FLOAT_2D", "converged")),
     outputs=(("VEC4", "out_color"),),
+    defines=(("WITH_SHADOW", False),),
+)
+SETTLE_SHADOW = replace(
+    SETTLE,
+    name="settle_shadow",
+    samplers=SETTLE.samplers + (("FLOAT_2D", "accum_shadow"),),
+    defines=(("WITH_SHADOW", True),),
 )
 MASK_SCALE = Program(
     name="mask_scale",

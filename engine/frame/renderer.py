@@ -147,7 +147,7 @@ class Renderer:
             film.accumulate(1.0, aux, emission, 0)
             if aux:
                 film.keep_centre()  # the Depth and Normal passes, for settled pixels too
-            stats.pixels_settled = settle_pixels(self, draws, snapshot, settings, adaptive, sample_count)
+            stats.pixels_settled = settle_pixels(self, draws, snapshot, settings, adaptive, sample_count, aux)
         for s in range(start, stop):
             if accumulate and film.converged >= pixels:
                 stats.stopped = "converged"  # (a later call of a frame that has converged)

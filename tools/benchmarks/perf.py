@@ -12,8 +12,9 @@ Sections (``--sections``, all by default):
   passes      the demo scene at 960x540, F12, timed pass by pass (the GPU waited for with a
               one-pixel read-back before and after each pass): the depth pass and the lit pass
               with PCF 5x5, with a single-tap filter (NONE) and with shadows off
-  samples     the demo at 960x540, F12 at 1 and 16 samples against Workbench: one further
-              sample's cost against the first, the 16-sample frame's lit and shadow passes
+  samples     the demo at 960x540, F12 at 1, 16 and 64 samples against Workbench, with pixels
+              settling (Noise Threshold 0.01) and without (0): one further sample's cost
+              against the first, the pixels settled, each frame's lit and shadow passes
   viewport    the viewport path at 960x540 (demo scene with its post layers), one engine
               instance: display only, redraw with nothing changed, camera moving, scene edited
   lights      N shadowed spot lights over a field of boxes (N = 1, 8, 32, 64): F12, and the
@@ -297,7 +298,9 @@ def _time_passes(times, current):
     def recorded(method):
         def run(self, *args, **kwargs):
             current["renderer"] = self  # the renderer whose targets ``_wait`` reads
-            return method(self, *args, **kwargs)
+            out = method(self, *args, **kwargs)
+            current["stats"] = out.stats  # the last frame's FrameStats
+            return out
 
         return run
 
@@ -317,32 +320,44 @@ def _restore(originals):
         setattr(owner, name, method)
 
 
+# The samples section's cases: (render samples, Noise Threshold). The default threshold lets
+# pixels settle after the pilot sample; 0 takes every sample in every pixel.
+SAMPLE_CASES = ((1, 0.01), (16, 0.01), (16, 0.0), (64, 0.01), (64, 0.0))
+
+
 def section_samples(plan):
-    """The demo at 960x540, F12 at 1 and 16 render samples against Workbench, interleaved: what
-    one further sample costs against the first, and how the 16-sample frame's time splits into
-    shadow (depth) passes and lit passes (summed over its samples, each timed as in
-    ``passes``)."""
+    """The demo at 960x540, F12 at 1, 16 and 64 render samples against Workbench, interleaved:
+    what one further sample costs against the first, with pixels settling (the default Noise
+    Threshold) and without (threshold 0), the pixels settled, and how each frame's time splits
+    into shadow (depth) passes and lit passes (summed over its samples, the pilot's and the
+    settle test's included, each timed as in ``passes``)."""
     scene = demo(960, 540)
     times, current = {}, {}
-    frames = {1: [], 16: []}
+    frames = {case: [] for case in SAMPLE_CASES}
+    settled = {}
     workbench = []
     originals = _time_passes(times, current)
+
+    def setup(case):
+        _penumbra(scene)
+        scene.penumbra.render_samples, scene.penumbra.adaptive_threshold = case
+
     try:
-        for n in frames:  # warm-up
-            _penumbra(scene)
-            scene.penumbra.render_samples = n
+        for case in frames:  # warm-up
+            setup(case)
             _render()
         _workbench(scene)
         _render()
         for run in range(plan["runs"]):
-            for n in frames:
-                _penumbra(scene)
-                scene.penumbra.render_samples = n
-                current["case"] = (n, run)
+            for case in frames:
+                setup(case)
+                current["case"] = (case, run)
                 start = time.perf_counter()
                 _render()
-                frames[n].append(time.perf_counter() - start)
+                frames[case].append(time.perf_counter() - start)
                 current.pop("case")
+                stats = current["stats"]
+                settled[case] = stats.pixels_settled / (960 * 540)
             _workbench(scene)
             start = time.perf_counter()
             _render()
@@ -350,25 +365,26 @@ def section_samples(plan):
     finally:
         _restore(originals)
         _penumbra(scene)
+        scene.penumbra.adaptive_threshold = 0.01
     w = statistics.median(workbench)
-    one, sixteen = statistics.median(frames[1]), statistics.median(frames[16])
+    one = statistics.median(frames[(1, 0.01)])
 
-    def part(name):
-        return statistics.median(sum(times.get(((16, r), name), [0.0])) for r in range(plan["runs"]))
+    def part(case, name):
+        return statistics.median(sum(times.get(((case, r), name), [0.0])) for r in range(plan["runs"]))
 
-    lit, depth = part("lit pass"), part("depth pass")
-    extra = (sixteen - one) / 15.0 / one
-    return [
-        _row("samples", "1 sample", {"PENUMBRA": one, "WORKBENCH": w}, runs=plan["runs"]),
-        _row(
-            "samples",
-            "16 samples",
-            {"PENUMBRA": sixteen, "WORKBENCH": w},
-            f"samples 2-16: {extra:.2f}x the first each; lit passes {lit * 1e3:.0f} ms ({lit / sixteen:.0%}), "
-            f"shadow passes {depth * 1e3:.0f} ms ({depth / sixteen:.0%})",
-            plan["runs"],
-        ),
-    ]
+    rows = [_row("samples", "1 sample", {"PENUMBRA": one, "WORKBENCH": w}, runs=plan["runs"])]
+    for case in SAMPLE_CASES[1:]:
+        n, threshold = case
+        t = statistics.median(frames[case])
+        lit, depth = part(case, "lit pass"), part(case, "depth pass")
+        label = f"{n} samples, " + (f"Noise Threshold {threshold:g}" if threshold else "threshold 0 (no settling)")
+        note = (
+            f"samples 2-{n}: {(t - one) / (n - 1) / one:.2f}x the first each; "
+            f"{settled[case]:.1%} of pixels settled; lit passes {lit * 1e3:.0f} ms ({lit / t:.0%}), "
+            f"shadow passes {depth * 1e3:.0f} ms ({depth / t:.0%})"
+        )
+        rows.append(_row("samples", label, {"PENUMBRA": t, "WORKBENCH": w}, note, plan["runs"]))
+    return rows
 
 
 def section_passes(plan):
