@@ -13,7 +13,6 @@ from .programs import (
     CONVERGED_DEPTH,
     CONVERGENCE,
     CONVERGENCE_ERROR,
-    MASK_SCALE,
     MASKED_COPY,
     MASKED_COPY_SHADOW_WEIGHT,
     MASKED_COPY_WEIGHT,
@@ -21,6 +20,7 @@ from .programs import (
     SCALED_COPY_SHADOW,
     SETTLE,
     SETTLE_SHADOW,
+    SETTLED_COPY,
     WEIGHTED_RESOLVE,
     WEIGHTED_RESOLVE_SHADOW,
 )
@@ -63,6 +63,13 @@ class FrameOutput:
 
     def shadow_array(self):
         return texture_array(self.shadow, 1)[..., 0]
+
+
+def gpu_framebuffer(texture):
+    """A framebuffer drawing into ``texture`` alone."""
+    import gpu
+
+    return gpu.types.GPUFrameBuffer(color_slots=(texture,))
 
 
 def buffer_array(buf):
@@ -317,41 +324,39 @@ class Film:
         self._settle[1].clear(format="FLOAT", value=(1.0, 0.0, 0.0, 0.0))
         return self._settle[2]
 
-    def settle(self, threshold, shifts, aux=False):
-        """After the pilot sample (accumulated with weight 1): settle the pixels no later
-        sample can change by ``threshold`` (the flags in ``settle_framebuffer`` and the image
-        so far; ``shifts``: ``settle.settle_shifts``): they join the converged pixels with
-        the pilot as their value; every other pixel starts afresh, as if the pilot had not
-        been taken. Returns the number of converged pixels."""
-        import gpu
-
+    def settle(self, threshold, shifts, aux=False, emission=False):
+        """After the first sample, with the pilot sample in the colour (and shadow, Emission)
+        targets: settle the pixels no later sample can change by ``threshold`` (the flags in
+        ``settle_framebuffer`` and the pilot's image; ``shifts``: ``settle.settle_shifts``).
+        They join the converged pixels with the pilot's value in place of the first sample's
+        (the same weight); the others keep their first sample. ``aux``/``emission``: the frame
+        has the Shadow / Emission pass. Returns the number of converged pixels."""
         (mx, my), (sxx, syy, sxy) = shifts
         src, dst = self._mask_index, 1 - self._mask_index
-        samplers = {"accum": self._accum_color, "flags": self._settle[1], "converged": self._masks[src]}
-        with_shadow = aux and self._accum_shadow is not None  # (``aux``: the frame has the Shadow pass)
+        samplers = {"accum": self.color, "flags": self._settle[1], "converged": self._masks[src]}
+        with_shadow = aux and self._accum_shadow is not None
         if with_shadow:
-            samplers["accum_shadow"] = self._accum_shadow
+            samplers["accum_shadow"] = self.shadow
         uniforms = {
             "threshold": float(threshold),
-            "weight_sum": float(self._weight_sum),
+            "weight_sum": 1.0,  # the pilot alone
             "mean_shift": (float(mx), float(my)),
             "moment_shift": (float(sxx), float(syy), float(sxy)),
         }
         program = SETTLE_SHADOW if with_shadow else SETTLE
         self.fullscreen(program, self._mask_fbs[dst], samplers, uniforms)
         count = self._take_mask(dst)
-        # The pilot stays only where it settled (with its weight, 1); the other pixels start
-        # their samples afresh.
-        mask = self._masks[dst]
-        emission = self._emission_targets[0] if self._emission_targets is not None else None
-        for target in (self._accum_color, self._accum_shadow, emission, self._weight):
-            if target is not None:
-                framebuffer = gpu.types.GPUFrameBuffer(color_slots=(target,))
-                self.fullscreen(MASK_SCALE, framebuffer, {"converged": mask}, {}, "MULTIPLY")
-        if self._half is not None:
-            self._half.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
-        self._weight_sum = 0.0
-        self.sample_weights = []
+        if count:
+            mask = self._masks[dst]
+            copies = [(self._accum_color, self.color)]
+            if with_shadow:
+                copies.append((self._accum_shadow, self.shadow))
+            if emission and self._emission_targets is not None:
+                copies.append((self._emission_targets[0], self.emission))
+            for target, source in copies:
+                framebuffer = gpu_framebuffer(target)
+                scale = self._weight_sum  # the first sample's weight, which the pilot takes over
+                self.fullscreen(SETTLED_COPY, framebuffer, {"src_color": source, "converged": mask}, {"scale": scale})
         return count
 
     def check(self, threshold):

@@ -472,12 +472,13 @@ SETTLE_SHADOW = replace(
     samplers=SETTLE.samplers + (("FLOAT_2D", "accum_shadow"),),
     defines=(("WITH_SHADOW", True),),
 )
-MASK_SCALE = Program(
-    name="mask_scale",
+SETTLED_COPY = Program(
+    name="settled_copy",
     vertex="fullscreen.vert.glsl",
-    fragment="mask_scale.frag.glsl",
+    fragment="settled_copy.frag.glsl",
     vertex_in=(("VEC2", "pos"),),
-    samplers=(("FLOAT_2D", "converged"),),
+    push_constants=(("FLOAT", "scale"),),
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "converged")),
     outputs=(("VEC4", "out_color"),),
 )
 CONVERGED_DEPTH = Program(

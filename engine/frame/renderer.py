@@ -135,20 +135,22 @@ class Renderer:
         if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + adaptive.time_limit
         pixels = width * height
-        pilot = settle and start == 0 and start < stop
-        if pilot:
-            # The pilot sample (settle.py): the centred pixel with every light at its centre,
-            # whose maps the settle test reads; it stays only in the pixels that settle.
-            centred = [
-                dataclasses.replace(lt, sampled=True, jittered=jitter) if i in moving else lt
-                for i, lt in enumerate(lights)
-            ]
-            plan = self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True)
-            film.accumulate(1.0, aux, emission, 0)
-            if aux:
-                film.keep_centre()  # the Depth and Normal passes, for settled pixels too
-            stats.pixels_settled = settle_pixels(self, draws, snapshot, settings, adaptive, sample_count, aux)
         for s in range(start, stop):
+            if settle and s == 1:
+                # Before the second sample, the pilot (settle.py): the centred pixel with every
+                # light at its centre, whose maps the settle test reads; settled pixels take
+                # its value in place of the first sample's and take no more samples.
+                centred = [
+                    dataclasses.replace(lt, sampled=True, jittered=jitter) if i in moving else lt
+                    for i, lt in enumerate(lights)
+                ]
+                self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True)
+                stats.pixels_settled = settle_pixels(
+                    self, draws, snapshot, settings, adaptive, sample_count, aux, emission
+                )
+                if film.converged >= pixels:
+                    stats.stopped = "converged"
+                    break
             if accumulate and film.converged >= pixels:
                 stats.stopped = "converged"  # (a later call of a frame that has converged)
                 break
@@ -178,7 +180,7 @@ class Renderer:
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
                 film.accumulate(weight, aux, emission, s)
-            if aux and accumulate and s == 0 and not pilot:  # the centred sample's depth and normal
+            if aux and accumulate and s == 0:  # the centred sample's depth and normal
                 film.keep_centre()
             stats.samples += 1
             # (No check after a frame's last sample: it ends there anyway.)
@@ -195,7 +197,7 @@ class Renderer:
             if stats.stopped:
                 break
         stats.pixels_converged = film.converged if accumulate else 0
-        if accumulate and (stats.samples or pilot):
+        if accumulate and stats.samples:
             film.resolve(aux, emission)
         self.batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()})
         debug_image = None

@@ -56,12 +56,12 @@ def settle_shifts(kept, count, filter_size):
     return tuple(mean_k - mean_n), tuple(second_k - second_n)
 
 
-def settle(renderer, draws, snapshot, settings, adaptive, sample_count, aux=False):
+def settle(renderer, draws, snapshot, settings, adaptive, sample_count, aux=False, emission=False):
     """Settle the pixels of ``renderer``'s film no later sample can change by
     ``adaptive.settle``: the settle test's variant of the lit pass over the last sample's
     surfaces, maps and lights (each light at its whole size), then the film's settle pass.
-    ``aux``: the frame has the Shadow pass, which must not change either. Returns the number
-    of pixels settled."""
+    ``aux``: the frame has the Shadow pass, which must not change either; ``emission``: and
+    the Emission pass. Returns the number of pixels settled."""
     film = renderer.film
     width, height = film.size
     plan = renderer._last_plan
@@ -93,5 +93,5 @@ def settle(renderer, draws, snapshot, settings, adaptive, sample_count, aux=Fals
         film, seen, view_camera, data, atlas, world, settings, False, False, stats, renderer._origin, masks, target
     )
     before = film.converged
-    film.settle(adaptive.settle, settle_shifts(1, sample_count, settings.filter_size), aux)
+    film.settle(adaptive.settle, settle_shifts(1, sample_count, settings.filter_size), aux, emission)
     return film.converged - before

@@ -1,13 +1,14 @@
-"""Settling (engine/frame/settle.py): after a pilot sample, a pixel that no later sample can
-change by the Noise Threshold takes no more samples.
+"""Settling (engine/frame/settle.py): after the first sample, a pilot sample (lights at their
+centres) settles the pixels no later sample can change by the Noise Threshold: they take the
+pilot's value and no more samples.
 
-What is checked: a settled pixel is shaded by the pilot alone (counted by the lit pass itself)
-and every other pixel by every sample; settled pixels hold what the samples would give them
-(against a plain 64-sample frame, in Cycles' error units, on scenes with soft and sharp
-shadows, highlights of a sphere light, anti-aliased edges); pixels the samples do change
-(penumbrae, edges, dithered and blended surfaces, procedural textures) never settle; a frame
-with nothing but the world settles whole after the pilot; the passes of settled pixels are
-the plain frame's."""
+What is checked: a settled pixel is shaded by the first sample alone (counted by the lit pass
+itself; the pilot is not a sample) and every other pixel by every sample; settled pixels hold
+what the samples would give them (against a plain 64-sample frame, in Cycles' error units, on
+scenes with soft and sharp shadows, highlights of a sphere light, anti-aliased edges); pixels
+the samples do change (penumbrae, edges, dithered and blended surfaces, procedural textures)
+never settle; a frame with nothing but the world settles whole at the pilot; the passes of
+settled pixels are the plain frame's."""
 
 import math
 
@@ -67,19 +68,19 @@ def _demo():
     return scene
 
 
-def test_a_settled_pixel_is_shaded_by_the_pilot_alone(penumbra, gpu_call):
-    """The lit pass's counting variant adds 1 per pixel it shades. A settled pixel is shaded
-    once (the pilot: as often as a single-sample frame shades it) and never again; every other
-    pixel by the pilot and by every sample, as the plain frame shades it."""
+def test_a_settled_pixel_is_shaded_by_the_first_sample_alone(penumbra, gpu_call):
+    """The lit pass's counting variant adds 1 per sample to each pixel it shades. A settled
+    pixel is shaded by the first sample (as often as a single-sample frame shades it) and
+    never again; every other pixel by every sample, as the plain frame shades it."""
     count = 16
     plain, settled, _ref, mask, stats, (plain_shaded, settled_shaded, one_shaded) = _frames(
         gpu_call, _demo(), count, reference=count, counted=True
     )
     assert 0.4 * mask.size < mask.sum() < 0.95 * mask.size, mask.mean()
     np.testing.assert_array_equal(settled_shaded[mask], one_shaded[mask])
-    np.testing.assert_array_equal(settled_shaded[~mask], one_shaded[~mask] + plain_shaded[~mask])
+    np.testing.assert_array_equal(settled_shaded[~mask], plain_shaded[~mask])
     assert stats.samples == count and stats.pixels_settled == stats.pixels_converged == mask.sum()
-    assert stats.pixel_samples_skipped == count * mask.sum()
+    assert stats.pixel_samples_skipped == (count - 1) * mask.sum()
     # The unsettled pixels took the plain frame's samples: the same values, to float rounding.
     np.testing.assert_allclose(settled[~mask], plain[~mask], atol=1e-5)
 
@@ -184,14 +185,14 @@ def test_procedural_textures_keep_sampling_image_textures_settle(penumbra, gpu_c
     assert mask.mean() > 0.5
 
 
-def test_a_frame_of_only_the_world_settles_after_the_pilot(penumbra, gpu_call):
-    """Nothing but the world: every pixel settles after the pilot, the frame ends there
-    ("converged", no further sample) and holds the world's colour; F12 writes it."""
+def test_a_frame_of_only_the_world_settles_at_the_pilot(penumbra, gpu_call):
+    """Nothing but the world: every pixel settles at the pilot, the frame ends after its first
+    sample ("converged") and holds the world's colour; F12 writes it."""
     scene = scenes.empty_scene(32, 24)
     scenes.set_world(scene, (0.2, 0.3, 0.4))
     scenes.top_camera(scene)
     _plain, settled, _ref, mask, stats, _ = _frames(gpu_call, scene, 16, reference=1)
-    assert mask.all() and stats.samples == 0 and stats.stopped == "converged"
+    assert mask.all() and stats.samples == 1 and stats.stopped == "converged"
     assert stats.pixels_settled == mask.size
     np.testing.assert_allclose(settled[..., :3], np.broadcast_to((0.2, 0.3, 0.4), settled[..., :3].shape), atol=1e-6)
     scene.penumbra.render_samples = 16

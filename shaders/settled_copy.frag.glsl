@@ -1,0 +1,11 @@
+/* Where a pixel settled (programs.SETTLED_COPY, engine/frame/settle.py): the pilot's value,
+ * times the first sample's weight, replaces what the first sample added; elsewhere nothing
+ * is written. */
+void main()
+{
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  if (texelFetch(converged, p, 0).r < 0.5) {
+    discard;
+  }
+  out_color = texelFetch(src_color, p, 0) * scale;
+}
