@@ -58,6 +58,12 @@ def add_arguments(parser):
     parser.add_argument(
         "--sweep-only", action="store_true", help="only the error/time sweep: no demo-scene cost, no close-up"
     )
+    parser.add_argument(
+        "--noise-threshold",
+        type=float,
+        default=None,
+        help="Penumbra's Noise Threshold (default: the scene's, 0.01; 0: no settling, no noise check)",
+    )
 
 
 def log(message):
@@ -86,7 +92,8 @@ def sweep(plan, cache):
         vis_ref = kit.cycles_reference(name, plan["reference_spp"], w, h, cache)
         lum_ref = kit.cycles_luminance(name, plan["reference_spp"], w, h, cache)
         scene = kit.build(name, w, h)
-        configs = [("Penumbra", n, "PENUMBRA", {"render_samples": n}) for n in plan["samples"]]
+        penumbra = {} if plan.get("threshold") is None else {"adaptive_threshold": plan["threshold"]}
+        configs = [("Penumbra", n, "PENUMBRA", {"render_samples": n, **penumbra}) for n in plan["samples"]]
         configs += [("Cycles", n, "CYCLES", {"samples": n}) for n in plan["cycles_spp"]]
         configs += [("EEVEE", EEVEE_SAMPLES, "EEVEE", {"taa_render_samples": EEVEE_SAMPLES})]
         for label, n, engine, settings in configs:
@@ -201,6 +208,7 @@ def run(args):
         plan["scenes"] = tuple(name.strip() for name in args.scenes.split(",") if name.strip())
     if args.samples:
         plan["samples"] = tuple(int(n) for n in args.samples.split(","))
+    plan["threshold"] = args.noise_threshold
     if args.cycles_spp:
         plan["cycles_spp"] = tuple(int(n) for n in args.cycles_spp.split(","))
     args.out.mkdir(parents=True, exist_ok=True)
