@@ -216,3 +216,36 @@ def test_the_passes_of_settled_pixels_are_the_plain_frames(penumbra):
     changed = np.abs(settled["Combined"] - plain["Combined"]).max(-1) > 1e-5  # settled pixels, some
     assert changed.mean() > 0.05
     assert np.abs(settled["Shadow"] - plain["Shadow"]).max() < SHADOW_TOLERANCE
+
+
+def test_a_single_sample_after_a_settled_frame_shades_every_pixel(penumbra, gpu_call):
+    """The same renderer, the same size: a one-sample frame after a frame whose pixels settled
+    is the one-sample frame of a fresh renderer (it once kept the earlier frame's settled
+    pixels out of its lit pass, leaving them the background)."""
+    from penumbra.engine.frame.renderer import Renderer
+    from penumbra.engine.frame.sampling import adaptive_settings
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    scene = _demo()
+
+    def job(engine, depsgraph):
+        cam = camera_from_scene(depsgraph, scene, 160, 90)
+        engine.renderer = Renderer()
+        settled = engine.render_frame(
+            depsgraph,
+            cam,
+            160,
+            90,
+            aux=False,
+            samples=(0, 8),
+            sample_count=8,
+            adaptive=adaptive_settings(True, THRESHOLD, 0, 0.0, 8),
+        )
+        after = engine.render_frame(depsgraph, cam, 160, 90, aux=False).color_array().copy()
+        engine.renderer = Renderer()
+        fresh = engine.render_frame(depsgraph, cam, 160, 90, aux=False).color_array().copy()
+        return settled.stats.pixels_settled, after, fresh
+
+    count, after, fresh = gpu_call(job)
+    assert count > 0.3 * 160 * 90
+    np.testing.assert_array_equal(after, fresh)
