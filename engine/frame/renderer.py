@@ -269,7 +269,35 @@ class Renderer:
         raster_camera = (
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
         )
-        atlas = self.shadows if plan.tiles else None
+        self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
+        data = self._lit(
+            draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot
+        )
+        self._last_data = data
+        stats.binned = data.bins is not None
+        return plan
+
+    def _lit(
+        self,
+        draws,
+        lights,
+        plan,
+        snapshot,
+        settings,
+        aux,
+        emission,
+        stats,
+        alpha_offset=0.5,
+        sample_count=1,
+        pilot=False,
+        target=None,
+    ):
+        """The lit pass of the last sample's cameras (``_last_cameras``) with ``lights`` and the
+        maps of ``plan``; ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
+        variant drawn into it, ``settle.py``). Returns the frame data it drew with."""
+        film = self.film
+        raster_camera, view_camera, rects = self._last_cameras
+        atlas = self.shadows if plan is not None and plan.tiles else None
         data = build_frame_data(
             lights,
             raster_camera,
@@ -279,24 +307,38 @@ class Renderer:
             tile_size=atlas.size if atlas else 1,
             atlas_columns=atlas.columns if atlas else 1,
             depth_format=atlas.depth_format if atlas else "FLOAT32",
-            aux_outputs=aux,
+            aux_outputs=aux and target is None,
             rects=rects,
-            size=(width, height),
+            size=film.size,
             alpha_offset=alpha_offset,
             origin=self._origin,
             sample_count=sample_count,
+            settle=target is not None,
             pilot=pilot,
         )
-        self._last_data = data
-        self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
-        stats.binned = data.bins is not None
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
         world = (snapshot.world, snapshot.world_color)
         self.lit_pass.draw(
-            film, seen, view_camera, data, atlas, world, settings, aux, emission, stats, self._origin, masks
+            film, seen, view_camera, data, atlas, world, settings, aux, emission, stats, self._origin, masks, target
         )
-        return plan
+        return data
+
+    def settle_test(self, draws, snapshot, settings, sample_count, target):
+        """The settle test's variant of the lit pass into ``target`` over the last sample's
+        surfaces, cameras, maps and lights (``settle.py``); its draws are not the frame's."""
+        self._lit(
+            draws,
+            self._last_lights,
+            self._last_plan,
+            snapshot,
+            settings,
+            False,
+            False,
+            FrameStats(),
+            sample_count=sample_count,
+            target=target,
+        )
 
     def _debug_view(self, view, accumulate, settings):
         """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``)."""

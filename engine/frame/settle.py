@@ -32,9 +32,6 @@ the first sample missed entirely (a sub-pixel wire between pixel centres).
 import numpy as np
 
 from . import sampling
-from .draw_list import light_masks
-from .frame_data import build_frame_data
-from .stats import FrameStats
 
 ENDLESS_MOMENTS = 1024  # the samples a frame without end is taken to have (its filter's moments)
 
@@ -58,40 +55,12 @@ def settle_shifts(kept, count, filter_size):
 
 def settle(renderer, draws, snapshot, settings, adaptive, sample_count, aux=False, emission=False):
     """Settle the pixels of ``renderer``'s film no later sample can change by
-    ``adaptive.settle``: the settle test's variant of the lit pass over the last sample's
-    surfaces, maps and lights (each light at its whole size), then the film's settle pass.
+    ``adaptive.settle``, after the pilot: the settle test's variant of the lit pass over the
+    pilot's surfaces, maps and lights (``Renderer.settle_test``), then the film's settle pass.
     ``aux``: the frame has the Shadow pass, which must not change either; ``emission``: and
     the Emission pass. Returns the number of pixels settled."""
     film = renderer.film
-    width, height = film.size
-    plan = renderer._last_plan
-    camera, view_camera, rects = renderer._last_cameras
-    lights = renderer._last_lights
-    atlas = renderer.shadows if plan is not None and plan.tiles else None
-    data = build_frame_data(
-        lights,
-        camera,
-        snapshot.world if snapshot.world is not None else snapshot.world_color,
-        settings,
-        plan,
-        tile_size=atlas.size if atlas else 1,
-        atlas_columns=atlas.columns if atlas else 1,
-        depth_format=atlas.depth_format if atlas else "FLOAT32",
-        aux_outputs=False,
-        rects=rects,
-        size=(width, height),
-        origin=renderer._origin,
-        sample_count=sample_count,
-        settle=True,
-    )
-    seen = [d for d in draws if d.instance.camera]
-    masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
-    world = (snapshot.world, snapshot.world_color)
-    target = film.settle_framebuffer()
-    stats = FrameStats()  # the test's draws are not the frame's
-    renderer.lit_pass.draw(
-        film, seen, view_camera, data, atlas, world, settings, False, False, stats, renderer._origin, masks, target
-    )
+    renderer.settle_test(draws, snapshot, settings, sample_count, film.settle_framebuffer())
     before = film.converged
     film.settle(adaptive.settle, settle_shifts(1, sample_count, settings.filter_size), aux, emission)
     return film.converged - before
