@@ -249,3 +249,20 @@ def test_a_single_sample_after_a_settled_frame_shades_every_pixel(penumbra, gpu_
     count, after, fresh = gpu_call(job)
     assert count > 0.3 * 160 * 90
     np.testing.assert_array_equal(after, fresh)
+
+
+def test_settling_is_the_same_at_every_scale(penumbra, gpu_call, sun_box_scene):
+    """The box over its plane under a 3 degree sun, the scene and camera scaled by 1e-3, 1 and
+    1e4: the settle test works in texels and Cycles' relative units, so the same pixels settle
+    (masks agree on 99 % of pixels) and settled pixels hold the plain frame's values."""
+    masks = {}
+    for scale in (1e-3, 1.0, 1e4):
+        scene = sun_box_scene(45.0, scale=scale, size=96)
+        scene.objects["Sun"].data.angle = math.radians(3.0)
+        plain, settled, _ref, mask, _stats, _ = _frames(gpu_call, scene, 16, reference=1)
+        assert 0.3 < mask.mean() < 0.99, (scale, mask.mean())  # 97 % at each scale (Blender 5.2)
+        error = _cycles_units(settled, plain)[mask]
+        assert np.percentile(error, 99) < THRESHOLD, (scale, np.percentile(error, 99))
+        masks[scale] = mask
+    for scale in (1e-3, 1e4):
+        assert (masks[scale] == masks[1.0]).mean() > 0.99, (scale, (masks[scale] == masks[1.0]).mean())
