@@ -166,11 +166,13 @@ def _light_point_progressive(s, light_index, dims):
     pixel after any multiple of 4 samples (adaptive sampling): the (0, 2)-sequence (van der
     Corput, Sobol' 2) digitally shifted per light, whose first 2^k points are stratified for
     every k, so a pixel stopped early has sampled the whole light evenly; a third coordinate
-    from the radical inverse in base 3, rotated per light."""
+    from the radical inverse in base 5, rotated per light (base 3 is the pixel offsets' y: a
+    point or spot light's angle then turned in step with it, and a sharp spot's 128 and 256
+    sample frames ended at 1.4x the error of its 64)."""
     x_mask, y_mask, rotation = _progressive_scramble(light_index)
     x = int(radical_inverse(s, 2) * (1 << 32)) ^ x_mask
     y = sobol_2(s) ^ y_mask
-    coords = [x / 2.0**32, y / 2.0**32, (radical_inverse(s, 3) + rotation) % 1.0]
+    coords = [x / 2.0**32, y / 2.0**32, (radical_inverse(s, 5) + rotation) % 1.0]
     return coords[:dims]
 
 
