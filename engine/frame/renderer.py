@@ -148,11 +148,8 @@ class Renderer:
                 stats.pixels_settled = settle_pixels(
                     self, draws, snapshot, settings, adaptive, sample_count, aux, emission
                 )
-                if film.converged >= pixels:
-                    stats.stopped = "converged"
-                    break
             if accumulate and film.converged >= pixels:
-                stats.stopped = "converged"  # (a later call of a frame that has converged)
+                stats.stopped = "converged"  # every pixel settled, or a later call of a converged frame
                 break
             dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
             view_camera = camera

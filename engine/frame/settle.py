@@ -29,6 +29,8 @@ region wider than 8 texels (a large light far from its casters), and detail unde
 the first sample missed entirely (a sub-pixel wire between pixel centres).
 """
 
+import functools
+
 import numpy as np
 
 from . import sampling
@@ -36,11 +38,14 @@ from . import sampling
 ENDLESS_MOMENTS = 1024  # the samples a frame without end is taken to have (its filter's moments)
 
 
+@functools.lru_cache(maxsize=16)
 def settle_shifts(kept, count, filter_size):
     """How the pixel offsets of samples 0 .. ``kept`` - 1 differ from those of all ``count``
     samples of the frame (0: without end): (mean dx, mean dy), (mean dx^2, mean dy^2,
     mean dx dy), the kept ones' minus the whole frame's. A smooth image's kept average
-    differs from the frame's by gradient . mean + 1/2 Hessian : moments (``settle.frag.glsl``)."""
+    differs from the frame's by gradient . mean + 1/2 Hessian : moments (``settle.frag.glsl``).
+    Cached: a frame without end takes 1024 offsets (a few ms), and every viewport refinement
+    asks again."""
 
     def moments(n):
         offsets = np.array([sampling.pixel_offset(s, filter_size)[:2] for s in range(n)], np.float64)
