@@ -266,3 +266,44 @@ def test_settling_is_the_same_at_every_scale(penumbra, gpu_call, sun_box_scene):
         masks[scale] = mask
     for scale in (1e-3, 1e4):
         assert (masks[scale] == masks[1.0]).mean() > 0.99, (scale, (masks[scale] == masks[1.0]).mean())
+
+
+def test_a_larger_threshold_settles_more_from_its_smallest_to_its_largest(penumbra, gpu_call):
+    """Noise Threshold from 1e-6 to its limit 1: the settled pixels only grow with it (each
+    threshold's settled set holds the smaller one's), every frame stays finite, and at 1e-6
+    nothing but the exact cases (flat world, pixels no light reaches) settles."""
+    from penumbra.engine.frame.film import texture_array
+    from penumbra.engine.frame.renderer import Renderer
+    from penumbra.engine.frame.sampling import adaptive_settings
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    scene = _demo()
+    thresholds = (1e-6, 1e-3, 0.01, 0.1, 1.0)
+
+    def job(engine, depsgraph):
+        engine.renderer = Renderer()
+        cam = camera_from_scene(depsgraph, scene, 160, 90)
+        out = []
+        for t in thresholds:
+            frame = engine.render_frame(
+                depsgraph,
+                cam,
+                160,
+                90,
+                aux=False,
+                samples=(0, 8),
+                sample_count=8,
+                adaptive=adaptive_settings(True, t, 0, 0.0, 8),
+            )
+            film = engine.renderer.film
+            mask = texture_array(film.mask, 1)[..., 0] > 0.5 if film.mask is not None else np.zeros((90, 160), bool)
+            out.append((mask, frame.color_array().copy()))
+        return out
+
+    results = gpu_call(job)
+    fractions = [mask.mean() for mask, _ in results]
+    for (small, _), (large, _) in zip(results, results[1:], strict=False):
+        assert not (small & ~large).any()
+    for _, image in results:
+        assert np.all(np.isfinite(image))
+    assert fractions[0] < fractions[2] < fractions[-1], fractions
