@@ -82,6 +82,23 @@ CHECKER_CELLS = 4
 PLANE = 2.0  # side of the frame-filling planes (and the orthographic scale that frames them)
 
 
+def srgb_decoded(c):
+    """sRGB display values ``c`` as an 8-bit image stores them (the nearest code), decoded to
+    linear by the exact sRGB curve."""
+    c = np.floor(np.asarray(c, dtype=np.float64) * 255.0 + 0.5) / 255.0
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def srgb_decode_tolerance(c):
+    """How far a GPU's decode of the 8-bit sRGB codes of ``c`` may lie from ``srgb_decoded``:
+    half the step to the next code. Image textures are Blender's sRGB8 textures, which the GPU
+    decodes; a conformant decode lands within the code's own interval (Mesa's llvmpipe
+    approximates the curve: 1.2 % low at code 38, a quarter of a step), so a test of exact
+    texels allows this much and no more."""
+    code = np.floor(np.asarray(c, dtype=np.float64) * 255.0 + 0.5)
+    return 0.5 * (srgb_decoded(np.minimum(code + 1.0, 255.0) / 255.0) - srgb_decoded(code / 255.0))
+
+
 # --- materials ----------------------------------------------------------------------------
 
 

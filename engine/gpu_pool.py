@@ -4,13 +4,14 @@ Every F12 render, and every frame of an animation render, is a new engine instan
 pool each one allocates its targets and its shadow atlas anew, and on llvmpipe a new texture
 costs its zero-fill: about 17 ms for the 32 MiB atlas of the demo at 960x540 (two 2048 maps).
 
-Only textures and programs are kept: render targets (``FINAL_RENDERS``), image textures by the
-hash of their pixels (``FINAL_IMAGES``, at most twice the targets' budget) and compiled programs
+Only textures and programs are kept: render targets (``FINAL_RENDERS``) and compiled programs
 (``final_shaders``: a variant compiles once a session, not once a render, about 7 ms a render
-for the demo). Textures and programs are shared between GPU contexts, while framebuffers and
-batches belong to the context that made them and are made again by each render. A texture
-taken from the pool holds the last render's pixels; the renderer clears or redraws all of it
-(its shadow maps start empty, so every map is drawn again).
+for the demo). Image textures need no pool: they are Blender's own, kept by each image
+datablock between renders (``scene/textures.py``). Textures and programs are shared between
+GPU contexts, while framebuffers and batches belong to the context that made them and are
+made again by each render. A texture taken from the pool holds the last render's pixels; the
+renderer clears or redraws all of it (its shadow maps start empty, so every map is drawn
+again).
 
 The pool holds what the last frame used, and at most ``budget`` bytes, oldest textures dropped
 first. A frame is one (scene, frame number, resolution): its view layers and views share it. At
@@ -22,7 +23,6 @@ its GPU module down) and when the interpreter exits, so no texture outlives the 
 """
 
 import atexit
-from collections import OrderedDict
 
 # Bytes per texel of the formats the renderer allocates.
 TEXEL_BYTES = {
@@ -110,40 +110,7 @@ def new_texture(pool, size, fmt):
     return texture if texture is not None else gpu.types.GPUTexture(size, format=fmt)
 
 
-class ImageTextures:
-    """Image textures final renders share, by ``textures.content_key`` (the pixels' hash and
-    how they are read): an animation render converts and uploads each image once, not once a
-    frame. At most ``budget`` bytes, least recently used dropped first."""
-
-    def __init__(self, budget=BUDGET * 2):
-        self.budget = budget
-        self._held = OrderedDict()  # content key -> texture, least recently used first
-        self.hits = 0
-
-    def __len__(self):
-        return len(self._held)
-
-    def get(self, key):
-        texture = self._held.get(key)
-        if texture is not None:
-            self._held.move_to_end(key)
-            self.hits += 1
-        return texture
-
-    def put(self, key, texture):
-        """Keep ``texture`` under ``key`` (inside the render's GPU context)."""
-        if texture_bytes(texture) > self.budget:
-            return
-        self._held[key] = texture
-        while sum(texture_bytes(t) for t in self._held.values()) > self.budget:
-            self._held.popitem(last=False)
-
-    def clear(self):
-        self._held.clear()
-
-
 FINAL_RENDERS = TexturePool()  # the pool of F12 and animation renders (never the viewport's)
-FINAL_IMAGES = ImageTextures()  # their image textures
 _final_shaders = []  # the ShaderCache final renders share, made on first use
 
 
@@ -159,7 +126,6 @@ def final_shaders():
 def clear():
     """Drop every pooled texture and program (on unregister, and at exit)."""
     FINAL_RENDERS.clear()
-    FINAL_IMAGES.clear()
     _final_shaders.clear()
 
 

@@ -11,5 +11,12 @@ void main()
   float len = length(d);
   d = (len > 0.0) ? d / len : vec3(0.0, 0.0, 1.0);
   vec2 uv = vec2(atan(d.y, -d.x) / (2.0 * M_PI) + 0.5, atan(d.z, length(d.xy)) / M_PI + 0.5);
-  out_color = vec4(strength * sample_image(env, uv, ivec4(1, 0, 0, 0)).rgb, 1.0);
+  /* The footprint from pixel to pixel, across the seam at u = 0 / 1 taken the short way round
+   * (else the seam's pixels would read the smallest mip level). */
+  vec2 dx = dFdx(uv);
+  vec2 dy = dFdy(uv);
+  dx.x -= round(dx.x);
+  dy.x -= round(dy.x);
+  vec4 env_color = sample_image_grad(env, uv, dx, dy, ivec4(1, 0, 0, 0), env_premultiplied > 0.5);
+  out_color = vec4(strength * env_color.rgb, 1.0);
 }

@@ -7,7 +7,14 @@ import numpy as np
 from ...shaders.loader import set_uniforms
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
-from .programs import BACKGROUND, JITTER_SIZE, SHADOW_SAMPLER, lit_program, terminator_uniforms
+from .programs import (
+    BACKGROUND,
+    JITTER_SIZE,
+    SHADOW_SAMPLER,
+    image_premultiplied_bits,
+    lit_program,
+    terminator_uniforms,
+)
 
 
 class LitPass:
@@ -24,6 +31,7 @@ class LitPass:
         self._jitter_dummy = None
         self._bins_tex = None
         self._dummy_shadow = None
+        self.uploaded = 0  # bytes sent to the GPU since creation (uniform blocks, textures of data)
 
     def draw(
         self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None, target=None
@@ -156,6 +164,8 @@ class LitPass:
                     shader.uniform_block("node_constants", self.materials.constants(mat))
                     for i, ref in enumerate(mat.tree.images):
                         shader.uniform_sampler(f"node_image_{i}", self.textures.get(ref.image))
+                if mat.textures or (mat.tree is not None and mat.tree.images):
+                    set_image_flags(shader, mat, self.textures)
                 batch.draw(shader)
                 stats.draws += 1
 
@@ -198,6 +208,7 @@ class LitPass:
             film.fb_color,
             {"env": self.textures.get(world.image)},
             {
+                "env_premultiplied": float(self.textures.premultiplied(world.image)),
                 "inverse_view_proj": Matrix(inverse.tolist()),
                 "viewport_origin": (0.0, 0.0),
                 "viewport_size": (float(width), float(height)),
@@ -210,6 +221,7 @@ class LitPass:
         import gpu
 
         raw = data.tobytes()
+        self.uploaded += len(raw)
         ubo = self._ubos.get(name)
         if ubo is None or ubo[1] != len(raw):
             self._ubos[name] = (gpu.types.GPUUniformBuf(raw), len(raw))
@@ -234,6 +246,7 @@ class LitPass:
             data = disk.reshape(JITTER_SIZE, JITTER_SIZE, samples // 2, 4).transpose(2, 0, 1, 3)
             buf = gpu.types.Buffer("FLOAT", data.size, data.ravel().tolist())
             tex = gpu.types.GPUTexture((JITTER_SIZE, JITTER_SIZE, samples // 2), format="RGBA32F", data=buf)
+            self.uploaded += data.nbytes
             self._jitter_tex = (samples, tex)
         return self._jitter_tex[1]
 
@@ -247,6 +260,7 @@ class LitPass:
         buf = gpu.types.Buffer("FLOAT", bins.size, np.ascontiguousarray(bins, np.float32).ravel())
         # Kept until the next frame: the draw that samples it runs after this call returns.
         self._bins_tex = gpu.types.GPUTexture((cols, rows), format="RGBA32F", data=buf)
+        self.uploaded += bins.size * 4
         return self._bins_tex
 
     def _shadow_dummy(self):
@@ -256,3 +270,13 @@ class LitPass:
             self._dummy_shadow = gpu.types.GPUTexture((1, 1), format="R32F")
             self._dummy_shadow.clear(format="FLOAT", value=(1.0,))
         return self._dummy_shadow
+
+
+def set_image_flags(shader, mat, textures):
+    """The ``image_premultiplied`` push constant of a draw of ``mat``: which of its images
+    Blender stores premultiplied (``programs.image_premultiplied_bits``)."""
+    channels = [(channel, ref.image) for channel, ref in mat.textures.items()]
+    tree_images = [ref.image for ref in mat.tree.images] if mat.tree is not None else []
+    set_uniforms(
+        shader, {"image_premultiplied": image_premultiplied_bits(textures.premultiplied, channels, tree_images)}
+    )

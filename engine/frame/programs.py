@@ -235,6 +235,27 @@ TERMINATOR_UNIFORMS = {
 }
 
 
+# Which images of a draw Blender stores premultiplied (``TextureCache.premultiplied``): bit i
+# for the compiled tree's node_image_<i>, bit IMAGE_BIT_<channel> for a channel's texture.
+IMAGE_PREMULTIPLIED = ("INT", "image_premultiplied")
+IMAGE_CHANNEL_BITS = {c: 1 << (16 + i) for i, c in enumerate(CHANNELS)}
+
+
+def image_premultiplied_bits(premultiplied, channels=(), tree_images=()):
+    """The ``image_premultiplied`` value of a draw: ``premultiplied(image name)`` of each of
+    its channel textures (``(channel, image name)`` pairs) and compiled-tree images."""
+    bits = 0
+    for channel, image in channels:
+        bits |= IMAGE_CHANNEL_BITS[channel] if premultiplied(image) else 0
+    for i, image in enumerate(tree_images):
+        bits |= (1 << i) if premultiplied(image) else 0
+    return bits
+
+
+def _with_image_flags(pushes):
+    return pushes if IMAGE_PREMULTIPLIED in pushes else pushes + (IMAGE_PREMULTIPLIED,)
+
+
 def _with_features(program, features, name):
     """``program`` with the vertex inputs, varyings and texture samplers ``features`` read."""
     defines = material_defines(features)
@@ -252,14 +273,19 @@ def _with_features(program, features, name):
     uniforms = []
     for feature, names in TERMINATOR_UNIFORMS.items():
         uniforms += [n for n in names if defines[feature] and n not in uniforms]
+    pushes = program.push_constants + tuple(("FLOAT", n) for n in uniforms)
+    bits = ()
+    if samplers:
+        pushes = _with_image_flags(pushes)
+        bits = tuple((f"IMAGE_BIT_{c}", bit) for c, bit in IMAGE_CHANNEL_BITS.items())
     return replace(
         program,
         name=name,
         vertex_in=program.vertex_in + vertex_in,
         varyings=program.varyings + varyings,
-        push_constants=program.push_constants + tuple(("FLOAT", n) for n in uniforms),
+        push_constants=pushes,
         samplers=program.samplers + samplers,
-        defines=program.defines + tuple(defines.items()),
+        defines=program.defines + tuple(defines.items()) + bits,
     )
 
 
@@ -332,7 +358,9 @@ def with_tree(program, tree):
         uniform_blocks=program.uniform_blocks
         + ((NODE_CONSTANT_STRUCT, "node_constants", max(len(tree.constants), 1)),),
         samplers=program.samplers + tuple(("FLOAT_2D", f"node_image_{i}") for i in range(len(tree.images))),
-        push_constants=program.push_constants + pushes,
+        push_constants=_with_image_flags(program.push_constants + pushes)
+        if tree.images
+        else program.push_constants + pushes,
     )
 
 
@@ -543,7 +571,21 @@ BACKGROUND = Program(
         ("VEC2", "viewport_origin"),
         ("VEC2", "viewport_size"),
         ("FLOAT", "strength"),
+        ("FLOAT", "env_premultiplied"),  # 1: Blender stores the image premultiplied
     ),
+    samplers=(("FLOAT_2D", "env"),),
+    outputs=(("VEC4", "out_color"),),
+)
+
+
+# The world's Environment Texture box-filtered to a small image, read back for its SH light
+# (``world_light.py``).
+WORLD_REDUCE = Program(
+    name="world_reduce",
+    vertex="fullscreen.vert.glsl",
+    fragment="world_reduce.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("VEC2", "target_size"), ("FLOAT", "env_premultiplied")),
     samplers=(("FLOAT_2D", "env"),),
     outputs=(("VEC4", "out_color"),),
 )

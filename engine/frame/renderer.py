@@ -12,7 +12,6 @@ import dataclasses
 import numpy as np
 
 from ..enums import DEBUG_VIEW, DEPTH_FORMAT
-from ..gpu_pool import FINAL_IMAGES
 from ..post import post_stack
 from ..scene.textures import TextureCache
 from ..shadows import lightspace
@@ -26,11 +25,16 @@ from .material_blocks import MaterialBlocks
 from .programs import MAX_LIGHTS
 from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
-from .stats import FrameStats
+from .stats import FrameStats, StageClock
+from .world_light import world_light
 
 
 class Renderer:
     """GPU state of one engine instance. Create and use only inside a GPU context."""
+
+    # True: each stage waits for the GPU before and after it (``StageClock``), so FrameStats
+    # splits Python time from GPU time (the benchmarks set it; it stalls the pipeline).
+    fence_stages = False
 
     def __init__(self, pool=None, shaders=None):
         """``pool``: a ``gpu_pool.TexturePool`` the frame's targets and shadow atlas come from
@@ -40,7 +44,7 @@ class Renderer:
 
         self.pool = pool
         self.shaders = shaders if shaders is not None else ShaderCache()
-        self.textures = TextureCache(FINAL_IMAGES if pool is not None else None)
+        self.textures = TextureCache()
         self.materials = MaterialBlocks()
         self.batches = Batches()
         self.film = Film(self.shaders, pool)
@@ -52,6 +56,7 @@ class Renderer:
         self._last_lights = []  # the lights of the last sample (what its shadow plan indexes)
         self._last_cameras = None  # the last sample's raster and view cameras, its lights' screen rects
         self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
+        self._clock = StageClock()  # the current frame's (``render``)
 
     @property
     def shadows(self):
@@ -88,8 +93,12 @@ class Renderer:
         unless ``deadline`` (a ``sampling.clock()`` value) says when. Neither looks at a clock
         when there is no time limit: a frame stays a function of the scene and its settings."""
         stats = FrameStats()
+        clock = StageClock(self.wait_gpu if self.fence_stages else None)
+        uploaded_before = self._uploaded()
         compiled_before = self.shaders.compiled
         seconds_before = self.shaders.compile_seconds
+        self._clock = clock
+        clock.begin("prepare")
         self.shadow_pass.begin_frame()
         emission = bool(emission and aux)
         film = self.film
@@ -103,6 +112,9 @@ class Renderer:
         draws = draw_list(snapshot, self.batches, stats, self._origin, camera, settings, (width, height))
         stats.messages.extend(getattr(snapshot, "messages", ()))
         self.textures.forget(getattr(snapshot, "images_changed", ()))
+        world = world_light(snapshot.world, self.textures, self.shaders)
+        if world is not snapshot.world:  # an Environment Texture's light, projected on the GPU
+            snapshot = dataclasses.replace(snapshot, world=world, world_color=world.mean)
         lights = select_lights(snapshot.lights, camera.position, MAX_LIGHTS)
         if len(lights) < len(snapshot.lights):
             stats.messages.append(
@@ -135,7 +147,9 @@ class Renderer:
         if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + adaptive.time_limit
         pixels = width * height
+        clock.end()
         for s in range(start, stop):
+            sample_start = clock.cpu_seconds
             if settle and s == 1:
                 # Before the second sample, the pilot (settle.py): the centred pixel with every
                 # light at its centre, whose maps the settle test reads; settled pixels take
@@ -145,12 +159,14 @@ class Renderer:
                     for i, lt in enumerate(lights)
                 ]
                 self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True)
-                stats.pixels_settled = settle_pixels(
-                    self, draws, snapshot, settings, adaptive, sample_count, aux, emission
-                )
+                with clock.stage("settle"):
+                    stats.pixels_settled = settle_pixels(
+                        self, draws, snapshot, settings, adaptive, sample_count, aux, emission
+                    )
             if accumulate and film.converged >= pixels:
                 stats.stopped = "converged"  # every pixel settled, or a later call of a converged frame
                 break
+            clock.begin("sample set-up")
             dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
             view_camera = camera
             if dx or dy:
@@ -160,6 +176,7 @@ class Renderer:
                 sampling.light_at_sample(lt, i, s, sample_count, jitter, progressive=noise) if i in moving else lt
                 for i, lt in enumerate(lights)
             ]
+            clock.end()
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
             plan = self._sample(
                 draws,
@@ -174,6 +191,7 @@ class Renderer:
                 alpha_offset,
                 sample_count if accumulate else 1,
             )
+            clock.begin("accumulate")
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
                 film.accumulate(weight, aux, emission, s)
@@ -184,6 +202,8 @@ class Renderer:
             last = s + 1 == sample_count
             if noise and not last and adaptive.checks_at(s + 1) and film.check(adaptive.threshold) >= pixels:
                 stats.stopped = "converged"
+            clock.end()
+            stats.sample_cpu_seconds.append(clock.cpu_seconds - sample_start)
             if deadline is not None and accumulate and not stats.stopped:
                 film.finish()  # the sample's GPU work done, so the clock counts it
                 if sampling.clock() >= deadline:
@@ -193,10 +213,13 @@ class Renderer:
                 break
             if stats.stopped:
                 break
+        clock.begin("resolve")
         stats.pixels_converged = film.converged if accumulate else 0
         if accumulate and stats.samples:
             film.resolve(aux, emission)
         self.batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()})
+        clock.end()
+        clock.begin("post")
         debug_image = None
         if debug.id != "NONE":  # the view instead of the image (and instead of the post stack)
             debug_image = self._debug_view(debug.id, accumulate, settings)
@@ -208,6 +231,10 @@ class Renderer:
         stats.texture_bytes = (
             film.target_bytes(aux, accumulate) + stats.shadow_bytes + film.post_ctx.memory_bytes + self.textures.bytes
         )
+        clock.end()
+        stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
+        stats.cpu_seconds, stats.gpu_seconds = clock.cpu, clock.gpu
+        stats.upload_bytes = self._uploaded() - uploaded_before
         stats.shaders_compiled = self.shaders.compiled - compiled_before
         stats.compile_seconds = self.shaders.compile_seconds - seconds_before
         if not aux:
@@ -243,6 +270,7 @@ class Renderer:
         width, height = film.size
         lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats)
         self._last_lights = lights
+        self._clock.begin("shadow pass")
         plan = self.shadow_pass.draw(
             draws,
             lights,
@@ -257,6 +285,7 @@ class Renderer:
             self._origin,
             alpha_offset,
         )
+        self._clock.end()
         self._last_plan = plan
         depth_range = self.shadow_pass.depth_range
         if depth_range is UNSET:  # no shadow plan this frame: the quick, wider bound
@@ -267,9 +296,10 @@ class Renderer:
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
         )
         self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
-        data = self._lit(
-            draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot
-        )
+        with self._clock.stage("lit pass"):
+            data = self._lit(
+                draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot
+            )
         self._last_data = data
         stats.binned = data.bins is not None
         return plan
@@ -364,6 +394,26 @@ class Renderer:
         ctx.pixel_scale = settings.pixel_scale
         ctx.stats = stats
         return self.post.run(ctx, self.film.color, settings.layers)
+
+    def _uploaded(self):
+        """Bytes this renderer's stages have sent to the GPU since it was made."""
+        return self.lit_pass.uploaded + self.shadows.uploaded + self.materials.uploaded + self.batches.uploaded
+
+    def wait_gpu(self):
+        """Return once the GPU has finished what was asked of it (a one-pixel read-back of the
+        frame's colour target and of the shadow atlas): the fence of ``fence_stages``."""
+        film = self.film
+        fb = film.fb or film.fb_color
+        if fb is not None:
+            with fb.bind():
+                fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+        atlas = self.shadows
+        if atlas._framebuffer is not None:
+            with atlas._framebuffer.bind():
+                if atlas.depth_format == "FLOAT32":
+                    atlas._framebuffer.read_depth(0, 0, 1, 1)
+                else:
+                    atlas._framebuffer.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
 
     def release(self):
         """Give the frame's targets and the shadow atlas back to the pool: at the end of a

@@ -41,7 +41,8 @@ class Caster:
     model: object  # mathutils.Matrix
     det: float  # sign of the model matrix (winding under negative scale)
     identity: tuple  # what a tile's content depends on
-    # (batch, material UBO, alpha texture or None, TreeCutout or None): covers a texel in a
+    # (batch, material UBO, (alpha texture, its image_premultiplied bits) or None, TreeCutout or
+    # None): covers a texel in a
     # fraction alpha of the samples
     cutouts: list = field(default_factory=list)
     cull_back: bool = False  # every material asks for shadow back-face culling: faces away from the light cast nothing
@@ -87,6 +88,7 @@ class ShadowAtlas:
         self._copy_batch = None
         self._ubos = []
         self._contents = {}  # tile index -> what its map holds
+        self.uploaded = 0  # bytes of tile blocks sent to the GPU since creation
 
     @staticmethod
     def grid(count):
@@ -154,6 +156,7 @@ class ShadowAtlas:
         import gpu
 
         raw = data.tobytes()
+        self.uploaded += len(raw)
         while len(self._ubos) <= index:
             self._ubos.append(gpu.types.GPUUniformBuf(raw))
         self._ubos[index].update(raw)
@@ -246,6 +249,7 @@ class ShadowAtlas:
                     for batch in caster.batches:
                         batch.draw(shader)
                         stats.draws += 1
+                        stats.shadow_draws += 1
                     stats.shadow_triangles += caster.triangles
                 gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
                 for caster in casters:
@@ -269,9 +273,11 @@ class ShadowAtlas:
                         cut.uniform_float("model", caster.model)
                         cut.uniform_block("material", material_ubo)
                         if texture is not None:
-                            cut.uniform_sampler("tex_alpha", texture)
+                            cut.uniform_sampler("tex_alpha", texture[0])
+                            set_uniforms(cut, {"image_premultiplied": texture[1]})
                         batch.draw(cut)
                         stats.draws += 1
+                        stats.shadow_draws += 1
                 gpu.state.face_culling_set("NONE")
                 gpu.state.front_facing_set(False)
                 gpu.state.depth_test_set("NONE")

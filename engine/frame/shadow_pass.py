@@ -8,6 +8,7 @@ from ..scene import simplify
 from ..shadows import lightspace
 from ..shadows.planning import MAX_SHADOW_TILES, Density, plan_shadows
 from .draw_list import corners_of
+from .programs import image_premultiplied_bits
 from .shadow_maps import Caster, ShadowAtlas, TreeCutout
 
 UNSET = object()  # ``ShadowPass.depth_range`` before this frame's first plan
@@ -18,11 +19,13 @@ class ShadowPass:
         self.atlas = ShadowAtlas(pool)
         self.depth_range = UNSET  # the frame's visible depth range, once a plan computed it
         self._receivers = None  # and what the camera sees (lightspace.visible_receivers)
+        self._casters = (None, None)  # (the frame's draw list, what each draw casts): once a frame
 
     def begin_frame(self):
-        """Forget the last frame's camera-dependent bounds."""
+        """Forget the last frame's camera-dependent bounds and casters."""
         self.depth_range = UNSET
         self._receivers = None
+        self._casters = (None, None)
 
     def plan(self, draws, lights, camera, settings, size, map_size=None):
         """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
@@ -89,7 +92,9 @@ class ShadowPass:
                             [c for c in tile.casters if blockers.links(draws[c].instance.names)], dtype=np.int64
                         )
         self.atlas.place(plan, settings.shadow_depth_format)
-        casters = [caster(d, materials, textures) for d in draws]
+        if self._casters[0] is not draws:  # what each draw casts is the frame's, not the sample's
+            self._casters = (draws, [caster(d, materials, textures) for d in draws])
+        casters = self._casters[1]
         levels = map_levels(plan, draws, casters, batches, float(getattr(settings, "shadow_caster_detail", 0.0)))
         self.atlas.render(plan, casters, shaders, settings.shadow_cull_front, stats, alpha_offset, origin, levels)
         return plan
@@ -122,7 +127,9 @@ def caster(d, materials, textures):
         elif mat.tree is not None and "FRAME" not in mat.tree.needs:
             cutouts.append((batch, materials.get(mat), None, _tree_cutout(d, mat, materials, textures)))
         elif "alpha" in mat.textures:
-            cutouts.append((batch, materials.get(mat), textures.get(mat.textures["alpha"].image), None))
+            image = mat.textures["alpha"].image
+            bits = image_premultiplied_bits(textures.premultiplied, [("alpha", image)])
+            cutouts.append((batch, materials.get(mat), (textures.get(image), bits), None))
         elif mat.alpha > 0.0:
             cutouts.append((batch, materials.get(mat), None, None))
     identity = (*d.identity, tuple(id(m) for _i, _b, m in mats))
@@ -134,6 +141,9 @@ def _tree_cutout(d, mat, materials, textures):
     tree = mat.tree
     uniforms = d.tree_uniforms(tree)
     images = tuple(textures.get(ref.image) for ref in tree.images)
+    if images:
+        names = [ref.image for ref in tree.images]
+        uniforms = {**uniforms, "image_premultiplied": image_premultiplied_bits(textures.premultiplied, (), names)}
     return TreeCutout(tree, materials.constants(mat), images, uniforms)
 
 

@@ -585,7 +585,8 @@ def summary(read):
 class World:
     """Light from the world: ``sh`` are order-2 spherical-harmonic coefficients (9, 3) of its
     radiance (a constant world has only the first), ``background`` the colour the film shows
-    where nothing is drawn."""
+    where nothing is drawn. An Environment Texture's world has both None until the renderer
+    projects them from the image's GPU texture (``frame/world_light.py``)."""
 
     sh: np.ndarray
     background: np.ndarray
@@ -595,7 +596,8 @@ class World:
 
     @property
     def mean(self):
-        return self.sh[0] * SH_C0
+        """The mean radiance (black until an Environment Texture's light is projected)."""
+        return self.sh[0] * SH_C0 if self.sh is not None else np.zeros(3)
 
     @classmethod
     def constant(cls, color, messages=()):
@@ -644,47 +646,6 @@ def equirect_sh(rgb):
     solid_angle = (2.0 * math.pi / w) * (math.pi / h) * np.broadcast_to(cl, (h, w))
     basis = sh_basis(d)  # (h, w, 9)
     return np.einsum("hwk,hwc,hw->kc", basis, rgb.astype(np.float64), solid_angle)
-
-
-def image_pixels(image, data=None):
-    """An image's pixels as float32 (h, w, 4), row 0 at the bottom, scene-linear colour with
-    straight alpha (as the Image Texture node outputs them), or None when it has none.
-    ``data``: ``image.pixels`` already read (``textures.raw_pixels``)."""
-    w, h = image.size
-    channels = image.channels
-    if w == 0 or h == 0 or channels == 0:
-        return None
-    if data is None:
-        data = np.empty(w * h * channels, np.float32)
-        image.pixels.foreach_get(data)
-    data = data.reshape(h, w, channels)
-    out = np.ones((h, w, 4), np.float32)
-    if channels >= 3:
-        out[..., :3] = data[..., :3]
-    else:
-        out[..., :3] = data[..., :1]
-    if channels in (2, 4):
-        out[..., 3] = data[..., -1]
-    settings = image.colorspace_settings
-    if not image.is_float and not settings.is_data and settings.name in {"sRGB", "sRGB EOTF"}:
-        # Byte images hold k / 255: decode through a 256-entry table (exact, and much faster
-        # than the power function over every texel).
-        codes = np.clip(np.rint(out[..., :3] * 255.0), 0, 255).astype(np.uint8)
-        out[..., :3] = _SRGB_TABLE[codes]
-    elif image.is_float and image.alpha_mode != "STRAIGHT" and channels == 4:
-        # Float buffers hold premultiplied scene-linear colour; the node outputs it straight.
-        a = out[..., 3:4]
-        out[..., :3] = np.where(a > 0.0, out[..., :3] / np.where(a > 0.0, a, 1.0), out[..., :3])
-    return out
-
-
-def srgb_to_linear(c):
-    """The sRGB transfer function, decoded to linear."""
-    c = np.asarray(c, dtype=np.float32)
-    return np.where(c <= 0.04045, c / 12.92, ((np.maximum(c, 0.04045) + 0.055) / 1.055) ** 2.4).astype(np.float32)
-
-
-_SRGB_TABLE = srgb_to_linear(np.arange(256) / 255.0)  # byte code -> linear
 
 
 def _linked_outputs(tree, idname, socket, targets=None):
@@ -739,15 +700,12 @@ def _world_surface(scene):
     src, out = _source(node.inputs["Color"])
     if src is None:
         return World.constant(np.array(node.inputs["Color"].default_value[:3]) * strength, messages)
-    if src.bl_idname == "ShaderNodeTexEnvironment" and src.image is not None:
-        pixels = image_pixels(src.image)
-        if pixels is not None:
-            if src.projection != "EQUIRECTANGULAR":
-                messages.append(f"world '{world.name}': {src.projection} projection (read as equirectangular)")
-            sh = equirect_sh(pixels[..., :3]) * strength
-            return World(
-                sh=sh, background=sh[0] * SH_C0, messages=tuple(messages), image=src.image.name_full, strength=strength
-            )
+    if src.bl_idname == "ShaderNodeTexEnvironment" and src.image is not None and all(src.image.size):
+        if src.projection != "EQUIRECTANGULAR":
+            messages.append(f"world '{world.name}': {src.projection} projection (read as equirectangular)")
+        # Its light (sh) is projected from the image's GPU texture by the renderer
+        # (frame/world_light.py): no pixel is read here.
+        return World(sh=None, background=None, messages=tuple(messages), image=src.image.name_full, strength=strength)
     if src.bl_idname == "ShaderNodeRGB":
         return World.constant(np.array(out.default_value[:3]) * strength, messages)
     messages.append(f"world '{world.name}': Color from a '{src.bl_label}' node (the world's viewport colour is used)")

@@ -1218,5 +1218,6 @@ def _image(c, node, socket, ctx):
     index = c.images.index(ref)
     uv = c.input(node, "Vector", ctx, "vec3") if c.linked(node, "Vector") else c.uv("")
     mode = f"ivec4({IMAGE_INTERPOLATION.get(ref.interpolation, 1)}, {IMAGE_EXTENSION.get(ref.extension, 0)}, 0, 0)"
-    texel = c.temp("vec4", f"sample_image(node_image_{index}, ({uv.expr}).xy, {mode})")
+    premultiplied = f"(image_premultiplied & {1 << index}) != 0"  # set per draw (``TextureCache``)
+    texel = c.temp("vec4", f"sample_image(node_image_{index}, ({uv.expr}).xy, {mode}, {premultiplied})")
     return Value(f"{texel.expr}.a", "float") if socket.identifier == "Alpha" else texel

@@ -1,113 +1,138 @@
-"""Image textures on the GPU, uploaded once per image datablock.
+"""Image textures on the GPU: Blender's own (``gpu.texture.from_image``).
 
-Pixels are read with ``foreach_get`` (``materials.image_pixels``: scene-linear, straight
-alpha, as the Image Texture node outputs them) and uploaded as RGBA16F; a texture stays until
-a depsgraph update says its image changed (``SceneCache.images_changed``) or it is no longer
-used. Final renders (a new engine each) also share textures between renders through
-``gpu_pool.FINAL_IMAGES``, by ``content_key``: an animation render converts and uploads each
-image once. A missing or unreadable image draws as magenta, Blender's own colour for a missing
-texture, with a message.
+Blender uploads every image once for EEVEE and the viewport, colour-managed (sRGB bytes as an
+sRGB texture the GPU decodes, other colour spaces converted to scene linear, Non-Color as it
+is), reduced to the GPU's limit and with its mipmaps. Penumbra draws from that texture, so no
+image is read into Python or hashed: the first frame that needs an image costs what Blender's
+upload costs, later frames (and later F12 renders, since the texture belongs to the image
+datablock) nothing. A texture is looked up once per image datablock and kept until a depsgraph
+update says its image changed (``SceneCache.images_changed``: edited, reloaded, packed, a
+generated image changed), when Blender has made a new one.
+
+What Blender's texture holds that the Image Texture node does not output is undone in the
+shader: a float image whose alpha mode is not Straight is stored premultiplied
+(``premultiplied``), and ``shaders/lib/material.glsl`` divides by alpha after filtering. An
+image without pixels (a missing file) draws as Blender's error texture, magenta, with a
+message; an image larger than the GPU's textures is drawn reduced, with a message; a UDIM
+image draws its first tile, with a message.
+
+The world's Environment Texture lights the scene through order-2 spherical harmonics
+(``materials.equirect_sh``); they are projected from a small mip level of the same texture,
+read back from the GPU (``world_sh``), never from the image's pixels.
 """
-
-import hashlib
-import sys
 
 import numpy as np
 
-from .materials import image_pixels
+from .materials import SH_C0, equirect_sh
 
-MISSING = (1.0, 0.0, 1.0, 1.0)
+# Bytes per texel of the formats Blender gives image textures (mipmaps add a third).
+FORMAT_BYTES = {"SRGB8_A8": 4, "RGBA8": 4, "RGBA16F": 8, "RGBA32F": 16, "R16F": 2, "R32F": 4, "R8": 1}
 
-
-def raw_pixels(image):
-    """``image.pixels`` as a float32 array (Blender's own buffer, about 2 ms a megapixel), or
-    None when it has none or cannot be read."""
-    w, h = image.size
-    if w == 0 or h == 0 or image.channels == 0:
-        return None
-    data = np.empty(w * h * image.channels, np.float32)
-    try:
-        image.pixels.foreach_get(data)
-    except (RuntimeError, ValueError):
-        return None
-    return data
+# The world's light is projected from a mip level at most this wide (and half as high): order-2
+# harmonics vary slowly, so a 128x64 image holds all they can show of an environment.
+SH_WIDTH = 128
 
 
-def content_key(image, data):
-    """What the texture of ``image`` with pixels ``data`` depends on: its pixels themselves
-    (SHA-1, about 8 ms for a 1024x1024 RGBA image, against about 35 ms to convert and upload
-    it) and how they are read (size, channels, float or byte, colour space, alpha mode). Any
-    change of pixels, saved or not, makes another key; two images alike share one texture."""
-    cs = image.colorspace_settings
-    digest = hashlib.sha1(data.data, usedforsecurity=False).digest()
-    how = (tuple(image.size), image.channels, image.is_float, cs.name, cs.is_data, image.alpha_mode)
-    return (*how, digest)
+def stores_premultiplied(image):
+    """Whether Blender's GPU texture of ``image`` holds premultiplied colour: float buffers are
+    kept premultiplied unless the image's alpha mode is Straight, byte buffers straight."""
+    return bool(image.is_float) and image.alpha_mode != "STRAIGHT"
 
 
 class TextureCache:
-    def __init__(self, shared=None):
-        self._textures = {}  # image name -> GPUTexture
-        self._shared = shared  # gpu_pool.ImageTextures of final renders, or None (the viewport)
-        self.uploads = 0  # images read and uploaded since creation (tests and the benchmark read it)
+    def __init__(self):
+        self._textures = {}  # image name -> (GPUTexture, premultiplied)
+        self._sh = {}  # image name -> its equirectangular SH (9, 3), strength 1
+        self.uploads = 0  # images taken from Blender since creation (tests and the benchmark read it)
+        self.pixel_reads = 0  # images read into Python (none: a test counts them)
         self.bytes = 0
+        self._messages = {}  # image name -> what the user must be told of it (``messages``)
 
     def forget(self, names):
         for name in names:
-            tex = self._textures.pop(name, None)
-            if tex is not None:
-                self.bytes -= tex.width * tex.height * 8
+            entry = self._textures.pop(name, None)
+            self._sh.pop(name, None)
+            self._messages.pop(name, None)
+            if entry is not None:
+                self.bytes -= _texture_bytes(entry[0])
 
     def clear(self):
         self._textures.clear()
+        self._sh.clear()
+        self._messages.clear()
         self.bytes = 0
 
     def get(self, name):
-        tex = self._textures.get(name)
-        if tex is None:
-            key = data = None
-            if self._shared is not None:
-                import bpy
+        """The GPU texture of image ``name``."""
+        return self._entry(name)[0]
 
-                image = bpy.data.images.get(name)
-                data = raw_pixels(image) if image is not None else None
-                key = content_key(image, data) if data is not None else None
-                tex = self._shared.get(key) if key is not None else None
-            if tex is None:
-                tex = self._upload(name, data)
-                if key is not None:
-                    self._shared.put(key, tex)
-            self._textures[name] = tex
-            self.bytes += tex.width * tex.height * 8
-        return tex
+    def premultiplied(self, name):
+        """Whether the texture of image ``name`` holds premultiplied colour."""
+        return self._entry(name)[1]
 
-    def _upload(self, name, data=None):
+    def _entry(self, name):
+        entry = self._textures.get(name)
+        if entry is None:
+            entry = self._textures[name] = self._take(name)
+            self.bytes += _texture_bytes(entry[0])
+        return entry
+
+    def _take(self, name):
         import bpy
         import gpu
 
         image = bpy.data.images.get(name)
-        pixels = None
-        if image is not None:
-            try:
-                pixels = image_pixels(image, data)
-            except (RuntimeError, ValueError) as exc:
-                print(f"Penumbra: image '{name}' could not be read: {exc}", file=sys.stderr)
-        if pixels is None:
-            print(f"Penumbra: image '{name}' has no pixels (missing file?): drawn magenta", file=sys.stderr)
-            pixels = np.array(MISSING, np.float32).reshape(1, 1, 4)
-        if image is not None and image.is_float:  # byte images cannot hold NaN/Inf
-            pixels = np.nan_to_num(pixels, nan=0.0, posinf=65504.0, neginf=-65504.0)
-        pixels = np.ascontiguousarray(pixels, np.float32)
-        h, w = pixels.shape[:2]
-        limit = gpu.capabilities.max_texture_size_get()
-        if w > limit or h > limit:
-            step = int(np.ceil(max(w, h) / limit))
-            pixels = np.ascontiguousarray(pixels[::step, ::step])
-            print(
-                f"Penumbra: image '{name}' ({w}x{h}) is larger than this GPU's textures: every {step}th pixel is used",
-                file=sys.stderr,
-            )
-            h, w = pixels.shape[:2]
-        buf = gpu.types.Buffer("FLOAT", pixels.size, pixels.ravel())
-        tex = gpu.types.GPUTexture((w, h), format="RGBA16F", data=buf)
+        if image is None:
+            self._messages[name] = f"Penumbra: image '{name}' not found: drawn magenta"
+            return _missing_texture(), False
+        texture = gpu.texture.from_image(image)
         self.uploads += 1
-        return tex
+        if not image.has_data:
+            # Blender's error texture (a file it could not read): magenta, as in its own engines.
+            self._messages[name] = f"Penumbra: image '{name}' has no pixels (missing file?): drawn magenta"
+            return _missing_texture(), False
+        w, h = image.size
+        if texture.width < w or texture.height < h:
+            self._messages[name] = (
+                f"Penumbra: image '{name}' ({w}x{h}) is larger than this GPU's textures: drawn at "
+                f"{texture.width}x{texture.height}"
+            )
+        if image.source == "TILED" and len(image.tiles) > 1:
+            self._messages[name] = (
+                f"Penumbra: image '{name}' has UDIM tiles: only tile {image.tiles[0].number} is drawn"
+            )
+        return texture, stores_premultiplied(image)
+
+    def world_sh(self, name, reduce):
+        """The SH (9, 3) of image ``name`` as an equirectangular environment of strength 1:
+        ``reduce(texture, premultiplied, width, height)`` draws the texture at most
+        ``SH_WIDTH`` wide on the GPU and returns it (height, width, 4); kept until the image
+        changes."""
+        sh = self._sh.get(name)
+        if sh is None:
+            texture, premultiplied = self._entry(name)
+            width = max(1, min(SH_WIDTH, texture.width))
+            height = max(1, min(SH_WIDTH // 2, texture.height))
+            rgba = np.nan_to_num(np.asarray(reduce(texture, premultiplied, width, height), np.float64))
+            sh = self._sh[name] = equirect_sh(np.clip(rgba[..., :3], 0.0, None))
+        return sh
+
+    def messages(self):
+        """What the user must be told of the images taken so far (until they change)."""
+        return list(self._messages.values())
+
+
+def world_background(sh):
+    """The colour behind the scene of a world whose light is ``sh``: its mean."""
+    return sh[0] * SH_C0
+
+
+def _texture_bytes(texture):
+    return texture.width * texture.height * FORMAT_BYTES.get(texture.format, 16) * 4 // 3
+
+
+def _missing_texture():
+    import gpu
+
+    data = gpu.types.Buffer("FLOAT", 4, [1.0, 0.0, 1.0, 1.0])
+    return gpu.types.GPUTexture((1, 1), format="RGBA16F", data=data)

@@ -1,7 +1,12 @@
-/* Image textures as Blender's Image Texture node reads them: interpolation (0 Closest,
- * 1 Linear) and extension (0 Repeat, 1 Extend, 2 Clip, 3 Mirror) are applied here with
- * texelFetch, so they do not depend on the texture's sampler state. Images are uploaded as
- * scene-linear RGBA with straight alpha (engine/scene/textures.py). */
+/* Image textures as Blender's Image Texture node reads them. The textures are Blender's own
+ * (gpu.texture.from_image: colour-managed to scene linear, with its mipmaps), filtered here
+ * with texelFetch so the result does not depend on a sampler state: interpolation (0 Closest,
+ * 1 Linear) and extension (0 Repeat, 1 Extend, 2 Clip, 3 Mirror) are applied at every mip
+ * level. Linear minifies trilinearly from the pixel's footprint (the uv derivatives), with up
+ * to IMAGE_MAX_ANISOTROPY trilinear probes along the footprint's long axis (anisotropic
+ * filtering as the texture units of GPUs do it); Closest reads the full-size image. A texture
+ * Blender stores premultiplied (a float image whose alpha mode is not Straight) is divided by
+ * its alpha after filtering, so the node's Color output is straight, as in EEVEE. */
 
 #ifndef MATERIAL_GLSL
 #define MATERIAL_GLSL
@@ -10,6 +15,7 @@
 #define EXTENSION_EXTEND 1
 #define EXTENSION_CLIP 2
 #define EXTENSION_MIRROR 3
+#define IMAGE_MAX_ANISOTROPY 8
 
 int wrap_mirror(int i, int n)
 {
@@ -18,7 +24,7 @@ int wrap_mirror(int i, int n)
   return (m < n) ? m : period - 1 - m;
 }
 
-vec4 image_texel(sampler2D tex, ivec2 p, ivec2 size, int extension)
+vec4 image_texel(sampler2D tex, ivec2 p, ivec2 size, int extension, int level)
 {
   if (extension == EXTENSION_CLIP) {
     if (any(lessThan(p, ivec2(0))) || any(greaterThanEqual(p, size))) {
@@ -34,28 +40,81 @@ vec4 image_texel(sampler2D tex, ivec2 p, ivec2 size, int extension)
   else {
     p = clamp(p, ivec2(0), size - 1);
   }
-  return texelFetch(tex, p, 0);
+  return texelFetch(tex, p, level);
 }
 
-/* mode: (interpolation, extension, use the alpha output, unused). */
-vec4 sample_image(sampler2D tex, vec2 uv, ivec4 mode)
+/* Bilinear at mip ``level`` between its texel centres; ``uv`` in [0, 1] image units. */
+vec4 image_bilinear(sampler2D tex, vec2 uv, int level, int extension)
+{
+  ivec2 size = max(textureSize(tex, level), ivec2(1));
+  vec2 st = uv * vec2(size) - 0.5;
+  ivec2 i = ivec2(floor(st));
+  vec2 f = st - floor(st);
+  vec4 a = image_texel(tex, i, size, extension, level);
+  vec4 b = image_texel(tex, i + ivec2(1, 0), size, extension, level);
+  vec4 c = image_texel(tex, i + ivec2(0, 1), size, extension, level);
+  vec4 d = image_texel(tex, i + ivec2(1, 1), size, extension, level);
+  return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
+/* Between the two mip levels around ``lod`` (0: the full-size image). */
+vec4 image_trilinear(sampler2D tex, vec2 uv, float lod, int levels, int extension)
+{
+  lod = clamp(lod, 0.0, float(levels - 1));
+  int l0 = int(floor(lod));
+  float f = lod - float(l0);
+  vec4 a = image_bilinear(tex, uv, l0, extension);
+  if (f <= 0.0 || l0 + 1 >= levels) {
+    return a;
+  }
+  return mix(a, image_bilinear(tex, uv, l0 + 1, extension), f);
+}
+
+/* mode: (interpolation, extension, use the alpha output, component); ``duv_dx``, ``duv_dy``:
+ * how uv changes from one pixel to the next (the footprint). */
+vec4 sample_image_grad(sampler2D tex, vec2 uv, vec2 duv_dx, vec2 duv_dy, ivec4 mode, bool premultiplied)
 {
   ivec2 size = textureSize(tex, 0);
   vec2 st = uv * vec2(size);
   if (!(abs(st.x) < 1e7 && abs(st.y) < 1e7)) {
     return vec4(0.0); /* NaN or absurd coordinates */
   }
+  vec4 t;
   if (mode.x == 0) {
-    return image_texel(tex, ivec2(floor(st)), size, mode.y);
+    t = image_texel(tex, ivec2(floor(st)), size, mode.y, 0);
   }
-  st -= 0.5;
-  ivec2 i = ivec2(floor(st));
-  vec2 f = st - floor(st);
-  vec4 a = image_texel(tex, i, size, mode.y);
-  vec4 b = image_texel(tex, i + ivec2(1, 0), size, mode.y);
-  vec4 c = image_texel(tex, i + ivec2(0, 1), size, mode.y);
-  vec4 d = image_texel(tex, i + ivec2(1, 1), size, mode.y);
-  return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+  else {
+    /* The footprint's axes in full-size texels. */
+    vec2 ax = duv_dx * vec2(size);
+    vec2 ay = duv_dy * vec2(size);
+    float lx = length(ax);
+    float ly = length(ay);
+    float major = max(lx, ly);
+    int levels = textureQueryLevels(tex);
+    if (!(major > 1.0) || levels <= 1 || !(major < 1e7)) {
+      t = image_bilinear(tex, uv, 0, mode.y); /* magnified (or no footprint): the full-size image */
+    }
+    else {
+      float minor = min(lx, ly);
+      int n = int(min(ceil(major / max(minor, 1e-6)), float(IMAGE_MAX_ANISOTROPY)));
+      float lod = log2(major / float(n));
+      vec2 axis = ((lx >= ly) ? duv_dx : duv_dy);
+      t = vec4(0.0);
+      for (int k = 0; k < n; k++) {
+        t += image_trilinear(tex, uv + axis * ((float(k) + 0.5) / float(n) - 0.5), lod, levels, mode.y);
+      }
+      t /= float(n);
+    }
+  }
+  if (premultiplied && t.a > 0.0) {
+    t.rgb /= t.a;
+  }
+  return t;
+}
+
+vec4 sample_image(sampler2D tex, vec2 uv, ivec4 mode, bool premultiplied)
+{
+  return sample_image_grad(tex, uv, dFdx(uv), dFdy(uv), mode, premultiplied);
 }
 
 vec2 texture_uv(vec2 uv, vec4 row_u, vec4 row_v)
@@ -68,7 +127,8 @@ vec2 texture_uv(vec2 uv, vec4 row_u, vec4 row_v)
 #define SAMPLE_COLOR(channel, uv) \
   sample_image(tex_##channel, \
                texture_uv(uv, material.channel##_uv_u, material.channel##_uv_v), \
-               material.channel##_mode)
+               material.channel##_mode, \
+               (image_premultiplied & IMAGE_BIT_##channel) != 0)
 
 /* A value channel: one component through a Separate Color node (mode.w 1-3: R, G, B), the
  * alpha output, or the colour converted to a value as Blender does (Rec.709 luminance). */
