@@ -7,6 +7,7 @@ functions add objects, materials, lights and cameras to a given scene.
 import math
 
 import bpy
+import numpy as np
 from mathutils import Vector
 
 WHITE_ALBEDO = 0.8  # albedo of white(): the Lambertian white of the shadow and light-unit scenes
@@ -256,4 +257,66 @@ def demo_scene(width=640, height=360):
     vig = s.layers.add()
     vig.effect, vig.name = "VIGNETTE", "Vignette"
     vig.vignette.radius, vig.vignette.softness = 0.9, 0.8
+    return scene
+
+
+def textured_asset(width=160, height=90, texels=2048, seed=7):
+    """A scanned-asset-like object as glTF's importer builds one (a DamagedHelmet stand-in):
+    a smooth mesh of about 16k triangles whose Principled BSDF reads four ``texels``² images
+    (Base Color and Emission in sRGB; metallic-roughness through Separate Color and a normal
+    map, Non-Color) with a fifth, occlusion, in an Image Texture node nothing reads; a sun and
+    a point light on a ground. The images are smooth noise made here, so nothing is downloaded."""
+    scene = empty_scene(width, height)
+    set_world(scene, (0.05, 0.05, 0.06))
+    plane(scene, "Ground", size=10.0, mat=material("Ground", (0.5, 0.5, 0.5), roughness=0.7))
+    rng = np.random.default_rng(seed)
+
+    def image(name, colorspace, channels):
+        coarse = rng.random((33, 33, channels), dtype=np.float32)
+        # Bilinear upsampling of a coarse grid: smooth detail at every scale above a texel.
+        t = np.linspace(0.0, 32.0, texels, dtype=np.float32)
+        i = np.minimum(t.astype(np.int32), 31)
+        f = (t - i)[:, None]
+        rows = coarse[i] * (1.0 - f[..., None]) + coarse[i + 1] * f[..., None]
+        grid = rows[:, i] * (1.0 - f[None, :, :]) + rows[:, i + 1] * f[None, :, :]
+        grain = rng.random((texels, texels, 1), dtype=np.float32) * 0.1
+        rgba = np.ones((texels, texels, 4), np.float32)
+        rgba[..., :3] = np.clip(grid[..., :3] * 0.9 + grain, 0.0, 1.0) if channels >= 3 else grid[..., :1]
+        img = bpy.data.images.new(name, texels, texels, alpha=True)
+        img.pixels.foreach_set(rgba.ravel())
+        img.colorspace_settings.name = colorspace
+        img.pack()
+        return img
+
+    mat = bpy.data.materials.new("Asset")
+    if bpy.app.version < (5, 0, 0):
+        mat.use_nodes = True
+    tree = mat.node_tree
+    bsdf = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+
+    def texture(name, colorspace, channels=3):
+        node = tree.nodes.new("ShaderNodeTexImage")
+        node.image = image(name, colorspace, channels)
+        return node
+
+    tree.links.new(texture("base_color", "sRGB").outputs["Color"], bsdf.inputs["Base Color"])
+    separate = tree.nodes.new("ShaderNodeSeparateColor")
+    tree.links.new(texture("metallic_roughness", "Non-Color").outputs["Color"], separate.inputs["Color"])
+    tree.links.new(separate.outputs["Green"], bsdf.inputs["Roughness"])
+    tree.links.new(separate.outputs["Blue"], bsdf.inputs["Metallic"])
+    normal_map = tree.nodes.new("ShaderNodeNormalMap")
+    tree.links.new(texture("normal", "Non-Color").outputs["Color"], normal_map.inputs["Color"])
+    tree.links.new(normal_map.outputs["Normal"], bsdf.inputs["Normal"])
+    emission = "Emission Color" if "Emission Color" in bsdf.inputs else "Emission"
+    tree.links.new(texture("emissive", "sRGB").outputs["Color"], bsdf.inputs[emission])
+    if "Emission Strength" in bsdf.inputs:
+        bsdf.inputs["Emission Strength"].default_value = 0.2
+    texture("occlusion", "Non-Color")  # glTF keeps occlusion beside the shader, unread
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=1.0, location=(0.0, 0.0, 1.1))
+    ob = bpy.context.object
+    ob.data.materials.append(mat)
+    bpy.ops.object.shade_smooth()
+    light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(40), 0.0, math.radians(30)), angle=math.radians(1.0))
+    light(scene, "Point", "POINT", 300.0, location=(-2.5, -2.0, 3.0), shadow_soft_size=0.1)
+    look_at(scene, (0.0, -4.5, 2.2), (0.0, 0.0, 1.0), lens=40.0)
     return scene

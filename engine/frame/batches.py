@@ -15,6 +15,7 @@ class Batches:
         self.levels = {}  # (geometry key, serial, level) -> (whole, parts) of ``simplify.simplified``
         self.terminators = {}  # (geometry key, serial[, level]) -> parts with the terminator's corner data
         self._used = set()  # the levels drawn this frame (lit pass or shadow maps)
+        self.uploaded = 0  # bytes of vertex and index buffers sent to the GPU since creation
 
     def get(self, key, geo):
         """The batches of the snapshot's geometry ``key``, built on first use of its serial."""
@@ -35,6 +36,7 @@ class Batches:
         cached = self.terminators.get(cache_key)
         if cached is None:
             cached = self.terminators[cache_key] = _terminator_parts(geo)
+            self.uploaded += _upload_bytes(_attributes(geo), 3 * len(geo.indices), len(geo.indices))
         return cached
 
     def keep(self, live):
@@ -49,13 +51,13 @@ class Batches:
             del self.terminators[stale]
         self._used = set()
 
-    @staticmethod
-    def _get(cache, cache_key, geo):
+    def _get(self, cache, cache_key, geo):
         import gpu
 
         cached = cache.get(cache_key)
         if cached is not None:
             return cached
+        self.uploaded += _upload_bytes(_attributes(geo), len(geo.positions), len(geo.indices))
         vbo = _vertex_buffer(_attributes(geo), len(geo.positions))
         whole = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices))
         parts = []
@@ -67,6 +69,11 @@ class Batches:
             parts.append((mat_index, gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)))
         cache[cache_key] = (whole, parts)
         return cache[cache_key]
+
+
+def _upload_bytes(attrs, vertices, triangles):
+    """Bytes a batch of ``vertices`` with ``attrs`` (32-bit floats) and ``triangles`` sends."""
+    return vertices * 4 * sum(int(a.shape[1]) for a in attrs.values()) + triangles * 12
 
 
 def _attributes(geo):

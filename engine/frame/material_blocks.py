@@ -13,6 +13,7 @@ class MaterialBlocks:
     def __init__(self):
         self._blocks = {}  # id(Material) -> (Material, GPUUniformBuf)
         self._constants = {}  # id(Material) -> (Material, GPUUniformBuf) of its node tree
+        self.uploaded = 0  # bytes of blocks sent to the GPU since creation
 
     def __len__(self):
         return len(self._blocks)
@@ -47,7 +48,9 @@ class MaterialBlocks:
                     int(ref.component),
                 )
             row[f"{channel}_mode"] = mode
-        ubo = gpu.types.GPUUniformBuf(MATERIAL_STRUCT.pack([row]).tobytes())
+        raw = MATERIAL_STRUCT.pack([row]).tobytes()
+        self.uploaded += len(raw)
+        ubo = gpu.types.GPUUniformBuf(raw)
         if len(self._blocks) > MAX_BLOCKS:
             self._blocks.clear()
         self._blocks[id(mat)] = (mat, ubo)
@@ -62,6 +65,7 @@ class MaterialBlocks:
             return cached[1]
         rows = mat.tree.constants if len(mat.tree.constants) else np.zeros((1, 4), np.float32)
         data = NODE_CONSTANT_STRUCT.pack([{"v": row} for row in rows])
+        self.uploaded += data.nbytes
         ubo = gpu.types.GPUUniformBuf(data.tobytes())
         if len(self._constants) > MAX_BLOCKS:
             self._constants.clear()

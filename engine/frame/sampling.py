@@ -43,6 +43,8 @@ import time
 
 import numpy as np
 
+from ..shadows.vectors import cross
+
 PIXEL_BASES = (2, 3)
 
 
@@ -191,9 +193,9 @@ def concentric_disk(u, v):
 def _basis(axis):
     """Two unit vectors perpendicular to ``axis`` and to each other."""
     helper = np.eye(3)[int(np.argmin(np.abs(axis)))]
-    u = np.cross(axis, helper)
+    u = cross(axis, helper)
     u /= np.linalg.norm(u)
-    return u, np.cross(axis, u)
+    return u, cross(axis, u)
 
 
 def has_size(light):
@@ -334,11 +336,11 @@ def light_at_sample(light, light_index, s, count, jitter=False, progressive=Fals
         nd /= np.linalg.norm(nd)
         # Lights shine along their local -Z: rotate the matrix's Z axis onto -nd.
         z = -nd
-        xa = np.cross(m[:3, 1], z)
+        xa = cross(m[:3, 1], z)
         if np.linalg.norm(xa) < 1e-12:
             xa = _basis(z)[0]
         xa /= np.linalg.norm(xa)
-        m[:3, 0], m[:3, 1], m[:3, 2] = xa, np.cross(z, xa), z
+        m[:3, 0], m[:3, 1], m[:3, 2] = xa, cross(z, xa), z
     elif light.type == "AREA":
         u, v = point(2)
         if light.shape in ("DISK", "ELLIPSE"):

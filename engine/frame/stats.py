@@ -1,6 +1,62 @@
-"""What a frame did (``FrameStats``): read by tests, the benchmarks and the render report."""
+"""What a frame did (``FrameStats``): read by tests, the benchmarks and the render report.
 
+On a GPU a frame's pixels are nearly free and its cost is the Python that asks for them, so
+a frame also says where its CPU time went (``StageClock``): each stage's Python time (the wall
+time of its calls) apart from the time spent waiting for the GPU, per frame and per sample,
+with the bytes it uploaded and the draw calls and triangles of each pass.
+"""
+
+import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+
+
+class StageClock:
+    """Seconds each stage of a frame spent in Python (``cpu``) and, when ``fence`` is set (a
+    function that returns once the GPU has finished everything asked so far: a one-pixel
+    read-back), waiting for the GPU to finish that stage's work (``gpu``). With a fence a
+    stage starts on an idle GPU, so its Python time is not another stage's GPU time; without
+    one (the default: a fence stalls the pipeline) ``cpu`` holds the calls' wall time, which
+    includes whatever the driver blocked in them."""
+
+    def __init__(self, fence=None):
+        self.fence = fence
+        self.cpu = {}
+        self.gpu = {}
+        self.waited = 0.0  # seconds the fences waited outside any stage (before the first)
+        self._open = None
+
+    def begin(self, name):
+        """Stage ``name`` starts (``end`` closes it; stages do not nest)."""
+        if self.fence is not None:
+            start = time.perf_counter()
+            self.fence()
+            self.waited += time.perf_counter() - start
+        self._open = (name, time.perf_counter())
+
+    def end(self):
+        name, start = self._open
+        issued = time.perf_counter()
+        self.cpu[name] = self.cpu.get(name, 0.0) + issued - start
+        if self.fence is not None:
+            self.fence()
+            self.gpu[name] = self.gpu.get(name, 0.0) + time.perf_counter() - issued
+
+    @contextmanager
+    def stage(self, name):
+        self.begin(name)
+        try:
+            yield
+        finally:
+            self.end()
+
+    @property
+    def cpu_seconds(self):
+        return sum(self.cpu.values())
+
+    @property
+    def gpu_seconds(self):
+        return sum(self.gpu.values())
 
 
 @dataclass
@@ -33,4 +89,9 @@ class FrameStats:
     simplified: int = 0  # instances drawn at a level of detail (``simplify``; ``triangles`` counts its)
     debug_legend: str = ""  # a debug view's legend: what its colours mean (``debug_view``)
     binned: bool = False  # the lit pass looped over each screen bin's lights only
+    shadow_draws: int = 0  # of ``draws``, the draw calls into shadow maps
+    upload_bytes: int = 0  # bytes sent to the GPU: uniform blocks, batches built, textures of data
+    cpu_seconds: dict = field(default_factory=dict)  # stage -> Python seconds (``StageClock.cpu``)
+    gpu_seconds: dict = field(default_factory=dict)  # stage -> seconds waiting on the GPU (with a fence only)
+    sample_cpu_seconds: list = field(default_factory=list)  # Python seconds of each sample (its stages)
     messages: list = field(default_factory=list)  # what the user must be told about this frame

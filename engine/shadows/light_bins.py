@@ -18,6 +18,8 @@ import math
 
 import numpy as np
 
+from .vectors import cross
+
 BIN_SIZE = 16  # pixels per side of a bin
 WORD_BITS = 16  # lights per float channel: sums of distinct powers of two below 2^16 are exact in float32
 WIDE_SPOT = math.radians(80.0)  # half-angles above this are bounded by their half-space only
@@ -65,9 +67,9 @@ def influence_planes(light):
     if half > WIDE_SPOT:
         return _unit_planes([(*(-a), -(a @ p))])
     helper = np.eye(3)[int(np.argmin(np.abs(a)))]
-    u = np.cross(a, helper)
+    u = cross(a, helper)
     u /= np.linalg.norm(u)
-    v = np.cross(a, u)
+    v = cross(a, u)
     c, s = math.cos(half), math.sin(half)
     rows = [(-a[0], -a[1], -a[2], -(a @ p))]  # in front of the apex
     for side in (u, -u, v, -v):
@@ -96,7 +98,7 @@ def polytope_vertices(planes, tolerance):
     if len(triples) == 0:
         return np.zeros((0, 3))
     normals = planes[:, :3]
-    pairs = np.cross(normals[:, None], normals[None, :])  # (p, p, 3): every pair's cross product
+    pairs = cross(normals[:, None], normals[None, :])  # (p, p, 3): every pair's cross product
     i, j, k = triples.T
     c12, c20, c01 = pairs[j, k], pairs[k, i], pairs[i, j]
     d = planes[triples, 3]  # (t, 3)

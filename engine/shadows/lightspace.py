@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from . import light_bins
+from .vectors import cross
 
 
 # Maps clip-space xyz in [-1, 1] to texture space [0, 1]: the "bias matrix" of projective shadow
@@ -51,8 +52,8 @@ def look_at(eye, forward):
     f = normalize(forward)
     axes = np.eye(3)
     up = axes[int(np.argmin(np.abs(axes @ f)))]
-    right = normalize(np.cross(f, up))
-    true_up = np.cross(right, f)
+    right = normalize(cross(f, up))
+    true_up = cross(right, f)
     view = np.eye(4)
     view[0, :3] = right
     view[1, :3] = true_up
@@ -113,9 +114,9 @@ def normal_matrix(model):
     """
     a = np.asarray(model, dtype=np.float64)[:3, :3]
     cof = np.empty((3, 3))
-    cof[:, 0] = np.cross(a[:, 1], a[:, 2])
-    cof[:, 1] = np.cross(a[:, 2], a[:, 0])
-    cof[:, 2] = np.cross(a[:, 0], a[:, 1])
+    cof[:, 0] = cross(a[:, 1], a[:, 2])
+    cof[:, 1] = cross(a[:, 2], a[:, 0])
+    cof[:, 2] = cross(a[:, 0], a[:, 1])
     det = float(np.linalg.det(a))
     sign = -1.0 if det < 0.0 else 1.0
     return cof * sign
@@ -206,7 +207,7 @@ def hull_planes(corners):
     rows = []
     for face in ((0, 2, 6, 4), (1, 5, 7, 3), (0, 4, 5, 1), (2, 3, 7, 6), (0, 1, 3, 2), (4, 6, 7, 5)):
         p = c[list(face)]
-        n = np.cross(p[2] - p[0], p[3] - p[1])  # the quad's diagonals: robust for thin faces
+        n = cross(p[2] - p[0], p[3] - p[1])  # the quad's diagonals: robust for thin faces
         length = float(np.linalg.norm(n))
         if not np.isfinite(length) or length <= 0.0:
             continue
@@ -349,7 +350,7 @@ def flat_casters_without_shadow(boxes, direction=None, position=None):
     thin = lengths.argmin(axis=1)
     rows = np.arange(n_boxes)
     a, b = edges[rows, (thin + 1) % 3], edges[rows, (thin + 2) % 3]
-    normal = np.cross(a, b)
+    normal = cross(a, b)
     area = np.linalg.norm(normal, axis=1)
     flat = flat_boxes(boxes) & (area > 1e-12 * longest**2) & np.isfinite(area)
     candidates = np.nonzero(flat)[0]

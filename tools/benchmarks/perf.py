@@ -8,6 +8,11 @@ Final renders (F12) go through ``bpy.ops.render.render``: a new engine instance 
 so every Penumbra row pays for extraction, shadow maps and allocation, as a batch render does.
 
 Sections (``--sections``, all by default):
+  cpu         where pixels cost nothing (160x90), what a frame's CPU costs: a textured asset
+              (``scenes.textured_asset``: four 2048² images, 16k triangles) at 1 sample against
+              Workbench on the same scene, and the demo at 16 samples against Workbench's one;
+              then one fenced frame of each (``Renderer.fence_stages``): Python and GPU time per
+              stage, per sample, bytes uploaded, draw calls and triangles per pass
   resolution  demo scene without post layers at 480x270, 960x540 and 1920x1080
   passes      the demo scene at 960x540, F12, timed pass by pass (the GPU waited for with a
               one-pixel read-back before and after each pass): the depth pass and the lit pass
@@ -50,6 +55,7 @@ from devkit import assets, engines, report, scenes, session
 
 HELP = "frame cost and scaling as ratios to Workbench (AA off, shadows on)"
 SECTIONS = (
+    "cpu",
     "resolution",
     "passes",
     "samples",
@@ -251,27 +257,74 @@ def bare_copy(mesh):
 # --- sections ------------------------------------------------------------------------------
 
 
+def _fenced_stats(scene):
+    """FrameStats of an F12 render of ``scene`` with every stage fenced (``StageClock``)."""
+    from penumbra.engine.frame.renderer import Renderer
+
+    seen = []
+    render = Renderer.render
+
+    def recorded(self, *args, **kwargs):
+        out = render(self, *args, **kwargs)
+        seen.append(out.stats)
+        return out
+
+    Renderer.fence_stages, Renderer.render = True, recorded
+    try:
+        _penumbra(scene)
+        _render()
+    finally:
+        Renderer.fence_stages, Renderer.render = False, render
+    return seen[-1]
+
+
+def cpu_note(stats):
+    """A FrameStats' CPU/GPU split in a few words (``section_cpu``, docs/benchmarks.md)."""
+    cpu, gpu = stats.cpu_seconds, stats.gpu_seconds
+    per_sample = sorted(stats.sample_cpu_seconds[1:]) or stats.sample_cpu_seconds
+    median = per_sample[len(per_sample) // 2] if per_sample else 0.0
+    stages = ", ".join(f"{k} {v * 1e3:.1f}/{gpu.get(k, 0.0) * 1e3:.1f}" for k, v in sorted(cpu.items()))
+    return (
+        f"Python {sum(cpu.values()) * 1e3:.1f} ms, GPU {sum(gpu.values()) * 1e3:.1f} ms; a further sample's Python "
+        f"{median * 1e3:.2f} ms; uploaded {stats.upload_bytes / 1024:.0f} KiB; draws {stats.draws} "
+        f"({stats.shadow_draws} into maps); triangles {stats.triangles} lit, {stats.shadow_triangles} in maps; "
+        f"stage Python/GPU ms: {stages}"
+    )
+
+
+def section_cpu(plan):
+    """At 160x90, where the pixels cost next to nothing even on llvmpipe, what a frame's CPU
+    work costs against Workbench's: a textured asset at 1 sample, and the demo at 16 samples
+    against Workbench's one sample; each with the CPU/GPU split of one fenced frame."""
+    rows = []
+    asset = scenes.textured_asset(160, 90)
+    t = paired(asset, plan["runs"])
+    rows.append(_row("cpu", "textured asset 160x90, 1 sample", t, cpu_note(_fenced_stats(asset)), plan["runs"]))
+    scene = demo(160, 90)
+    times = {"PENUMBRA": [], "WORKBENCH": []}
+    for key, setup in (("PENUMBRA", _penumbra), ("WORKBENCH", _workbench)):  # warm-up
+        setup(scene)
+        _render()
+    for _ in range(plan["runs"]):
+        for key, setup in (("PENUMBRA", _penumbra), ("WORKBENCH", _workbench)):
+            setup(scene)
+            scene.penumbra.render_samples = 16
+            start = time.perf_counter()
+            _render()
+            times[key].append(time.perf_counter() - start)
+    t = {k: statistics.median(v) for k, v in times.items()}
+    scene.penumbra.render_samples = 16
+    note = cpu_note(_fenced_stats(scene))
+    rows.append(_row("cpu", "demo 160x90, 16 samples (Workbench: 1 sample)", t, note, plan["runs"]))
+    return rows
+
+
 def section_resolution(plan):
     rows = []
     for w, h in plan["resolutions"]:
         scene = demo(w, h)
         rows.append(_row("resolution", f"{w}x{h}", paired(scene, plan["runs"]), runs=plan["runs"]))
     return rows
-
-
-def _wait(renderer):
-    """Return once the GPU has finished what was drawn into the frame's targets."""
-    fb = renderer.film.fb or renderer.film.fb_color
-    if fb is not None:
-        with fb.bind():
-            fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
-    atlas = renderer.shadows._framebuffer
-    if atlas is not None:
-        with atlas.bind():
-            if renderer.shadows.depth_format == "FLOAT32":
-                atlas.read_depth(0, 0, 1, 1)
-            else:
-                atlas.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
 
 
 def _time_passes(times, current):
@@ -285,10 +338,10 @@ def _time_passes(times, current):
 
     def timed(method, part):
         def run(self, *args, **kwargs):
-            _wait(current["renderer"])
+            current["renderer"].wait_gpu()
             start = time.perf_counter()
             out = method(self, *args, **kwargs)
-            _wait(current["renderer"])
+            current["renderer"].wait_gpu()
             if "case" in current:
                 times.setdefault((current["case"], part), []).append(time.perf_counter() - start)
             return out
@@ -297,7 +350,7 @@ def _time_passes(times, current):
 
     def recorded(method):
         def run(self, *args, **kwargs):
-            current["renderer"] = self  # the renderer whose targets ``_wait`` reads
+            current["renderer"] = self  # the renderer whose targets ``wait_gpu`` reads
             out = method(self, *args, **kwargs)
             current["stats"] = out.stats  # the last frame's FrameStats
             return out
