@@ -789,12 +789,13 @@ def texture_wave(p, distortion, detail, detail_scale, detail_roughness, phase, k
                           max(F(detail_roughness), F(0.0)), 2.0, True)  # fmt: skip
             n = n + F(distortion) * (f * F(2.0) - F(1.0))
         n = finite(n)
+        # Clamped to [0, 1] as the shader does (sin's rounding, n + 0.5 rounding up from 2^23).
         if profile == WAVE_SINE:
-            return (F(0.5) + F(0.5) * np.sin(n - _HALF_PI)).astype(np.float32)
+            return np.clip(F(0.5) + F(0.5) * np.sin(n - _HALF_PI), F(0.0), F(1.0)).astype(np.float32)
         n = n / _TWO_PI
         if profile == WAVE_SAW:
-            return (n - np.floor(n)).astype(np.float32)
-        return (np.abs(n - np.floor(n + F(0.5))) * F(2.0)).astype(np.float32)
+            return np.clip(n - np.floor(n), F(0.0), F(1.0)).astype(np.float32)
+        return np.clip(np.abs(n - np.floor(n + F(0.5))) * F(2.0), F(0.0), F(1.0)).astype(np.float32)
 
 
 def node_tex_wave(

@@ -42,7 +42,29 @@ def points(n=2048, seed=7):
 NEAR = np.r_[0:128, 352:2048]  # rows of points() within [-10, 10]^4
 
 
+def rounding_spread(f, pts, ulps=4, trials=6, seed=0):
+    """How far ``f(pts)`` (numpy, (n, k)) moves when each input component moves by up to
+    ``ulps`` float32 ulps of its own magnitude: (n, k). Two conformant GPUs may round the scaled
+    coordinate, an octave's coordinate or a fused multiply-add differently by about that much,
+    so an output may differ from the reference by that much too (far more at 1e4 than near 0)."""
+    pts = np.asarray(pts, np.float32)
+    base = f(pts).astype(np.float64)
+    rng = np.random.default_rng(seed)
+    spread = np.zeros_like(base)
+    wide = pts.astype(np.float64)
+    for t in range(trials):
+        sign = rng.choice([-1.0, 1.0], pts.shape) if t >= 2 else np.full(pts.shape, 1.0 - 2.0 * t)
+        with np.errstate(invalid="ignore", over="ignore"):
+            moved = (wide * (1.0 + sign * ulps * 2.0**-23)).astype(np.float32)
+        moved = np.where(np.isfinite(pts), moved, pts)
+        with np.errstate(invalid="ignore"):
+            diff = np.abs(f(moved).astype(np.float64) - base)
+        spread = np.maximum(spread, np.where(np.isfinite(diff), diff, 0.0))
+    return spread
+
+
 def compare(out, expected, rtol, atol, what):
+    """``atol`` may be per value (e.g. plus ``rounding_spread``)."""
     assert np.all(np.isfinite(out)), what
     err = np.abs(out.astype(np.float64) - expected)
     assert np.all(err <= atol + rtol * np.abs(expected)), (what, float(err.max()), int(np.argmax(err.max(1))))

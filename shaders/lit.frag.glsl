@@ -633,7 +633,9 @@ void main()
 #endif
 #if AUX_OUTPUTS
   out_depth = v_view_depth;
-  out_shadow = (unshadowed > 0.0) ? arriving / unshadowed : 1.0;
+  /* A ratio of weighted sums lies in [0, 1] but for rounding (a division need not be
+   * correctly rounded: w / w may be 1.0000001). */
+  out_shadow = (unshadowed > 0.0) ? clamp(arriving / unshadowed, 0.0, 1.0) : 1.0;
 #  if NODE_LOBES == 2
   out_normal = vec4((s.w.y > s.w.x) ? s.N_b : N, 0.0); /* the heavier lobe's */
 #  else

@@ -6,6 +6,10 @@ void main()
   ivec2 p = ivec2(gl_FragCoord.xy) - origin;
   out_color = scale * texelFetch(src_color, p, 0);
 #if WITH_SHADOW
+#  if CLAMP_SHADOW
+  out_shadow = vec4(clamp(scale * texelFetch(src_shadow, p, 0).r, 0.0, 1.0));
+#  else
   out_shadow = vec4(scale * texelFetch(src_shadow, p, 0).r);
+#  endif
 #endif
 }

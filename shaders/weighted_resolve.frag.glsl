@@ -7,6 +7,7 @@ void main()
   float inverse = (w > 0.0) ? 1.0 / w : 0.0;
   out_color = inverse * texelFetch(src_color, p, 0);
 #if WITH_SHADOW
-  out_shadow = vec4(inverse * texelFetch(src_shadow, p, 0).r);
+  /* sum(w v) / sum(w) of visibilities in [0, 1]: in [0, 1] but for rounding. */
+  out_shadow = vec4(clamp(inverse * texelFetch(src_shadow, p, 0).r, 0.0, 1.0));
 #endif
 }

@@ -18,6 +18,7 @@ from .programs import (
     MASKED_COPY_WEIGHT,
     SCALED_COPY,
     SCALED_COPY_SHADOW,
+    SCALED_RESOLVE_SHADOW,
     SETTLE,
     SETTLE_SHADOW,
     SETTLED_COPY,
@@ -272,7 +273,7 @@ class Film:
                 self.fullscreen(WEIGHTED_RESOLVE, resolve_fb, {"src_color": accum, "weight": self._weight}, {})
             return
         inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
-        self._scaled_copy(self._resolve_fb[1], (self._accum_color, self._accum_shadow), inverse, aux)
+        self._scaled_copy(self._resolve_fb[1], (self._accum_color, self._accum_shadow), inverse, aux, resolve=True)
         if emission:
             accum, _accum_fb, resolve_fb = self._emission_targets
             self.fullscreen(SCALED_COPY, resolve_fb, {"src_color": accum}, {"scale": inverse})
@@ -507,14 +508,14 @@ class Film:
             )
         return self._emission_targets[0]
 
-    def _scaled_copy(self, framebuffer, sources, scale, aux, blend="NONE"):
+    def _scaled_copy(self, framebuffer, sources, scale, aux, blend="NONE", resolve=False):
         """framebuffer (<blend>)= scale * sources: colour, and shadow when ``aux`` and the
-        accumulation carries it."""
+        accumulation carries it (clamped to [0, 1] when ``resolve``: a mean visibility)."""
         with_shadow = aux and self._accum_shadow is not None
         samplers = {"src_color": sources[0]}
         if with_shadow:
             samplers["src_shadow"] = sources[1]
-        program = SCALED_COPY_SHADOW if with_shadow else SCALED_COPY
+        program = (SCALED_RESOLVE_SHADOW if resolve else SCALED_COPY_SHADOW) if with_shadow else SCALED_COPY
         self.fullscreen(program, framebuffer, samplers, {"scale": scale}, blend)
 
     def _batch(self, shader):

@@ -412,7 +412,12 @@ SCALED_COPY_SHADOW = replace(
     name="scaled_copy_shadow",
     samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "src_shadow")),
     outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
-    defines=(("WITH_SHADOW", True),),
+    defines=(("WITH_SHADOW", True), ("CLAMP_SHADOW", False)),
+)
+# The accumulation resolved: the shadow's weighted mean of visibilities clamped to [0, 1]
+# (rounding of the sums and of 1 / total weight may carry it past 1).
+SCALED_RESOLVE_SHADOW = replace(
+    SCALED_COPY_SHADOW, name="scaled_resolve_shadow", defines=(("WITH_SHADOW", True), ("CLAMP_SHADOW", True))
 )
 
 

@@ -124,7 +124,8 @@ float shadow_disk(ivec2 origin, vec2 st, float ref, float r, vec2 grad)
     ivec2 t = ivec2(floor(st + disk_sample(i) * r));
     lit += shadow_tap(origin, t, plane_ref(t, st, ref, grad));
   }
-  return lit / float(DISK_SAMPLES);
+  /* A division need not be correctly rounded (x * rcp(y) on some GPUs): n / n may exceed 1. */
+  return min(lit / float(DISK_SAMPLES), 1.0);
 }
 
 /* ``filter_id`` is a literal at every call (FILTER_*), so each call compiles to its one filter:
@@ -264,7 +265,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
       lit += dot(tap, wx * wy);
     }
   }
-  return lit;
+  return min(lit, 1.0); /* the weights sum to 1 up to rounding (and fused multiply-adds) */
   }
 #  endif
   for (int y = -PCF_RADIUS; y <= PCF_RADIUS; y++) {
@@ -275,7 +276,7 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
     }
     lit += w[y + PCF_RADIUS] * row;
   }
-  return lit;
+  return min(lit, 1.0); /* the weights sum to 1 up to rounding (and fused multiply-adds) */
   }
 #endif
   if (filter_id == FILTER_JITTER) {

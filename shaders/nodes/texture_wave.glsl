@@ -13,7 +13,8 @@
  *
  * Deviations, on purpose: a non-finite coordinate, or a value that overflows, reads as 0 where
  * Blender would return NaN; Detail is clamped to [0, 15] and Detail Roughness to >= 0 (the
- * sockets' own ranges) so the octave loop stays bounded. Color is Fac in every channel. */
+ * sockets' own ranges) so the octave loop stays bounded; the profile is clamped to [0, 1]
+ * (Blender's is not: its sin may round past 1). Color is Fac in every channel. */
 
 #ifndef TEXTURE_WAVE_GLSL
 #define TEXTURE_WAVE_GLSL
@@ -79,14 +80,16 @@ float texture_wave(vec3 p,
     n += distortion * (f * 2.0 - 1.0);
   }
   n = texture_finite(n);
+  /* Each profile lies in [0, 1], but GLSL gives sin no exact precision (it may return
+   * 1.0000001) and from 2^23 on n + 0.5 rounds to the next integer (a triangle of 2): clamped. */
   if (profile == WAVE_SINE) {
-    return 0.5 + 0.5 * sin(n - 1.5707963267948966);
+    return clamp(0.5 + 0.5 * sin(n - 1.5707963267948966), 0.0, 1.0);
   }
   n /= 6.2831853071795864;
   if (profile == WAVE_SAW) {
-    return n - floor(n);
+    return clamp(n - floor(n), 0.0, 1.0);
   }
-  return abs(n - floor(n + 0.5)) * 2.0;
+  return clamp(abs(n - floor(n + 0.5)) * 2.0, 0.0, 1.0);
 }
 
 /* The node: Color in .rgb (Fac, grey), Fac in .a. */

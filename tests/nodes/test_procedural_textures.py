@@ -12,7 +12,7 @@ import pytest
 from devkit import texture_reference as ref
 from devkit.render import render
 from devkit.texture_gpu import evaluate_many
-from devkit.texture_tiles import build_tiles, compare, gpu_scene, points, tile_errors
+from devkit.texture_tiles import NEAR, build_tiles, compare, gpu_scene, points, rounding_spread, tile_errors
 
 HASH = ["texture_hash.glsl"]
 NOISE = HASH + ["texture_noise.glsl"]
@@ -86,14 +86,32 @@ def test_noise_glsl_matches_numpy(penumbra, gpu_call):
     )
     outs = evaluate_many(gpu_call, jobs)
     for out, (d, *params) in zip(outs, NOISE_CASES):
-        expected = ref.node_tex_noise(d, pts[:, :3], pts[:, 3], scale, *params)
+
+        def noise(p, d=d, params=params):
+            return ref.node_tex_noise(d, p[:, :3], p[:, 3], scale, *params)
+
+        expected = noise(pts)
         # float32 evaluation order (the GPU may fuse multiply-adds): measured up to 1.3e-5 on
-        # the 4D colour, whose octaves and distortion compound the rounding.
-        compare(out, expected, 1e-4, 5e-5, ("noise", d, params))
+        # the 4D colour, whose octaves and distortion compound the rounding. Far from the
+        # origin (rows outside NEAR) an ulp of the coordinate is a visible step of the noise
+        # (0.002 at 1.7e4): a GPU that rounds a scaled, octave or distorted coordinate
+        # otherwise lands anywhere the reference reaches within 4 ulps of the point, so there
+        # that spread is added; within [-10, 10]^4 the bound stays as it was.
+        far = far_allowance(rounding_spread(noise, pts))
+        compare(out, expected, 1e-4, 5e-5 + far, ("noise", d, params))
     signed = np.stack([ref.snoise(pts[:, :k]) for k in (1, 2, 3, 4)], -1)
-    compare(outs[-1], signed, 0.0, 2e-6, "snoise")
+    # The same for the signed noise (no scale, no fractal: exact near the origin).
+    far = far_allowance(rounding_spread(lambda p: np.stack([ref.snoise(p[:, :k]) for k in (1, 2, 3, 4)], -1), pts))
+    compare(outs[-1], signed, 0.0, 2e-6 + far, "snoise")
     # The reduction keeps far coordinates in range: noise at 1e5-scale points is not constant.
     assert np.std(signed[256:320]) > 0.05
+
+
+def far_allowance(spread):
+    """``spread`` (``rounding_spread``) on the rows outside [-10, 10]^4, 0 on the others."""
+    far = np.ones(len(spread), bool)
+    far[NEAR] = False
+    return np.where(far[:, None], spread, 0.0)
 
 
 VORONOI_CASES = [
@@ -137,23 +155,33 @@ def test_voronoi_glsl_matches_numpy(penumbra, gpu_call, hash_mode):
         )
     outs = evaluate_many(gpu_call, jobs)
     for i, (d, feature, metric, detail, smooth, exponent, rnd, norm) in enumerate(VORONOI_CASES):
-        e = ref.node_tex_voronoi(
-            d, pts[:, :3], pts[:, 3], feature, metric, scale, detail, 0.5, 2.0, smooth, exponent, rnd, norm, hash_mode
-        )
-        expected = np.concatenate(
-            [
-                np.stack([e[:, 0], e[:, 1], e[:, 2], 0 * e[:, 0]], -1),
-                np.stack([e[:, 3], e[:, 4], e[:, 5], e[:, 6] + e[:, 7]], -1),
-            ],
-            1,
-        )
+
+        def voronoi(p, d=d, feature=feature, metric=metric, detail=detail, smooth=smooth, exponent=exponent,
+                    rnd=rnd, norm=norm):  # fmt: skip
+            e = ref.node_tex_voronoi(
+                d, p[:, :3], p[:, 3], feature, metric, scale, detail, 0.5, 2.0, smooth, exponent, rnd, norm, hash_mode
+            )
+            return np.concatenate(
+                [
+                    np.stack([e[:, 0], e[:, 1], e[:, 2], 0 * e[:, 0]], -1),
+                    np.stack([e[:, 3], e[:, 4], e[:, 5], e[:, 6] + e[:, 7]], -1),
+                ],
+                1,
+            )
+
+        expected = voronoi(pts)
         out = np.concatenate([outs[2 * i], outs[2 * i + 1]], 1)
         assert np.all(np.isfinite(out))
         # Positions carry the cell coordinate (up to 1e30 / scale here): relative tolerance.
-        # A point equidistant from two feature points to float32 rounding may pick either.
+        tol = 1e-5 + 2e-6 * np.abs(expected)
         err = np.abs(out.astype(np.float64) - expected)
-        bad = np.any(err > 1e-5 + 2e-6 * np.abs(expected), axis=1)
-        assert bad.sum() <= 2, (d, feature, metric, int(bad.sum()), float(err.max()))
+        bad = np.any(err > tol, axis=1)
+        # A point equidistant from two feature points to float32 rounding may pick either (a
+        # fused multiply-add in a distance is enough): a point may differ only where the
+        # reference itself picks another cell within 4 ulps of it, and at most 1 % of them do.
+        tie = np.any(rounding_spread(voronoi, pts) > tol, axis=1)
+        assert not np.any(bad & ~tie), (d, feature, metric, np.flatnonzero(bad & ~tie)[:8], float(err.max()))
+        assert bad.sum() <= 0.01 * len(pts), (d, feature, metric, int(bad.sum()), int(tie.sum()))
 
 
 def test_white_noise_glsl_matches_numpy_bit_for_bit(penumbra, gpu_call):
