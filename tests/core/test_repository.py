@@ -10,8 +10,16 @@ OUTSIDE = re.compile(r"\.\./shared|shared/assets|seeds?/")
 DOCUMENT_NUMBER = re.compile(r"\bseeds? ?\d{3}\b", re.IGNORECASE)
 
 
+def _tracked_names():
+    """``git ls-files``; outside a checkout (the GPU bundle holds ``git archive HEAD``, the
+    tracked files without git), every file but Python's caches."""
+    if (ROOT / ".git").exists():
+        return subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
+    return [p.relative_to(ROOT).as_posix() for p in ROOT.rglob("*") if p.is_file() and "__pycache__" not in p.parts]
+
+
 def _tracked_text_files():
-    names = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
+    names = _tracked_names()
     for name in names:
         path = ROOT / name
         if path.suffix in {".npz", ".png", ".exr", ".blend", ".zip"} or not path.is_file():
