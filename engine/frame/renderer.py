@@ -140,6 +140,7 @@ class Renderer:
         jitter = accumulate and bool(settings.shadow_map_jitter)
         if accumulate:
             first = self.shadow_pass.plan(draws, lights, camera, settings, film.size)
+            self.shadow_pass.keep_sizes(first, settings)
             moving = sampling.sampled_lights(lights, first, every=jitter)
             if jitter:
                 moving |= {i for i in first.lights if i < len(lights)}

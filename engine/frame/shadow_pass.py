@@ -6,7 +6,7 @@ import numpy as np
 
 from ..scene import simplify
 from ..shadows import lightspace
-from ..shadows.planning import MAX_SHADOW_TILES, Density, plan_shadows
+from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, plan_shadows
 from .draw_list import corners_of
 from .programs import image_premultiplied_bits
 from .shadow_maps import Caster, ShadowAtlas, TreeCutout
@@ -20,14 +20,21 @@ class ShadowPass:
         self.depth_range = UNSET  # the frame's visible depth range, once a plan computed it
         self._receivers = None  # and what the camera sees (lightspace.visible_receivers)
         self._casters = (None, None)  # (the frame's draw list, what each draw casts): once a frame
+        self._sizes = None  # {light index: map sizes} of the frame's first plan (``keep_sizes``)
 
     def begin_frame(self):
-        """Forget the last frame's camera-dependent bounds and casters."""
+        """Forget the last frame's camera-dependent bounds, casters and map sizes."""
         self.depth_range = UNSET
         self._receivers = None
         self._casters = (None, None)
+        self._sizes = None
 
-    def plan(self, draws, lights, camera, settings, size, map_size=None):
+    def keep_sizes(self, plan, settings):
+        """The frame's later samples draw each light's maps at the sizes of ``plan`` (the
+        frame's plan with every light at its centre): planned once a sample, not twice."""
+        self._sizes = frame_sizes(plan, max(1, int(settings.shadow_map_size)))
+
+    def plan(self, draws, lights, camera, settings, size, map_size=None, sizes=None):
         """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
         (width, height), with maps of ``map_size`` (default: the setting)."""
         corners = corners_of(draws)
@@ -50,6 +57,7 @@ class ShadowPass:
             pcss=settings.shadow_filter == "PCSS",
             receivers=self._receivers,
             density=_density(camera, settings, size),
+            known_sizes=sizes,
         )
 
     def draw(
@@ -59,7 +67,7 @@ class ShadowPass:
         ``materials`` (``MaterialBlocks``) and ``textures`` serve alpha cutouts; ``batches``
         (``Batches``) the casters' levels of detail in each map. Returns the plan."""
         map_size = max(1, int(settings.shadow_map_size))
-        plan = self.plan(draws, lights, camera, settings, size, map_size)
+        plan = self.plan(draws, lights, camera, settings, size, map_size, self._sizes)
         if not plan.tiles:
             return plan
         columns, _rows = self.atlas.grid(len(plan.tiles))
@@ -70,6 +78,7 @@ class ShadowPass:
                 "GPU's largest texture"
             )
             map_size = clamped
+            self._sizes = None  # planned afresh at the clamped size
             plan = self.plan(draws, lights, camera, settings, size, map_size)
         if plan.unshadowed:
             stats.messages.append(

@@ -303,6 +303,7 @@ def plan_shadows(
     pcss=False,
     receivers=None,
     density=None,
+    known_sizes=None,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -317,6 +318,10 @@ def plan_shadows(
     most ``map_size``) that still give every visible receiver they hold that many texels per
     screen pixel (times the fixed filter's radius: its blur stays within half a pixel); the
     light is then planned again at that size. Tiles carry the size they were planned with.
+    ``known_sizes``: {light index: texels a side of each of its maps} (``frame_sizes`` of the
+    frame's first plan): those lights are planned once, at those sizes, with no density pass;
+    so every sample of a frame draws a light's maps at one size, and planning a further
+    sample costs one fit per map, not two.
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
@@ -408,13 +413,20 @@ def plan_shadows(
             continue
         flat_free = flat_free_of(light)
         memo = {}
-        tiles, mode = light_tiles(light, [map_size] * 6, flat_free, memo)
+        known = known_sizes.get(i) if known_sizes is not None else None
+        tiles, mode = light_tiles(light, list(known) if known else [map_size] * 6, flat_free, memo)
         # A map needs no more texels than the pixels it shadows can show (density): each map
         # (cascade, cube face) of the light is planned again at the size it needs. A sun
         # fitted to the whole scene (no view corners) keeps its size: it must not depend on
         # the camera, so moving the view never redraws it.
         camera_bound = light.type != "SUN" or view_corners is not None
-        if density is not None and receivers is not None and camera_bound and any(t is not None for t in tiles):
+        if (
+            not known
+            and density is not None
+            and receivers is not None
+            and camera_bound
+            and any(t is not None for t in tiles)
+        ):
             soft = light.sampled or pcss
             per_pixel = density.texels_per_pixel * (1.0 if soft else max(1.0, kernel - 1.0))
             sizes = [map_size if t is None else needed_size(t, map_size, receivers, density, per_pixel) for t in tiles]
@@ -441,6 +453,15 @@ def plan_shadows(
         plan.lights[i] = entry
     plan.unshadowed = dropped
     return plan
+
+
+def frame_sizes(plan, map_size):
+    """{light index: texels a side of each of its maps (``map_size`` where it needs none)} of
+    ``plan``: what ``plan_shadows(known_sizes=...)`` takes for the frame's later samples."""
+    return {
+        i: [plan.tiles[t].size if t >= 0 else map_size for t in entry.tiles] + [map_size] * (6 - len(entry.tiles))
+        for i, entry in plan.lights.items()
+    }
 
 
 def _cascade_slices(corners, view_corners, camera, requested, depth=None):
