@@ -6,7 +6,8 @@
  * to IMAGE_MAX_ANISOTROPY trilinear probes along the footprint's long axis (anisotropic
  * filtering as the texture units of GPUs do it); Closest reads the full-size image. A texture
  * Blender stores premultiplied (a float image whose alpha mode is not Straight) is divided by
- * its alpha after filtering, so the node's Color output is straight, as in EEVEE. */
+ * its alpha after filtering, so the node's Color output is straight, as in EEVEE. NaN texels
+ * read as 0 and infinite ones as +-65504. */
 
 #ifndef MATERIAL_GLSL
 #define MATERIAL_GLSL
@@ -109,7 +110,10 @@ vec4 sample_image_grad(sampler2D tex, vec2 uv, vec2 duv_dx, vec2 duv_dy, ivec4 m
   if (premultiplied && t.a > 0.0) {
     t.rgb /= t.a;
   }
-  return t;
+  /* A float image may hold NaN or infinite texels (and its mipmaps spread them): NaN reads as
+   * 0, infinities as the half-float limit, so the frame stays finite. */
+  t = mix(t, vec4(0.0), isnan(t));
+  return clamp(t, vec4(-65504.0), vec4(65504.0));
 }
 
 vec4 sample_image(sampler2D tex, vec2 uv, ivec4 mode, bool premultiplied)

@@ -1,0 +1,98 @@
+"""What a frame's CPU does (FrameStats' CPU/GPU split, ``StageClock``), and that a further
+sample of a frame adds its GPU work and a small constant of Python, nothing that grows with
+the scene: planning once per light per sample, no batch or material block rebuilt, no image
+read. Counts, not seconds: the speed itself is measured by ``tools.bench perf --sections cpu``."""
+
+import pytest
+
+from devkit import scenes
+
+SIZE = (64, 36)
+STAGES = {"prepare", "shadow pass", "lit pass", "accumulate", "resolve", "post"}
+
+
+def _render(gpu_call, scene, samples, fenced=False, before=None):
+    """FrameStats of a frame of ``samples`` of ``scene`` (threshold 0: every sample in every
+    pixel), and the renderer's upload counters; ``before(renderer)`` runs first."""
+
+    def job(engine, depsgraph):
+        from penumbra.engine.frame.renderer import Renderer
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, scene, *SIZE)
+        engine.render_frame(depsgraph, camera, *SIZE)  # a warm engine: batches and programs made
+        renderer = engine.renderer
+        if before is not None:
+            before(renderer)
+        Renderer.fence_stages = fenced
+        try:
+            counters = (renderer.batches.uploaded, renderer.materials.uploaded)
+            out = engine.render_frame(depsgraph, camera, *SIZE, samples=(0, samples), sample_count=samples)
+            after = (renderer.batches.uploaded, renderer.materials.uploaded)
+        finally:
+            Renderer.fence_stages = False
+        return out.stats, counters, after, renderer.textures.pixel_reads
+
+    return gpu_call(job)
+
+
+@pytest.fixture(scope="module")
+def demo(penumbra):
+    scene = scenes.demo_scene(*SIZE)
+    scene.penumbra.layers.clear()
+    scene.penumbra.adaptive_threshold = 0.0
+    return scene
+
+
+def test_a_fenced_frame_splits_python_from_gpu_time_per_stage_and_sample(demo, gpu_call):
+    stats, *_ = _render(gpu_call, demo, 6, fenced=True)
+    assert STAGES <= set(stats.cpu_seconds), stats.cpu_seconds
+    assert set(stats.gpu_seconds) == set(stats.cpu_seconds)
+    assert all(v >= 0.0 for v in (*stats.cpu_seconds.values(), *stats.gpu_seconds.values()))
+    assert len(stats.sample_cpu_seconds) == stats.samples == 6
+    # The samples' Python is part of the frame's: no stage is counted twice.
+    assert sum(stats.sample_cpu_seconds) <= sum(stats.cpu_seconds.values()) + 1e-9
+    assert stats.shadow_draws > 0 and stats.draws > stats.shadow_draws
+    assert stats.upload_bytes > 0
+
+
+def test_an_unfenced_frame_waits_for_nothing(demo, gpu_call):
+    stats, *_ = _render(gpu_call, demo, 3)
+    assert STAGES <= set(stats.cpu_seconds) and stats.gpu_seconds == {}
+
+
+def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_call):
+    """Fits of maps (a sun's and a spot's) counted over frames of 2 and 10 samples: the 8
+    further samples fit each map once (the frame's first plan fixes their sizes); no batch or
+    material block is built again, and what a further sample uploads is its uniform blocks
+    and light bins, a few KiB, whatever the scene's size."""
+    from penumbra.engine.shadows import planning
+
+    fits = []
+    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view
+
+    def counted(fn):
+        def run(*args, **kwargs):
+            fits.append(fn.__name__)
+            return fn(*args, **kwargs)
+
+        return run
+
+    planning.perspective_tile = counted(original[0])
+    planning.lightspace.fit_sun_to_view = counted(original[1])
+    try:
+        results = {}
+        for samples in (2, 10):
+            del fits[:]
+            stats, counters, after, reads = _render(gpu_call, demo, samples)
+            results[samples] = (len(fits), stats, counters, after, reads)
+    finally:
+        planning.perspective_tile, planning.lightspace.fit_sun_to_view = original
+    (fits2, stats2, *_), (fits10, stats10, counters, after, reads) = results[2], results[10]
+    maps = stats10.shadow_maps // stats10.samples  # maps drawn per sample (every light moves)
+    assert maps >= 2
+    assert fits10 - fits2 == 8 * maps, (fits2, fits10, maps)
+    assert after == counters  # no batch, no material block made again
+    assert reads == 0
+    per_sample = (stats10.upload_bytes - stats2.upload_bytes) / 8
+    assert 0 < per_sample < 32 * 1024, per_sample
