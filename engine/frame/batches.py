@@ -101,7 +101,7 @@ def _terminator_parts(geo):
 
     corners = np.ascontiguousarray(geo.indices, np.int32).ravel()
     attrs = {name: np.ascontiguousarray(data[corners]) for name, data in _attributes(geo).items()}
-    attrs.update(terminator.corner_data(geo.positions, geo.normals, geo.indices))
+    attrs.update(terminator.corner_data_cached(geo.positions, geo.normals, geo.indices))
     vbo = _vertex_buffer(attrs, len(corners))
     parts = []
     for mat_index, first, count in geo.ranges:

@@ -62,6 +62,33 @@ class Terminator:
         return value if math.isfinite(value) else 0.0
 
 
+_CORNERS = {}  # content digest of (positions, normals, indices) -> corner_data: final renders build anew
+_CORNERS_BUDGET = 256 * 2**20  # bytes of corner data kept
+
+
+def corner_data_cached(positions, normals, indices):
+    """``corner_data``, remembered by the content of its inputs (as ``extract._closed_cached``
+    remembers closedness): every F12 render is a new engine that builds its batches anew, and
+    hashing the arrays costs a small part of computing the corners again."""
+    import hashlib
+
+    digest = hashlib.blake2b(digest_size=16)
+    for a in (positions, normals, indices):
+        a = np.ascontiguousarray(a)
+        digest.update(repr((a.dtype.str, a.shape)).encode())
+        digest.update(a.data)
+    key = digest.digest()
+    got = _CORNERS.get(key)
+    if got is None:
+        got = corner_data(positions, normals, indices)
+        size = sum(v.nbytes for v in got.values())
+        while _CORNERS and sum(v.nbytes for d in _CORNERS.values() for v in d.values()) + size > _CORNERS_BUDGET:
+            del _CORNERS[next(iter(_CORNERS))]  # oldest first
+        if size <= _CORNERS_BUDGET:
+            _CORNERS[key] = got
+    return got
+
+
 def corner_data(positions, normals, indices):
     """Per-corner attributes (one row per corner of each triangle, in ``indices`` order) from
     which a fragment rebuilds its triangle's smooth-surface offset:

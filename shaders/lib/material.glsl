@@ -25,36 +25,42 @@ int wrap_mirror(int i, int n)
   return (m < n) ? m : period - 1 - m;
 }
 
-vec4 image_texel(sampler2D tex, ivec2 p, ivec2 size, int extension, int level)
+/* A texel index along an axis of ``n`` texels under ``extension``; -1 outside (Clip). */
+int wrap_index(int i, int n, int extension)
 {
+  if (extension == EXTENSION_REPEAT) {
+    return ((i % n) + n) % n;
+  }
+  if (extension == EXTENSION_MIRROR) {
+    return wrap_mirror(i, n);
+  }
   if (extension == EXTENSION_CLIP) {
-    if (any(lessThan(p, ivec2(0))) || any(greaterThanEqual(p, size))) {
-      return vec4(0.0);
-    }
+    return (i < 0 || i >= n) ? -1 : i;
   }
-  else if (extension == EXTENSION_REPEAT) {
-    p = ((p % size) + size) % size;
-  }
-  else if (extension == EXTENSION_MIRROR) {
-    p = ivec2(wrap_mirror(p.x, size.x), wrap_mirror(p.y, size.y));
-  }
-  else {
-    p = clamp(p, ivec2(0), size - 1);
-  }
-  return texelFetch(tex, p, level);
+  return clamp(i, 0, n - 1);
 }
 
-/* Bilinear at mip ``level`` between its texel centres; ``uv`` in [0, 1] image units. */
+vec4 texel_or_zero(sampler2D tex, int x, int y, int level)
+{
+  return (x < 0 || y < 0) ? vec4(0.0) : texelFetch(tex, ivec2(x, y), level);
+}
+
+/* Bilinear at mip ``level`` between its texel centres; ``uv`` in [0, 1] image units. The
+ * four texels' indices are wrapped once per axis. */
 vec4 image_bilinear(sampler2D tex, vec2 uv, int level, int extension)
 {
   ivec2 size = max(textureSize(tex, level), ivec2(1));
   vec2 st = uv * vec2(size) - 0.5;
   ivec2 i = ivec2(floor(st));
   vec2 f = st - floor(st);
-  vec4 a = image_texel(tex, i, size, extension, level);
-  vec4 b = image_texel(tex, i + ivec2(1, 0), size, extension, level);
-  vec4 c = image_texel(tex, i + ivec2(0, 1), size, extension, level);
-  vec4 d = image_texel(tex, i + ivec2(1, 1), size, extension, level);
+  int x0 = wrap_index(i.x, size.x, extension);
+  int x1 = wrap_index(i.x + 1, size.x, extension);
+  int y0 = wrap_index(i.y, size.y, extension);
+  int y1 = wrap_index(i.y + 1, size.y, extension);
+  vec4 a = texel_or_zero(tex, x0, y0, level);
+  vec4 b = texel_or_zero(tex, x1, y0, level);
+  vec4 c = texel_or_zero(tex, x0, y1, level);
+  vec4 d = texel_or_zero(tex, x1, y1, level);
   return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
@@ -82,7 +88,8 @@ vec4 sample_image_grad(sampler2D tex, vec2 uv, vec2 duv_dx, vec2 duv_dy, ivec4 m
   }
   vec4 t;
   if (mode.x == 0) {
-    t = image_texel(tex, ivec2(floor(st)), size, mode.y, 0);
+    ivec2 p = ivec2(floor(st));
+    t = texel_or_zero(tex, wrap_index(p.x, size.x, mode.y), wrap_index(p.y, size.y, mode.y), 0);
   }
   else {
     /* The footprint's axes in full-size texels. */

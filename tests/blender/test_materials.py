@@ -411,6 +411,39 @@ def test_images_upload_once_and_reupload_after_an_update(penumbra, gpu_call):
     assert cache.images_changed == {image.name_full}
 
 
+def test_images_drawn_in_part_are_named(penumbra, gpu_call, capfd):
+    """An image wider than the GPU's textures is drawn reduced by Blender, and a UDIM image
+    draws its first tile: each is named once in the render report, and the reduced image's
+    colour is still drawn (a uniform image reads the same at any size)."""
+    import gpu
+
+    limit = gpu_call(lambda engine, depsgraph: gpu.capabilities.max_texture_size_get())
+    scene = _builder("texture_base_color")
+    node = next(
+        n
+        for ob in scene.objects
+        if ob.type == "MESH"
+        for slot in ob.material_slots
+        for n in slot.material.node_tree.nodes
+        if n.bl_idname == "ShaderNodeTexImage"
+    )
+    wide = bpy.data.images.new("Wide", limit + 1, 2, alpha=True)
+    wide.generated_color = (0.8, 0.2, 0.1, 1.0)
+    node.image = wide
+    image = _penumbra(scene, samples=1)
+    out = capfd.readouterr().out
+    assert f"Penumbra: image 'Wide' ({limit + 1}x2) is larger than this GPU's textures" in out
+    centre = image[SIZE // 2, SIZE // 2, :3]
+    assert centre[0] > 5 * centre[2]  # its red, not magenta
+
+    tiles = bpy.data.images.new("Tiles", 8, 8, alpha=True, tiled=True)
+    tiles.tiles.new(1002)
+    node.image = tiles
+    _penumbra(scene, samples=1)
+    out = capfd.readouterr().out
+    assert "Penumbra: image 'Tiles' has UDIM tiles: only tile 1001 is drawn" in out
+
+
 def test_bad_texture_inputs_render_finite_with_messages(penumbra, capfd):
     """A float image with NaN/Inf texels, an image whose file is missing, and a mesh without
     the UV map a texture asks for: the frame is finite, the missing image draws magenta (as in

@@ -90,3 +90,26 @@ def test_settings_follow_blender():
     assert terminator.offset_amount(0.1, 0.05, -0.02) == 1.0
     assert terminator.offset_amount(0.1, 0.5, 0.5) == 0.0
     assert terminator.offset_amount(0.0, 0.0, 0.0) == 0.0
+
+
+def test_corner_data_is_remembered_by_the_content_of_its_inputs():
+    """Final renders build their batches anew: the corner data of unchanged geometry is the
+    one computed before (the same arrays), equal to a fresh computation, and changed geometry
+    (one position moved) gets its own."""
+    from penumbra.engine.scene import terminator
+
+    rng = np.random.default_rng(4)
+    positions = rng.normal(size=(30, 3)).astype(np.float32)
+    normals = rng.normal(size=(30, 3)).astype(np.float32)
+    indices = rng.integers(0, 30, size=(40, 3)).astype(np.int32)
+    first = terminator.corner_data_cached(positions, normals, indices)
+    again = terminator.corner_data_cached(positions.copy(), normals.copy(), indices.copy())
+    assert again is first
+    fresh = terminator.corner_data(positions, normals, indices)
+    for name, data in fresh.items():
+        np.testing.assert_array_equal(first[name], data)
+    moved = positions.copy()
+    moved[3, 0] += 0.5
+    other = terminator.corner_data_cached(moved, normals, indices)
+    assert other is not first
+    assert not np.array_equal(other["tfront"], first["tfront"])
