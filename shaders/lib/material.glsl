@@ -104,7 +104,8 @@ vec4 sample_image_grad(sampler2D tex, vec2 uv, vec2 duv_dx, vec2 duv_dy, ivec4 m
     }
     else {
       float minor = min(lx, ly);
-      int n = int(min(ceil(major / max(minor, 1e-6)), float(IMAGE_MAX_ANISOTROPY)));
+      /* Probes: the footprint's aspect ratio, rounded (a nearly round footprint takes one). */
+      int n = int(clamp(floor(major / max(minor, 1e-6) + 0.5), 1.0, float(IMAGE_MAX_ANISOTROPY)));
       float lod = log2(major / float(n));
       vec2 axis = ((lx >= ly) ? duv_dx : duv_dy);
       t = vec4(0.0);
