@@ -26,6 +26,7 @@ from .programs import (
     WEIGHTED_RESOLVE_SHADOW,
 )
 from .sampling import THRESHOLD_SCALE
+from .stats import StageClock
 
 
 @dataclass
@@ -108,6 +109,7 @@ class Film:
         self.color = self.zbuffer = self.depth = self.shadow = self.normal = self.emission = None
         self.fb = self.fb_color = self.fb_emit = None
         self.post_ctx = None  # the post stack's targets at this size
+        self.clock = StageClock()  # the frame's (``Renderer.render``): read-backs count as GPU time
         self.centre = None  # (depth, normal) arrays of a multi-sample frame's centred sample
         self._accum_color = self._accum_shadow = self._accum_fb = self._resolve_fb = None
         self._emission_targets = None  # (accumulation, its framebuffer, the resolve's framebuffer)
@@ -251,7 +253,8 @@ class Film:
     def keep_centre(self):
         """Keep the centred sample's depth and normal (a multi-sample frame's Depth and Normal
         passes are that sample's, not an average)."""
-        self.centre = (texture_array(self.depth, 1)[..., 0].copy(), texture_array(self.normal, 4).copy())
+        with self.clock.waiting():
+            self.centre = (texture_array(self.depth, 1)[..., 0].copy(), texture_array(self.normal, 4).copy())
 
     def resolve(self, aux, emission):
         """The filtered average (accumulation / total weight) into the colour (and shadow,
@@ -384,7 +387,9 @@ class Film:
         """Mask ``dst`` becomes the converged mask; returns its count (and from the first
         converged pixel on, each pixel keeps its own weight)."""
         self._mask_index = dst
-        count = int(np.count_nonzero(texture_array(self._masks[dst], 1) > 0.5))
+        with self.clock.waiting():
+            mask = texture_array(self._masks[dst], 1)
+        count = int(np.count_nonzero(mask > 0.5))
         if count and self._weight is None:
             # From now on pixels hold different numbers of samples; so far each has them all.
             self._weight = new_texture(self.pool, self.size, "R32F")
@@ -395,7 +400,7 @@ class Film:
 
     def finish(self):
         """Wait until the GPU has drawn everything asked so far (one pixel read back)."""
-        with self._accum_fb.bind():
+        with self._accum_fb.bind(), self.clock.waiting():
             self._accum_fb.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
 
     def weights_array(self):

@@ -98,6 +98,7 @@ class Renderer:
         compiled_before = self.shaders.compiled
         seconds_before = self.shaders.compile_seconds
         self._clock = clock
+        self.film.clock = clock
         clock.begin("prepare")
         self.shadow_pass.begin_frame()
         emission = bool(emission and aux)

@@ -25,6 +25,7 @@ class StageClock:
         self.gpu = {}
         self.waited = 0.0  # seconds the fences waited outside any stage (before the first)
         self._open = None
+        self._read_back = 0.0  # seconds the open stage waited in read-backs (``waiting``)
 
     def begin(self, name):
         """Stage ``name`` starts (``end`` closes it; stages do not nest)."""
@@ -33,14 +34,29 @@ class StageClock:
             self.fence()
             self.waited += time.perf_counter() - start
         self._open = (name, time.perf_counter())
+        self._read_back = 0.0
 
     def end(self):
         name, start = self._open
         issued = time.perf_counter()
-        self.cpu[name] = self.cpu.get(name, 0.0) + issued - start
+        self.cpu[name] = self.cpu.get(name, 0.0) + issued - start - self._read_back
+        gpu = self._read_back
         if self.fence is not None:
             self.fence()
-            self.gpu[name] = self.gpu.get(name, 0.0) + time.perf_counter() - issued
+            gpu += time.perf_counter() - issued
+        if self.fence is not None or gpu:
+            self.gpu[name] = self.gpu.get(name, 0.0) + gpu
+        self._read_back = 0.0
+
+    @contextmanager
+    def waiting(self):
+        """A read-back inside the open stage (a count of converged pixels, the centred
+        sample's depth): its time is the GPU's, not Python's."""
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self._read_back += time.perf_counter() - start
 
     @contextmanager
     def stage(self, name):
