@@ -1,9 +1,9 @@
 """What a frame did (``FrameStats``): read by tests, the benchmarks and the render report.
 
 On a GPU a frame's pixels are nearly free and its cost is the Python that asks for them, so
-a frame also says where its CPU time went (``StageClock``): each stage's Python time (the wall
-time of its calls) apart from the time spent waiting for the GPU, per frame and per sample,
-with the bytes it uploaded and the draw calls and triangles of each pass.
+a frame also says where its CPU time went (``StageClock``): each stage's CPU time on the
+render thread apart from the time spent waiting for the GPU, per frame and per sample, with
+the bytes it uploaded and the draw calls and triangles of each pass.
 """
 
 import time
@@ -12,12 +12,12 @@ from dataclasses import dataclass, field
 
 
 class StageClock:
-    """Seconds each stage of a frame spent in Python (``cpu``) and, when ``fence`` is set (a
-    function that returns once the GPU has finished everything asked so far: a one-pixel
-    read-back), waiting for the GPU to finish that stage's work (``gpu``). With a fence a
-    stage starts on an idle GPU, so its Python time is not another stage's GPU time; without
-    one (the default: a fence stalls the pipeline) ``cpu`` holds the calls' wall time, which
-    includes whatever the driver blocked in them."""
+    """Seconds each stage of a frame spent on the CPU (``cpu``: the render thread's CPU time,
+    ``time.thread_time``: Python and the driver's work on that thread, not the time it slept
+    waiting for the GPU) and waiting for the GPU (``gpu``: the stage's read-backs, and, when
+    ``fence`` is set, a function that returns once the GPU has finished everything asked so
+    far, the time the GPU took to finish the stage's work after its last call). A fence
+    stalls the pipeline, so only the benchmarks set one (``Renderer.fence_stages``)."""
 
     def __init__(self, fence=None):
         self.fence = fence
@@ -33,13 +33,13 @@ class StageClock:
             start = time.perf_counter()
             self.fence()
             self.waited += time.perf_counter() - start
-        self._open = (name, time.perf_counter())
+        self._open = (name, time.thread_time())
         self._read_back = 0.0
 
     def end(self):
         name, start = self._open
+        self.cpu[name] = self.cpu.get(name, 0.0) + time.thread_time() - start
         issued = time.perf_counter()
-        self.cpu[name] = self.cpu.get(name, 0.0) + issued - start - self._read_back
         gpu = self._read_back
         if self.fence is not None:
             self.fence()
@@ -51,7 +51,7 @@ class StageClock:
     @contextmanager
     def waiting(self):
         """A read-back inside the open stage (a count of converged pixels, the centred
-        sample's depth): its time is the GPU's, not Python's."""
+        sample's depth): its wall time counts as the stage's GPU time."""
         start = time.perf_counter()
         try:
             yield
@@ -107,7 +107,7 @@ class FrameStats:
     binned: bool = False  # the lit pass looped over each screen bin's lights only
     shadow_draws: int = 0  # of ``draws``, the draw calls into shadow maps
     upload_bytes: int = 0  # bytes sent to the GPU: uniform blocks, batches built, textures of data
-    cpu_seconds: dict = field(default_factory=dict)  # stage -> Python seconds (``StageClock.cpu``)
+    cpu_seconds: dict = field(default_factory=dict)  # stage -> render-thread CPU seconds (``StageClock.cpu``)
     gpu_seconds: dict = field(default_factory=dict)  # stage -> seconds waiting on the GPU (with a fence only)
-    sample_cpu_seconds: list = field(default_factory=list)  # Python seconds of each sample (its stages)
+    sample_cpu_seconds: list = field(default_factory=list)  # CPU seconds of each sample (its stages)
     messages: list = field(default_factory=list)  # what the user must be told about this frame

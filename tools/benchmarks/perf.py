@@ -11,8 +11,9 @@ Sections (``--sections``, all by default):
   cpu         where pixels cost nothing (160x90), what a frame's CPU costs: a textured asset
               (``scenes.textured_asset``: four 2048² images, 16k triangles) at 1 sample against
               Workbench on the same scene, and the demo at 16 samples against Workbench's one;
-              then one fenced frame of each (``Renderer.fence_stages``): Python and GPU time per
-              stage, per sample, bytes uploaded, draw calls and triangles per pass
+              then one fenced frame of each (``Renderer.fence_stages``): the render thread's
+              CPU time and the GPU's per stage, per sample, bytes uploaded, draw calls and
+              triangles per pass
   resolution  demo scene without post layers at 480x270, 960x540 and 1920x1080
   passes      the demo scene at 960x540, F12, timed pass by pass (the GPU waited for with a
               one-pixel read-back before and after each pass): the depth pass and the lit pass
@@ -285,10 +286,10 @@ def cpu_note(stats):
     median = per_sample[len(per_sample) // 2] if per_sample else 0.0
     stages = ", ".join(f"{k} {v * 1e3:.1f}/{gpu.get(k, 0.0) * 1e3:.1f}" for k, v in sorted(cpu.items()))
     return (
-        f"Python {sum(cpu.values()) * 1e3:.1f} ms, GPU {sum(gpu.values()) * 1e3:.1f} ms; a further sample's Python "
+        f"CPU {sum(cpu.values()) * 1e3:.1f} ms, GPU {sum(gpu.values()) * 1e3:.1f} ms; a further sample's CPU "
         f"{median * 1e3:.2f} ms; uploaded {stats.upload_bytes / 1024:.0f} KiB; draws {stats.draws} "
         f"({stats.shadow_draws} into maps); triangles {stats.triangles} lit, {stats.shadow_triangles} in maps; "
-        f"stage Python/GPU ms: {stages}"
+        f"stage CPU/GPU ms: {stages}"
     )
 
 
