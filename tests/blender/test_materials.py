@@ -33,6 +33,18 @@ def _builder(name, size=SIZE):
     return material_scenes.BUILDERS[name](size, size)
 
 
+def _image_node(scene):
+    """The first Image Texture node of the scene's meshes' materials."""
+    return next(
+        n
+        for ob in scene.objects
+        if ob.type == "MESH"
+        for slot in ob.material_slots
+        for n in slot.material.node_tree.nodes
+        if n.bl_idname == "ShaderNodeTexImage"
+    )
+
+
 def _against_eevee(name, samples=8, size=SIZE):
     """(Penumbra, EEVEE) renders of builder ``name``."""
     ours = _penumbra(_builder(name, size), samples)
@@ -419,14 +431,7 @@ def test_images_drawn_in_part_are_named(penumbra, gpu_call, capfd):
 
     limit = gpu_call(lambda engine, depsgraph: gpu.capabilities.max_texture_size_get())
     scene = _builder("texture_base_color")
-    node = next(
-        n
-        for ob in scene.objects
-        if ob.type == "MESH"
-        for slot in ob.material_slots
-        for n in slot.material.node_tree.nodes
-        if n.bl_idname == "ShaderNodeTexImage"
-    )
+    node = _image_node(scene)
     wide = bpy.data.images.new("Wide", limit + 1, 2, alpha=True)
     wide.generated_color = (0.8, 0.2, 0.1, 1.0)
     node.image = wide
@@ -508,14 +513,7 @@ def test_final_renders_draw_blenders_own_image_texture(penumbra):
     import tracemalloc
 
     scene = _builder("texture_base_color")
-    node = next(
-        n
-        for ob in scene.objects
-        if ob.type == "MESH"
-        for s in ob.material_slots
-        for n in s.material.node_tree.nodes
-        if n.bl_idname == "ShaderNodeTexImage"
-    )
+    node = _image_node(scene)
     size = 1024
     image = bpy.data.images.new("Large", size, size, alpha=True)
     rng = np.random.default_rng(3)
