@@ -60,14 +60,23 @@ class Needs:
     tangents: bool = False  # MikkTSpace tangents of ``uv_map`` (normal maps)
 
     @classmethod
-    def of(cls, materials):
+    def of(cls, materials, data=None):
+        """What ``materials`` read of an object whose geometry is ``data`` (a Mesh, or None),
+        and what more they ask that is not drawn: (uv maps, colour attributes) beyond the
+        first. A map or attribute named as the mesh's active render one is that one ("" too):
+        glTF's importer names the UV map on its Normal Map nodes and not on its images."""
+        active_uv, active_color = _active_layers(data)
         uv_maps, colors, tangents = [], [], False
         for mat in materials:
             if mat is None:
                 continue
-            uv_maps += [m for m in mat.uv_maps if m not in uv_maps]
-            if mat.color_attribute is not None and mat.color_attribute not in colors:
-                colors.append(mat.color_attribute)
+            maps = ["" if m == active_uv else m for m in mat.uv_maps]
+            uv_maps += [m for m in dict.fromkeys(maps) if m not in uv_maps]
+            color = (
+                "" if mat.color_attribute is not None and mat.color_attribute == active_color else mat.color_attribute
+            )
+            if color is not None and color not in colors:
+                colors.append(color)
             tangents |= "normal" in mat.textures
         return cls(uv_maps[0] if uv_maps else None, colors[0] if colors else None, tangents), (
             uv_maps[1:],
@@ -77,6 +86,19 @@ class Needs:
     @property
     def any(self):
         return self.uv_map is not None or self.color_attribute is not None
+
+
+def _active_layers(data):
+    """Names of the active render UV map and colour attribute of mesh ``data`` (None each
+    where it has none, or is no mesh)."""
+    uv = color = None
+    layers = getattr(data, "uv_layers", None)
+    if layers is not None:
+        uv = next((u.name for u in layers if u.active_render), None)
+    attrs = getattr(data, "color_attributes", None)
+    if attrs is not None and 0 <= attrs.render_color_index < len(attrs):
+        color = attrs[attrs.render_color_index].name
+    return uv, color
 
 
 @dataclass
@@ -758,7 +780,7 @@ class SceneCache:
             if not (camera or shadow):
                 continue
             materials = [self._material(slot.material) for slot in ob.material_slots]
-            needs, extra = Needs.of(materials)
+            needs, extra = Needs.of(materials, ob.data if ob.type == "MESH" else None)
             if extra[0] or extra[1]:
                 messages.append(
                     f"object '{ob.name}': its materials read several UV maps or colour attributes; only "

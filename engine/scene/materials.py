@@ -308,7 +308,9 @@ def _compiled(mat, read, notes, whole):
     if len(principled) == 1 and not tree.normal:
         _normal_map(None, principled[0], new_notes, out)
         normal = out.textures.get("normal")
-        if normal is not None and "UV" in tree.needs and normal.uv_map != tree.uv_map:
+        # Both named and different (one unnamed may be the same layer: the object decides,
+        # extract.Needs.of).
+        if normal is not None and "UV" in tree.needs and normal.uv_map and tree.uv_map and normal.uv_map != tree.uv_map:
             new_notes.append("a normal map on another UV map than the tree's (the tree's map is used)")
     return out, new_notes
 
@@ -514,10 +516,9 @@ def _principled(mat, node, notes):
     _normal_map(wrapper, node, notes, out)
     if "alpha" in out.textures or alpha < 1.0:
         out.blend = "HASHED"  # the material's render method decides (material_from_blender)
-    for name in ("Transmission Weight", "Transmission", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
-        sock = inputs.get(name)
-        if sock is not None and (sock.is_linked or float(sock.default_value) > 0.0):
-            notes.append(f"{name} is not drawn")
+    from .nodetree import principled_unread
+
+    notes += [f"{name} is not drawn" for name in principled_unread(node)]
     return out
 
 

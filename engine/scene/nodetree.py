@@ -627,10 +627,7 @@ def _principled(c, node, socket, ctx):
     if _first(node, "Emission Strength"):
         strength = c.shader_input(node, "Emission Strength", ctx, "float", 1.0).expr
     normal = c.normal_input(node, ctx)
-    for name in ("Transmission Weight", "Transmission", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
-        sock = node.inputs.get(name)
-        if sock is not None and (sock.is_linked or float(sock.default_value) > 0.0):
-            c.messages.append(f"{name} is not drawn")
+    c.messages += [f"{name} is not drawn" for name in principled_unread(node)]
     expr = (
         f"node_principled({base.expr}, {metal.expr}, {rough.expr}, {spec.expr}, {alpha.expr}, "
         f"({emission.expr}).rgb * {strength}, {normal.expr})"
@@ -1221,3 +1218,26 @@ def _image(c, node, socket, ctx):
     premultiplied = f"(image_premultiplied & {1 << index}) != 0"  # set per draw (``TextureCache``)
     texel = c.temp("vec4", f"sample_image(node_image_{index}, ({uv.expr}).xy, {mode}, {premultiplied})")
     return Value(f"{texel.expr}.a", "float") if socket.identifier == "Alpha" else texel
+
+
+# Principled BSDF inputs Penumbra does not draw, named when they would change the surface: a
+# weight above 0, a Specular Tint other than white, or any of them linked.
+PRINCIPLED_UNREAD = ("Transmission Weight", "Transmission", "Coat Weight", "Sheen Weight", "Subsurface Weight")
+
+
+def principled_unread(node):
+    """Names of the inputs of Principled BSDF ``node`` that change its surface and are not
+    drawn (``PRINCIPLED_UNREAD``, and Specular Tint: glTF's specular-glossiness import drives
+    it with a texture)."""
+    out = []
+    for name in PRINCIPLED_UNREAD:
+        sock = node.inputs.get(name)
+        if sock is not None and (sock.is_linked or float(sock.default_value) > 0.0):
+            out.append(name)
+    tint = node.inputs.get("Specular Tint")
+    if tint is not None:
+        value = tint.default_value
+        white = all(float(v) == 1.0 for v in value[:3]) if hasattr(value, "__len__") else float(value) == 0.0
+        if tint.is_linked or not white:
+            out.append("Specular Tint")
+    return out
