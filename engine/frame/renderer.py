@@ -57,6 +57,7 @@ class Renderer:
         self._last_cameras = None  # the last sample's raster and view cameras, its lights' screen rects
         self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
         self._clock = StageClock()  # the current frame's (``render``)
+        self._frame_plan = None  # (key, moving lights, map sizes) of the frame's first call
 
     @property
     def shadows(self):
@@ -140,11 +141,20 @@ class Renderer:
         # grid), so lights with an extent are sampled on it however small their penumbra.
         jitter = accumulate and bool(settings.shadow_map_jitter)
         if accumulate:
-            first = self.shadow_pass.plan(draws, lights, camera, settings, film.size)
-            self.shadow_pass.keep_sizes(first, settings)
-            moving = sampling.sampled_lights(lights, first, every=jitter)
-            if jitter:
-                moving |= {i for i in first.lights if i < len(lights)}
+            # The frame's centred plan decides which lights move and the sizes of their maps;
+            # a later call of the same frame (the viewport's next refinement: nothing changed,
+            # or the frame would start afresh) keeps what the first call decided.
+            frame_key = (sample_count, jitter, tuple(lt.use_shadow for lt in lights))
+            if start > 0 and self._frame_plan is not None and self._frame_plan[0] == frame_key:
+                moving, sizes = self._frame_plan[1:]
+                self.shadow_pass.use_sizes(sizes)
+            else:
+                first = self.shadow_pass.plan(draws, lights, camera, settings, film.size)
+                self.shadow_pass.keep_sizes(first, settings)
+                moving = sampling.sampled_lights(lights, first, every=jitter)
+                if jitter:
+                    moving |= {i for i in first.lights if i < len(lights)}
+                self._frame_plan = (frame_key, moving, self.shadow_pass.sizes)
         stats.lights_sampled = len(moving)
         if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + adaptive.time_limit

@@ -34,6 +34,15 @@ class ShadowPass:
         frame's plan with every light at its centre): planned once a sample, not twice."""
         self._sizes = frame_sizes(plan, max(1, int(settings.shadow_map_size)))
 
+    @property
+    def sizes(self):
+        """The frame's map sizes (``keep_sizes``), or None."""
+        return self._sizes
+
+    def use_sizes(self, sizes):
+        """A later call of the same frame: the map sizes its first call kept."""
+        self._sizes = sizes
+
     def plan(self, draws, lights, camera, settings, size, map_size=None, sizes=None):
         """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
         (width, height), with maps of ``map_size`` (default: the setting)."""

@@ -99,3 +99,41 @@ def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_c
     assert reads == 0
     per_sample = (stats10.upload_bytes - stats2.upload_bytes) / 8
     assert 0 < per_sample < 32 * 1024, per_sample
+
+
+def test_a_viewport_refinement_plans_each_map_once(demo, gpu_call):
+    """The viewport renders a frame one sample per redraw (``samples=(k, k + 1)``): its first
+    call plans the frame (sizes and moving lights) and its sample; every later call of the
+    same frame fits each map once, for its sample alone."""
+    from penumbra.engine.shadows import planning
+
+    fits = []
+    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view
+
+    def counted(fn):
+        def run(*args, **kwargs):
+            fits.append(fn.__name__)
+            return fn(*args, **kwargs)
+
+        return run
+
+    def job(engine, depsgraph):
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, demo, *SIZE)
+        counts = []
+        for k in range(4):
+            del fits[:]
+            out = engine.render_frame(depsgraph, camera, *SIZE, aux=False, samples=(k, k + 1), sample_count=8)
+            counts.append((len(fits), out.stats.shadow_maps))
+        return counts
+
+    planning.perspective_tile = counted(original[0])
+    planning.lightspace.fit_sun_to_view = counted(original[1])
+    try:
+        counts = gpu_call(job)
+    finally:
+        planning.perspective_tile, planning.lightspace.fit_sun_to_view = original
+    for fitted, maps in counts[1:]:
+        assert maps >= 2 and fitted == maps, counts
+    assert counts[0][0] > counts[0][1]  # the first call also planned the frame
