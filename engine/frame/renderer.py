@@ -33,7 +33,7 @@ class Renderer:
     """GPU state of one engine instance. Create and use only inside a GPU context."""
 
     # True: each stage waits for the GPU before and after it (``StageClock``), so FrameStats
-    # splits Python time from GPU time (the benchmarks set it; it stalls the pipeline).
+    # splits CPU time from GPU time (the benchmarks set it; it stalls the pipeline).
     fence_stages = False
 
     def __init__(self, pool=None, shaders=None):
