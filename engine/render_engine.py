@@ -69,11 +69,13 @@ class PenumbraEngineCore:
         emission=False,
         adaptive=None,
         deadline=None,
+        navigating=False,
     ):
         """Extract, then render samples ``samples`` of a frame of ``sample_count`` samples
         (``Renderer.render``); returns the renderer's FrameOutput. ``pixel_scale`` scales the
         post layers' sizes in pixels (a final render's resolution %); ``aux``: also produce the
-        depth, shadow and normal targets (passes), not only colour."""
+        depth, shadow and normal targets (passes), not only colour. ``navigating``: a frame
+        while the view moves (``Renderer.render``: its maps keep the last such frame's sizes)."""
         from .frame.renderer import Renderer
 
         if self.renderer is None:
@@ -100,6 +102,7 @@ class PenumbraEngineCore:
             emission=emission,
             adaptive=adaptive,
             deadline=deadline,
+            navigating=navigating,
         )
         self.last_stats = out.stats
         return out
@@ -143,7 +146,7 @@ class PenumbraEngineCore:
         self._stopped = ""
         if moving:
             w, h = max(1, round(width * scale)), max(1, round(height * scale))
-            out = self.render_frame(depsgraph, camera, w, h, pixel_scale=w / width, aux=False)
+            out = self.render_frame(depsgraph, camera, w, h, pixel_scale=w / width, aux=False, navigating=True)
             self._shown = (key, out, 0, target)
         else:
             self._started = sampling.clock()

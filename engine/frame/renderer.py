@@ -15,6 +15,7 @@ from ..enums import DEBUG_VIEW, DEPTH_FORMAT
 from ..post import post_stack
 from ..scene.textures import TextureCache
 from ..shadows import lightspace
+from ..shadows.planning import frame_sizes
 from . import debug_view, sampling
 from .batches import Batches
 from .draw_list import corners_of, draw_list, light_masks, lights_in_view
@@ -27,6 +28,10 @@ from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
 from .world_light import world_light
+
+# While the view moves, a frame's maps keep the sizes of the last navigation frame that
+# planned them afresh, this many frames ago at most (``Renderer.render``'s ``navigating``).
+NAVIGATION_REPLAN = 8
 
 
 class Renderer:
@@ -58,6 +63,7 @@ class Renderer:
         self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
         self._clock = StageClock()  # the current frame's (``render``)
         self._frame_plan = None  # (key, moving lights, map sizes) of the frame's first call
+        self._navigation = None  # (key, map sizes, frames) of the frames drawn while the view moves
 
     @property
     def shadows(self):
@@ -78,6 +84,7 @@ class Renderer:
         emission=False,
         adaptive=None,
         deadline=None,
+        navigating=False,
     ):
         """Samples ``samples[0] .. samples[1] - 1`` of a frame of ``sample_count`` samples
         (``frame/sampling.py``), added to the samples this renderer already accumulated for
@@ -92,7 +99,10 @@ class Renderer:
         shaded again) and ends the frame when every pixel has converged; its time limit ends
         it after the first sample that reaches it, counted from the first sample of this call
         unless ``deadline`` (a ``sampling.clock()`` value) says when. Neither looks at a clock
-        when there is no time limit: a frame stays a function of the scene and its settings."""
+        when there is no time limit: a frame stays a function of the scene and its settings.
+        ``navigating``: a one-sample frame while the view moves; its lights' maps keep the
+        sizes a navigation frame planned at most NAVIGATION_REPLAN frames before (one fit per
+        map, not two), and the frame after the view stops plans afresh."""
         stats = FrameStats()
         clock = StageClock(self.wait_gpu if self.fence_stages else None)
         uploaded_before = self._uploaded()
@@ -132,6 +142,14 @@ class Renderer:
         settle = adaptive is not None and adaptive.settle > 0.0
         if not accumulate:
             film.converged = 0  # a single sample shades every pixel, whatever an earlier frame left
+            # While the view moves, maps keep the sizes planned NAVIGATION_REPLAN frames ago.
+            nav_key = (width, height, tuple(lt.use_shadow for lt in lights))
+            last = self._navigation
+            if navigating and last is not None and last[0] == nav_key and last[2] % NAVIGATION_REPLAN:
+                self.shadow_pass.use_sizes(last[1])
+                self._navigation = (nav_key, last[1], last[2] + 1)
+            else:
+                self._navigation = (nav_key, None, 1) if navigating else None
         if accumulate:
             # The NOISE view shows the estimate even where no threshold uses it.
             film.begin(aux, emission, fresh=start == 0, adaptive=noise or debug.id == "NOISE", settle=settle)
@@ -230,6 +248,9 @@ class Renderer:
         if accumulate and stats.samples:
             film.resolve(aux, emission)
         self.batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()})
+        nav = self._navigation
+        if nav is not None and nav[1] is None and plan is not None:  # a navigation frame that planned afresh
+            self._navigation = (nav[0], frame_sizes(plan, max(1, int(settings.shadow_map_size))), nav[2])
         clock.end()
         clock.begin("post")
         debug_image = None

@@ -137,3 +137,48 @@ def test_a_viewport_refinement_plans_each_map_once(demo, gpu_call):
     for fitted, maps in counts[1:]:
         assert maps >= 2 and fitted == maps, counts
     assert counts[0][0] > counts[0][1]  # the first call also planned the frame
+
+
+def test_frames_while_the_view_moves_keep_their_map_sizes(demo, gpu_call):
+    """Navigation frames (one sample while the view moves): the first plans its maps' sizes
+    (a fit at full size, then one at the size the pixels need), the next ones keep them and
+    fit each map once, and every NAVIGATION_REPLAN-th plans afresh."""
+    from penumbra.engine.frame.renderer import NAVIGATION_REPLAN
+    from penumbra.engine.shadows import planning
+
+    fits = []
+    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view
+
+    def counted(fn):
+        def run(*args, **kwargs):
+            fits.append(fn.__name__)
+            return fn(*args, **kwargs)
+
+        return run
+
+    def job(engine, depsgraph):
+        import dataclasses
+
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, demo, *SIZE)
+        counts = []
+        for k in range(NAVIGATION_REPLAN + 1):
+            moved = camera.view.copy()
+            moved[0, 3] += 0.01 * k
+            del fits[:]
+            out = engine.render_frame(
+                depsgraph, dataclasses.replace(camera, view=moved), *SIZE, aux=False, navigating=True
+            )
+            counts.append((len(fits), out.stats.shadow_maps))
+        return counts
+
+    planning.perspective_tile = counted(original[0])
+    planning.lightspace.fit_sun_to_view = counted(original[1])
+    try:
+        counts = gpu_call(job)
+    finally:
+        planning.perspective_tile, planning.lightspace.fit_sun_to_view = original
+    assert counts[0][0] > counts[0][1] >= 2, counts  # planned afresh: two fits where sizes shrink
+    assert all(fitted == maps for fitted, maps in counts[1:NAVIGATION_REPLAN]), counts
+    assert counts[NAVIGATION_REPLAN][0] > counts[NAVIGATION_REPLAN][1], counts
