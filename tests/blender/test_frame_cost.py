@@ -3,6 +3,8 @@ sample of a frame adds its GPU work and a small constant of Python, nothing that
 the scene: planning once per light per sample, no batch or material block rebuilt, no image
 read. Counts, not seconds: the speed itself is measured by ``tools.bench perf --sections cpu``."""
 
+from contextlib import contextmanager
+
 import pytest
 
 from devkit import scenes
@@ -34,6 +36,30 @@ def _render(gpu_call, scene, samples, fenced=False, before=None):
         return out.stats, counters, after, renderer.textures.pixel_reads
 
     return gpu_call(job)
+
+
+@contextmanager
+def counting_fits():
+    """A list that collects one entry per map fitted (a spot's or a point light's face, a
+    sun's cascade) while the block runs."""
+    from penumbra.engine.shadows import planning
+
+    fits = []
+    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view
+
+    def counted(fn):
+        def run(*args, **kwargs):
+            fits.append(fn.__name__)
+            return fn(*args, **kwargs)
+
+        return run
+
+    planning.perspective_tile = counted(original[0])
+    planning.lightspace.fit_sun_to_view = counted(original[1])
+    try:
+        yield fits
+    finally:
+        planning.perspective_tile, planning.lightspace.fit_sun_to_view = original
 
 
 @pytest.fixture(scope="module")
@@ -69,28 +95,12 @@ def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_c
     further samples fit each map once (the frame's first plan fixes their sizes); no batch or
     material block is built again, and what a further sample uploads is its uniform blocks
     and light bins, a few KiB, whatever the scene's size."""
-    from penumbra.engine.shadows import planning
-
-    fits = []
-    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view
-
-    def counted(fn):
-        def run(*args, **kwargs):
-            fits.append(fn.__name__)
-            return fn(*args, **kwargs)
-
-        return run
-
-    planning.perspective_tile = counted(original[0])
-    planning.lightspace.fit_sun_to_view = counted(original[1])
-    try:
+    with counting_fits() as fits:
         results = {}
         for samples in (2, 10):
             del fits[:]
             stats, counters, after, reads = _render(gpu_call, demo, samples)
             results[samples] = (len(fits), stats, counters, after, reads)
-    finally:
-        planning.perspective_tile, planning.lightspace.fit_sun_to_view = original
     (fits2, stats2, *_), (fits10, stats10, counters, after, reads) = results[2], results[10]
     maps = stats10.shadow_maps // stats10.samples  # maps drawn per sample (every light moves)
     assert maps >= 2
@@ -105,17 +115,6 @@ def test_a_viewport_refinement_plans_each_map_once(demo, gpu_call):
     """The viewport renders a frame one sample per redraw (``samples=(k, k + 1)``): its first
     call plans the frame (sizes and moving lights) and its sample; every later call of the
     same frame fits each map once, for its sample alone."""
-    from penumbra.engine.shadows import planning
-
-    fits = []
-    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view
-
-    def counted(fn):
-        def run(*args, **kwargs):
-            fits.append(fn.__name__)
-            return fn(*args, **kwargs)
-
-        return run
 
     def job(engine, depsgraph):
         from penumbra.engine.scene.extract import camera_from_scene
@@ -128,12 +127,8 @@ def test_a_viewport_refinement_plans_each_map_once(demo, gpu_call):
             counts.append((len(fits), out.stats.shadow_maps))
         return counts
 
-    planning.perspective_tile = counted(original[0])
-    planning.lightspace.fit_sun_to_view = counted(original[1])
-    try:
+    with counting_fits() as fits:
         counts = gpu_call(job)
-    finally:
-        planning.perspective_tile, planning.lightspace.fit_sun_to_view = original
     for fitted, maps in counts[1:]:
         assert maps >= 2 and fitted == maps, counts
     assert counts[0][0] > counts[0][1]  # the first call also planned the frame
@@ -144,17 +139,6 @@ def test_frames_while_the_view_moves_keep_their_map_sizes(demo, gpu_call):
     (a fit at full size, then one at the size the pixels need), the next ones keep them and
     fit each map once, and every NAVIGATION_REPLAN-th plans afresh."""
     from penumbra.engine.frame.renderer import NAVIGATION_REPLAN
-    from penumbra.engine.shadows import planning
-
-    fits = []
-    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view
-
-    def counted(fn):
-        def run(*args, **kwargs):
-            fits.append(fn.__name__)
-            return fn(*args, **kwargs)
-
-        return run
 
     def job(engine, depsgraph):
         import dataclasses
@@ -173,12 +157,8 @@ def test_frames_while_the_view_moves_keep_their_map_sizes(demo, gpu_call):
             counts.append((len(fits), out.stats.shadow_maps))
         return counts
 
-    planning.perspective_tile = counted(original[0])
-    planning.lightspace.fit_sun_to_view = counted(original[1])
-    try:
+    with counting_fits() as fits:
         counts = gpu_call(job)
-    finally:
-        planning.perspective_tile, planning.lightspace.fit_sun_to_view = original
     assert counts[0][0] > counts[0][1] >= 2, counts  # planned afresh: two fits where sizes shrink
     assert all(fitted == maps for fitted, maps in counts[1:NAVIGATION_REPLAN]), counts
     assert counts[NAVIGATION_REPLAN][0] > counts[NAVIGATION_REPLAN][1], counts
