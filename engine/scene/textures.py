@@ -44,7 +44,6 @@ class TextureCache:
         self._textures = {}  # image name -> (GPUTexture, premultiplied)
         self._sh = {}  # image name -> its equirectangular SH (9, 3), strength 1
         self.uploads = 0  # images taken from Blender since creation (tests and the benchmark read it)
-        self.pixel_reads = 0  # images read into Python (none: a test counts them)
         self.bytes = 0
         self._messages = {}  # image name -> what the user must be told of it (``messages``)
 

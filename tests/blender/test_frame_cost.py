@@ -1,7 +1,8 @@
 """What a frame's CPU does (FrameStats' CPU/GPU split, ``StageClock``), and that a further
 sample of a frame adds its GPU work and a small constant of Python, nothing that grows with
-the scene: planning once per light per sample, no batch or material block rebuilt, no image
-read. Counts, not seconds: the speed itself is measured by ``tools.bench perf --sections cpu``."""
+the scene: planning once per light per sample, no batch or material block rebuilt (that no
+image is read into Python is test_materials' tracemalloc test). Counts, not seconds: the
+speed itself is measured by ``tools.bench perf --sections cpu``."""
 
 from contextlib import contextmanager
 
@@ -33,7 +34,7 @@ def _render(gpu_call, scene, samples, fenced=False, before=None):
             after = (renderer.batches.uploaded, renderer.materials.uploaded)
         finally:
             Renderer.fence_stages = False
-        return out.stats, counters, after, renderer.textures.pixel_reads
+        return out.stats, counters, after
 
     return gpu_call(job)
 
@@ -99,14 +100,13 @@ def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_c
         results = {}
         for samples in (2, 10):
             del fits[:]
-            stats, counters, after, reads = _render(gpu_call, demo, samples)
-            results[samples] = (len(fits), stats, counters, after, reads)
-    (fits2, stats2, *_), (fits10, stats10, counters, after, reads) = results[2], results[10]
+            stats, counters, after = _render(gpu_call, demo, samples)
+            results[samples] = (len(fits), stats, counters, after)
+    (fits2, stats2, *_), (fits10, stats10, counters, after) = results[2], results[10]
     maps = stats10.shadow_maps // stats10.samples  # maps drawn per sample (every light moves)
     assert maps >= 2
     assert fits10 - fits2 == 8 * maps, (fits2, fits10, maps)
     assert after == counters  # no batch, no material block made again
-    assert reads == 0
     per_sample = (stats10.upload_bytes - stats2.upload_bytes) / 8
     assert 0 < per_sample < 32 * 1024, per_sample
 
