@@ -247,7 +247,8 @@ SCENE_PARAMS = (
         "filter_size",
         "FLOAT",
         1.5,
-        "Width of the pixel filter (Blackman-Harris) the samples are spread over and weighted by, in pixels",
+        "How far the pixel filter (Blackman-Harris) the samples are spread over reaches each way, in pixels: "
+        "the same image as Cycles' Pixel Filter Width and EEVEE's Filter Size of this value",
         min=0.0,
         max=10.0,
         label="Filter Size",

@@ -3,15 +3,16 @@
  * by the Noise Threshold. Two causes could:
  *   - a light: the settle test's flags (``flags``: red 1 where no moving light's visibility
  *     or facet can change, green the change of reflected light over the lights' extents),
- *     needed settled over the pixel's 3x3 neighbourhood (the pixel filter reaches into it);
+ *     needed settled ``flag_reach`` pixels each way (as far as the pixel filter reaches);
  *   - the pixel filter: later samples look elsewhere in the pixel. For an image f smooth
  *     over the filter, the samples kept (their offsets' mean m_k and second moments S_k)
  *     differ from the whole frame's (m, S) by
  *       grad f . (m_k - m) + 1/2 tr(H (S_k - S)),
  *     with central differences of the image so far (``accum`` / ``weight_sum``) and K the
  *     largest second difference along the four lines through the pixel (rows, columns,
- *     diagonals). That holds where f is smooth; an edge within the filter's reach (0.75 px)
- *     moves the filtered value by up to half its step, and has a neighbour on its other side:
+ *     diagonals). That holds where f is smooth; an edge within a pixel moves the filtered
+ *     value by up to half its step, and has a neighbour on its other side (the filter reaches
+ *     Filter Size pixels, 1.5 by default, but beyond 1 px it weighs 0.6 % each way):
  *     so the change is bounded by the larger of the smooth estimate and half of R, the
  *     largest departure of a neighbour from the plane through the pixel (its gradient), which
  *     is a step's size at an edge, a thin line or a texture's detail, and small where the
@@ -33,9 +34,13 @@ void main()
   vec4 c[9];
   for (int y = -1; y <= 1; y++) {
     for (int x = -1; x <= 1; x++) {
-      ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
-      settled = settled && texelFetch(flags, q, 0).r > 0.5;
-      c[(y + 1) * 3 + (x + 1)] = texelFetch(accum, q, 0) * inv;
+      c[(y + 1) * 3 + (x + 1)] = texelFetch(accum, clamp(p + ivec2(x, y), ivec2(0), size - 1), 0) * inv;
+    }
+  }
+  int reach = int(flag_reach + 0.5);
+  for (int y = -reach; y <= reach; y++) {
+    for (int x = -reach; x <= reach; x++) {
+      settled = settled && texelFetch(flags, clamp(p + ivec2(x, y), ivec2(0), size - 1), 0).r > 0.5;
     }
   }
   vec4 fx = 0.5 * (c[5] - c[3]), fy = 0.5 * (c[7] - c[1]);

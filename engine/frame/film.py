@@ -328,13 +328,14 @@ class Film:
         self._settle[1].clear(format="FLOAT", value=(1.0, 0.0, 0.0, 0.0))
         return self._settle[2]
 
-    def settle(self, threshold, shifts, aux=False, emission=False):
+    def settle(self, threshold, shifts, aux=False, emission=False, reach=1):
         """After the first sample, with the pilot sample in the colour (and shadow, Emission)
         targets: settle the pixels no later sample can change by ``threshold`` (the flags in
         ``settle_framebuffer`` and the pilot's image; ``shifts``: ``settle.settle_shifts``).
         They join the converged pixels with the pilot's value in place of the first sample's
         (the same weight); the others keep their first sample. ``aux``/``emission``: the frame
-        has the Shadow / Emission pass. Returns the number of converged pixels."""
+        has the Shadow / Emission pass; ``reach``: how many pixels away the pixel filter still
+        reads (its light test must hold that far). Returns the number of converged pixels."""
         (mx, my), (sxx, syy, sxy) = shifts
         src, dst = self._mask_index, 1 - self._mask_index
         samplers = {"accum": self.color, "flags": self._settle[1], "converged": self._masks[src]}
@@ -346,6 +347,7 @@ class Film:
             "weight_sum": 1.0,  # the pilot alone
             "mean_shift": (float(mx), float(my)),
             "moment_shift": (float(sxx), float(syy), float(sxy)),
+            "flag_reach": float(reach),
         }
         program = SETTLE_SHADOW if with_shadow else SETTLE
         self.fullscreen(program, self._mask_fbs[dst], samplers, uniforms)

@@ -494,6 +494,7 @@ SETTLE = Program(
         ("FLOAT", "weight_sum"),
         ("VEC2", "mean_shift"),
         ("VEC3", "moment_shift"),
+        ("FLOAT", "flag_reach"),
     ),
     samplers=(("FLOAT_2D", "accum"), ("FLOAT_2D", "flags"), ("FLOAT_2D", "converged")),
     outputs=(("VEC4", "out_color"),),

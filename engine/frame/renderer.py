@@ -111,7 +111,9 @@ class Renderer:
         self._clock = clock
         self.film.clock = clock
         clock.begin("prepare")
-        self.shadow_pass.begin_frame()
+        # A multi-sample frame's pixel offsets reach Filter Size pixels beyond the image: its
+        # maps are planned for what those samples see too.
+        self.shadow_pass.begin_frame(max(float(settings.filter_size), 0.0) if sample_count > 1 else 0.0)
         emission = bool(emission and aux)
         film = self.film
         film.ensure(width, height, aux, emission)

@@ -5,8 +5,9 @@ them with the film filter's weights:
 
 * **Pixels.** Sample s shifts the whole image by a sub-pixel offset: sample 0 by nothing (the
   pixel centre), sample s > 0 by the Halton (2, 3) point s mapped through the inverse CDF of
-  the Blackman-Harris filter of width ``filter_size`` pixels (Cycles' "pixel filter width"),
-  so offsets are distributed as the filter and the plain average converges to the image
+  the Blackman-Harris filter Blender calls ``filter_size`` pixels wide (``filter_width``:
+  it reaches ``filter_size`` pixels each way, as Cycles' Pixel Filter Width and EEVEE's Filter
+  Size do), so offsets are distributed as the filter and the plain average converges to the image
   convolved with it.
 * **Soft lights.** A light with size (sun ``angle``, point/spot ``shadow_soft_size``, area
   ``size``/``size_y`` and shape) shines from a different point of itself in each sample, in
@@ -71,10 +72,19 @@ def blackman_harris(x, width):
     return 0.35875 - 0.48829 * math.cos(a) + 0.14128 * math.cos(2 * a) - 0.01168 * math.cos(3 * a)
 
 
+def filter_width(filter_size):
+    """The total width in pixels of the Blackman-Harris window of Blender's ``filter_size``:
+    twice it. Cycles doubles the Pixel Filter Width it is given for this filter (its film's
+    filter table), and EEVEE weighs samples up to Filter Size pixels away, so the same number
+    gives the same image in all three engines."""
+    return 2.0 * float(filter_size)
+
+
 @functools.lru_cache(maxsize=8)
 def _filter_cdf(filter_size, table=1024):
-    x = (np.arange(table + 1) / table - 0.5) * filter_size
-    pdf = np.array([blackman_harris(v, filter_size) for v in x])
+    width = filter_width(filter_size)
+    x = (np.arange(table + 1) / table - 0.5) * width
+    pdf = np.array([blackman_harris(v, width) for v in x])
     cdf = np.concatenate([[0.0], np.cumsum(0.5 * (pdf[1:] + pdf[:-1]))])
     return cdf / cdf[-1], x
 
@@ -106,6 +116,16 @@ def jittered_projection(projection, dx, dy, width, height):
     shift[0, 3] = 2.0 * dx / width
     shift[1, 3] = 2.0 * dy / height
     return shift @ p
+
+
+def widened_projection(projection, reach, width, height):
+    """``projection`` seeing ``reach`` pixels more on every side of a ``width`` x ``height``
+    image: every pixel offset of a frame whose filter reaches that far stays inside it, so
+    what is planned from it (the visible receivers the maps cover, the visible depth range)
+    holds for every sample. Returns (projection, (width, height) of the widened image)."""
+    p = np.array(projection, dtype=np.float64)
+    grow = np.diag([width / (width + 2.0 * reach), height / (height + 2.0 * reach), 1.0, 1.0])
+    return grow @ p, (width + 2.0 * reach, height + 2.0 * reach)
 
 
 @functools.lru_cache(maxsize=256)

@@ -13,7 +13,8 @@ whether any of these could move it by the Noise Threshold, in Cycles' error unit
   light, and the light the surface reflects may change only a little over the light's
   extent (it moves the light by its radius each way: highlights and close lights do not
   settle). Dithered and blended surfaces never settle (what is behind them shows in some
-  samples). A pixel needs its 3x3 neighbourhood settled, as far as the pixel filter reaches.
+  samples). A pixel needs its neighbourhood settled as far as the pixel filter reaches
+  (``flag_reach``: 2 pixels each way at the default 1.5).
 * **The pixel filter.** For an image smooth over the pixel, the samples taken so far average
   to the whole frame's filtered value up to gradient . (mean offset difference) + 1/2 Hessian :
   (second-moment difference) (``settle_shifts``, exact for the frame's own offsets); the
@@ -30,12 +31,22 @@ the first sample missed entirely (a sub-pixel wire between pixel centres).
 """
 
 import functools
+import math
 
 import numpy as np
 
 from . import sampling
 
 ENDLESS_MOMENTS = 1024  # the samples a frame without end is taken to have (its filter's moments)
+
+
+MAX_FLAG_REACH = 4  # pixels: a wider filter keeps the 9x9 test (its weight beyond is tiny)
+
+
+def flag_reach(filter_size):
+    """How many pixels around a pixel the light test must hold: the nearest pixel centres
+    the pixel filter reaches (Filter Size pixels each way; at least the 3x3 neighbourhood)."""
+    return min(max(1, math.ceil(float(filter_size) - 1e-6)), MAX_FLAG_REACH)
 
 
 @functools.lru_cache(maxsize=16)
@@ -67,5 +78,11 @@ def settle(renderer, draws, snapshot, settings, adaptive, sample_count, aux=Fals
     film = renderer.film
     renderer.settle_test(draws, snapshot, settings, sample_count, film.settle_framebuffer())
     before = film.converged
-    film.settle(adaptive.settle, settle_shifts(1, sample_count, settings.filter_size), aux, emission)
+    film.settle(
+        adaptive.settle,
+        settle_shifts(1, sample_count, settings.filter_size),
+        aux,
+        emission,
+        flag_reach(settings.filter_size),
+    )
     return film.converged - before

@@ -2,11 +2,14 @@
 apply shadow linking to each map's casters, and draw the maps whose content changed into the
 atlas (``shadow_maps.ShadowAtlas``)."""
 
+import dataclasses
+
 import numpy as np
 
 from ..scene import simplify
 from ..shadows import lightspace
 from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, plan_shadows
+from . import sampling
 from .draw_list import corners_of
 from .programs import image_premultiplied_bits
 from .shadow_maps import Caster, ShadowAtlas, TreeCutout
@@ -21,13 +24,17 @@ class ShadowPass:
         self._receivers = None  # and what the camera sees (lightspace.visible_receivers)
         self._casters = (None, None)  # (the frame's draw list, what each draw casts): once a frame
         self._sizes = None  # {light index: map sizes} of the frame's first plan (``keep_sizes``)
+        self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
 
-    def begin_frame(self):
-        """Forget the last frame's camera-dependent bounds, casters and map sizes."""
+    def begin_frame(self, reach=0.0):
+        """Forget the last frame's camera-dependent bounds, casters and map sizes. ``reach``:
+        how many pixels beyond the image the frame's samples look (the pixel filter's reach in
+        a multi-sample frame; 0 for one sample), so maps are planned for all of them."""
         self.depth_range = UNSET
         self._receivers = None
         self._casters = (None, None)
         self._sizes = None
+        self.reach = float(reach)
 
     def keep_sizes(self, plan, settings):
         """The frame's later samples draw each light's maps at the sizes of ``plan`` (the
@@ -47,6 +54,9 @@ class ShadowPass:
         """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
         (width, height), with maps of ``map_size`` (default: the setting)."""
         corners = corners_of(draws)
+        if self.reach > 0.0 and size is not None:
+            projection, size = sampling.widened_projection(camera.projection, self.reach, *size)
+            camera = dataclasses.replace(camera, projection=projection)
         view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
         map_size = max(1, int(settings.shadow_map_size)) if map_size is None else map_size
         if self.depth_range is UNSET:

@@ -21,15 +21,15 @@ def _light(kind, **kw):
 
 def test_first_sample_is_centred_and_offsets_fill_the_filter_width():
     assert sampling.pixel_offset(0, 1.5) == (0.0, 0.0, 1.0)
-    offsets = np.array([sampling.pixel_offset(s, 2.0)[:2] for s in range(1, 1025)])
-    assert np.all(np.abs(offsets) < 1.0)  # within +-width/2
+    offsets = np.array([sampling.pixel_offset(s, 1.0)[:2] for s in range(1, 1025)])
+    assert np.all(np.abs(offsets) < 1.0)  # within +-filter_size, as in Cycles and EEVEE
     # Low discrepancy: every quarter of the square gets a quarter of the points, +-2.
     quadrants = np.histogram2d(offsets[:, 0], offsets[:, 1], bins=2, range=[[-1, 1], [-1, 1]])[0]
     assert np.all(np.abs(quadrants - 256) <= 2)
     # Distributed as the filter: the histogram of x follows the Blackman-Harris window.
     counts, edges = np.histogram(offsets[:, 0], bins=8, range=(-1, 1))
     centres = 0.5 * (edges[1:] + edges[:-1])
-    window = np.array([sampling.blackman_harris(c, 2.0) for c in centres])
+    window = np.array([sampling.blackman_harris(c, sampling.filter_width(1.0)) for c in centres])
     np.testing.assert_allclose(counts / counts.sum(), window / window.sum(), atol=0.01)
     assert all(sampling.pixel_offset(s, 0.0) == (0.0, 0.0, 1.0) for s in range(5))  # no filter: no jitter
 

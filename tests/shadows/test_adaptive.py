@@ -199,8 +199,9 @@ def test_time_limit_stops_within_one_sample_of_the_budget(penumbra, gpu_call, mo
 def test_threshold_zero_or_off_is_bit_identical_to_the_plain_frame(penumbra, gpu_call):
     """The plain frame (no ``adaptive``) is the code path without adaptive sampling; Noise
     Threshold 0 and adaptive sampling off give its passes to the bit, through F12. With the
-    threshold on, pixels stop and the image moves a little: measured on 5.2 and 4.5, mean
-    |difference| 0.00091, max 0.042, mean brightness -0.045 %, Shadow pass 0.00081."""
+    threshold on, pixels stop and the image moves a little: measured on 5.2 and 4.5 with the
+    pixel filter reaching 1.5 px (Cycles' width), mean |difference| 0.0016, max 0.041, mean
+    brightness +0.21 %, Shadow pass 0.0012 (half as wide: 0.00091, 0.042, -0.045 %, 0.00081)."""
     from penumbra.engine.scene.extract import camera_from_scene
 
     scene = _soft_demo(64, 36)
@@ -227,6 +228,6 @@ def test_threshold_zero_or_off_is_bit_identical_to_the_plain_frame(penumbra, gpu
     np.testing.assert_array_equal(plain, off["Combined"])
     np.testing.assert_array_equal(on["Depth"], off["Depth"])  # the centred sample's, always taken
     diff = np.abs(on["Combined"] - off["Combined"])[..., :3]
-    assert 0.0 < diff.mean() < 0.002 and diff.max() < 0.08, (diff.mean(), diff.max())
-    assert math.isclose(on["Combined"][..., :3].mean(), off["Combined"][..., :3].mean(), rel_tol=0.002)
+    assert 0.0 < diff.mean() < 0.0025 and diff.max() < 0.08, (diff.mean(), diff.max())
+    assert math.isclose(on["Combined"][..., :3].mean(), off["Combined"][..., :3].mean(), rel_tol=0.003)
     assert np.abs(on["Shadow"] - off["Shadow"]).mean() < 0.002

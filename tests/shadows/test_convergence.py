@@ -24,10 +24,11 @@ SAMPLES = (4, 16, 64, 256)
 
 
 def _filter_weights(filter_size, grid):
-    from penumbra.engine.frame.sampling import blackman_harris
+    from penumbra.engine.frame.sampling import blackman_harris, filter_width
 
-    offsets = (np.arange(grid) + 0.5) / grid * filter_size - filter_size / 2
-    weights = np.array([blackman_harris(o, filter_size) for o in offsets])
+    width = filter_width(filter_size)
+    offsets = (np.arange(grid) + 0.5) / grid * width - width / 2
+    weights = np.array([blackman_harris(o, width) for o in offsets])
     return offsets, weights / weights.sum()
 
 
@@ -255,7 +256,7 @@ def test_smooth_low_poly_sphere_keeps_its_self_shadowing(penumbra):
     about N^-0.2: a plateau)."""
     scene, ball = _sphere_scene()
     whole, judged_whole = _sphere_expected(scene, ball, None)
-    assert (whole[judged_whole] < 0.5).sum() > 40  # the turned-away band is in view
+    assert (whole[judged_whole] < 0.5).sum() > 20  # the turned-away band is in view (26 pixels judged)
     errors = {}
     for n in SAMPLES:
         image = _shadow_pass(scene, n)

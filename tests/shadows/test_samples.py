@@ -39,11 +39,12 @@ def _expected_coverage(verts, size, ortho_scale, filter_size, grid=48):
     ``filter_size`` pixels: a dense grid of offsets over the filter, each weighted by it."""
     from matplotlib.path import Path
 
-    from penumbra.engine.frame.sampling import blackman_harris
+    from penumbra.engine.frame.sampling import blackman_harris, filter_width
 
     px = ortho_scale / size
-    offs = (np.arange(grid) + 0.5) / grid * filter_size - filter_size / 2
-    w1 = np.array([blackman_harris(o, filter_size) for o in offs])
+    width = filter_width(filter_size)
+    offs = (np.arange(grid) + 0.5) / grid * width - width / 2
+    w1 = np.array([blackman_harris(o, width) for o in offs])
     centres = (np.arange(size) + 0.5) * px - ortho_scale / 2
     path = Path(np.array(verts)[:, :2])
     out = np.zeros((size, size))

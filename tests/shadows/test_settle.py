@@ -179,7 +179,7 @@ def test_procedural_textures_keep_sampling_image_textures_settle(penumbra, gpu_c
     plain, _settled, _ref, mask, _stats, _ = _frames(gpu_call, scene, 8, reference=8)
     world = np.all(np.abs(plain[..., :3] - plain[0, 0, :3]) < 1e-6, axis=-1)  # the background
     assert world.sum() > 0.3 * mask.size and not (mask & ~world).any()
-    assert mask[world].mean() > 0.9
+    assert mask[world].mean() > 0.85  # all but the pixels the filter reaches from the sphere (2 px)
     scene = material_scenes.texture_base_color(64, 64)
     _plain, _settled, _ref, mask, _stats, _ = _frames(gpu_call, scene, 8, reference=8)
     assert mask.mean() > 0.5
