@@ -37,6 +37,20 @@ room       a point light (radius 0.05) in a closed 6 x 5 x 3 m room with a table
            bunny: cube-face seams cross floor and wall shadows
 =========  ============================================================================
 
+Thin casters (``THIN_SCENES``, on the same large ground, at DETAILED_WIDTH x DETAILED_HEIGHT),
+whose shadows are a few pixels wide, so the pixel filter decides as much as the maps: they are
+compared with Cycles through the same Blackman-Harris filter (``matched_filter``):
+
+=========  ============================================================================
+knot       a (2, 3) torus knot of 2 cm tube radius floating 0.8 m up, sharp sun at 35 deg
+fence      24 slats 2 cm square and 1 m tall with a 1.5 cm rail, sun 12 deg above the
+           horizon: long parallel shadows two pixels wide
+wires      five sagging wires of 6-22 mm diameter 1.5 m up, sharp sun at 55 deg: shadows
+           partly lit (the sun's disc is wider than the thinnest wires seen from the ground)
+leaves     160 leaves (10 x 5 cm quads) scattered around 1.6 m under a near-hard spot
+stack      six boxes of shrinking size stacked under a near-hard spot (radius 0.02)
+=========  ============================================================================
+
 The shadow terminator (``TERMINATOR_SCENES``; Object › Shading › Shadow Terminator):
 
 ===============  ======================================================================
@@ -333,6 +347,118 @@ def room(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
     return scene
 
 
+def _tube(points, radius, sides, closed):
+    """A tube of ``sides`` faces around the polyline ``points`` (n, 3): (verts, quads)."""
+    p = np.asarray(points, np.float64)
+    n = len(p)
+    t = (np.roll(p, -1, 0) - np.roll(p, 1, 0)) if closed else np.gradient(p, axis=0)
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    a = np.cross(t, (0.0, 0.0, 1.0))
+    flat = np.linalg.norm(a, axis=1) < 1e-3
+    a[flat] = np.cross(t[flat], (1.0, 0.0, 0.0))
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    b = np.cross(t, a)
+    ang = np.arange(sides) * (2.0 * math.pi / sides)
+    ring = np.cos(ang)[None, :, None] * a[:, None, :] + np.sin(ang)[None, :, None] * b[:, None, :]
+    verts = (p[:, None, :] + radius * ring).reshape(-1, 3)
+    faces = []
+    for i in range(n if closed else n - 1):
+        j = (i + 1) % n
+        for k in range(sides):
+            k2 = (k + 1) % sides
+            faces.append((i * sides + k, i * sides + k2, j * sides + k2, j * sides + k))
+    return verts, faces
+
+
+def knot(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    scene, grey, far = _big_stage(width, height)
+    s = np.linspace(0.0, 2.0 * math.pi, 360, endpoint=False)
+    r = 0.35 + 0.15 * np.cos(3 * s)
+    points = np.stack([r * np.cos(2 * s), r * np.sin(2 * s), 0.15 * np.sin(3 * s) + 0.8], 1)
+    verts, faces = _tube(points, 0.02, 8, closed=True)
+    scenes.mesh_object(scene, "Knot", verts, faces, mat=grey)
+    _sharp_sun(scene, 35.0, azimuth_deg=200.0)
+    _camera(scene, (0.6, -2.4, 1.9), (0.0, 0.8, 0.2), 40.0, far)
+    return scene
+
+
+def fence(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    scene, grey, far = _big_stage(width, height)
+    for k in range(24):
+        scenes.box(scene, f"Slat{k}", center=(-1.2 + 0.1 * k, 0.0, 0.5), size=(0.02, 0.02, 1.0), mat=grey)
+    scenes.box(scene, "Rail", center=(0.0, 0.0, 0.9), size=(2.5, 0.015, 0.015), mat=grey)
+    _sharp_sun(scene, 12.0, azimuth_deg=160.0)
+    _camera(scene, (1.5, -4.5, 2.5), (0.0, 1.5, 0.0), 35.0, far)
+    return scene
+
+
+def wires(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    scene, grey, far = _big_stage(width, height)
+    x = np.linspace(-3.0, 3.0, 60)
+    sag = 1.5 - 0.15 * np.cos(np.linspace(-1.0, 1.0, 60) * math.pi / 2)
+    for k in range(5):
+        points = np.stack([x, np.full(60, -0.6 + 0.3 * k), sag], 1)
+        verts, faces = _tube(points, 0.003 + 0.002 * k, 6, closed=False)
+        scenes.mesh_object(scene, f"Wire{k}", verts, faces, mat=grey)
+    _sharp_sun(scene, 55.0, azimuth_deg=190.0)
+    _camera(scene, (0.5, -2.5, 2.2), (0.0, 1.0, 0.0), 40.0, far)
+    return scene
+
+
+def _spot_over(scene, location, target, radius=0.02, cone_deg=90.0):
+    ob = scenes.light(
+        scene,
+        "Spot",
+        "SPOT",
+        300.0,
+        location=location,
+        shadow_soft_size=radius,
+        spot_size=math.radians(cone_deg),
+        spot_blend=0.2,
+    )
+    scenes.aim(ob, target)
+    return _hide_from_camera(ob)
+
+
+def leaves(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    scene, grey, far = _big_stage(width, height)
+    rng = np.random.default_rng(3)
+    verts, faces = [], []
+    for _ in range(160):
+        c = rng.normal(0.0, 0.35, 3) * (1.0, 1.0, 0.5) + (0.0, 0.0, 1.6)
+        u = rng.normal(size=3)
+        u /= np.linalg.norm(u)
+        w = rng.normal(size=3)
+        w -= u * (w @ u)
+        w /= np.linalg.norm(w)
+        base = len(verts)
+        verts += [c + 0.05 * u, c + 0.025 * w, c - 0.05 * u, c - 0.025 * w]
+        faces.append((base, base + 1, base + 2, base + 3))
+    scenes.mesh_object(scene, "Leaves", np.array(verts), faces, mat=grey)
+    _spot_over(scene, (0.8, 0.6, 4.0), (0.0, 0.0, 0.0))
+    _camera(scene, (1.2, -3.0, 2.6), (0.0, 0.0, 0.4), 40.0, far)
+    return scene
+
+
+def stack(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
+    scene, grey, far = _big_stage(width, height)
+    z = 0.0
+    for k, side in enumerate((0.6, 0.45, 0.33, 0.24, 0.17, 0.12)):
+        scenes.box(scene, f"Box{k}", center=(0.05 * k, 0.03 * k, z + side / 2), size=(side,) * 3, mat=grey)
+        z += side
+    _spot_over(scene, (-1.5, 1.0, 4.0), (0.0, 0.0, 0.5), cone_deg=80.0)
+    _camera(scene, (2.0, -3.0, 2.4), (0.0, 0.2, 0.6), 40.0, far)
+    return scene
+
+
+def matched_filter(scene):
+    """Cycles settings that filter pixels as Penumbra does on ``scene``: its Blackman-Harris
+    filter of the same reach (Cycles' Pixel Filter Width). The kit's other comparisons keep
+    Cycles' narrow box (pixel centres), which barely differs where edges are long and smooth;
+    a shadow a few pixels wide is mostly edge, and its pixels' values are the filter's."""
+    return {"pixel_filter_type": "BLACKMAN_HARRIS", "filter_width": float(scene.penumbra.filter_size)}
+
+
 TERMINATOR_SEGMENTS, TERMINATOR_RINGS = 16, 8
 TERMINATOR_CENTER = (0.0, 0.0, 1.0)
 
@@ -395,12 +521,18 @@ SCENES = {
     "tiny": tiny,
     "lamp": lamp,
     "room": room,
+    "knot": knot,
+    "fence": fence,
+    "wires": wires,
+    "leaves": leaves,
+    "stack": stack,
     "terminator": terminator,
     "terminator_off": terminator_off,
 }
 LIGHT_SCENES = ("sun_hard", "sun_soft", "spot", "point", "area", "contact")
 SOFT_SCENES = ("sun_soft", "spot", "point", "area", "contact")  # visibly soft shadows in Cycles
 DETAILED_SCENES = ("bunny", "suzanne", "grazing", "tiny", "lamp", "room")  # detailed casters, large grounds
+THIN_SCENES = ("knot", "fence", "wires", "leaves", "stack")  # shadows a few pixels wide (matched_filter)
 TERMINATOR_SCENES = ("terminator", "terminator_off")
 
 
@@ -525,11 +657,16 @@ def cache_path(name, samples, width, height, cache_dir=DEFAULT_CACHE):
 
 def cycles_reference(name, samples=512, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT, cache_dir=DEFAULT_CACHE):
     """Cycles visibility of reference scene ``name`` at ``samples`` spp, from the cache when
-    present; otherwise rendered (this rebuilds the current scene) and cached."""
+    present; otherwise rendered (this rebuilds the current scene) and cached. THIN_SCENES are
+    rendered through ``matched_filter``."""
     path = cache_path(name, samples, width, height, cache_dir)
+    if name in THIN_SCENES:
+        path = path.with_name(path.name.replace(".npy", "-matched.npy"))
     if path.exists():
         return np.load(path)
-    vis = measure_visibility(build(name, width, height), "CYCLES", samples=samples)
+    scene = build(name, width, height)
+    extra = matched_filter(scene) if name in THIN_SCENES else {}
+    vis = measure_visibility(scene, "CYCLES", samples=samples, **extra)
     path.parent.mkdir(parents=True, exist_ok=True)
     # Write then rename, so a concurrent reader never sees half a file.
     fd, tmp = tempfile.mkstemp(suffix=".npy", dir=path.parent)

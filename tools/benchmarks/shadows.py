@@ -21,8 +21,12 @@ engines set up by ``devkit.engines``:
    IoU, missed and false shadow fractions, texels per metre at the caster and frame time
    against Workbench's in the same run, for PCF and PCSS at the defaults.
    -> ``<out>/shadow_detailed.csv``.
+6. Thin casters (``kit.THIN_SCENES``, 320x180): shadows a few pixels wide, against Cycles
+   through the same pixel filter (``kit.matched_filter``; 1024 spp, 256 with --quick): IoU
+   and MAE of Penumbra at the default 16 samples and at 64, EEVEE (16 TAA) and Cycles 16 spp
+   with the same filter, each with its median frame time. -> ``<out>/shadow_thin.csv``.
 
-``--sections`` runs a subset (tradeoff, scaling, work, early_out, detailed).
+``--sections`` runs a subset (tradeoff, scaling, work, early_out, detailed, thin).
 
 Machines here are shared and noisy: absolute times only describe this run; compare engines
 and configurations by their ratios. Markdown tables for the README go to stdout, progress and
@@ -578,6 +582,34 @@ def detailed(plan, cache_dir):
     return rows
 
 
+THIN_SPP, THIN_SPP_QUICK = 1024, 256
+THIN_CONFIGS = (
+    ("Penumbra, 16 samples", "PENUMBRA", {"render_samples": 16}),
+    ("Penumbra, 64 samples", "PENUMBRA", {"render_samples": 64}),
+    (f"EEVEE, {EEVEE_SAMPLES} TAA", "EEVEE", {}),
+    ("Cycles, 16 spp", "CYCLES", {"samples": 16}),
+)
+
+
+def thin(plan, cache_dir, quick):
+    """Per thin-caster scene and configuration: IoU and MAE against Cycles through the same
+    pixel filter, and the median frame time of the shadowed render."""
+    width, height = kit.DETAILED_WIDTH, kit.DETAILED_HEIGHT
+    rows = []
+    for name in kit.THIN_SCENES:
+        log(f"thin scene {name}")
+        ref = kit.cycles_reference(name, THIN_SPP_QUICK if quick else THIN_SPP, width, height, cache_dir)
+        for label, engine, settings in THIN_CONFIGS:
+            scene = kit.build(name, width, height)
+            extra = kit.matched_filter(scene) if engine == "CYCLES" else {}
+            vis = kit.measure_visibility(scene, engine, **settings, **extra)
+            seconds = timing.render(plan.runs, warmup=0).median
+            score = kit.compare(vis, ref)
+            rows.append({"scene": name, "config": label, "iou": score["iou"], "mae": score["mae"], "time_s": seconds})
+            log(f"  {rows[-1]}")
+    return rows
+
+
 # --- output ----------------------------------------------------------------------------------------
 
 
@@ -663,6 +695,18 @@ def md_detailed(rows):
     return report.markdown_table(header, cells, align="llrrrrrr")
 
 
+def md_thin(rows):
+    configs = [label for label, _engine, _settings in THIN_CONFIGS]
+    cells = []
+    for name in kit.THIN_SCENES:
+        line = [name]
+        for label in configs:
+            r = next((r for r in rows if r["scene"] == name and r["config"] == label), None)
+            line.append(f"{r['iou']:.3f} / {r['mae']:.4f} / {r['time_s'] * 1e3:.0f}" if r else "")
+        cells.append(line)
+    return report.markdown_table(["Scene", *configs], cells)
+
+
 def md_early_out(rows, size):
     cells = [[r["samples"], f"{r['on'] * 1e3:.0f}", f"{r['off'] * 1e3:.0f}", f"{r['off'] / r['on']:.2f}"] for r in rows]
     header = [f"JITTER samples ({size[0]}x{size[1]})", "Early out on (ms)", "Off (ms)", "Off / on"]
@@ -686,7 +730,7 @@ def add_arguments(parser):
     )
 
 
-SECTIONS = ("tradeoff", "scaling", "work", "early_out", "detailed")
+SECTIONS = ("tradeoff", "scaling", "work", "early_out", "detailed", "thin")
 
 
 def run(args):
@@ -708,6 +752,7 @@ def run(args):
         work_rows = frame_work(plan) if "work" in sections else None
         early = early_out(plan) if "early_out" in sections else None
         detailed_rows = detailed(plan, args.cache) if "detailed" in sections else None
+        thin_rows = thin(plan, args.cache, args.quick) if "thin" in sections else None
     gpu = session.gpu_renderer() or "n/a"
     written = []
     if rows is not None:
@@ -725,6 +770,9 @@ def run(args):
         fields = ["scene", "filter", "iou", "missed", "false", "texels_per_m", "time_s", "workbench_s"]
         report.write_csv(args.out / "shadow_detailed.csv", detailed_rows, fields)
         written.append("shadow_detailed.csv")
+    if thin_rows is not None:
+        report.write_csv(args.out / "shadow_thin.csv", thin_rows, ["scene", "config", "iou", "mae", "time_s"])
+        written.append("shadow_thin.csv")
 
     elapsed = time.perf_counter() - started
     conditions = (
@@ -754,6 +802,13 @@ def run(args):
             f"but the filter; reference Cycles {DETAILED_SPP} spp; missed/false: share of the valid pixels)\n"
         )
         print(md_detailed(detailed_rows))
+    if thin_rows is not None:
+        spp = THIN_SPP_QUICK if args.quick else THIN_SPP
+        print(
+            f"\n### Thin casters ({kit.DETAILED_WIDTH}x{kit.DETAILED_HEIGHT}; IoU / MAE / ms per frame against "
+            f"Cycles {spp} spp through the same pixel filter)\n"
+        )
+        print(md_thin(thin_rows))
     print(f"\n{conditions}")
     print(f"Wrote {', '.join(str(args.out / w) for w in written)}.")
     return 0
