@@ -14,7 +14,8 @@ something the asset does not use is a false one.
 
 -> ``<out>/assets.csv`` and a contact sheet ``<out>/assets.png`` (or ``--sheet``): rows are
 assets; columns the Cycles reference, Penumbra, EEVEE and |error| x4 of both. ``--quick``
-(one timed run, 256 spp references) takes about 3 minutes on 2 shared cores with llvmpipe.
+(one timed run, 256 spp references) took 8 minutes on 2 busy shared cores with llvmpipe, most
+of it EEVEE's renders (the alpha-blended asset's above all); cached references save about 2.
 """
 
 import hashlib
