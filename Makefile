@@ -9,6 +9,7 @@ PYTEST_ARGS ?=
 # make bench BENCH=shadows ARGS=--quick        shadow error against time (ARGS: that command's options)
 # make bench BENCH=samples                     render samples: error against time, against Cycles and EEVEE
 # make bench BENCH=soak                        process memory over 300 F12 renders
+# make bench BENCH=assets ARGS=--quick         glTF assets (devkit/gltf/): error against Cycles, Penumbra vs EEVEE
 BENCH ?= frame
 ARGS ?=
 

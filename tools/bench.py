@@ -1,5 +1,7 @@
 """Benchmarks, one command each (modules in tools/benchmarks/):
 
+    assets    glTF assets (devkit/gltf/) imported with Blender's importer: error against Cycles and
+              time, Penumbra against EEVEE -> <out>/assets.csv, assets.png
     frame     render time of Penumbra, EEVEE, Workbench and Cycles on the demo scene
               -> <out>/benchmark.csv
     perf      frame cost and scaling as ratios to Workbench: resolution, viewport redraw,
@@ -26,9 +28,10 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import frame, perf, post, samples, shadows, soak, terminator
+from tools.benchmarks import assets, frame, perf, post, samples, shadows, soak, terminator
 
 COMMANDS = {
+    "assets": assets,
     "frame": frame,
     "perf": perf,
     "post": post,
