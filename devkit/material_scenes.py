@@ -539,6 +539,62 @@ def hair(width=SIZE, height=SIZE):
     return scene
 
 
+HAIR_STRANDS = 2500  # strands of ``hair_patch``'s Curves object
+HAIR_PATCH = 0.5  # half side of the square its strands grow from, centred at the origin
+
+
+def hair_curves(name, strands=HAIR_STRANDS, points=4, half=HAIR_PATCH, height=0.5, radius=0.004, seed=7):
+    """A Curves datablock of ``strands`` strands of ``points`` points growing up from random roots
+    in [-half, half]^2 (z = 0), leaning a little in +x, each ``height`` tall and of ``radius``."""
+    rng = np.random.default_rng(seed)
+    curves = bpy.data.hair_curves.new(name)
+    curves.add_curves([points] * strands)
+    roots = rng.uniform(-half, half, (strands, 2))
+    t = np.linspace(0.0, 1.0, points)
+    lean = rng.uniform(0.05, 0.15, strands)
+    pos = np.empty((strands, points, 3), np.float32)
+    pos[:, :, 0] = roots[:, None, 0] + lean[:, None] * t[None, :] ** 2
+    pos[:, :, 1] = roots[:, None, 1]
+    pos[:, :, 2] = height * t[None, :]
+    curves.position_data.foreach_set("vector", pos.ravel())
+    attr = curves.attributes.new("radius", "FLOAT", "POINT")
+    attr.data.foreach_set("value", np.full(strands * points, radius, np.float32))
+    return curves
+
+
+def hair_patch(width=240, height=135, particles=True, top=False):
+    """Hair over a white ground under a sun from +x and above: a Curves object of HAIR_STRANDS
+    strands on [-HAIR_PATCH, HAIR_PATCH]^2 and (``particles``) a sphere with particle hair and
+    interpolated children beside it; seen from the front and above, or (``top``) straight
+    down by an orthographic camera, where the strands' shadow falls on the ground at +x."""
+    scene = base(width, height)
+    ground = scenes.material("Ground", (0.8, 0.8, 0.8), roughness=0.8)
+    brown = scenes.material("Hair", (0.45, 0.25, 0.1), roughness=0.6)
+    scenes.plane(scene, "Ground", size=8.0, mat=ground)
+    curves = hair_curves("Strands")
+    curves.materials.append(brown)
+    scenes.link(scene, bpy.data.objects.new("Strands", curves))
+    if particles:
+        body = scenes.uv_sphere(scene, "HairBall", center=(-1.4, 0.6, 0.45), radius=0.35, mat=brown)
+        body.modifiers.new("Hair", "PARTICLE_SYSTEM")
+        ps = body.particle_systems[0].settings
+        ps.type = "HAIR"
+        ps.count = 200
+        ps.hair_length = 0.3
+        ps.render_type = "PATH"
+        ps.radius_scale = 0.01
+        ps.child_type = "INTERPOLATED"
+        ps.child_percent = 5
+        ps.rendered_child_count = 5
+        ps.display_step = ps.render_step = 2
+    if top:
+        scenes.top_camera(scene, height=10.0, ortho_scale=3.2)
+    else:
+        scenes.look_at(scene, (0.0, -3.4, 2.0), (-0.3, 0.2, 0.2), lens=40.0)
+    sun(scene, toward=(4.0, -1.0, 4.0))
+    return scene
+
+
 def _procedural_sphere(width, height, name, node_type, output="Color", props=None, **inputs):
     """The sphere whose Principled Base Color is output ``output`` of texture ``node_type``
     (Generated coordinates) with node properties ``props`` and ``inputs``: (scene, material,

@@ -473,6 +473,21 @@ void main()
     nlen = length(N);
   }
   N = (nlen > 1e-30) ? N / nlen : vec3(0.0, 0.0, 1.0);
+#if HAIR_STRIP
+  {
+    /* Hair shaded as a cylinder, as EEVEE does: the normal turns from the camera (the strip's
+     * centre) to the binormal (its edges); a pixel-wide strand (hair_pixel > 0) takes a random
+     * point across it in each sample (EEVEE's random cosine distribution). */
+    float cos_theta = clamp(v_hair.w, -1.0, 1.0);
+    if (hair_pixel > 0.0) {
+      cos_theta = 2.0 * fract(pixel_hash(gl_FragCoord.xy + 17.0) + frame.alpha_offset) - 1.0;
+    }
+    float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+    vec3 B = v_hair.xyz;
+    float bl = length(B);
+    N = normalize(N * sin_theta + ((bl > 1e-20) ? B / bl : vec3(0.0)) * cos_theta + 1e-30);
+  }
+#endif
 
   s.V = (frame.is_ortho != 0) ? -frame.camera_forward : normalize(frame.camera_position - s.P);
   s.Ng = (dot(N, s.V) < 0.0) ? -N : N;

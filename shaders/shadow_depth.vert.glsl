@@ -3,6 +3,25 @@
 void main()
 {
   vec4 view_pos = tile.view * (model * vec4(pos, 1.0));
+#if HAIR_STRIP
+  {
+    /* A hair strip (engine/scene/hair.py) widened across the strand facing the light, as EEVEE
+     * draws curves toward the shadow view: by the strand's radius, or one map texel
+     * (hair_texels > 0, Strand shape: a pixel-wide strand is a texel wide in the map). */
+    mat3 m = mat3(model);
+    vec3 T = mat3(tile.view) * (m * nor);
+    bool ortho = tile.proj_tex[2][3] == 0.0;
+    vec3 V = ortho ? vec3(0.0, 0.0, 1.0) : -view_pos.xyz;
+    vec3 B = cross(V, T);
+    float bl = length(B);
+    B = (bl > 1e-20) ? B / bl : vec3(1.0, 0.0, 0.0);
+    float half_width = hair.y * pow(abs(determinant(m)), 1.0 / 3.0);
+    if (hair_texels > 0.0) {
+      half_width = 0.5 * (ortho ? tile.texel : tile.texel_per_distance * max(-view_pos.z, 0.0));
+    }
+    view_pos.xyz += B * (hair.x * half_width);
+  }
+#endif
   v_distance = -view_pos.z;
 #if HAS_UV
   v_uv = uv;

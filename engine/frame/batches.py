@@ -78,7 +78,14 @@ def _upload_bytes(attrs, vertices, triangles):
 
 def _attributes(geo):
     """The vertex attributes of ``geo`` by shader input name (those it has)."""
-    attrs = {"pos": geo.positions, "nor": geo.normals, "uv": geo.uvs, "col": geo.colors, "tan": geo.tangents}
+    attrs = {
+        "pos": geo.positions,
+        "nor": geo.normals,
+        "uv": geo.uvs,
+        "col": geo.colors,
+        "tan": geo.tangents,
+        "hair": geo.strands,
+    }
     return {name: data for name, data in attrs.items() if data is not None}
 
 

@@ -118,7 +118,7 @@ def draw_list(snapshot, batches, stats, origin, camera=None, settings=None, size
             model[:3, 3] -= origin
             model = Matrix(model.tolist())
             draw = Draw(inst, whole, parts, model, float(dets[i]), identity, corners[i])
-            draw.geometry = geo if lod is None else None
+            draw.geometry = geo if lod is None and inst.hair is None else None  # strips have no levels
             draw.bounds = bounds[i]
             draw.triangles = (lod or geo).triangle_count
             if inst.terminator.geometry_offset > 0.0 and (lod or geo).smooth and facets[i] >= TERMINATOR_MIN_PIXELS:
@@ -171,8 +171,8 @@ def _levels(kept, matrices, bounds, corners, camera, settings, size):
     for i, (inst, geo) in enumerate(kept):
         if not beyond[i] or geo.triangle_count < simplify.MIN_TRIANGLES:
             continue
-        if geo.uvs is not None or geo.colors is not None or geo.tangents is not None:
-            continue  # its materials read more than positions and normals
+        if geo.uvs is not None or geo.colors is not None or geo.tangents is not None or geo.strands is not None:
+            continue  # its materials read more than positions and normals, or hair strips
         if any(m is not None and m.uses_alpha for m in inst.materials):
             continue
         levels[i] = simplify.level_for(float(extent[i]), float(stretch[i]), float(nearest[i]), footprint, pixels)

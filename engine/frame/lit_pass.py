@@ -93,12 +93,16 @@ class LitPass:
             for mat_index, batch in parts:
                 mat = d.material(mat_index)
                 features = mat.features | ({"HOLDOUT"} if d.instance.holdout else set()) | term
+                if d.instance.hair is not None:
+                    features = features | {"HAIR"}
                 entry = (features, rank, d, batch, mat)
                 (blended if "ALPHA_BLEND" in features and not d.instance.holdout else opaque).append(entry)
         opaque.sort(key=lambda e: (target is not None and "ALPHA_HASHED" in e[0], sorted(e[0]), e[1]))
         blended.sort(key=lambda e: -e[1])
         width, height = film.size
         bound = {"shader": None, "counted": counted}
+        # Strand-shaped hair: half a pixel's width per unit of clip w (the camera's y scale).
+        hair_pixel = 1.0 / max(abs(float(camera.projection[1, 1])) * height, 1e-30)
 
         def bind(features, with_aux, tree):
             program = lit_program(
@@ -139,7 +143,7 @@ class LitPass:
             for features, _rank, d, batch, mat in entries:
                 # Material › Backface Culling › Camera: faces turned away are not drawn (the
                 # winding flips under a mirroring model matrix).
-                cull = mat.cull_camera or id(d) in outside
+                cull = (mat.cull_camera or id(d) in outside) and d.instance.hair is None  # strips have no back
                 culling = (cull, cull and d.det < 0.0)
                 if bound.get("culling") != culling:
                     gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
@@ -154,6 +158,8 @@ class LitPass:
                         shader.uniform_int("light_mask", masks[id(d)])
                     if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
                         set_uniforms(shader, terminators[id(d)])
+                    if d.instance.hair is not None:
+                        shader.uniform_float("hair_pixel", hair_pixel if d.instance.hair == "STRAND" else 0.0)
                     last, bound["model_shader"] = d, shader
                 if mat.tree is not None and mat.tree.needs & {"GENERATED", "OBJECT_INFO"}:
                     set_uniforms(shader, d.tree_uniforms(mat.tree))

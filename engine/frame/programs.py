@@ -105,6 +105,13 @@ FRAME_STRUCT = Struct(
 )
 
 MESH_VERTEX_IN = (("VEC3", "pos"), ("VEC3", "nor"))
+# Hair strips (``hair.strips``): per vertex its side of the strand (-1, 1) and the radius there;
+# ``pos`` lies on the strand and ``nor`` is its tangent. The lit pass reads ``hair_pixel``: 0 for
+# strips of the strands' radius (Render > Curves > Strip), else the half width of a pixel per
+# unit of clip w (Strand: a pixel wide); shadow maps read ``hair_texels``: 0 (radius) or 1 (a
+# map texel wide).
+HAIR_VERTEX_IN = ("VEC2", "hair")
+HAIR_PIXEL = ("FLOAT", "hair_pixel")
 
 # One material's values and, per texture channel (materials.CHANNELS), the rows of its UV
 # transform (uv' = (dot(row_u, uv1), dot(row_v, uv1))) and its mode (interpolation,
@@ -157,6 +164,7 @@ def material_defines(features):
     out["HOLDOUT"] = "HOLDOUT" in features
     for name in TERMINATOR_FEATURES:
         out[name] = name in features
+    out["HAIR_STRIP"] = "HAIR" in features  # hair strips widened in the vertex shader
     return out
 
 
@@ -270,10 +278,15 @@ def _with_features(program, features, name):
     if defines["TERMINATOR_OFFSET"]:
         vertex_in += tuple((typ, name) for typ, name, _v, _q in _TERMINATOR_INPUTS)
         varyings += tuple((q, typ, v) for typ, _n, v, q in _TERMINATOR_INPUTS) + (("smooth", "VEC3", "v_tnormal"),)
+    if defines["HAIR_STRIP"]:
+        vertex_in += (HAIR_VERTEX_IN,)
+        varyings += (("smooth", "VEC4", "v_hair"),)
     uniforms = []
     for feature, names in TERMINATOR_UNIFORMS.items():
         uniforms += [n for n in names if defines[feature] and n not in uniforms]
     pushes = program.push_constants + tuple(("FLOAT", n) for n in uniforms)
+    if defines["HAIR_STRIP"]:
+        pushes += (HAIR_PIXEL,)
     bits = ()
     if samplers:
         pushes = _with_image_flags(pushes)
@@ -374,7 +387,15 @@ SHADOW_DEPTH = Program(
     push_constants=(("MAT4", "model"),),
     uniform_blocks=((TILE_STRUCT, "tile", 0),),
     outputs=(("VEC4", "out_depth"),),
-    defines=tuple({**DEPTH_FORMAT.defines(), "ALPHA_CUTOUT": False, "HAS_UV": False, "RASTER_DEPTH": False}.items()),
+    defines=tuple(
+        {
+            **DEPTH_FORMAT.defines(),
+            "ALPHA_CUTOUT": False,
+            "HAS_UV": False,
+            "RASTER_DEPTH": False,
+            "HAIR_STRIP": False,
+        }.items()
+    ),
 )
 
 
@@ -543,6 +564,19 @@ def shadow_cutout_program(depth_format, textured, raster_depth=False):
     if not textured:
         return replace(program, name=f"{base.name}_alpha")
     return _with_features(program, features, f"{base.name}_alpha_tex")
+
+
+def shadow_hair_program(depth_format, raster_depth=False):
+    """The depth pass of hair strips: widened across the strand facing the light (the map's
+    eye), by the strands' radius or one map texel (``hair_texels``)."""
+    base = shadow_program(depth_format, raster_depth)
+    return replace(
+        base,
+        name=f"{base.name}_hair",
+        vertex_in=MESH_VERTEX_IN + (HAIR_VERTEX_IN,),
+        push_constants=base.push_constants + (("FLOAT", "hair_texels"),),
+        defines=base.defines + (("HAIR_STRIP", True),),
+    )
 
 
 def shadow_tree_program(depth_format, tree, raster_depth=False):

@@ -17,6 +17,7 @@ from .programs import (
     TILE_STRUCT,
     depth_defines,
     shadow_cutout_program,
+    shadow_hair_program,
     shadow_program,
     shadow_tree_program,
 )
@@ -50,6 +51,7 @@ class Caster:
     corners: object = None  # (8, 3) world corners of its bounds, with ``closed``
     triangles: int = 0  # triangles of ``batches`` (drawn whole)
     level: int = None  # drawn into this map at a level of detail (``_at_level``), else None
+    hair: str = None  # hair strips (Render > Curves > Shape: STRAND or STRIP), drawn by ``shadow_hair_program``
 
 
 def _at_level(caster, batches, level, triangles):
@@ -240,6 +242,8 @@ class ShadowAtlas:
                     front = {id(c) for c, inside in zip(closed, ok, strict=True) if inside}
                     stats.closed_culled += len(front)
                 for caster in casters:
+                    if caster.hair is not None:
+                        continue  # below, with the strips' program
                     if cull_front or caster.cull_back or id(caster) in front:
                         gpu.state.face_culling_set("FRONT" if cull_front else "BACK")
                         gpu.state.front_facing_set(caster.det < 0.0)
@@ -252,6 +256,19 @@ class ShadowAtlas:
                         stats.shadow_draws += 1
                     stats.shadow_triangles += caster.triangles
                 gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
+                strips = [c for c in casters if c.hair is not None]
+                if strips:
+                    hair = shaders.get(shadow_hair_program(self.depth_format, raster), defines)
+                    hair.bind()
+                    hair.uniform_block("tile", tile_ubo)
+                    for caster in strips:
+                        hair.uniform_float("model", caster.model)
+                        hair.uniform_float("hair_texels", 1.0 if caster.hair == "STRAND" else 0.0)
+                        for batch in caster.batches:
+                            batch.draw(hair)
+                            stats.draws += 1
+                            stats.shadow_draws += 1
+                        stats.shadow_triangles += caster.triangles
                 for caster in casters:
                     for batch, material_ubo, texture, tree in caster.cutouts:
                         if tree is not None:

@@ -134,6 +134,9 @@ def caster(d, materials, textures):
     fraction alpha of the samples (``shadow_maps.ShadowAtlas.render``)."""
     if not d.instance.shadow:
         return None
+    if d.instance.hair is not None:  # hair strips: widened toward the light (``shadow_hair_program``)
+        identity = (*d.identity, d.instance.hair)
+        return Caster([d.whole], d.model, d.det, identity, triangles=d.triangles, hair=d.instance.hair)
     mats = [(index, batch, d.material(index)) for index, batch in d.parts]
     cull = bool(mats) and all(m.cull_shadow for _i, _b, m in mats)
     # Material > Settings > Transparent Shadows off: its alpha casts as an opaque surface.

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import hair
 from .materials import material_from_blender, world_from_blender
 from .terminator import Terminator
 
@@ -40,6 +41,9 @@ class Geometry:
     uvs: np.ndarray | None = None  # (vertices, 2) float32: the UV map a material's textures read
     colors: np.ndarray | None = None  # (vertices, 4) float32 linear: a colour attribute
     tangents: np.ndarray | None = None  # (vertices, 4) float32 MikkTSpace tangent and sign; w 0: none
+    # Hair strips (``hair.strips``): (vertices, 2) float32 side (-1, 1) and radius; positions
+    # then lie on the strands' centre lines and normals are their tangents.
+    strands: np.ndarray | None = None
     closed: bool = False  # the triangles bound solids with outward normals (``closed_outward``)
     smooth: bool = False  # some faces are smooth-shaded (normals not all the faces' own)
     messages: tuple = ()
@@ -113,6 +117,7 @@ class MeshInstance:
     terminator: Terminator = Terminator()  # Object > Shading > Shadow Terminator
     color: tuple = (1.0, 1.0, 1.0, 1.0)  # Object > Viewport Display > Color (the Object Info node's)
     random: float = 0.0  # the Object Info node's Random: Blender's per-object (or per-instance) hash
+    hair: str | None = None  # hair strips (``Geometry.strands``): Render > Curves > Shape (STRAND, STRIP)
 
 
 @dataclass(frozen=True)
@@ -697,6 +702,17 @@ class SceneCache:
         geo.serial = self.built
         return geo
 
+    def _strips_for(self, key, deps, build):
+        """The hair strips kept under ``key``, built by ``build()`` on first use."""
+        geo = self.geometry.get(key)
+        if geo is None:
+            geo = build()
+            geo.deps = deps
+            self.geometry[key] = geo
+            self.built += 1
+            geo.serial = self.built
+        return geo
+
     def snapshot(self, depsgraph):
         scene = depsgraph.scene
         instances = []
@@ -744,6 +760,9 @@ class SceneCache:
             return terminators[key]
 
         messages = []
+        render = depsgraph.mode == "RENDER"
+        # Render > Curves > Shape: Strand (a pixel wide) or Strip (the strands' radius; Cylinder too).
+        strip_mode = "STRAND" if getattr(scene.render, "hair_type", "STRIP") == "STRAND" else "STRIP"
         for inst in depsgraph.object_instances:
             ob = inst.object
             if ob.type == "LIGHT":
@@ -760,16 +779,13 @@ class SceneCache:
                         light.blockers = linked(linking.blocker_collection)
                     lights.append(light)
                 continue
-            if ob.type == "CURVES":
-                messages.append(f"hair curves object '{ob.name}' is not drawn (hair is not supported)")
-                continue
             if ob.type in _NOT_DRAWN:
                 messages.append(f"{_NOT_DRAWN[ob.type]} '{ob.name}' is not drawn")
                 continue
-            if ob.type not in GEOMETRY_TYPES:
+            if ob.type not in GEOMETRY_TYPES and ob.type != "CURVES":
                 continue
-            _note_hair(ob, inst, messages)
-            if not inst.is_instance and not inst.show_self:
+            systems = hair.particle_hair(ob, render) if ob.type in GEOMETRY_TYPES else []
+            if ob.type != "CURVES" and not systems and not inst.is_instance and not inst.show_self:
                 continue  # a particle emitter with Show Emitter off for this render
             matrix = matrix_np(inst.matrix_world)
             if not np.all(np.isfinite(matrix)):
@@ -779,7 +795,53 @@ class SceneCache:
             camera, shadow = bool(orig.visible_camera), bool(orig.visible_shadow)
             if not (camera or shadow):
                 continue
-            materials = [self._material(slot.material) for slot in ob.material_slots]
+
+            def add(key, geo, materials, strip=None):
+                """The instance of ``geo`` (kept under ``key``) with ``materials``."""
+                used.add(key)
+                messages.extend(geo.messages)
+                for mat in materials:
+                    if mat is not None:
+                        messages.extend(mat.messages)
+                instances.append(
+                    MeshInstance(
+                        key=key,
+                        matrix=matrix,
+                        materials=materials,
+                        shadow=shadow,
+                        camera=camera,
+                        holdout=holdout(orig, inst),
+                        terminator=terminator(ob) if strip is None else Terminator(),
+                        color=tuple(float(c) for c in orig.color),
+                        random=object_random(orig.name, inst),
+                        names=(orig.name_full, inst.parent.original.name_full)
+                        if inst.is_instance and inst.parent is not None
+                        else (orig.name_full,),
+                        hair=strip,
+                    )
+                )
+
+            slots = [self._material(slot.material) for slot in ob.material_slots]
+            if ob.type == "CURVES":
+                key, deps = _geometry_key(inst, ob, own_data)
+                geo = self._strips_for(key, deps, lambda ob=ob: hair.geometry_from_curves(ob.data))
+                if geo.triangle_count:
+                    add(key, geo, slots, strip_mode)
+                continue
+            for psys in systems:
+                settings = psys.settings
+                key = ("PS", orig.name_full, psys.name)
+                deps = frozenset({orig.name_full, settings.original.name_full if settings.original else settings.name})
+                geo = self._strips_for(
+                    key, deps, lambda ob=ob, psys=psys: hair.geometry_from_particles(ob, psys, render)
+                )
+                index = int(settings.material) - 1  # the particle settings' material slot (1-based)
+                mat = slots[index] if 0 <= index < len(slots) else None
+                if geo.triangle_count:
+                    add(key, geo, [mat], strip_mode)
+            if not inst.is_instance and not inst.show_self:
+                continue  # a particle emitter with Show Emitter off for this render
+            materials = slots
             needs, extra = Needs.of(materials, ob.data if ob.type == "MESH" else None)
             if extra[0] or extra[1]:
                 messages.append(
@@ -793,27 +855,9 @@ class SceneCache:
             geo = self._geometry_for(inst, ob, key, deps, needs)
             if geo is None or geo.triangle_count == 0:
                 continue
-            used.add(key)
-            messages += geo.messages
-            for mat in materials:
-                if mat is not None:
-                    messages += mat.messages
-            instances.append(
-                MeshInstance(
-                    key=key,
-                    matrix=matrix,
-                    materials=materials,
-                    shadow=shadow,
-                    camera=camera,
-                    holdout=holdout(orig, inst),
-                    terminator=terminator(ob),
-                    color=tuple(float(c) for c in orig.color),
-                    random=object_random(orig.name, inst),
-                    names=(orig.name_full, inst.parent.original.name_full)
-                    if inst.is_instance and inst.parent is not None
-                    else (orig.name_full,),
-                )
-            )
+            add(key, geo, materials)
+        if any(i.hair for i in instances) and int(getattr(scene.render, "hair_subdiv", 0)) > 0:
+            messages.append("Render > Curves > Additional Subdivision is not drawn (strands keep their own points)")
         # Forget geometry no longer in the scene so its GPU buffers are freed.
         for key in [k for k in self.geometry if k not in used]:
             del self.geometry[key]
@@ -832,17 +876,6 @@ class SceneCache:
     def _take_images_changed(self):
         changed, self.images_changed = self.images_changed, set()
         return changed
-
-
-def _note_hair(ob, inst, messages):
-    if inst.is_instance:
-        return
-    for psys in getattr(ob, "particle_systems", ()):
-        settings = psys.settings
-        if settings.type == "HAIR" and settings.render_type == "PATH":
-            messages.append(
-                f"hair of particle system '{psys.name}' on '{ob.name}' is not drawn (hair is not supported)"
-            )
 
 
 def emitter_area(data, matrix):

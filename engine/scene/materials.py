@@ -331,6 +331,8 @@ def _shader(mat, node, notes, depth=0):
         return _emission_shader(node, notes)
     if idname == "ShaderNodeBsdfDiffuse":
         return _diffuse_shader(node, notes)
+    if idname in {"ShaderNodeBsdfHair", "ShaderNodeBsdfHairPrincipled"}:
+        return _hair_shader(mat, node, notes)
     if idname in {"ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic"}:
         out = Material(metallic=1.0)
         out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
@@ -559,6 +561,20 @@ def _diffuse_shader(node, notes):
     out = Material(specular=0.0, roughness=1.0)
     out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
     _normal_map(None, node, notes, out)  # a Bump, ...: named, so the compiled tree draws it
+    return out
+
+
+def _hair_shader(mat, node, notes):
+    """A Hair BSDF, or a Principled Hair BSDF given by its colour: a diffuse surface of that
+    colour (no hair lobes; named). A Principled Hair BSDF by melanin or absorption takes the
+    viewport display colour."""
+    if getattr(node, "parametrization", "COLOR") != "COLOR":
+        return _display(
+            mat, notes, f"'{node.name}' (hair, by {node.parametrization.lower()}): the viewport display colour"
+        )
+    notes.append(f"'{node.name}' (hair BSDF) is drawn as a diffuse surface of its colour")
+    out = Material(specular=0.0, roughness=1.0)
+    out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
     return out
 
 
