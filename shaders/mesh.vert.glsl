@@ -17,19 +17,19 @@ void main()
   float det = dot(m[0], cof[0]);
 #if HAIR_STRIP
   {
-    vec3 T = m * nor;
-    float tl = length(T);
-    T = (tl > 1e-20) ? T / tl : vec3(0.0, 0.0, 1.0);
+    vec3 tangent = m * nor;
+    float tl = length(tangent);
+    tangent = (tl > 1e-20) ? tangent / tl : vec3(0.0, 0.0, 1.0);
     vec3 V = (frame.is_ortho != 0) ? -frame.camera_forward : frame.camera_position - wp.xyz;
-    vec3 B = cross(V, T);
+    vec3 B = cross(V, tangent);
     float bl = length(B);
-    B = (bl > 1e-20) ? B / bl : normalize(cross(abs(T.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0), T));
+    B = (bl > 1e-20) ? B / bl : normalize(cross(abs(tangent.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0), tangent));
     float half_width = hair.y * pow(abs(det), 1.0 / 3.0);
     if (hair_pixel > 0.0) {
       half_width = hair_pixel * (frame.view_proj * wp).w;
     }
     wp.xyz += B * (hair.x * half_width);
-    v_normal = cross(T, B);
+    v_normal = cross(tangent, B);
     v_hair = vec4(B, hair.x);
   }
 #else

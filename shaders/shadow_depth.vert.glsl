@@ -9,10 +9,10 @@ void main()
      * draws curves toward the shadow view: by the strand's radius, or one map texel
      * (hair_texels > 0, Strand shape: a pixel-wide strand is a texel wide in the map). */
     mat3 m = mat3(model);
-    vec3 T = mat3(tile.view) * (m * nor);
+    vec3 tangent = mat3(tile.view) * (m * nor);
     bool ortho = tile.proj_tex[2][3] == 0.0;
     vec3 V = ortho ? vec3(0.0, 0.0, 1.0) : -view_pos.xyz;
-    vec3 B = cross(V, T);
+    vec3 B = cross(V, tangent);
     float bl = length(B);
     B = (bl > 1e-20) ? B / bl : vec3(1.0, 0.0, 0.0);
     float half_width = hair.y * pow(abs(determinant(m)), 1.0 / 3.0);
