@@ -35,7 +35,7 @@ class Draw:
     identity: tuple  # what a shadow tile's content depends on
     corners: np.ndarray  # (8, 3) world corners of the instance's bounds
     closed: bool = False  # a closed opaque surface: back faces hidden from outside its bounds
-    geometry: object = None  # the extract.Geometry drawn whole (None: drawn at a level of detail)
+    geometry: object = None  # the geometry.Geometry drawn whole (None: drawn at a level of detail)
     bounds: np.ndarray = None  # (2, 3) object-space bounds (Generated texture coordinates)
     triangles: int = 0  # triangles of what it draws
     # () -> [(material index, GPUBatch)] with the Shadow Terminator's corner data, built on

@@ -18,6 +18,8 @@ tip, shape and scale, as EEVEE's ``hair_shape_radius``.
 
 import numpy as np
 
+from .geometry import Geometry
+
 DEFAULT_RESOLUTION = 12  # Blender's resolution of a curve without the attribute
 CURVE_TYPES = {0: "CATMULL_ROM", 1: "POLY", 2: "BEZIER", 3: "NURBS"}
 
@@ -53,7 +55,6 @@ def catmull_rom(points, offsets, values, resolution):
 def strips(points, offsets, radii, curve_materials=None):
     """The strip ``Geometry`` of polylines ``points`` (P, 3) split by ``offsets`` (C + 1), with
     a radius per point (``radii``, P) and a material index per curve (``curve_materials``)."""
-    from .extract import Geometry
 
     points = np.asarray(points, np.float32)
     offsets = np.asarray(offsets, np.int64)

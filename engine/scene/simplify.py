@@ -21,6 +21,8 @@ import math
 
 import numpy as np
 
+from .geometry import Geometry
+
 MIN_LEVEL = 2  # 4 cells along the longest side: the coarsest level
 MAX_LEVEL = 12  # 4096 cells: finer ones keep nearly every triangle of real meshes
 MIN_TRIANGLES = 2048  # smaller meshes are drawn whole (their draw costs more than their triangles)
@@ -44,7 +46,7 @@ def level_for(extent, stretch, nearest_depth, footprint, pixels):
 
 
 def simplified(geo, level):
-    """``geo`` (an ``extract.Geometry``) clustered at ``level``, remembered by content; None when
+    """``geo`` (a ``geometry.Geometry``) clustered at ``level``, remembered by content; None when
     the level would keep more than WORTH of the triangles or none at all."""
     digest = getattr(geo, "_simplify_digest", None)
     if digest is None:
@@ -66,7 +68,6 @@ def simplified(geo, level):
 
 def cluster(geo, level):
     """The clustering of ``simplified`` (not remembered)."""
-    from .extract import Geometry
 
     tris = np.asarray(geo.indices, np.int64)
     if len(tris) == 0:
