@@ -506,17 +506,24 @@ def visibility(width=SIZE, height=SIZE):
     return scene
 
 
+def particle_hair(ob, count, length, radius_scale):
+    """A hair particle system of ``count`` strands ``length`` long on ``ob``, rendered as paths;
+    returns its settings."""
+    ob.modifiers.new("Hair", "PARTICLE_SYSTEM")
+    ps = ob.particle_systems[0].settings
+    ps.type = "HAIR"
+    ps.count = count
+    ps.hair_length = length
+    ps.render_type = "PATH"
+    ps.radius_scale = radius_scale
+    return ps
+
+
 def hair(width=SIZE, height=SIZE):
     scene = base(width, height)
     brown = scenes.material("Hair", (0.45, 0.25, 0.1), roughness=0.6)
     body = scenes.uv_sphere(scene, "HairBall", center=(-0.9, 0.0, 0.0), radius=0.6, mat=brown)
-    body.modifiers.new("Hair", "PARTICLE_SYSTEM")
-    ps = body.particle_systems[0].settings
-    ps.type = "HAIR"
-    ps.count = 300
-    ps.hair_length = 0.5
-    ps.render_type = "PATH"
-    ps.radius_scale = 0.02
+    particle_hair(body, 300, 0.5, 0.02)
     if hasattr(bpy.data, "hair_curves"):
         curves = bpy.data.hair_curves.new("Curves")
         side, points = 7, 5
@@ -576,13 +583,7 @@ def hair_patch(width=240, height=135, particles=True, top=False):
     scenes.link(scene, bpy.data.objects.new("Strands", curves))
     if particles:
         body = scenes.uv_sphere(scene, "HairBall", center=(-1.4, 0.6, 0.45), radius=0.35, mat=brown)
-        body.modifiers.new("Hair", "PARTICLE_SYSTEM")
-        ps = body.particle_systems[0].settings
-        ps.type = "HAIR"
-        ps.count = 200
-        ps.hair_length = 0.3
-        ps.render_type = "PATH"
-        ps.radius_scale = 0.01
+        ps = particle_hair(body, 200, 0.3, 0.01)
         ps.child_type = "INTERPOLATED"
         ps.child_percent = 5
         ps.rendered_child_count = 5

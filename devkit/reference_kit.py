@@ -655,6 +655,18 @@ def cache_path(name, samples, width, height, cache_dir=DEFAULT_CACHE):
     return Path(cache_dir) / key
 
 
+def save_npy(path, array):
+    """Save ``array`` to ``path`` (.npy), its folder made: written then renamed, so a
+    concurrent reader never sees half a file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".npy", dir=path.parent)
+    with os.fdopen(fd, "wb") as f:
+        np.save(f, array)
+    os.chmod(tmp, 0o644)  # mkstemp creates files readable by their owner only
+    os.replace(tmp, path)
+
+
 def cycles_reference(name, samples=512, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT, cache_dir=DEFAULT_CACHE):
     """Cycles visibility of reference scene ``name`` at ``samples`` spp, from the cache when
     present; otherwise rendered (this rebuilds the current scene) and cached. THIN_SCENES are
@@ -667,13 +679,7 @@ def cycles_reference(name, samples=512, width=DEFAULT_WIDTH, height=DEFAULT_HEIG
     scene = build(name, width, height)
     extra = matched_filter(scene) if name in THIN_SCENES else {}
     vis = measure_visibility(scene, "CYCLES", samples=samples, **extra)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    # Write then rename, so a concurrent reader never sees half a file.
-    fd, tmp = tempfile.mkstemp(suffix=".npy", dir=path.parent)
-    with os.fdopen(fd, "wb") as f:
-        np.save(f, vis)
-    os.chmod(tmp, 0o644)  # mkstemp creates files readable by their owner only
-    os.replace(tmp, path)
+    save_npy(path, vis)
     return vis
 
 
@@ -686,12 +692,7 @@ def cycles_luminance(name, samples=512, width=DEFAULT_WIDTH, height=DEFAULT_HEIG
     scene = build(name, width, height)
     configure(scene, "CYCLES", samples=samples)
     lum = render_luminance(scene)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".npy", dir=path.parent)
-    with os.fdopen(fd, "wb") as f:
-        np.save(f, lum)
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, path)
+    save_npy(path, lum)
     return lum
 
 

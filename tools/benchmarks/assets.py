@@ -28,6 +28,7 @@ import bpy
 import numpy as np
 
 from devkit import assets, engines, report, session, timing
+from devkit import reference_kit as kit
 from devkit.render import render
 from devkit.session import ROOT
 
@@ -105,12 +106,7 @@ def reference(name, spp, cache_dir=CACHE):
     engines.configure(scene, "CYCLES", **dict(SETTINGS["CYCLES"], samples=spp))
     with session.stdout_to_stderr():
         image = display(render(scene)["Combined"][::-1])
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".npy", dir=path.parent)
-    with os.fdopen(fd, "wb") as f:
-        np.save(f, image)
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, path)
+    kit.save_npy(path, image)
     return image
 
 
