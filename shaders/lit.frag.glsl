@@ -55,14 +55,16 @@ struct Surface {
 #if TERMINATOR_OFFSET
   vec3 smooth_offset; /* from the flat triangle to the smooth surface (world) */
 #endif
-  vec3 albedo, f0;
+  vec3 albedo;
+  vec4 f0; /* rgb: reflectance at normal incidence, a: at grazing (Schlick's f90) */
   float shininess;
   float alpha; /* GGX roughness (Principled roughness squared) */
 #if NODE_LOBES == 2
   /* The second lobe (N, albedo, f0, shininess, alpha above are the first), and the lobes'
    * weights. */
   vec3 N_b;
-  vec3 albedo_b, f0_b;
+  vec3 albedo_b;
+  vec4 f0_b;
   float shininess_b, alpha_b;
   vec2 w;
 #endif
@@ -115,7 +117,7 @@ float cosine_term(float NdotL)
 
 /* One lobe's BSDF for light from ``to_light`` (N.L > 0): its diffuse and specular parts, each
  * scaled by the light's factors. */
-vec3 lobe_brdf(vec3 N, vec3 V, vec3 albedo, vec3 f0, float shininess, float alpha, vec3 to_light, float NdotL,
+vec3 lobe_brdf(vec3 N, vec3 V, vec3 albedo, vec4 f0, float shininess, float alpha, vec3 to_light, float NdotL,
                LightData L)
 {
 #if SPECULAR_MODEL == SPECULAR_GGX
@@ -130,10 +132,8 @@ vec3 lobe_brdf(vec3 N, vec3 V, vec3 albedo, vec3 f0, float shininess, float alph
   float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
   float Vis = 0.5 / max(gv + gl, 1e-8);
   float fw = pow(clamp(1.0 - dot(to_light, H), 0.0, 1.0), 5.0);
-  /* Schlick Fresnel towards f90; a surface without specular (f0 ~ 0) has none at grazing
-   * angles either, as the Principled BSDF at Specular 0. */
-  float f90 = clamp(50.0 * dot(f0, vec3(0.3333)), 0.0, 1.0);
-  vec3 spec = (f0 + (f90 - f0) * fw) * (D * Vis);
+  /* Schlick Fresnel from f0.rgb towards f90 (f0.a: lobe_setup). */
+  vec3 spec = (f0.rgb + (f0.a - f0.rgb) * fw) * (D * Vis);
   return albedo / M_PI * L.diffuse_factor + spec * L.specular_factor;
 #else
 #  if SPECULAR_MODEL == SPECULAR_BLINN
@@ -143,7 +143,7 @@ vec3 lobe_brdf(vec3 N, vec3 V, vec3 albedo, vec3 f0, float shininess, float alph
   vec3 R = reflect(-to_light, N);
   float spec = (shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, V), 0.0), shininess);
 #  endif
-  return albedo / M_PI * L.diffuse_factor + f0 * spec * L.specular_factor;
+  return albedo / M_PI * L.diffuse_factor + f0.rgb * spec * L.specular_factor;
 #endif
 }
 
@@ -346,15 +346,15 @@ vec3 world_sh(vec3 d, vec2 g)
 }
 
 /* The split-sum environment BRDF (scale and bias of f0), an analytic fit (Karis, "Physically
- * based shading on mobile"); a surface without specular (f0 ~ 0) gets no Fresnel rim. */
-vec2 env_brdf(vec3 f0, float rough, float NdotV)
+ * based shading on mobile"); the bias (the Fresnel rim) scaled by f90. */
+vec2 env_brdf(float f90, float rough, float NdotV)
 {
   vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
   vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
   vec4 r = rough * c0 + c1;
   float a004 = min(r.x * r.x, exp2(-9.28 * NdotV)) * r.x + r.y;
   vec2 ab = vec2(-1.04, 1.04) * a004 + r.zw;
-  ab.y *= clamp(50.0 * dot(f0, vec3(0.3333)), 0.0, 1.0);
+  ab.y *= f90;
   return ab;
 }
 
@@ -371,14 +371,20 @@ vec3 world_light(vec3 N, vec3 V, vec3 albedo, vec3 f0, float rough, vec2 ab)
 
 /* One lobe's shading values from its Principled parameters (``albedo`` with the specular
  * layer's energy taken out), and the light the world gives it. */
-vec3 lobe_setup(vec3 base, float rough, float metal, float spec_level, vec3 N, vec3 V, out vec3 albedo,
-                out vec3 f0, out float shininess, out float alpha)
+vec3 lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, out vec3 albedo, out vec4 f0,
+                out float shininess, out float alpha)
 {
   rough = clamp(rough, 0.0, 1.0);
-  spec_level = max(spec_level, 0.0);
+  /* The dielectric's F0 (rgb, tinted) and untinted f0 (a): from IOR, Specular IOR Level and
+   * Specular Tint (node_principled_f0; materials.dielectric_f0 for a read material). */
+  spec = max(spec, vec4(0.0));
   metal = clamp(metal, 0.0, 1.0);
   albedo = base * (1.0 - metal);
-  f0 = mix(vec3(0.08 * spec_level), base, metal);
+  /* Schlick's f90: 1, but a surface without specular (f0 ~ 0) has no Fresnel rim either, as
+   * the Principled BSDF at IOR 1 or Specular IOR Level 0 (the tint does not change it: F90 is
+   * white in Blender's generalized Schlick). */
+  float f90 = clamp(50.0 * mix(spec.a, dot(base, vec3(0.3333)), metal), 0.0, 1.0);
+  f0 = vec4(mix(spec.rgb, base, metal), f90);
   float a = max(rough * rough, 0.02);
   shininess = 2.0 / (a * a) - 2.0;
   alpha = max(rough * rough, 0.002);
@@ -386,13 +392,12 @@ vec3 lobe_setup(vec3 base, float rough, float metal, float spec_level, vec3 N, v
   /* Energy: light reflected by the specular layer does not reach the diffuse one below (the
    * Principled BSDF's layering), estimated per pixel from the directional albedo. */
   float NdotV = max(dot(N, V), 1e-4);
-  vec2 ab = env_brdf(f0, rough, NdotV);
-  /* Metallic mixes a metal and a dielectric; only the dielectric's own specular (f0 from the
-   * Specular level) sits over its diffuse. */
-  float f0_dielectric = 0.08 * spec_level;
-  vec2 ab_dielectric = env_brdf(vec3(f0_dielectric), rough, NdotV);
-  albedo *= clamp(1.0 - (f0_dielectric * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
-  return world_light(N, V, albedo, f0, rough, ab);
+  vec2 ab = env_brdf(f90, rough, NdotV);
+  /* Metallic mixes a metal and a dielectric; only the dielectric's own specular sits over its
+   * diffuse, per channel (a tinted specular takes its own colour out of the diffuse). */
+  vec2 ab_dielectric = env_brdf(clamp(50.0 * spec.a, 0.0, 1.0), rough, NdotV);
+  albedo *= clamp(1.0 - (spec.rgb * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
+  return world_light(N, V, albedo, f0.rgb, rough, ab);
 }
 
 void main()
@@ -403,12 +408,13 @@ void main()
   float metal = material.metallic;
   float coverage = material.alpha;
   vec3 emission = material.emission;
-  float spec_level = material.specular;
+  vec4 spec_f0 = material.specular; /* the dielectric's F0 (lobe_setup) */
   vec3 tree_normal = vec3(0.0); /* the tree's shading normal (NODE_NORMAL) */
 #if NODE_LOBES == 2
   /* The second lobe's parameters and the lobes' weights (shaders/nodes/shader.glsl). */
   vec4 base_b = base;
-  float rough_b = rough, metal_b = metal, spec_level_b = spec_level;
+  float rough_b = rough, metal_b = metal;
+  vec4 spec_f0_b = spec_f0;
   vec3 tree_normal_b = vec3(0.0);
   vec2 lobe_weights = vec2(1.0, 0.0);
 #endif
@@ -421,11 +427,11 @@ void main()
     Nt = (l > 1e-20) ? Nt / l : vec3(0.0, 0.0, 1.0);
     bool front = dot(Nt, V) >= 0.0;
 #  if NODE_LOBES == 2
-    node_closure_resolve_lobes(node_tree_closure(front ? Nt : -Nt, V, front), base, rough, metal, spec_level,
-                               coverage, emission, tree_normal, base_b, rough_b, metal_b, spec_level_b, tree_normal_b,
+    node_closure_resolve_lobes(node_tree_closure(front ? Nt : -Nt, V, front), base, rough, metal, spec_f0,
+                               coverage, emission, tree_normal, base_b, rough_b, metal_b, spec_f0_b, tree_normal_b,
                                lobe_weights);
 #  else
-    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec_level, coverage, emission, tree_normal);
+    node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec_f0, coverage, emission, tree_normal);
 #  endif
   }
 #endif
@@ -534,7 +540,7 @@ void main()
     N = -N; /* two-sided, as Blender draws meshes */
   }
   s.N = N;
-  vec3 color = lobe_setup(base.rgb, rough, metal, spec_level, s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha);
+  vec3 color = lobe_setup(base.rgb, rough, metal, spec_f0, s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha);
 #if NODE_LOBES == 2
   /* The second lobe: its own normal where the tree gives one, else the first lobe's. */
 #  if NODE_NORMAL
@@ -543,7 +549,7 @@ void main()
   vec3 N_b = N;
 #  endif
   s.N_b = (dot(N_b, s.V) < 0.0) ? -N_b : N_b;
-  vec3 color_b = lobe_setup(base_b.rgb, rough_b, metal_b, spec_level_b, s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b,
+  vec3 color_b = lobe_setup(base_b.rgb, rough_b, metal_b, spec_f0_b, s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b,
                             s.alpha_b);
   s.w = lobe_weights;
   color = lobe_weights.x * color + lobe_weights.y * color_b;

@@ -16,7 +16,8 @@ void main()
     vec3 Nt = (l > 1e-20) ? v_normal / l : V;
     bool front = dot(Nt, V) >= 0.0;
     vec4 base = vec4(0.8, 0.8, 0.8, 1.0);
-    float rough = 0.5, metal = 0.0, spec = 0.5;
+    float rough = 0.5, metal = 0.0;
+    vec4 spec = vec4(0.04);
     vec3 emission = vec3(0.0), normal = vec3(0.0);
     node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec, coverage, emission, normal);
   }

@@ -30,7 +30,7 @@ class MaterialBlocks:
             "emission": tuple(mat.emission)[:3],
             "roughness": float(mat.roughness),
             "metallic": float(mat.metallic),
-            "specular": float(mat.specular),
+            "specular": tuple(mat.f0),
             "alpha": float(mat.alpha),
             "normal_strength": float(mat.normal_strength),
         }

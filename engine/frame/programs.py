@@ -121,10 +121,10 @@ MATERIAL_STRUCT = Struct(
     "MaterialData",
     (
         ("VEC4", "base_color"),
+        ("VEC4", "specular"),  # the dielectric's F0: rgb tinted, a untinted (materials.dielectric_f0)
         ("VEC3", "emission"),
         ("FLOAT", "roughness"),
         ("FLOAT", "metallic"),
-        ("FLOAT", "specular"),
         ("FLOAT", "alpha"),
         ("FLOAT", "normal_strength"),
         *(f for c in CHANNELS for f in (("VEC4", f"{c}_uv_u"), ("VEC4", f"{c}_uv_v"), ("IVEC4", f"{c}_mode"))),

@@ -1,7 +1,7 @@
 """Materials and the world as Penumbra draws them, read from Blender's node trees.
 
 A Principled BSDF is read through Blender's own ``PrincipledBSDFWrapper`` (the reader its
-importers and exporters use): base colour, roughness, metallic, specular level, alpha,
+importers and exporters use): base colour, roughness, metallic, IOR, specular level and tint, alpha,
 emission colour and strength, and the normal map, each as a value or an image texture with
 its UV map and Mapping node. Besides what the wrapper follows, an input may come from a
 Color Attribute / Attribute node (vertex colours), an RGB or Value node, or through reroutes.
@@ -47,7 +47,9 @@ class TextureRef:
 class Material:
     base_color: tuple = (0.8, 0.8, 0.8, 1.0)
     roughness: float = 0.5
-    specular: float = 0.5
+    specular: float = 0.5  # Specular IOR Level
+    ior: float = 1.5
+    specular_tint: tuple = (1.0, 1.0, 1.0)
     metallic: float = 0.0
     alpha: float = 1.0
     emission: tuple = (0.0, 0.0, 0.0)  # colour * strength
@@ -61,6 +63,11 @@ class Material:
     transparent_shadow: bool = True  # Settings > Transparent Shadows: off, alpha casts as opaque
     messages: tuple = ()  # what could not be read, for the render report and the panel
     tree: object = None  # nodetree.CompiledTree: the node tree drawn as generated GLSL
+
+    @property
+    def f0(self):
+        """The dielectric's reflectance at normal incidence (``dielectric_f0``)."""
+        return dielectric_f0(self.ior, self.specular, self.specular_tint)
 
     @property
     def uv_maps(self):
@@ -94,6 +101,17 @@ class Material:
             if self.tree.lobes == 2:
                 out.add("TREE_LOBES")
         return frozenset(out)
+
+
+def dielectric_f0(ior, level, tint=(1.0, 1.0, 1.0)):
+    """The Principled BSDF's dielectric reflectance at normal incidence, as Blender's (Cycles'
+    principled closure, EEVEE's principled GLSL): f0 = ((ior - 1) / (ior + 1))^2, times
+    2 x Specular IOR Level, times Specular Tint, clamped to [0, 1] per channel -> (r, g, b,
+    the untinted f0). The GLSL twin is ``node_principled_f0`` (shaders/nodes/shader.glsl)."""
+    ior = max(float(ior), 0.0) if math.isfinite(float(ior)) else 1.5
+    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2 * 2.0 * max(float(level), 0.0)
+    rgb = tuple(min(max(f0 * max(float(t), 0.0), 0.0), 1.0) for t in tuple(tint)[:3])
+    return (*rgb, min(max(f0, 0.0), 1.0))
 
 
 # --- reading ------------------------------------------------------------------------------
@@ -353,7 +371,7 @@ def _shader(mat, node, notes, depth=0):
     return None
 
 
-_MIXED = ("roughness", "specular", "metallic", "alpha", "normal_strength")
+_MIXED = ("roughness", "specular", "metallic", "alpha", "normal_strength")  # and ior, tint: the reflecting side's
 
 
 def _mix_shader(mat, node, notes, depth):
@@ -387,6 +405,9 @@ def _mix_shader(mat, node, notes, depth):
     ta = wa / total if total > 0.0 else 0.5
     for name in _MIXED:
         setattr(out, name, ta * getattr(a, name) + (1.0 - ta) * getattr(b, name))
+    # The level is mixed (f0 scales with it); IOR and tint are the more reflecting side's.
+    reflecting = a if ta * a.specular >= (1.0 - ta) * b.specular else b
+    out.ior, out.specular_tint = reflecting.ior, reflecting.specular_tint
     # Keep the mixed diffuse albedo (what the eye reads as the colour): base * (1 - metallic).
     albedo = ta * np.array(a.base_color[:3]) * (1.0 - a.metallic) + (1.0 - ta) * np.array(b.base_color[:3]) * (
         1.0 - b.metallic
@@ -506,6 +527,13 @@ def _principled(mat, node, notes):
     out.metallic = _value_channel(inputs["Metallic"], notes, "Metallic", out, "metallic", float(mat.metallic))
     spec_name = "Specular IOR Level" if "Specular IOR Level" in inputs else "Specular"
     out.specular = _value_channel(inputs[spec_name], notes, spec_name, out, None, 0.5)
+    if "IOR" in inputs:
+        out.ior = _value_channel(inputs["IOR"], notes, "IOR", out, None, 1.5)
+    tint = inputs.get("Specular Tint")
+    if tint is not None and hasattr(tint.default_value, "__len__"):  # a colour since Blender 4.0
+        if _source(tint)[0] is not None:
+            notes.append("a linked Specular Tint (its own value is used)")
+        out.specular_tint = tuple(float(v) for v in tint.default_value[:3])
     alpha = _value_channel(inputs["Alpha"], notes, "Alpha", out, "alpha", 1.0)
     out.alpha = alpha
     emit_name = "Emission Color" if "Emission Color" in inputs else "Emission"

@@ -6,7 +6,7 @@ function of our own (``shaders/nodes/<family>.glsl``, every one with a numpy twi
 ``devkit/node_reference.py``). The result (``CompiledTree``) is plain data: the code of
 
     void node_tree(vec3 N, vec3 V, bool front, inout vec4 base, inout float roughness,
-                   inout float metallic, inout float specular, inout float alpha,
+                   inout float metallic, inout vec4 specular, inout float alpha,
                    inout vec3 emission, inout vec3 normal)
 
 which the lit pass calls where it reads the material (``shaders/lit.frag.glsl``, under
@@ -498,7 +498,8 @@ class Compiler:
         base = self.const(tuple(m.diffuse_color), "vec4")
         r = self.const(float(m.roughness), "float")
         metal = self.const(float(m.metallic), "float")
-        return Value(f"node_principled({base.expr}, {metal.expr}, {r.expr}, 0.5, 1.0, vec3(0.0), N)", "closure", 1)
+        spec = "vec4(0.04)"  # Specular IOR Level 0.5 at IOR 1.5
+        return Value(f"node_principled({base.expr}, {metal.expr}, {r.expr}, {spec}, 1.0, vec3(0.0), N)", "closure", 1)
 
     # -- the whole tree --
 
@@ -507,7 +508,7 @@ class Compiler:
         body = "\n".join(self.lines)
         signature = (
             "void node_tree(vec3 N, vec3 V, bool front, inout vec4 base, inout float roughness,\n"
-            "               inout float metallic, inout float specular, inout float alpha, inout vec3 emission,\n"
+            "               inout float metallic, inout vec4 specular, inout float alpha, inout vec3 emission,\n"
             "               inout vec3 normal)\n"
         )
         if v.lobes < 2:
@@ -616,7 +617,14 @@ def _principled(c, node, socket, ctx):
     base = c.shader_input(node, "Base Color", ctx, "vec4", tuple(m.diffuse_color))
     metal = c.shader_input(node, "Metallic", ctx, "float", float(m.metallic))
     rough = c.shader_input(node, "Roughness", ctx, "float", float(m.roughness))
-    spec = c.shader_input(node, _first(node, "Specular IOR Level", "Specular"), ctx, "float", 0.5)
+    level = c.shader_input(node, _first(node, "Specular IOR Level", "Specular"), ctx, "float", 0.5)
+    ior = c.shader_input(node, "IOR", ctx, "float", 1.5) if _first(node, "IOR") else Value("1.5", "float")
+    tint_socket = _socket(node.inputs, "Specular Tint") if _first(node, "Specular Tint") else None
+    if tint_socket is not None and hasattr(tint_socket.default_value, "__len__"):  # a colour since 4.0
+        tint = c.shader_input(node, "Specular Tint", ctx, "vec4", (1.0, 1.0, 1.0, 1.0))
+    else:
+        tint = Value("vec4(1.0)", "vec4")
+    spec = c.temp("vec4", f"node_principled_f0({ior.expr}, {level.expr}, {tint.expr})")
     alpha_socket = _socket(node.inputs, "Alpha")
     if _link(alpha_socket) is not None or float(alpha_socket.default_value) < 1.0:
         c.transparent = True
@@ -653,7 +661,7 @@ def _glossy(c, node, socket, ctx):
     color = c.shader_input(node, "Color", ctx, "vec4")
     rough = c.shader_input(node, "Roughness", ctx, "float")
     normal = c.normal_input(node, ctx)
-    expr = f"node_principled({color.expr}, 1.0, {rough.expr}, 0.5, 1.0, vec3(0.0), {normal.expr})"
+    expr = f"node_principled({color.expr}, 1.0, {rough.expr}, vec4(0.04), 1.0, vec3(0.0), {normal.expr})"
     return c.temp("closure", expr, 1)
 
 
@@ -1221,23 +1229,17 @@ def _image(c, node, socket, ctx):
 
 
 # Principled BSDF inputs Penumbra does not draw, named when they would change the surface: a
-# weight above 0, a Specular Tint other than white, or any of them linked.
+# weight above 0, or any of them linked. (IOR, Specular IOR Level and Specular Tint are drawn:
+# node_principled_f0.)
 PRINCIPLED_UNREAD = ("Transmission Weight", "Transmission", "Coat Weight", "Sheen Weight", "Subsurface Weight")
 
 
 def principled_unread(node):
     """Names of the inputs of Principled BSDF ``node`` that change its surface and are not
-    drawn (``PRINCIPLED_UNREAD``, and Specular Tint: glTF's specular-glossiness import drives
-    it with a texture)."""
+    drawn (``PRINCIPLED_UNREAD``)."""
     out = []
     for name in PRINCIPLED_UNREAD:
         sock = node.inputs.get(name)
         if sock is not None and (sock.is_linked or float(sock.default_value) > 0.0):
             out.append(name)
-    tint = node.inputs.get("Specular Tint")
-    if tint is not None:
-        value = tint.default_value
-        white = all(float(v) == 1.0 for v in value[:3]) if hasattr(value, "__len__") else float(value) == 0.0
-        if tint.is_linked or not white:
-            out.append("Specular Tint")
     return out

@@ -2,6 +2,8 @@
  * lobes, each the Principled parameters Penumbra shades with as sums weighted by how much of
  * that surface there is, plus the coverage and emission the lobes share:
  *   lobe a, lobe b   color, roughness, metallic, specular, normal: each x ``weight``
+ *                    (specular: the dielectric's F0 from IOR, Specular IOR Level and
+ *                    Specular Tint as rgb, untinted as a: node_principled_f0)
  *                    (a Transparent BSDF or an Emission adds no lobe)
  *   alpha            coverage (Transparent adds 0, every other shader 1 x its alpha)
  *   emission         weighted by coverage
@@ -23,7 +25,7 @@ struct NodeLobe {
   vec3 color;
   float roughness;
   float metallic;
-  float specular;
+  vec4 specular;
   float weight;
   vec3 normal;
 };
@@ -37,7 +39,7 @@ struct NodeClosure {
 
 NodeLobe node_lobe_empty()
 {
-  return NodeLobe(vec3(0.0), 0.0, 0.0, 0.0, 0.0, vec3(0.0));
+  return NodeLobe(vec3(0.0), 0.0, 0.0, vec4(0.0), 0.0, vec3(0.0));
 }
 
 NodeClosure node_closure_empty()
@@ -45,7 +47,22 @@ NodeClosure node_closure_empty()
   return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0));
 }
 
-NodeClosure node_principled(vec4 base, float metallic, float roughness, float specular, float alpha,
+/* The Principled BSDF's dielectric reflectance at normal incidence, as Blender's (Cycles'
+ * principled closure, EEVEE's gpu_shader_material_principled.glsl): f0 from the IOR,
+ * ((ior - 1) / (ior + 1))^2, scaled by 2 x Specular IOR Level (0.5 leaves it), times Specular
+ * Tint, clamped to [0, 1] per channel (rgb); a: the untinted f0 (what decides whether the
+ * surface has a Fresnel rim at all: Blender's F90 is 1 unless the IOR comes to 1). */
+vec4 node_principled_f0(float ior, float level, vec4 tint)
+{
+  ior = isnan(ior) ? 1.5 : max(ior, 0.0);
+  float r = (ior - 1.0) / (ior + 1.0);
+  float f0 = r * r * 2.0 * max(isnan(level) ? 0.0 : level, 0.0);
+  vec3 tinted = clamp(f0 * max(tint.rgb, vec3(0.0)), 0.0, 1.0);
+  return vec4(isnan(tinted.r) ? 0.0 : tinted.r, isnan(tinted.g) ? 0.0 : tinted.g, isnan(tinted.b) ? 0.0 : tinted.b,
+              clamp(f0, 0.0, 1.0));
+}
+
+NodeClosure node_principled(vec4 base, float metallic, float roughness, vec4 specular, float alpha,
                             vec3 emission, vec3 normal)
 {
   float a = clamp(alpha, 0.0, 1.0);
@@ -60,7 +77,7 @@ NodeClosure node_emission(vec4 color, float strength)
 
 NodeClosure node_diffuse(vec4 color, vec3 normal)
 {
-  return NodeClosure(NodeLobe(color.rgb, 1.0, 0.0, 0.0, 1.0, normal), node_lobe_empty(), 1.0, vec3(0.0));
+  return NodeClosure(NodeLobe(color.rgb, 1.0, 0.0, vec4(0.0), 1.0, normal), node_lobe_empty(), 1.0, vec3(0.0));
 }
 
 NodeClosure node_transparent()
@@ -127,8 +144,10 @@ float node_lobe_distance(NodeLobe x, NodeLobe y)
   float nx = length(x.normal), ny = length(y.normal);
   float bend = (nx > 1e-12 && ny > 1e-12) ? 0.5 * (1.0 - dot(x.normal, y.normal) / (nx * ny)) : 0.0;
   vec3 dc = abs(x.color * ix - y.color * iy);
+  /* F0 counts as Specular IOR Level would (0.08 per unit of level at IOR 1.5). */
+  vec3 ds = abs(x.specular.rgb * ix - y.specular.rgb * iy) * 12.5;
   float d = abs(x.roughness * ix - y.roughness * iy) + abs(x.metallic * ix - y.metallic * iy) +
-            abs(x.specular * ix - y.specular * iy) + (dc.r + dc.g + dc.b) / 3.0 + bend;
+            (ds.r + ds.g + ds.b) / 3.0 + (dc.r + dc.g + dc.b) / 3.0 + bend;
   return isnan(d) ? 0.0 : d;
 }
 
@@ -207,21 +226,21 @@ vec3 node_finite3(vec3 v, float limit)
  * and specular (a surface with no reflecting part: black, rough, no specular); NaN or
  * infinite inputs (a division the tree did, an absurd constant) draw finite. */
 void node_lobe_resolve(NodeLobe c, float coverage, inout vec4 base, inout float roughness, inout float metallic,
-                       inout float specular, inout vec3 normal)
+                       inout vec4 specular, inout vec3 normal)
 {
   float nl = length(c.normal);
   normal = (nl > 1e-12 && !isinf(nl)) ? c.normal / nl : normal;
   float inv = (coverage > 1e-6) ? 1.0 / coverage : 0.0;
   float winv = (c.weight > 1e-6) ? 1.0 / c.weight : 0.0;
   base = vec4(node_finite3(c.color * inv, 1e6), 1.0);
-  specular = node_finite3(vec3(c.specular * inv), 1e6).x;
+  specular = vec4(node_finite3(c.specular.rgb * inv, 1e6), node_finite3(vec3(c.specular.a * inv), 1e6).x);
   roughness = node_finite3(vec3((c.weight > 1e-6) ? c.roughness * winv : 1.0), 1.0).x;
   metallic = node_finite3(vec3(c.metallic * winv), 1.0).x;
 }
 
 /* One set of parameters: the lobes summed. */
 void node_closure_resolve(NodeClosure c, inout vec4 base, inout float roughness, inout float metallic,
-                          inout float specular, inout float alpha, inout vec3 emission, inout vec3 normal)
+                          inout vec4 specular, inout float alpha, inout vec3 emission, inout vec3 normal)
 {
   float coverage = clamp(c.alpha, 0.0, 1.0);
   node_lobe_resolve(node_lobe_sum(c.a, c.b), coverage, base, roughness, metallic, specular, normal);
@@ -234,9 +253,9 @@ void node_closure_resolve(NodeClosure c, inout vec4 base, inout float roughness,
  * coverage (the lit pass's colour is the lobes' shading summed by these; an Add Shader's
  * lobes may sum above 1, as in Blender). */
 void node_closure_resolve_lobes(NodeClosure c, inout vec4 base, inout float roughness, inout float metallic,
-                                inout float specular, inout float alpha, inout vec3 emission, inout vec3 normal,
+                                inout vec4 specular, inout float alpha, inout vec3 emission, inout vec3 normal,
                                 inout vec4 base_b, inout float roughness_b, inout float metallic_b,
-                                inout float specular_b, inout vec3 normal_b, out vec2 weights)
+                                inout vec4 specular_b, inout vec3 normal_b, out vec2 weights)
 {
   float coverage = clamp(c.alpha, 0.0, 1.0);
   node_lobe_resolve(c.a, c.a.weight, base, roughness, metallic, specular, normal);
