@@ -774,6 +774,10 @@ class SceneCache:
                 for mat in materials:
                     if mat is not None:
                         messages.extend(mat.messages)
+                if strip is not None and shadow and any(m is not None and m.uses_alpha for m in materials):
+                    messages.append(
+                        f"hair of '{ob.name}': its material's alpha is not drawn in shadows (strands cast solid)"
+                    )
                 instances.append(
                     MeshInstance(
                         key=key,

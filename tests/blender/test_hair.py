@@ -171,3 +171,20 @@ def test_strips_and_catmull_rom(penumbra):
     assert geo.ranges == [(0, 0, 2), (1, 2, 6)]
     np.testing.assert_allclose(geo.bounds, [[-0.1, -0.1, -0.1], [6.1, 5.1, 5.1]], atol=1e-6)
     assert set(geo.strands[:, 0]) == {-1.0, 1.0}
+
+
+def test_hair_with_alpha_names_its_solid_shadow(penumbra, capfd):
+    """Strands whose material has alpha cast solid shadows (the strips' shadow program has no
+    alpha): the render report says so, once; opaque strands say nothing of it."""
+
+    def translucent(scene):
+        mat = scene.objects["Strands"].data.materials[0]
+        bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+        bsdf.inputs["Alpha"].default_value = 0.5
+
+    capfd.readouterr()
+    _render("PENUMBRA", samples=1, particles=False, top=True)
+    assert "alpha is not drawn in shadows" not in capfd.readouterr().out
+    _render("PENUMBRA", samples=1, particles=False, top=True, edit=translucent)
+    out = capfd.readouterr().out
+    assert out.count("hair of 'Strands': its material's alpha is not drawn in shadows") == 1, out[-2000:]
