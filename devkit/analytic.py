@@ -67,3 +67,82 @@ def iou(a, b):
     b = np.asarray(b, bool)
     union = (a | b).sum()
     return float((a & b).sum() / union) if union else 1.0
+
+
+# Blender's Principled BSDF (Cycles), dielectric: GGX with height-correlated Smith masking-
+# shadowing, the exact dielectric Fresnel, multiple scattering as microfacet_ggx_preserve_energy
+# adds it and the diffuse weighted by 1 - the specular's albedo (closure_layering_weight).
+
+
+def fresnel_dielectric(c, eta=1.5):
+    c = np.abs(c)
+    g = np.sqrt(np.maximum(eta * eta - 1.0 + c * c, 0.0))
+    a = (g - c) / (g + c)
+    b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0)
+    return 0.5 * a * a * (1.0 + b * b)
+
+
+def fresnel_shape(c, eta=1.5):
+    """s: the real Fresnel remapped from F0 to 1 (0 at normal incidence, 1 at grazing)."""
+    f0 = ((eta - 1.0) / (eta + 1.0)) ** 2
+    return (fresnel_dielectric(c, eta) - f0) / (1.0 - f0)
+
+
+def smith_lambda(a2, mu):
+    return 0.5 * (np.sqrt(1.0 + a2 * np.maximum(1.0 / (mu * mu) - 1.0, 0.0)) - 1.0)
+
+
+def ggx_albedo(rough, mu, fresnel, n_theta=1024, n_phi=256):
+    """int f(v, l) cos(l) dl of the GGX lobe with Fresnel ``fresnel(h.v)`` at N.V = ``mu``."""
+    a = max(rough * rough, 1e-3)
+    a2 = a * a
+    u1 = (np.arange(n_theta) + 0.5) / n_theta
+    u2 = (np.arange(n_phi) + 0.5) / n_phi
+    U1, U2 = np.meshgrid(u1, u2, indexing="ij")
+    theta = np.arctan(a * np.sqrt(U1 / (1.0 - U1)))
+    phi = 2.0 * np.pi * U2
+    h = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)
+    v = np.array([np.sqrt(1.0 - mu * mu), 0.0, mu])
+    hv = h @ v
+    mul = (2.0 * hv[..., None] * h - v)[..., 2]
+    ok = (mul > 0.0) & (hv > 0.0)
+    g2 = 1.0 / (1.0 + smith_lambda(a2, mu) + smith_lambda(a2, np.maximum(mul, 1e-9)))
+    # f cos(l) dl = F D G2 (h.v) / mu dh; the samples' density is D cos(h).
+    return float(np.where(ok, fresnel(hv) * g2 * hv / (mu * h[..., 2]), 0.0).mean())
+
+
+def principled_dielectric(base, rough, v, to_light, ior=1.5):
+    """(diffuse, specular) reflectance f cos(theta_l) of Blender's Principled BSDF (metallic 0,
+    Specular IOR Level 0.5, so F0 = F0(ior)) for unit view ``v`` and light ``to_light`` directions about
+    the normal +z, as Cycles evaluates it."""
+    v, w = np.asarray(v, float), np.asarray(to_light, float)
+    mu_v, mu_l = v[2], w[2]
+    if mu_l <= 0.0:
+        return 0.0, 0.0
+    a2 = max(rough * rough, 1e-3) ** 2
+    one = np.ones_like
+    e = ggx_albedo(rough, mu_v, one)
+    mus = (np.arange(64) + 0.5) / 64
+    e_avg = 2.0 * np.mean([ggx_albedo(rough, m, one, 256, 64) * m for m in mus])
+    f_ss = 2.0 * np.mean(fresnel_dielectric(mus, ior) * mus)
+    f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg))
+    ms = 1.0 + f_ms * (1.0 - e) / e
+    albedo = ggx_albedo(rough, mu_v, lambda c: fresnel_dielectric(c, ior)) * ms
+    h = (v + w) / np.linalg.norm(v + w)
+    d = a2 / (np.pi * (h[2] ** 2 * (a2 - 1.0) + 1.0) ** 2)
+    g2 = 1.0 / (1.0 + smith_lambda(a2, mu_v) + smith_lambda(a2, mu_l))
+    spec = fresnel_dielectric(np.dot(h, w), ior) * d * g2 / (4.0 * mu_v * mu_l) * ms
+    return float((1.0 - albedo) * base / np.pi * mu_l), float(spec * mu_l)
+
+
+def principled_dielectric_albedo(base, rough, mu_v, ior=1.5):
+    """What the Principled dielectric reflects of a uniform world of radiance 1 seen at N.V =
+    ``mu_v``: its diffuse (1 - A) base plus its specular's albedo A (multiple scattering in)."""
+    one = np.ones_like
+    e = ggx_albedo(rough, mu_v, one)
+    mus = (np.arange(64) + 0.5) / 64
+    e_avg = 2.0 * np.mean([ggx_albedo(rough, m, one, 256, 64) * m for m in mus])
+    f_ss = 2.0 * np.mean(fresnel_dielectric(mus, ior) * mus)
+    f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg))
+    albedo = ggx_albedo(rough, mu_v, lambda c: fresnel_dielectric(c, ior)) * (1.0 + f_ms * (1.0 - e) / e)
+    return float((1.0 - albedo) * base + albedo)

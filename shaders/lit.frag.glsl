@@ -115,6 +115,19 @@ float cosine_term(float NdotL)
 #endif
 }
 
+/* The Principled specular's Fresnel between f0 and 1: the exact dielectric Fresnel of IOR 1.5
+ * remapped from its F0 (0.04) to 1, as Cycles' generalized Schlick Fresnel with a negative
+ * exponent (bsdf_microfacet.h) gives it; Schlick's (1 - cos)^5 falls short of it by up to a
+ * third between 40 and 80 degrees. ``c``: the cosine between the light and the half vector. */
+float fresnel_shape(float c)
+{
+  c = clamp(c, 0.0, 1.0);
+  float g = sqrt(1.25 + c * c); /* eta^2 - 1 + c^2 at eta = 1.5 */
+  float a = (g - c) / (g + c);
+  float b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+  return (0.5 * a * a * (1.0 + b * b) - 0.04) / 0.96;
+}
+
 /* One lobe's BSDF for light from ``to_light`` (N.L > 0): its diffuse and specular parts, each
  * scaled by the light's factors. */
 vec3 lobe_brdf(vec3 N, vec3 V, vec3 albedo, vec4 f0, float shininess, float alpha, vec3 to_light, float NdotL,
@@ -131,8 +144,9 @@ vec3 lobe_brdf(vec3 N, vec3 V, vec3 albedo, vec4 f0, float shininess, float alph
   float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
   float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
   float Vis = 0.5 / max(gv + gl, 1e-8);
-  float fw = pow(clamp(1.0 - dot(to_light, H), 0.0, 1.0), 5.0);
-  /* Schlick Fresnel from f0.rgb towards f90 (f0.a: lobe_setup). */
+  /* Fresnel from f0.rgb towards f90 (f0.a: lobe_setup) along the exact dielectric curve
+   * (fresnel_shape). */
+  float fw = fresnel_shape(dot(to_light, H));
   vec3 spec = (f0.rgb + (f0.a - f0.rgb) * fw) * (D * Vis);
   return albedo / M_PI * L.diffuse_factor + spec * L.specular_factor;
 #else
@@ -345,17 +359,22 @@ vec3 world_sh(vec3 d, vec2 g)
   return max(r, vec3(0.0));
 }
 
-/* The split-sum environment BRDF (scale and bias of f0), an analytic fit (Karis, "Physically
- * based shading on mobile"); the bias (the Fresnel rim) scaled by f90. */
-vec2 env_brdf(float f90, float rough, float NdotV)
+/* The specular lobe's directional albedo as a scale and bias of f0 (the split sum's
+ * environment BRDF): f0 a + b is what the lobe reflects of light from all directions, the
+ * energy the diffuse layer below does not get and the weight of the world's specular. (E, S)
+ * come from lib/ggx_albedo.glsl (GGX, height-correlated Smith, the Fresnel curve of
+ * fresnel_shape). Multiple scattering between the microfacets adds 1 + F_ms (1 - E) / E (Kulla
+ * and Conty 2017, as Cycles' microfacet_ggx_preserve_energy: F_ms = F_ss E_avg / (1 - F_ss
+ * (1 - E_avg)), F_ss the Fresnel's cosine-weighted mean), for ``f`` the lobe's mean f0. The
+ * bias (the Fresnel rim) is scaled by ``f90``: a surface without specular has none. */
+vec2 env_brdf(float f, float f90, float rough, float NdotV)
 {
-  vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
-  vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
-  vec4 r = rough * c0 + c1;
-  float a004 = min(r.x * r.x, exp2(-9.28 * NdotV)) * r.x + r.y;
-  vec2 ab = vec2(-1.04, 1.04) * a004 + r.zw;
-  ab.y *= f90;
-  return ab;
+  vec2 es = ggx_albedo(rough, NdotV);
+  float e_avg = ggx_albedo_avg(rough);
+  float f_ss = f + (1.0 - f) * GGX_S_AVG * f90;
+  float f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg));
+  float ms = 1.0 + f_ms * (1.0 - es.x) / max(es.x, 1e-4);
+  return vec2(es.x - es.y, es.y * f90) * ms;
 }
 
 /* Light from the world: diffuse irradiance, and specular radiance around the reflected
@@ -392,10 +411,10 @@ vec3 lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   /* Energy: light reflected by the specular layer does not reach the diffuse one below (the
    * Principled BSDF's layering), estimated per pixel from the directional albedo. */
   float NdotV = max(dot(N, V), 1e-4);
-  vec2 ab = env_brdf(f90, rough, NdotV);
+  vec2 ab = env_brdf(dot(f0.rgb, vec3(0.3333)), f90, rough, NdotV);
   /* Metallic mixes a metal and a dielectric; only the dielectric's own specular sits over its
    * diffuse, per channel (a tinted specular takes its own colour out of the diffuse). */
-  vec2 ab_dielectric = env_brdf(clamp(50.0 * spec.a, 0.0, 1.0), rough, NdotV);
+  vec2 ab_dielectric = env_brdf(dot(spec.rgb, vec3(0.3333)), clamp(50.0 * spec.a, 0.0, 1.0), rough, NdotV);
   albedo *= clamp(1.0 - (spec.rgb * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
   return world_light(N, V, albedo, f0.rgb, rough, ab);
 }

@@ -192,6 +192,7 @@ LIT = Program(
         "lib/depth_encoding.glsl",
         "lib/shadow_filters.glsl",
         "lib/material.glsl",
+        "lib/ggx_albedo.glsl",
     ),
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
