@@ -120,13 +120,7 @@ def principled_dielectric(base, rough, v, to_light, ior=1.5):
     if mu_l <= 0.0:
         return 0.0, 0.0
     a2 = max(rough * rough, 1e-3) ** 2
-    one = np.ones_like
-    e = ggx_albedo(rough, mu_v, one)
-    mus = (np.arange(64) + 0.5) / 64
-    e_avg = 2.0 * np.mean([ggx_albedo(rough, m, one, 256, 64) * m for m in mus])
-    f_ss = 2.0 * np.mean(fresnel_dielectric(mus, ior) * mus)
-    f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg))
-    ms = 1.0 + f_ms * (1.0 - e) / e
+    ms = _multiple_scattering(rough, mu_v, ior)
     albedo = ggx_albedo(rough, mu_v, lambda c: fresnel_dielectric(c, ior)) * ms
     h = (v + w) / np.linalg.norm(v + w)
     d = a2 / (np.pi * (h[2] ** 2 * (a2 - 1.0) + 1.0) ** 2)
@@ -138,11 +132,17 @@ def principled_dielectric(base, rough, v, to_light, ior=1.5):
 def principled_dielectric_albedo(base, rough, mu_v, ior=1.5):
     """What the Principled dielectric reflects of a uniform world of radiance 1 seen at N.V =
     ``mu_v``: its diffuse (1 - A) base plus its specular's albedo A (multiple scattering in)."""
+    albedo = ggx_albedo(rough, mu_v, lambda c: fresnel_dielectric(c, ior)) * _multiple_scattering(rough, mu_v, ior)
+    return float((1.0 - albedo) * base + albedo)
+
+
+def _multiple_scattering(rough, mu_v, ior):
+    """Cycles' energy gain of the GGX lobe for light bouncing between microfacets at N.V =
+    ``mu_v``: 1 + F_ms (1 - E) / E (Kulla and Conty 2017; microfacet_ggx_preserve_energy)."""
     one = np.ones_like
     e = ggx_albedo(rough, mu_v, one)
     mus = (np.arange(64) + 0.5) / 64
     e_avg = 2.0 * np.mean([ggx_albedo(rough, m, one, 256, 64) * m for m in mus])
     f_ss = 2.0 * np.mean(fresnel_dielectric(mus, ior) * mus)
     f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg))
-    albedo = ggx_albedo(rough, mu_v, lambda c: fresnel_dielectric(c, ior)) * (1.0 + f_ms * (1.0 - e) / e)
-    return float((1.0 - albedo) * base + albedo)
+    return 1.0 + f_ms * (1.0 - e) / e
