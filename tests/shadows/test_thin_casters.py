@@ -27,10 +27,16 @@ def _reference():
     return kit.measure_visibility(scene, "CYCLES", samples=256, seed=1, **kit.matched_filter(scene))
 
 
-def _measure(engine, **settings):
+@functools.lru_cache(maxsize=None)
+def _visibility(engine, samples):
     scene = kit.build(SCENE, WIDTH, HEIGHT)
-    extra = kit.matched_filter(scene) if engine == "CYCLES" else {}
-    return kit.compare(kit.measure_visibility(scene, engine, **settings, **extra), _reference())
+    if engine == "CYCLES":
+        return kit.measure_visibility(scene, engine, samples=samples, **kit.matched_filter(scene))
+    return kit.measure_visibility(scene, engine, render_samples=samples)
+
+
+def _measure(engine, samples):
+    return kit.compare(_visibility(engine, samples), _reference())
 
 
 def test_thin_shadows_converge_past_cycles_16_spp(penumbra):
@@ -40,9 +46,9 @@ def test_thin_shadows_converge_past_cycles_16_spp(penumbra):
     ref = _reference()
     valid = np.isfinite(ref)
     assert valid.mean() > 0.5 and (ref[valid] < 0.9).mean() > 0.02  # there are thin shadows to judge
-    cycles = _measure("CYCLES", samples=16)
-    at_64 = _measure("PENUMBRA", render_samples=64)
-    at_16 = _measure("PENUMBRA", render_samples=16)
+    cycles = _measure("CYCLES", 16)
+    at_64 = _measure("PENUMBRA", 64)
+    at_16 = _measure("PENUMBRA", 16)
     scores = {"cycles16": cycles, "penumbra64": at_64, "penumbra16": at_16}
     assert at_64["mae"] <= 1.5 * cycles["mae"], scores
     assert at_16["mae"] <= 2.0 * cycles["mae"], scores
@@ -55,7 +61,7 @@ def test_the_pixel_filter_is_blenders(penumbra):
     filter, by a wide margin."""
     scene = kit.build(SCENE, WIDTH, HEIGHT)
     centres = kit.measure_visibility(scene, "CYCLES", samples=64, seed=1)
-    penumbra_vis = kit.measure_visibility(kit.build(SCENE, WIDTH, HEIGHT), "PENUMBRA", render_samples=64)
+    penumbra_vis = _visibility("PENUMBRA", 64)
     matched = kit.compare(penumbra_vis, _reference())["mae"]
     unmatched = kit.compare(penumbra_vis, centres)["mae"]
     assert matched < 0.6 * unmatched, (matched, unmatched)
