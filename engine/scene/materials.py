@@ -108,10 +108,17 @@ def dielectric_f0(ior, level, tint=(1.0, 1.0, 1.0)):
     principled closure, EEVEE's principled GLSL): f0 = ((ior - 1) / (ior + 1))^2, times
     2 x Specular IOR Level, times Specular Tint, clamped to [0, 1] per channel -> (r, g, b,
     the untinted f0). The GLSL twin is ``node_principled_f0`` (shaders/nodes/shader.glsl)."""
-    ior = max(float(ior), 0.0) if math.isfinite(float(ior)) else 1.5
-    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2 * 2.0 * max(float(level), 0.0)
-    rgb = tuple(min(max(f0 * max(float(t), 0.0), 0.0), 1.0) for t in tuple(tint)[:3])
-    return (*rgb, min(max(f0, 0.0), 1.0))
+    ior, level = _bounded(ior, 1.5), _bounded(level, 0.0)
+    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2 * 2.0 * level
+    rgb = tuple(min(f0 * _bounded(t, 0.0), 1.0) for t in tuple(tint)[:3])
+    return (*rgb, min(f0, 1.0))
+
+
+def _bounded(value, nan):
+    """``value`` in [0, 1e6] (``nan`` when NaN), as ``node_principled_f0`` bounds its inputs:
+    no product of them is 0 x inf."""
+    value = float(value)
+    return nan if math.isnan(value) else min(max(value, 0.0), 1e6)
 
 
 # --- reading ------------------------------------------------------------------------------

@@ -54,12 +54,14 @@ NodeClosure node_closure_empty()
  * surface has a Fresnel rim at all: Blender's F90 is 1 unless the IOR comes to 1). */
 vec4 node_principled_f0(float ior, float level, vec4 tint)
 {
-  ior = isnan(ior) ? 1.5 : max(ior, 0.0);
+  /* Every input finite and bounded first (materials.dielectric_f0 does the same), so no
+   * product below is 0 x inf. */
+  ior = isnan(ior) ? 1.5 : clamp(ior, 0.0, 1e6);
+  level = isnan(level) ? 0.0 : clamp(level, 0.0, 1e6);
+  vec3 t = vec3(isnan(tint.r) ? 0.0 : tint.r, isnan(tint.g) ? 0.0 : tint.g, isnan(tint.b) ? 0.0 : tint.b);
   float r = (ior - 1.0) / (ior + 1.0);
-  float f0 = r * r * 2.0 * max(isnan(level) ? 0.0 : level, 0.0);
-  vec3 tinted = clamp(f0 * max(tint.rgb, vec3(0.0)), 0.0, 1.0);
-  return vec4(isnan(tinted.r) ? 0.0 : tinted.r, isnan(tinted.g) ? 0.0 : tinted.g, isnan(tinted.b) ? 0.0 : tinted.b,
-              clamp(f0, 0.0, 1.0));
+  float f0 = r * r * 2.0 * level;
+  return vec4(clamp(f0 * clamp(t, 0.0, 1e6), 0.0, 1.0), clamp(f0, 0.0, 1.0));
 }
 
 NodeClosure node_principled(vec4 base, float metallic, float roughness, vec4 specular, float alpha,

@@ -246,3 +246,42 @@ def test_a_shifted_fit_moves_the_texel_grid_by_that_many_texels():
         texels = (b[:2] / b[3] - a[:2] / a[3]) * 0.5 * 512
         np.testing.assert_allclose(texels, [0.25, -0.5], atol=1e-9)
         assert (moved.near, moved.far, moved.texel) == (fit.near, fit.far, fit.texel)
+
+
+def test_widened_projection_keeps_every_offset_of_the_filter_inside():
+    """A pixel centre on the frame's border moved outward by the filter's whole reach lands on
+    the edge of the widened frustum's clip square; with no reach nothing changes."""
+    proj = np.array([[1.2, 0, 0.1, 0], [0, 2.0, 0, 0], [0, 0, -1.01, -0.2], [0, 0, -1, 0]])
+    width, height, reach = 64, 36, 1.5
+    wide, size = sampling.widened_projection(proj, reach, width, height)
+    assert size == (width + 3.0, height + 3.0)
+    for px, py, edge in ((-reach, -reach, -1.0), (width + reach, height + reach, 1.0)):
+        ndc = np.array([2.0 * px / width - 1.0, 2.0 * py / height - 1.0])  # of the original frame
+        z = -3.0
+        # The view point at depth z seen at that NDC position through ``proj``.
+        xy = np.linalg.solve(proj[:2, :2], ndc * -z - proj[:2, 2] * z)
+        clip = wide @ np.array([*xy, z, 1.0])
+        assert clip[:2] / clip[3] == pytest.approx((edge, edge))
+    assert sampling.widened_projection(proj, 0.0, width, height)[0] == pytest.approx(proj)
+
+
+def test_filter_reach_at_its_extremes():
+    from penumbra.engine.frame.settle import MAX_FLAG_REACH, flag_reach
+
+    assert sampling.filter_width(0.0) == 0.0 and sampling.filter_width(10.0) == 20.0
+    assert [flag_reach(f) for f in (0.0, 0.5, 1.0, 1.5, 2.0, 10.0)] == [1, 1, 1, 2, 2, MAX_FLAG_REACH]
+    offsets = np.array([sampling.pixel_offset(s, 10.0)[:2] for s in range(1, 257)])
+    assert np.all(np.isfinite(offsets)) and np.all(np.abs(offsets) < 10.0)  # within the reach
+
+
+@pytest.mark.parametrize("ior", [0.0, -1.0, 1.0, 1.5, 1e6, math.inf, math.nan])
+@pytest.mark.parametrize("level", [0.0, -1.0, 0.5, 1e6])
+def test_dielectric_f0_is_finite_and_in_range_at_the_extremes(ior, level):
+    from penumbra.engine.scene.materials import dielectric_f0
+
+    f0 = dielectric_f0(ior, level, (2.0, -1.0, math.inf))
+    assert len(f0) == 4 and all(math.isfinite(v) and 0.0 <= v <= 1.0 for v in f0)
+    if ior == 1.0 or level <= 0.0:
+        assert f0 == (0.0, 0.0, 0.0, 0.0)  # no specular: IOR 1 or level 0
+    if ior == 1.5 and level == 0.5:
+        assert f0 == pytest.approx((0.08, 0.0, 1.0, 0.04))
