@@ -126,6 +126,8 @@ SAMPLING_VIEWPORT = "sampling_viewport"  # the Sampling panel's Viewport and Ren
 SAMPLING_RENDER = "sampling_render"
 SHADOWS = "shadows"
 LIGHTING = "lighting"
+WORLD = "world"  # World Properties › Penumbra (the world's light and its visibility)
+LIGHT_PATHS = "light_paths"  # Render Properties › Light Paths (indirect light)
 VIEWPORT = "viewport"
 SIMPLIFY = "simplify"
 DEBUG = "debug"
@@ -433,6 +435,79 @@ SCENE_PARAMS = (
         enum=SPECULAR_MODEL,
         label="Specular",
         section=LIGHTING,
+    ),
+    Param(
+        "world_shadows",
+        "BOOL",
+        True,
+        "The world's light is blocked by what stands in its way: each sample draws a shadow map for a few "
+        "directions taken from the world's light, so the frame converges to Cycles' direct light from the "
+        "world. Off: the world lights every surface as if nothing stood in its way",
+        label="Shadows",
+        section=WORLD,
+    ),
+    Param(
+        "world_samples",
+        "INT",
+        2,
+        "Directions of the world's light per sample, each with its own shadow map (importance-sampled from "
+        "the world's light, stratified over the frame's samples)",
+        min=1,
+        max=16,
+        label="Directions per Sample",
+        section=WORLD,
+    ),
+    Param(
+        "world_map_size",
+        "INT",
+        1024,
+        "Texels per side of each world direction's shadow map (at most the Shadow Map Size)",
+        min=16,
+        soft_max=4096,
+        label="Map Size",
+        section=WORLD,
+    ),
+    Param(
+        "world_ao",
+        "BOOL",
+        True,
+        "One-sample frames (the viewport while the view moves) and a frame's first sample estimate the "
+        "world's visibility from the depth buffer (ground-truth ambient occlusion); later samples use the "
+        "world's shadow maps",
+        label="Ambient Occlusion",
+        section=WORLD,
+    ),
+    Param(
+        "world_ao_distance",
+        "FLOAT",
+        2.0,
+        "How far the ambient occlusion looks for what blocks the world's light",
+        min=0.0,
+        soft_max=100.0,
+        subtype="DISTANCE",
+        label="Distance",
+        section=WORLD,
+    ),
+    Param(
+        "indirect_bounces",
+        "INT",
+        0,
+        "Diffuse bounces of light from suns, spots and area lights (and the world with Shadows on): 1 adds "
+        "the light their shadow maps see reflected once (reflective shadow maps), sampled anew each sample",
+        min=0,
+        max=1,
+        label="Diffuse Bounces",
+        section=LIGHT_PATHS,
+    ),
+    Param(
+        "indirect_samples",
+        "INT",
+        16,
+        "Points of each light's reflective shadow map gathered per pixel and sample",
+        min=1,
+        max=256,
+        label="Bounce Samples",
+        section=LIGHT_PATHS,
     ),
     Param(
         "navigation_scale",

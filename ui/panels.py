@@ -88,6 +88,25 @@ class PENUMBRA_PT_lighting(_SettingsPanel, bpy.types.Panel):
     section = settings.LIGHTING
 
 
+class PENUMBRA_PT_light_paths(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Light Paths"
+    section = settings.LIGHT_PATHS
+
+
+class PENUMBRA_PT_world(_SettingsPanel, bpy.types.Panel):
+    """The world's light and its visibility, in World Properties (where EEVEE and Cycles put a
+    world's settings); the values are the scene's, saved with it."""
+
+    bl_label = "Penumbra"
+    bl_context = "world"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.world is not None
+
+    section = settings.WORLD
+
+
 class PENUMBRA_PT_viewport(_SettingsPanel, bpy.types.Panel):
     bl_label = "Viewport"
     section = settings.VIEWPORT
@@ -286,6 +305,8 @@ classes = (
     PENUMBRA_PT_shadows,
     PENUMBRA_PT_light,
     PENUMBRA_PT_lighting,
+    PENUMBRA_PT_light_paths,
+    PENUMBRA_PT_world,
     PENUMBRA_PT_viewport,
     PENUMBRA_PT_simplify,
     PENUMBRA_PT_debug,

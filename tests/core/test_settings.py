@@ -103,6 +103,8 @@ def test_every_scene_setting_is_drawn_by_a_panel_section():
         settings.SAMPLING_RENDER,
         settings.SHADOWS,
         settings.LIGHTING,
+        settings.LIGHT_PATHS,
+        settings.WORLD,
         settings.VIEWPORT,
         settings.SIMPLIFY,
         settings.DEBUG,
