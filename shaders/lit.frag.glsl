@@ -326,8 +326,16 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
     settle_light(L, s, to_light, irradiance, NgdotL);
   }
 #endif
-  unshadowed += weight;
-  arriving += weight * visibility;
+#if WORLD_LIGHTS
+  /* A direction of the world's light (frame/world_sampling.py): its light less the SH light's
+   * share, which the world already gave this surface unshadowed; not part of the Shadow pass
+   * (the lights' alone, as Cycles'). */
+  float world_light = float(L.world);
+#else
+  const float world_light = 0.0;
+#endif
+  unshadowed += weight * (1.0 - world_light);
+  arriving += weight * visibility * (1.0 - world_light);
 #if NODE_LOBES == 2
   /* Both lobes under the one shadow lookup, summed by their weights. */
   vec3 reflected = vec3(0.0);
@@ -338,9 +346,9 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
     reflected += (s.w.y * cosine_b) *
                  lobe_brdf(s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b, s.alpha_b, to_light, NdotL_b, L);
   }
-  color += L.color * (irradiance * visibility) * reflected;
+  color += (L.color * visibility - world_light * L.world_baseline) * irradiance * reflected;
 #else
-  vec3 E = L.color * (irradiance * cosine * visibility);
+  vec3 E = (L.color * visibility - world_light * L.world_baseline) * (irradiance * cosine);
   color += E * lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
 #endif
 }
@@ -574,6 +582,9 @@ void main()
   color = lobe_weights.x * color + lobe_weights.y * color_b;
 #endif
   float arriving = 0.0, unshadowed = 0.0;
+#if SETTLE_TEST && WORLD_LIGHTS
+  vec3 world_term = color; /* the world's light, unshadowed (lobe_setup) */
+#endif
 #if DEBUG_LIT
   debug_dPdx = dFdx(s.P);
   debug_dPdy = dFdy(s.P);
@@ -660,6 +671,14 @@ void main()
 #endif
 #if SETTLE_TEST
   bool settled = !settle_unstable;
+#  if WORLD_LIGHTS
+  /* The world's light is sampled with shadow maps in this frame: what blocks it differs with
+   * every direction, and the pilot cannot tell. Its samples can change the pixel by at most
+   * the world's whole unshadowed light here (all of it blocked), which the settle test
+   * weighs against the threshold like any light's spread: a dim world under bright lights
+   * still settles, a world that lights the pixel keeps it sampling. */
+  settle_spread += dot(max(world_term, vec3(0.0)), vec3(1.0));
+#  endif
 #  if NODE_PROCEDURAL
   /* Procedural textures are evaluated at each sample's point, unfiltered: one sample cannot
    * tell their detail under the pixel (mortar lines between pixel centres), so they keep

@@ -100,6 +100,8 @@ def light_row(light, shadow=None, origin=_ZERO):
         "offset_scale": light.offset_scale,
         "cascade_splits": (list(shadow.splits) + [3.0e38] * 4)[:4] if shadow and shadow.splits else (3.0e38,) * 4,
         "cascade_blend": (list(shadow.blend) + [0.0] * 4)[:4] if shadow and shadow.blend else (0.0,) * 4,
+        "world_baseline": light.world_baseline if light.world_baseline is not None else _ZERO,
+        "world": int(light.world),
     }
 
 
@@ -135,11 +137,13 @@ def shading_order(lights, plan):
     """Light indices as the lit pass loops over them: lights sampled over their extent with a
     map first, then the other lights with a map, then the rest (each group in its own order).
     The lit pass runs a shadow filter only in its first two loops, so a light without a map
-    never pays for one. Returns (order, number sampled, number with maps)."""
+    never pays for one. A direction of the world's light without a map (nothing casts a
+    shadow from it) adds nothing and is left out. Returns (order, number sampled, number with
+    maps)."""
     mapped = [i for i in range(len(lights)) if i in plan.lights]
     sampled = [i for i in mapped if lights[i].sampled]
     others = [i for i in mapped if not lights[i].sampled]
-    rest = [i for i in range(len(lights)) if i not in plan.lights]
+    rest = [i for i in range(len(lights)) if i not in plan.lights and not getattr(lights[i], "world", False)]
     return sampled + others + rest, len(sampled), len(mapped)
 
 
@@ -160,6 +164,7 @@ def build_frame_data(
     sample_count=1,
     settle=False,
     pilot=False,
+    world_sampled=False,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -171,7 +176,9 @@ def build_frame_data(
     ``alpha_offset``: this sample's shift of the alpha-hash threshold ((s + 0.5) / N);
     ``origin``: the frame origin: every position the GPU gets is relative to it;
     ``sample_count``: the frame's samples, which share the disk filters' taps; ``settle``:
-    for the settle test's variant (``settle.py``); ``pilot``: for a frame's pilot sample."""
+    for the settle test's variant (``settle.py``); ``pilot``: for a frame's pilot sample;
+    ``world_sampled``: the frame samples the world's light with shadow maps (its settle test
+    settles no surface), whether or not this sample's directions have maps."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings, sample_count)
@@ -180,7 +187,7 @@ def build_frame_data(
     frame = frame_row(
         camera,
         world_color.mean if sh is not None else world_color,
-        len(lights),
+        len(order),
         settings,
         tile_size,
         atlas_columns,
@@ -212,11 +219,12 @@ def build_frame_data(
             bins is not None,
             settings.pcf_spacing,
             sampled > 0,
-            (sampled, shadowed, len(lights)),
+            (sampled, shadowed, len(order)),
             any(light.receivers is not None for light in lights),
             DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].lit and not settle,
             settle,
             pilot,
+            world_sampled or any(getattr(lights[i], "world", False) for i in order),
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

@@ -50,6 +50,11 @@ LIGHT_STRUCT = Struct(
         ("FLOAT", "offset_scale"),  # multiplies the normal offset (besides bias_scale)
         ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
         ("VEC4", "cascade_blend"),  # CASCADE: depth before each end over which the next one fades in
+        # A direction of the world's light (frame/world_sampling.py): ``color`` and this are the
+        # world's radiance and its SH radiance from it, over its probability; the light adds
+        # color x visibility - world_baseline (the SH light was given unshadowed).
+        ("VEC3", "world_baseline"),
+        ("INT", "world"),  # 1: a direction of the world's light
     ),
 )
 
@@ -672,6 +677,7 @@ def lit_defines(
     debug=False,
     settle=False,
     pilot=False,
+    world_lights=False,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -690,7 +696,9 @@ def lit_defines(
     sun cascade + 1, texel density of the worst-sampled light, coverage). ``settle``: the
     variant writes the settle test's flags instead (``SETTLE_TEST``, ``settle.py``), looking
     at most SETTLE_REACH texels around a point in a map; ``pilot``: a frame's pilot sample
-    (``PILOT_SAMPLE``), which reads moving lights' maps with one bilinear lookup."""
+    (``PILOT_SAMPLE``), which reads moving lights' maps with one bilinear lookup.
+    ``world_lights``: some lights are directions of the world's light (``WORLD_LIGHTS``,
+    ``world_sampling.py``), which add their light less the SH light's share."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -721,6 +729,7 @@ def lit_defines(
         "DEBUG_LIT": bool(debug),
         "SETTLE_TEST": bool(settle),
         "PILOT_SAMPLE": bool(pilot),
+        "WORLD_LIGHTS": bool(world_lights),
         "SETTLE_REACH": SETTLE_REACH,
         "SETTLE_GRID": SETTLE_GRID,
     }

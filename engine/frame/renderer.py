@@ -28,6 +28,7 @@ from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
 from .world_light import world_light
+from .world_sampling import needs_directions, world_lights
 
 # While the view moves, a frame's maps keep the sizes of the last navigation frame that
 # planned them afresh, this many frames ago at most (``Renderer.render``'s ``navigating``).
@@ -64,6 +65,7 @@ class Renderer:
         self._clock = StageClock()  # the current frame's (``render``)
         self._frame_plan = None  # (key, moving lights, map sizes) of the frame's first call
         self._navigation = None  # (key, map sizes, frames) of the frames drawn while the view moves
+        self._world_sampled = False  # the current frame samples the world's light with maps
 
     @property
     def shadows(self):
@@ -129,14 +131,18 @@ class Renderer:
         world = world_light(snapshot.world, self.textures, self.shaders)
         if world is not snapshot.world:  # an Environment Texture's light, projected on the GPU
             snapshot = dataclasses.replace(snapshot, world=world, world_color=world.mean)
-        lights = select_lights(snapshot.lights, camera.position, MAX_LIGHTS)
-        if len(lights) < len(snapshot.lights):
-            stats.messages.append(
-                f"Penumbra: {len(snapshot.lights)} lights; only the {MAX_LIGHTS} that contribute most to the view "
-                "are lit"
-            )
         start, stop = samples
         accumulate = sample_count > 1
+        # The world's light with visibility (world_sampling.py): a multi-sample frame adds
+        # ``world_samples`` directions of it per sample, each a sun with its own map.
+        directions = int(settings.world_samples) if accumulate and needs_directions(snapshot.world, settings) else 0
+        self._world_sampled = directions > 0
+        room = MAX_LIGHTS - directions
+        lights = select_lights(snapshot.lights, camera.position, room)
+        if len(lights) < len(snapshot.lights):
+            stats.messages.append(
+                f"Penumbra: {len(snapshot.lights)} lights; only the {room} that contribute most to the view are lit"
+            )
         debug = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
         # A lit debug view's values are not colour: no noise estimate of theirs ends a frame.
         adaptive = adaptive if accumulate and not debug.lit else None
@@ -208,6 +214,9 @@ class Renderer:
                 sampling.light_at_sample(lt, i, s, sample_count, jitter, progressive=noise) if i in moving else lt
                 for i, lt in enumerate(lights)
             ]
+            if directions:
+                sample_lights += world_lights(snapshot.world, s * directions, directions)
+                stats.world_directions += directions
             clock.end()
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
             plan = self._sample(
@@ -377,6 +386,7 @@ class Renderer:
             sample_count=sample_count,
             settle=target is not None,
             pilot=pilot,
+            world_sampled=self._world_sampled,
         )
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None

@@ -54,6 +54,20 @@ class Caster:
     hair: str = None  # hair strips (Render > Curves > Shape: STRAND or STRIP), drawn by ``shadow_hair_program``
 
 
+def _crosses_near(fit, casters):
+    """Whether a caster's bounds cross the near plane of ``fit`` (some corners nearer the light
+    than it, some beyond)."""
+    boxes = [c.corners for c in casters if getattr(c, "corners", None) is not None]
+    if not boxes:
+        return False
+    m = fit.view_proj
+    points = np.stack(boxes)  # (n, 8, 3)
+    z = points @ m[2, :3] + m[2, 3]
+    w = points @ m[3, :3] + m[3, 3]
+    nearer = z < -w
+    return bool(np.any(nearer.any(axis=1) & ~nearer.all(axis=1)))
+
+
 def _at_level(caster, batches, level, triangles):
     """``caster`` as drawn into one map at a level of detail: its content key names the level,
     and back faces are not culled (a merged surface is not tested for closedness)."""
@@ -228,7 +242,12 @@ class ShadowAtlas:
                 gpu.state.depth_test_set("LESS")
                 gpu.state.depth_mask_set(True)
                 tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(origin)]))
-                raster = depth_only and tile.fit.orthographic
+                # The depth pass flattens casters nearer the light than the near plane per
+                # vertex (pancaking), exact only for triangles wholly nearer: a caster that
+                # crosses the plane (a ground under light from below it) would have its depth
+                # bent, so such a tile writes each fragment's own depth, clamped, instead of the
+                # rasterised one.
+                raster = depth_only and tile.fit.orthographic and not _crosses_near(tile.fit, casters)
                 shader = program(raster)
                 shader.bind()
                 shader.uniform_block("tile", tile_ubo)

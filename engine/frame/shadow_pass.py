@@ -77,6 +77,7 @@ class ShadowPass:
             receivers=self._receivers,
             density=_density(camera, settings, size),
             known_sizes=sizes,
+            world_map_size=getattr(settings, "world_map_size", None),
         )
 
     def draw(

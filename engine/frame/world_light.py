@@ -24,7 +24,9 @@ def world_light(world, textures, shaders):
         return reduce_environment(shaders, texture, premultiplied, width, height)
 
     sh = textures.world_sh(world.image, reduce) * world.strength
-    return dataclasses.replace(world, sh=sh, background=world_background(sh))
+    env = textures.world_env(world.image)
+    env = env * world.strength if env is not None else None
+    return dataclasses.replace(world, sh=sh, background=world_background(sh), env=env)
 
 
 def reduce_environment(shaders, texture, premultiplied, width, height):

@@ -645,6 +645,7 @@ class World:
     messages: tuple = ()
     image: str | None = None  # an Environment Texture image drawn behind the scene
     strength: float = 1.0  # its Background strength
+    env: np.ndarray | None = None  # the image box-filtered to at most 128 x 64, times strength (world_light)
 
     @property
     def mean(self):

@@ -43,6 +43,7 @@ class TextureCache:
     def __init__(self):
         self._textures = {}  # image name -> (GPUTexture, premultiplied)
         self._sh = {}  # image name -> its equirectangular SH (9, 3), strength 1
+        self._env = {}  # image name -> the image box-filtered as the SH saw it (h, w, 3), strength 1
         self.uploads = 0  # images taken from Blender since creation (tests and the benchmark read it)
         self.bytes = 0
         self._messages = {}  # image name -> what the user must be told of it (``messages``)
@@ -51,6 +52,7 @@ class TextureCache:
         for name in names:
             entry = self._textures.pop(name, None)
             self._sh.pop(name, None)
+            self._env.pop(name, None)
             self._messages.pop(name, None)
             if entry is not None:
                 self.bytes -= _texture_bytes(entry[0])
@@ -58,6 +60,7 @@ class TextureCache:
     def clear(self):
         self._textures.clear()
         self._sh.clear()
+        self._env.clear()
         self._messages.clear()
         self.bytes = 0
 
@@ -113,8 +116,15 @@ class TextureCache:
             width = max(1, min(SH_WIDTH, texture.width))
             height = max(1, min(SH_WIDTH // 2, texture.height))
             rgba = np.nan_to_num(np.asarray(reduce(texture, premultiplied, width, height), np.float64))
-            sh = self._sh[name] = equirect_sh(np.clip(rgba[..., :3], 0.0, None))
+            env = self._env[name] = np.clip(rgba[..., :3], 0.0, None)
+            sh = self._sh[name] = equirect_sh(env)
         return sh
+
+    def world_env(self, name):
+        """The image ``name`` box-filtered as ``world_sh`` projected it (h, w, 3), row 0 at the
+        bottom, strength 1: what the world's directions are drawn from
+        (``frame/world_sampling.py``). None before ``world_sh``."""
+        return self._env.get(name)
 
     def messages(self):
         """What the user must be told of the images taken so far (until they change)."""

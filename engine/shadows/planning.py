@@ -304,6 +304,7 @@ def plan_shadows(
     receivers=None,
     density=None,
     known_sizes=None,
+    world_map_size=None,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -321,7 +322,9 @@ def plan_shadows(
     ``known_sizes``: {light index: texels a side of each of its maps} (``frame_sizes`` of the
     frame's first plan): those lights are planned once, at those sizes, with no density pass;
     so every sample of a frame draws a light's maps at one size, and planning a further
-    sample costs one fit per map, not two.
+    sample costs one fit per map, not two. A direction of the world's light (``light.world``)
+    gets one map fitted to everything the camera sees (no cascades) of at most
+    ``world_map_size`` texels a side.
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
@@ -354,7 +357,7 @@ def plan_shadows(
             if view_corners is None:
                 fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), sizes[0])
                 tiles = [Tile(fit, everything)] if fit is not None else []
-            elif slices is None:
+            elif slices is None or getattr(light, "world", False):
                 fitted = lightspace.fit_sun_to_view(
                     light.direction, corners, view_corners, sizes[0], soft=spread, flat_free=flat_free
                 )
@@ -365,7 +368,13 @@ def plan_shadows(
                     for k, (sc, _end) in enumerate(slices)
                 ]
                 tiles = [Tile(*f) if f is not None else None for f in fits]
-            mode = "CASCADE" if view_corners is not None and slices is not None and len(slices) > 1 else "SINGLE"
+            cascaded = (
+                view_corners is not None
+                and slices is not None
+                and len(slices) > 1
+                and not getattr(light, "world", False)
+            )
+            mode = "CASCADE" if cascaded else "SINGLE"
         elif light.type == "SPOT":
             fov = min(light.cone_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
             tile = perspective_tile(
@@ -413,8 +422,10 @@ def plan_shadows(
             continue
         flat_free = flat_free_of(light)
         memo = {}
-        known = known_sizes.get(i) if known_sizes is not None else None
-        tiles, mode = light_tiles(light, list(known) if known else [map_size] * 6, flat_free, memo)
+        world = getattr(light, "world", False)
+        known = known_sizes.get(i) if known_sizes is not None and not world else None
+        largest = min(map_size, max(1, int(world_map_size))) if world and world_map_size else map_size
+        tiles, mode = light_tiles(light, list(known) if known else [largest] * 6, flat_free, memo)
         # A map needs no more texels than the pixels it shadows can show (density): each map
         # (cascade, cube face) of the light is planned again at the size it needs. A sun
         # fitted to the whole scene (no view corners) keeps its size: it must not depend on
@@ -429,8 +440,8 @@ def plan_shadows(
         ):
             soft = light.sampled or pcss
             per_pixel = density.texels_per_pixel * (1.0 if soft else max(1.0, kernel - 1.0))
-            sizes = [map_size if t is None else needed_size(t, map_size, receivers, density, per_pixel) for t in tiles]
-            if min(sizes, default=map_size) < map_size:
+            sizes = [largest if t is None else needed_size(t, largest, receivers, density, per_pixel) for t in tiles]
+            if min(sizes, default=largest) < largest:
                 smaller, smaller_mode = light_tiles(light, sizes, flat_free, memo)
                 if [t is None for t in smaller] == [t is None for t in tiles]:
                     tiles, mode = smaller, smaller_mode

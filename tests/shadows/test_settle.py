@@ -65,6 +65,9 @@ def _demo():
     scene = scenes.demo_scene(160, 90)
     scene.penumbra.layers.clear()
     scene.objects["Spot"].data.shadow_soft_size = 0.5
+    # These tests are about what the lights leave to settle: the demo world's light, sampled
+    # with shadow maps, keeps the pixels it lights sampling (test_world_light_keeps_sampling).
+    scene.penumbra.world_shadows = False
     return scene
 
 
@@ -162,6 +165,7 @@ def test_dithered_and_blended_surfaces_keep_sampling(penumbra, gpu_call):
     covers keeps sampling, the ground around it settles."""
     for make in (material_scenes.alpha_quarter, material_scenes.alpha_blend):
         scene = make(64, 64)
+        scene.penumbra.world_shadows = False  # the lights' settling, not the world's (see _demo)
         _plain, _settled, _ref, mask, _stats, _ = _frames(gpu_call, scene, 8, reference=8)
         # Top view, 3 m wide: the 1.5 m plane covers the middle half of each axis.
         covered = np.zeros_like(mask)
@@ -176,11 +180,13 @@ def test_procedural_textures_keep_sampling_image_textures_settle(penumbra, gpu_c
     """A sphere with a Brick texture (mortar lines thinner than a pixel, which one sample can
     miss) keeps sampling; the same sphere with an image texture (mipmapped) settles."""
     scene = material_scenes.brick_texture(64, 64)
+    scene.penumbra.world_shadows = False  # the lights' settling, not the world's (see _demo)
     plain, _settled, _ref, mask, _stats, _ = _frames(gpu_call, scene, 8, reference=8)
     world = np.all(np.abs(plain[..., :3] - plain[0, 0, :3]) < 1e-6, axis=-1)  # the background
     assert world.sum() > 0.3 * mask.size and not (mask & ~world).any()
     assert mask[world].mean() > 0.85  # all but the pixels the filter reaches from the sphere (2 px)
     scene = material_scenes.texture_base_color(64, 64)
+    scene.penumbra.world_shadows = False  # the lights' settling, not the world's (see _demo)
     _plain, _settled, _ref, mask, _stats, _ = _frames(gpu_call, scene, 8, reference=8)
     assert mask.mean() > 0.5
 
@@ -307,3 +313,17 @@ def test_a_larger_threshold_settles_more_from_its_smallest_to_its_largest(penumb
     for _, image in results:
         assert np.all(np.isfinite(image))
     assert fractions[0] < fractions[2] < fractions[-1], fractions
+
+
+def test_world_light_keeps_sampling(penumbra, gpu_call):
+    """The demo under its dim world with World > Shadows on: a pixel settles only where all of
+    the world's unshadowed light there (what its sampled shadows could take away) is within
+    the threshold, so fewer settle than with the world's shadows off, and every settled pixel
+    still holds what the samples give."""
+    on = _demo()
+    on.penumbra.world_shadows = True
+    _plain, settled_on, ref_on, mask_on, _stats, _ = _frames(gpu_call, on, 16, reference=16)
+    _plain, _settled, _ref, mask_off, _stats, _ = _frames(gpu_call, _demo(), 16, reference=16)
+    assert mask_on.sum() < mask_off.sum(), (int(mask_on.sum()), int(mask_off.sum()))
+    if mask_on.any():
+        assert np.percentile(_cycles_units(settled_on, ref_on)[mask_on], 99) < 0.02
