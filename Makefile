@@ -10,6 +10,7 @@ PYTEST_ARGS ?=
 # make bench BENCH=samples                     render samples: error against time, against Cycles and EEVEE
 # make bench BENCH=soak                        process memory over 300 F12 renders
 # make bench BENCH=assets ARGS=--quick         glTF assets (devkit/gltf/): error against Cycles, Penumbra vs EEVEE
+# make bench BENCH=world ARGS=--quick          world light with visibility: error against time vs Cycles and EEVEE
 BENCH ?= frame
 ARGS ?=
 

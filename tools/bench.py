@@ -15,6 +15,9 @@
               -> <out>/soak.csv
     terminator  frame time with Shadow Terminator Geometry Offset 0 against 0.1 (smooth
               spheres) -> stdout
+    world     the world's light with visibility: error against time on scenes lit by the world
+              alone, Penumbra (world shadows on and off, one bounce) against Cycles and EEVEE
+              -> <out>/world.csv, world.png
 
 Run from the repository root, e.g.::
 
@@ -28,7 +31,7 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import assets, frame, perf, post, samples, shadows, soak, terminator
+from tools.benchmarks import assets, frame, perf, post, samples, shadows, soak, terminator, world
 
 COMMANDS = {
     "assets": assets,
@@ -39,6 +42,7 @@ COMMANDS = {
     "shadows": shadows,
     "soak": soak,
     "terminator": terminator,
+    "world": world,
 }
 
 

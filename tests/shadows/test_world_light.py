@@ -1,0 +1,98 @@
+"""The world's light with visibility (issue 33): the short version of ``tools.bench world``.
+
+``sky_outdoor`` (objects on a ground under a uniform sky) and ``window_room`` (a closed room
+lit through one window) from ``devkit.world_scenes`` at 160x90, Penumbra against Cycles with
+max_bounces 0 (the world's direct light, with visibility) at 256 spp through the same pixel
+filter; error is the mean absolute difference of display RGB ('Standard' view, 0..1). The
+references are cached in out/reference_cache (rendered once when missing: about 15 s).
+
+Measured on 5.2 before the renderer read ``world_shadows`` (the world lit every surface as if
+nothing blocked it; on and off gave the same image): MAE at 64 samples 0.050 outdoors and 0.768
+in the room, whose inside then saw the whole sky at strength 4 and rendered white; the
+one-sample frame was 0.0012 (outdoors) and 0.0000 (room) from the 64-sample one.
+"""
+
+import functools
+
+import numpy as np
+import pytest
+
+from devkit import scenes
+from devkit import world_scenes as ws
+
+WIDTH, HEIGHT = 160, 90
+REFERENCE_SPP = 256
+SAMPLES = 64
+TARGETS = {"sky_outdoor": 0.02, "window_room": 0.03}  # MAE at SAMPLES against Cycles' direct light
+
+# The renderer does not read the world settings yet: the tests of its result fail until it
+# does. Remove this mark when the world's visibility lands.
+NEEDS_WORLD_SHADOWS = pytest.mark.xfail(
+    reason="issue 33: the renderer does not yet read world_shadows (the world's light is unoccluded)",
+    strict=False,
+)
+
+
+@functools.lru_cache(maxsize=None)
+def _reference(name):
+    return ws.cycles_reference(name, REFERENCE_SPP, WIDTH, HEIGHT)
+
+
+@functools.lru_cache(maxsize=None)
+def _penumbra(name, samples, world_shadows=True):
+    scene = ws.build(name, WIDTH, HEIGHT)
+    ws.use_engine(scene, "PENUMBRA", render_samples=samples, world_shadows=world_shadows)
+    return ws.render_display(scene)
+
+
+def _error(name, samples, world_shadows=True):
+    return ws.mae(_penumbra(name, samples, world_shadows), _reference(name))
+
+
+@pytest.mark.parametrize("name", sorted(TARGETS))
+@NEEDS_WORLD_SHADOWS
+def test_world_light_matches_cycles_direct(penumbra, name):
+    """At 64 samples Penumbra is within the issue's target of Cycles' direct light from the
+    world: 0.02 outdoors (contact shadows and creases darkened as Cycles darkens them), 0.03
+    in the room (light only through the window)."""
+    error = _error(name, SAMPLES)
+    assert error <= TARGETS[name], (name, error)
+
+
+@pytest.mark.parametrize("name", sorted(TARGETS))
+@NEEDS_WORLD_SHADOWS
+def test_world_shadows_are_what_brings_it_close(penumbra, name):
+    """Premise of the accuracy test: with world_shadows off the frame is much farther from
+    Cycles (at least twice the error and 0.02 more), so the measurement can tell the two."""
+    on, off = _error(name, SAMPLES, True), _error(name, SAMPLES, False)
+    assert off >= 2.0 * on and off - on >= 0.02, (name, on, off)
+
+
+@pytest.mark.parametrize("name", sorted(TARGETS))
+def test_one_sample_frame_is_close_to_the_converged_one(penumbra, name):
+    """The one-sample frame (the viewport while the view moves; ambient occlusion for the
+    world's visibility once the renderer has it) is within 0.04 MAE of the 64-sample frame."""
+    first, converged = _penumbra(name, 1), _penumbra(name, SAMPLES)
+    error = ws.mae(first, converged)
+    assert error <= 0.04, (name, error)
+
+
+def test_the_room_is_closed_but_for_its_window(penumbra):
+    """No light leaks at the room's seams: with the window plugged (a box filling the
+    opening, overlapping the wall), Cycles' direct light inside is black; open, the floor
+    and walls are lit."""
+    scene = ws.build("window_room", 64, 36)
+    ws.use_engine(scene, "CYCLES", samples=8)
+    lit = ws.render_display(scene)
+    x0, x1, z0, z1, y = scene["world_window"]
+
+    scenes.box(
+        scene,
+        "Plug",
+        center=((x0 + x1) / 2, y + ws.WALL / 2, (z0 + z1) / 2),
+        size=(x1 - x0 + 0.1, ws.WALL, z1 - z0 + 0.1),
+        mat=scene.objects["WallN_left"].data.materials[0],
+    )
+    closed = ws.render_display(scene)
+    assert float(closed.max()) < 1e-6, float(closed.max())
+    assert float(np.median(lit)) > 0.05, float(np.median(lit))
