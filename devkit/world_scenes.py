@@ -320,7 +320,8 @@ def _portal(scene, present):
     """Add (``present``) or remove Cycles' light portal over a room's window
     (``scene['world_window']``): an area light flagged as a portal, which only guides Cycles'
     sampling of the sky through the window (the image converges to the same light, much
-    faster). Rasterisers are not shown it."""
+    faster). Penumbra reads it the same way (its directions of the world gather in the cone
+    through the window); EEVEE is not shown it."""
     existing = scene.objects.get(PORTAL)
     if existing is not None and not present:
         data = existing.data
@@ -348,12 +349,12 @@ def use_engine(scene, engine, **settings):
     PENUMBRA  ``scene.penumbra`` settings; a world or light-path setting this build does not
               have (WORLD_SETTINGS) is skipped, any other unknown name is an error
     CYCLES    ``bounces`` (0: direct light; 1: one diffuse bounce), ``samples``, ``seed``,
-              through Penumbra's pixel filter, a portal over a room's window
+              through Penumbra's pixel filter, a portal over a room's window (Penumbra too)
     EEVEE     ``devkit.engines``' EEVEE (16 TAA samples), no light probe baked
 
     Returns the names of the settings skipped."""
     key = engine.upper()
-    _portal(scene, key == "CYCLES")
+    _portal(scene, key in ("CYCLES", "PENUMBRA"))
     if key == "CYCLES":
         engines.configure(scene, "CYCLES", **cycles_settings(**settings), **kit.matched_filter(scene))
         return []

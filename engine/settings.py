@@ -449,7 +449,7 @@ SCENE_PARAMS = (
     Param(
         "world_samples",
         "INT",
-        2,
+        4,
         "Directions of the world's light per sample, each with its own shadow map (importance-sampled from "
         "the world's light, stratified over the frame's samples)",
         min=1,
@@ -460,7 +460,7 @@ SCENE_PARAMS = (
     Param(
         "world_map_size",
         "INT",
-        1024,
+        512,
         "Texels per side of each world direction's shadow map (at most the Shadow Map Size)",
         min=16,
         soft_max=4096,

@@ -138,13 +138,19 @@ def shading_order(lights, plan):
     map first, then the other lights with a map, then the rest (each group in its own order).
     The lit pass runs a shadow filter only in its first two loops, so a light without a map
     never pays for one. A direction of the world's light without a map (nothing casts a
-    shadow from it) adds nothing and is left out. Returns (order, number sampled, number with
-    maps)."""
+    shadow from it) whose light equals its SH baseline adds nothing and is left out. Returns
+    (order, number sampled, number with maps)."""
     mapped = [i for i in range(len(lights)) if i in plan.lights]
     sampled = [i for i in mapped if lights[i].sampled]
     others = [i for i in mapped if not lights[i].sampled]
-    rest = [i for i in range(len(lights)) if i not in plan.lights and not getattr(lights[i], "world", False)]
+    rest = [i for i in range(len(lights)) if i not in plan.lights and not _adds_nothing(lights[i])]
     return sampled + others + rest, len(sampled), len(mapped)
+
+
+def _adds_nothing(light):
+    """A direction of the world's light that, unshadowed, gives what the SH light gave."""
+    baseline = getattr(light, "world_baseline", None)
+    return bool(getattr(light, "world", False)) and baseline is not None and np.array_equal(light.color, baseline)
 
 
 def build_frame_data(
@@ -165,6 +171,7 @@ def build_frame_data(
     settle=False,
     pilot=False,
     world_sampled=False,
+    world_sh=True,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -178,7 +185,9 @@ def build_frame_data(
     ``sample_count``: the frame's samples, which share the disk filters' taps; ``settle``:
     for the settle test's variant (``settle.py``); ``pilot``: for a frame's pilot sample;
     ``world_sampled``: the frame samples the world's light with shadow maps (its settle test
-    settles no surface), whether or not this sample's directions have maps."""
+    weighs the world's light), whether or not this sample's directions have maps;
+    ``world_sh``: the surfaces take the world's SH light (False: this sample's directions of
+    the world carry all of it, ``world_sampling.world_lights`` with portals)."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings, sample_count)
@@ -193,9 +202,11 @@ def build_frame_data(
         atlas_columns,
         origin,
     )
-    if sh is not None:
+    if sh is not None and world_sh:
         for k in range(1, 9):
             frame[f"world_sh{k}"] = (*sh[k], 0.0)
+    if not world_sh:
+        frame["world_color"] = _ZERO
     frame["alpha_offset"] = alpha_offset
     frame["shadowed_count"] = shadowed
     frame["shadowed_mask"] = light_bins.word_masks(0, shadowed, LIGHT_WORDS)

@@ -28,7 +28,7 @@ from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
 from .world_light import world_light
-from .world_sampling import needs_directions, world_lights
+from .world_sampling import needs_directions, portal_cones, world_lights
 
 # While the view moves, a frame's maps keep the sizes of the last navigation frame that
 # planned them afresh, this many frames ago at most (``Renderer.render``'s ``navigating``).
@@ -66,6 +66,7 @@ class Renderer:
         self._frame_plan = None  # (key, moving lights, map sizes) of the frame's first call
         self._navigation = None  # (key, map sizes, frames) of the frames drawn while the view moves
         self._world_sampled = False  # the current frame samples the world's light with maps
+        self._world_sh = True  # its surfaces take the world's SH light (not with light portals)
 
     @property
     def shadows(self):
@@ -135,8 +136,20 @@ class Renderer:
         accumulate = sample_count > 1
         # The world's light with visibility (world_sampling.py): a multi-sample frame adds
         # ``world_samples`` directions of it per sample, each a sun with its own map.
-        directions = int(settings.world_samples) if accumulate and needs_directions(snapshot.world, settings) else 0
+        sampled_world = needs_directions(snapshot.world, settings)
+        # Light portals: the directions gather where the world's light enters what the camera
+        # sees, and carry all of its light (no SH light on the surfaces of those samples). A
+        # one-sample frame then takes its directions too: the SH light of a room's sky, even
+        # occluded on screen, is nothing like the light through its windows.
+        cones = []
+        if sampled_world and getattr(snapshot, "portals", ()):
+            seen = [d for d in draws if d.instance.camera]
+            if seen:
+                box = corners_of(seen).reshape(-1, 3)
+                cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
+        directions = int(settings.world_samples) if sampled_world and (accumulate or cones) else 0
         self._world_sampled = directions > 0
+        self._world_sh = not cones
         room = MAX_LIGHTS - directions
         lights = select_lights(snapshot.lights, camera.position, room)
         if len(lights) < len(snapshot.lights):
@@ -215,7 +228,7 @@ class Renderer:
                 for i, lt in enumerate(lights)
             ]
             if directions:
-                sample_lights += world_lights(snapshot.world, s * directions, directions)
+                sample_lights += world_lights(snapshot.world, s * directions, directions, cones=cones)
                 stats.world_directions += directions
             clock.end()
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
@@ -387,6 +400,7 @@ class Renderer:
             settle=target is not None,
             pilot=pilot,
             world_sampled=self._world_sampled,
+            world_sh=self._world_sh or not any(getattr(lt, "world", False) for lt in lights),
         )
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None

@@ -35,6 +35,8 @@ from .sampling import radical_inverse, sobol_2
 
 # The share of directions drawn uniformly over the sphere (the rest follow the luminance).
 UNIFORM_SHARE = 0.15
+# With light portals, the share of directions drawn in the cones through them.
+PORTAL_SHARE = 0.75
 _LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 _SCRAMBLE = (0x6C8E9CF5, 0x2545F491)  # digital shifts of the two coordinates
 
@@ -60,8 +62,10 @@ class WorldDistribution:
     proportion to luminance per solid angle of its environment image ``env`` (h, w, 3), row 0
     at the bottom, or uniformly for a constant world (``env`` None)."""
 
-    def __init__(self, sh, env=None):
+    def __init__(self, sh, env=None, cones=()):
         self.sh = np.nan_to_num(np.asarray(sh, np.float64), posinf=0.0, neginf=0.0)
+        # (unit axis, cos of the half-angle) of each portal's cone (``portal_cones``).
+        self.cones = [(np.asarray(a, np.float64), float(c)) for a, c in cones if -1.0 <= c < 1.0]
         self.env = None
         if env is not None:
             env = np.nan_to_num(np.asarray(env, np.float64)[..., :3], posinf=0.0, neginf=0.0)
@@ -106,6 +110,16 @@ class WorldDistribution:
 
     def pdf(self, d):
         """The probability density (per steradian) of drawing unit directions ``d`` (n, 3)."""
+        base = self._base_pdf(d)
+        if not self.cones:
+            return base
+        cones = np.zeros(len(d))
+        for axis, cos_max in self.cones:
+            inside = d @ axis >= cos_max
+            cones += inside / (2.0 * math.pi * (1.0 - cos_max))
+        return PORTAL_SHARE * cones / len(self.cones) + (1.0 - PORTAL_SHARE) * base
+
+    def _base_pdf(self, d):
         uniform = np.full(len(d), 1.0 / (4.0 * math.pi))
         if self.env is None:
             return uniform
@@ -123,6 +137,24 @@ class WorldDistribution:
     def directions(self, points):
         """Unit directions (n, 3) from points ``points`` (n, 2) of [0, 1)^2."""
         points = np.asarray(points, np.float64).reshape(-1, 2)
+        if not self.cones:
+            return self._base_directions(points)
+        a, b = points[:, 0], points[:, 1]
+        out = np.empty((len(points), 3))
+        in_cone = a < PORTAL_SHARE
+        rest = ~in_cone
+        if rest.any():
+            ar = np.clip((a[rest] - PORTAL_SHARE) / (1.0 - PORTAL_SHARE), 0.0, 1.0 - 1e-12)
+            out[rest] = self._base_directions(np.stack([ar, b[rest]], axis=-1))
+        n = len(self.cones)
+        for k in np.nonzero(in_cone)[0]:
+            x = a[k] / PORTAL_SHARE * n
+            i = min(int(x), n - 1)
+            axis, cos_max = self.cones[i]
+            out[k] = _in_cone(axis, cos_max, min(x - i, 1.0 - 1e-12), b[k])
+        return out
+
+    def _base_directions(self, points):
         a, b = points[:, 0], points[:, 1]
         share = self.uniform_share
         uniform = a < share
@@ -154,6 +186,44 @@ class WorldDistribution:
         return np.stack([-np.cos(lon) * cl, np.sin(lon) * cl, np.sin(lat)], axis=-1)
 
 
+def _in_cone(axis, cos_max, a, b):
+    """A uniform direction within ``cos_max`` of ``axis`` from (a, b) of [0, 1)^2."""
+    z = 1.0 - a * (1.0 - cos_max)
+    r = math.sqrt(max(1.0 - z * z, 0.0))
+    phi = 2.0 * math.pi * b
+    frame = _frame_towards(axis)
+    return frame @ np.array([r * math.cos(phi), r * math.sin(phi), z])
+
+
+def portal_cones(portals, lo, hi):
+    """Per light portal (``Snapshot.portals``: matrix, size x, size y), the cone of directions
+    that can reach the box [lo, hi] (what the camera sees) through it from the sky: around
+    the direction from the box's centre to the portal, wide enough for the portal's and the
+    box's extents seen from there (a hemisphere at most). Directions of the world drawn in
+    these cones are the ones that light a room through its windows."""
+    lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        return []
+    centre = 0.5 * (lo + hi)
+    radius = 0.5 * float(np.linalg.norm(hi - lo))
+    cones = []
+    for matrix, size_x, size_y in portals:
+        m = np.asarray(matrix, np.float64)
+        if not np.all(np.isfinite(m)):
+            continue
+        reach = 0.5 * math.hypot(np.linalg.norm(m[:3, 0]) * size_x, np.linalg.norm(m[:3, 1]) * size_y)
+        axis = m[:3, 3] - centre
+        dist = float(np.linalg.norm(axis))
+        if dist > 1e-9 * max(radius, 1.0):
+            axis = axis / dist
+        else:  # the portal at the box's centre: the half-space it faces away from (its +Z)
+            z = m[:3, 2]
+            axis = z / max(float(np.linalg.norm(z)), 1e-300)
+        half = min(math.atan2(reach + radius, dist), 0.5 * math.pi)
+        cones.append((axis, math.cos(half)))
+    return cones
+
+
 def _sphere(a, b):
     """Uniform directions on the sphere from [0, 1)^2 (equal areas: z = 1 - 2a)."""
     z = 1.0 - 2.0 * a
@@ -172,27 +242,32 @@ def sequence_points(first, count):
     return out
 
 
-def distribution(world):
-    """The ``WorldDistribution`` of ``world`` (a ``materials.World`` whose SH is known),
-    remembered on the world object (a snapshot's world is rebuilt when the world changes)."""
-    dist = getattr(world, "_distribution", None)
-    if dist is None:
-        dist = WorldDistribution(world.sh, getattr(world, "env", None))
-        object.__setattr__(world, "_distribution", dist)
-    return dist
+def distribution(world, cones=()):
+    """The ``WorldDistribution`` of ``world`` (a ``materials.World`` whose SH is known) with
+    the portals' ``cones``, remembered on the world object for those cones (a snapshot's
+    world is rebuilt when the world changes)."""
+    key = tuple((tuple(np.round(a, 12)), round(c, 12)) for a, c in cones)
+    cached = getattr(world, "_distribution", None)
+    if cached is None or cached[0] != key:
+        cached = (key, WorldDistribution(world.sh, getattr(world, "env", None), cones))
+        object.__setattr__(world, "_distribution", cached)
+    return cached[1]
 
 
-def world_lights(world, index, count, name="World"):
+def world_lights(world, index, count, name="World", cones=()):
     """The ``count`` world directions of one sample, as suns (``extract.Light`` with
     ``world`` set): directions ``index`` .. ``index + count - 1`` of the frame's sequence.
     Each sun's colour is the world's radiance from it over (its probability x ``count``),
-    its ``world_baseline`` the same of the SH radiance."""
-    dist = distribution(world)
+    its ``world_baseline`` the same of the SH radiance. With light portals (``cones``) the
+    directions gather in the portals' cones and carry the world's whole light (baseline 0):
+    inside a room the SH light would have to be almost all subtracted again, which only adds
+    noise, so such a frame lights surfaces with these directions alone (``control_variate``)."""
+    dist = distribution(world, cones)
     d = dist.directions(sequence_points(index, count))
     pdf = np.maximum(dist.pdf(d), 1e-30)
     scale = 1.0 / (pdf * count)
     radiance = dist.radiance(d) * scale[:, None]
-    baseline = dist.sh_radiance(d) * scale[:, None]
+    baseline = dist.sh_radiance(d) * scale[:, None] if not cones else np.zeros_like(radiance)
     lights = []
     for k in range(count):
         matrix = np.eye(4)

@@ -266,6 +266,9 @@ class Snapshot:
     world: object = None  # materials.World: the world's light as spherical harmonics
     messages: tuple = ()  # what the scene uses that is not drawn (materials, world, objects)
     images_changed: frozenset = frozenset()  # images updated since the last snapshot
+    # Cycles' light portals (area lights flagged Portal): where the world's light comes in,
+    # as (matrix, size x, size y); they guide the world's directions and emit nothing.
+    portals: tuple = ()
 
 
 def matrix_np(m):
@@ -692,7 +695,7 @@ class SceneCache:
     def snapshot(self, depsgraph):
         scene = depsgraph.scene
         instances = []
-        lights = []
+        lights, portals = [], []
         used = set()
         own = {}
 
@@ -742,6 +745,11 @@ class SceneCache:
         for inst in depsgraph.object_instances:
             ob = inst.object
             if ob.type == "LIGHT":
+                if is_portal(ob.data):
+                    size_x = float(ob.data.size)
+                    size_y = float(ob.data.size_y) if ob.data.shape in {"RECTANGLE", "ELLIPSE"} else size_x
+                    portals.append((matrix_np(inst.matrix_world), size_x, size_y))
+                    continue
                 if ob.data.type == "AREA" and float(getattr(ob.data, "spread", math.pi)) < math.pi - 1e-6:
                     messages.append(
                         f"area light '{ob.name}': Spread is not rendered (it emits over the whole half-space)"
@@ -851,6 +859,7 @@ class SceneCache:
             world=world,
             messages=tuple(f"Penumbra: {m}" for m in dict.fromkeys(messages)),
             images_changed=frozenset(self._take_images_changed()),
+            portals=tuple(portals),
         )
 
     def _take_images_changed(self):
@@ -873,6 +882,12 @@ def emitter_area(data, matrix):
     else:
         area = 4.0 * math.pi * float(getattr(data, "shadow_soft_size", 0.0)) ** 2
     return area if area > 0.0 and math.isfinite(area) else 1.0
+
+
+def is_portal(data):
+    """Whether light ``data`` is a Cycles light portal (an area light that only tells where the
+    world's light enters: it emits nothing)."""
+    return data.type == "AREA" and bool(getattr(getattr(data, "cycles", None), "is_portal", False))
 
 
 def light_from_blender(data, matrix):
