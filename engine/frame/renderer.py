@@ -27,6 +27,7 @@ from .programs import MAX_LIGHTS
 from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
+from .world_ao import WorldAO
 from .world_light import world_light
 
 # While the view moves, a frame's maps keep the sizes of the last navigation frame that
@@ -55,6 +56,7 @@ class Renderer:
         self.film = Film(self.shaders, pool)
         self.shadow_pass = ShadowPass(pool)
         self.lit_pass = LitPass(self.shaders, self.materials, self.textures)
+        self.world_ao = WorldAO(pool)  # the camera depth prepass of the world's ambient occlusion
         self.post = post_stack()
         self._last_plan = None  # the last sample's shadow plan (the SHADOW_MAPS view)
         self._last_data = None  # and its frame data (light bins, light order)
@@ -130,6 +132,18 @@ class Renderer:
         if world is not snapshot.world:  # an Environment Texture's light, projected on the GPU
             snapshot = dataclasses.replace(snapshot, world=world, world_color=world.mean)
         lights = select_lights(snapshot.lights, camera.position, MAX_LIGHTS)
+        # The world's ambient occlusion (``sampling.world_ao_sample``): which samples, how far.
+        ao_world = snapshot.world if snapshot.world is not None else snapshot.world_color
+        ao_distance = None
+
+        def world_ao(s):
+            nonlocal ao_distance
+            if not sampling.world_ao_sample(s, accumulate, settings, ao_world, debug.id):
+                return None
+            if ao_distance is None:
+                ao_distance = sampling.world_ao_distance(settings, corners_of(draws)) if draws else 0.0
+            return (ao_distance, sampling.ao_jitter(s)) if ao_distance > 0.0 else None
+
         if len(lights) < len(snapshot.lights):
             stats.messages.append(
                 f"Penumbra: {len(snapshot.lights)} lights; only the {MAX_LIGHTS} that contribute most to the view "
@@ -190,7 +204,9 @@ class Renderer:
                     dataclasses.replace(lt, sampled=True, jittered=jitter) if i in moving else lt
                     for i, lt in enumerate(lights)
                 ]
-                self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True)
+                self._sample(
+                    draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True, ao=world_ao(0)
+                )
                 with clock.stage("settle"):
                     stats.pixels_settled = settle_pixels(
                         self, draws, snapshot, settings, adaptive, sample_count, aux, emission
@@ -222,6 +238,7 @@ class Renderer:
                 stats,
                 alpha_offset,
                 sample_count if accumulate else 1,
+                ao=world_ao(s),
             )
             clock.begin("accumulate")
             if accumulate:
@@ -264,7 +281,11 @@ class Renderer:
             color = self._post_pass(settings, stats)
         stats.shadow_bytes = self.shadows.memory_bytes if plan is not None and plan.tiles else 0
         stats.texture_bytes = (
-            film.target_bytes(aux, accumulate) + stats.shadow_bytes + film.post_ctx.memory_bytes + self.textures.bytes
+            film.target_bytes(aux, accumulate)
+            + stats.shadow_bytes
+            + film.post_ctx.memory_bytes
+            + self.textures.bytes
+            + (self.world_ao.memory_bytes if stats.ao_prepasses else 0)
         )
         clock.end()
         stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
@@ -297,10 +318,13 @@ class Renderer:
         alpha_offset=0.5,
         sample_count=1,
         pilot=False,
+        ao=None,
     ):
         """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
         does not move between samples keeps its map), then the lit pass seen through
-        ``view_camera``. Returns the shadow plan."""
+        ``view_camera``. ``ao``: (distance, jitter) when the sample occludes the world's light
+        (``sampling.world_ao_sample``): the camera depth prepass is drawn first through the lit
+        pass's raster camera (``world_ao.py``). Returns the shadow plan."""
         film = self.film
         width, height = film.size
         lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats)
@@ -331,9 +355,22 @@ class Renderer:
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
         )
         self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
+        if ao is not None:
+            with self._clock.stage("world ao"):
+                self.world_ao.draw(
+                    draws,
+                    raster_camera,
+                    film.size,
+                    self._origin,
+                    self.shaders,
+                    self.materials,
+                    self.textures,
+                    stats,
+                    alpha_offset,
+                )
         with self._clock.stage("lit pass"):
             data = self._lit(
-                draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot
+                draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot, ao=ao
             )
         self._last_data = data
         stats.binned = data.bins is not None
@@ -353,10 +390,15 @@ class Renderer:
         sample_count=1,
         pilot=False,
         target=None,
+        ao=None,
     ):
         """The lit pass of the last sample's cameras (``_last_cameras``) with ``lights`` and the
         maps of ``plan``; ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
-        variant drawn into it, ``settle.py``). Returns the frame data it drew with."""
+        variant drawn into it, ``settle.py``; never occluded); ``ao``: (distance, jitter) of
+        the world's ambient occlusion over the prepass just drawn, or None. Returns the frame
+        data it drew with."""
+        if target is not None:
+            ao = None
         film = self.film
         raster_camera, view_camera, rects = self._last_cameras
         atlas = self.shadows if plan is not None and plan.tiles else None
@@ -377,12 +419,26 @@ class Renderer:
             sample_count=sample_count,
             settle=target is not None,
             pilot=pilot,
+            world_ao=ao,
         )
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
         world = (snapshot.world, snapshot.world_color)
         self.lit_pass.draw(
-            film, seen, view_camera, data, atlas, world, settings, aux, emission, stats, self._origin, masks, target
+            film,
+            seen,
+            view_camera,
+            data,
+            atlas,
+            world,
+            settings,
+            aux,
+            emission,
+            stats,
+            self._origin,
+            masks,
+            target,
+            ao_depth=self.world_ao.texture if ao is not None else None,
         )
         return data
 
@@ -457,3 +513,4 @@ class Renderer:
             return
         self.film.release()
         self.shadows.free()
+        self.world_ao.release()
