@@ -274,7 +274,7 @@ class Renderer:
         clock.begin("post")
         debug_image = None
         if debug.id != "NONE":  # the view instead of the image (and instead of the post stack)
-            debug_image = self._debug_view(debug.id, accumulate, settings)
+            debug_image = self._debug_view(debug.id, accumulate, settings, stats.ao_prepasses > 0)
             color = debug_view.upload(debug_image, settings.pixel_scale)
             stats.debug_legend = debug_image.legend
         else:
@@ -458,14 +458,15 @@ class Renderer:
             target=target,
         )
 
-    def _debug_view(self, view, accumulate, settings):
-        """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``)."""
+    def _debug_view(self, view, accumulate, settings, occluded=False):
+        """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``);
+        ``occluded``: its samples ran the world's ambient occlusion (WORLD_AO)."""
         from .film import texture_array
 
         film = self.film
         width, height = film.size
         if DEBUG_VIEW[view].lit:
-            return debug_view.lit_view(view, texture_array(film.color, 4))
+            return debug_view.lit_view(view, texture_array(film.color, 4), occluded)
         if view == "SAMPLES":
             samples = film.samples_array() if accumulate else np.ones((height, width), np.float32)
             return debug_view.samples_view(samples)

@@ -229,3 +229,27 @@ def test_extremes_stay_finite(penumbra):
     for ortho in (False, True):
         tiny = render(wall_scene(ortho=ortho, size=(1, 1)))["Combined"]
         assert np.all(np.isfinite(tiny)) and tiny[..., :3].max() > 0.0
+
+
+def test_world_ao_debug_view(penumbra, gpu_call):
+    """The WORLD_AO debug view shows the visibility the lit pass used: about 1/2 at the wall's
+    foot, 1 on the open floor beyond the distance; every sample occluded; all ones (and no
+    prepass) with a black world."""
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    scene = wall_scene(distance=0.2)
+    scene.penumbra.debug_view = "WORLD_AO"
+    y = floor_points(scene)[..., 1]
+
+    def job(engine, depsgraph):
+        cam = camera_from_scene(depsgraph, scene, W, H)
+        out = engine.render_frame(depsgraph, cam, W, H, samples=(0, 2), sample_count=2)
+        return out.stats, out.debug.values.copy(), out.debug.covered.copy()
+
+    stats, values, covered = gpu_call(job)
+    assert stats.ao_prepasses == 2 and covered.all()
+    np.testing.assert_allclose(values[y < -0.25], 1.0, rtol=1e-5)
+    assert 0.5 < values[(y > -0.1) & (y < -0.03)].mean() < 0.9
+    scenes.set_world(scene, (0.0, 0.0, 0.0))
+    stats, values, covered = gpu_call(job)
+    assert stats.ao_prepasses == 0 and np.all(values == 1.0)
