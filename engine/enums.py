@@ -248,6 +248,18 @@ DEBUG_VIEW = Enum(
             6,
             {"legend": "noise estimate: green below the Noise Threshold (converged), yellow to red up to 10x it"},
         ),
+        (
+            "WORLD_AO",
+            "World Occlusion",
+            "The world's cosine-weighted visibility the ambient occlusion gives each shaded point (World > "
+            "Ambient Occlusion), averaged over the frame's samples",
+            7,
+            {
+                "lit": True,
+                "legend": "world visibility: black occluded, white open; white everywhere when no occlusion ran "
+                "(ambient occlusion off or a black world)",
+            },
+        ),
     ),
     # lit: the lit pass writes the view's values instead of colour (the DEBUG_LIT variant);
     # legend: what the colours mean (the viewport's text and the render report).

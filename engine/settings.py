@@ -480,8 +480,9 @@ SCENE_PARAMS = (
     Param(
         "world_ao_distance",
         "FLOAT",
-        2.0,
-        "How far the ambient occlusion looks for what blocks the world's light",
+        0.0,
+        "How far the ambient occlusion looks for what blocks the world's light (0: automatic, a tenth of the "
+        "size of everything drawn, so it does the same in a scene of millimetres or of kilometres)",
         min=0.0,
         soft_max=100.0,
         subtype="DISTANCE",

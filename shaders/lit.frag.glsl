@@ -29,9 +29,13 @@
  * lobe's cosine, the Normal pass writes the heavier lobe's normal. Other materials compile
  * one lobe, as before.
  *
+ * WORLD_AO (engine/frame/world_ao.py, lib/gtao.glsl): the world's diffuse light is scaled by its
+ * visibility from screen-space ground-truth ambient occlusion over the camera depth prepass, its
+ * specular by the specular occlusion that implies; lights and emission are untouched.
+ *
  * DEBUG_LIT (the TEXEL_DENSITY, CASCADES and LIGHT_COST debug views, engine/frame/debug_view.py):
  * the pixel writes the lights it evaluated, the cascade it read and its worst texel density
- * instead of colour.
+ * instead of colour; with WORLD_AO (the WORLD_AO view) the world's visibility.
  *
  * SETTLE_TEST (engine/frame/settle.py, after a frame's pilot sample, lights at their centres):
  * the pixel writes whether any later sample could change it through a light (1 in red where
@@ -385,15 +389,28 @@ vec2 env_brdf(float f, float f90, float rough, float NdotV)
   return vec2(es.x - es.y, es.y * f90) * ms;
 }
 
+#if WORLD_AO
+/* The world's cosine-weighted visibility at the normal of the lobe being set up (lib/gtao.glsl,
+ * set in main before each lobe_setup). */
+float world_visibility = 1.0;
+#endif
+
 /* Light from the world: diffuse irradiance, and specular radiance around the reflected
- * direction, wider with roughness, weighted by the environment BRDF ``ab``. */
+ * direction, wider with roughness, weighted by the environment BRDF ``ab``. With WORLD_AO the
+ * diffuse is scaled by the world's visibility and the specular by the specular occlusion it
+ * implies for this lobe (gtao_specular). */
 vec3 world_light(vec3 N, vec3 V, vec3 albedo, vec3 f0, float rough, vec2 ab)
 {
   vec3 diffuse = albedo * world_sh(N, vec2(2.0 / 3.0, 0.25));
   vec3 R = reflect(-V, N);
   float t = rough * rough;
   vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
-  return diffuse + radiance * (f0 * ab.x + ab.y);
+  vec3 specular = radiance * (f0 * ab.x + ab.y);
+#if WORLD_AO
+  diffuse *= world_visibility;
+  specular *= gtao_specular(world_visibility, max(dot(N, V), 0.0), t);
+#endif
+  return diffuse + specular;
 }
 
 /* One lobe's shading values from its Principled parameters (``albedo`` with the specular
@@ -567,6 +584,14 @@ void main()
     N = -N; /* two-sided, as Blender draws meshes */
   }
   s.N = N;
+#if WORLD_AO
+  /* The world's visibility from the camera depth prepass (lib/gtao.glsl): horizons marched
+   * once, integrated for each lobe's normal. */
+  mat3 ao_rotation = mat3(frame.view);
+  GtaoHorizons ao_horizons = gtao_horizons((frame.view * vec4(s.P, 1.0)).xyz, gl_FragCoord.xy);
+  world_visibility = gtao_visibility(ao_horizons, normalize(ao_rotation * s.N));
+  float debug_world_ao = world_visibility;
+#endif
   vec3 color = lobe_setup(base.rgb, rough, metal, spec_f0, s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha);
 #if NODE_LOBES == 2
   /* The second lobe: its own normal where the tree gives one, else the first lobe's. */
@@ -576,6 +601,10 @@ void main()
   vec3 N_b = N;
 #  endif
   s.N_b = (dot(N_b, s.V) < 0.0) ? -N_b : N_b;
+#  if WORLD_AO
+  world_visibility = gtao_visibility(ao_horizons, normalize(ao_rotation * s.N_b));
+  debug_world_ao = dot(lobe_weights, vec2(debug_world_ao, world_visibility));
+#  endif
   vec3 color_b = lobe_setup(base_b.rgb, rough_b, metal_b, spec_f0_b, s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b,
                             s.alpha_b);
   s.w = lobe_weights;
@@ -666,7 +695,9 @@ void main()
 #else
   out_color = vec4(color, 1.0);
 #endif
-#if DEBUG_LIT
+#if DEBUG_LIT && WORLD_AO
+  out_color = vec4(debug_world_ao, 0.0, 0.0, 1.0); /* the WORLD_AO debug view: the world's visibility */
+#elif DEBUG_LIT
   out_color = vec4(debug_lights, debug_cascade, debug_density, 1.0); /* a lit debug view's values */
 #endif
 #if SETTLE_TEST

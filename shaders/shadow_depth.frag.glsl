@@ -3,7 +3,9 @@
  * selected encoding (half float, or the seeds' RGBA8 packing). A caster with alpha
  * (ALPHA_CUTOUT) covers a texel in a fraction alpha of the samples, with the lit pass's
  * stratified hash: over a frame its shadow lets 1 - alpha of the light through, as Cycles'
- * transparent shadows; an alpha texture of 0 and 1 casts its exact cut-out in every sample. */
+ * transparent shadows; an alpha texture of 0 and 1 casts its exact cut-out in every sample.
+ * CAMERA_DEPTH (the world's ambient occlusion prepass): the camera's view depth as colour, with
+ * the lit pass's hash, so a dithered surface covers the same pixels as in the lit pass. */
 void main()
 {
 #if ALPHA_CUTOUT
@@ -29,7 +31,9 @@ void main()
     discard;
   }
 #endif
-#if DEPTH_FORMAT == DEPTH_FLOAT32
+#if CAMERA_DEPTH
+  out_depth = vec4(v_distance); /* the view depth itself, in a float target (world_ao.py) */
+#elif DEPTH_FORMAT == DEPTH_FLOAT32
 #  if !RASTER_DEPTH /* orthographic tiles rasterise this depth already (frame/programs.py) */
   gl_FragDepth = clamp((v_distance - tile.near) / (tile.far - tile.near), 0.0, 1.0);
 #  endif

@@ -1,5 +1,7 @@
 /* Light-space depth pass. The tile's proj_tex maps to texture space; clip space is recovered
- * from it (tex.xyz = 0.5 * clip.xyz + 0.5 * clip.w), so one tile record serves both passes. */
+ * from it (tex.xyz = 0.5 * clip.xyz + 0.5 * clip.w), so one tile record serves both passes.
+ * CAMERA_DEPTH: the camera depth prepass of the world's ambient occlusion (engine/frame/
+ * world_ao.py), whose tile is the lit pass's raster camera. */
 void main()
 {
   vec4 view_pos = tile.view * (model * vec4(pos, 1.0));
@@ -39,10 +41,13 @@ void main()
 #endif
   vec4 t = tile.proj_tex * view_pos;
   gl_Position = vec4(2.0 * t.xyz - t.w, t.w);
+#if !CAMERA_DEPTH
   /* Pancaking: a caster nearer the light than the tile's near plane is flattened onto it
    * (depth 0) instead of clipped away, so it still occludes what is behind it; the tile's
-   * depth range then only has to span the receivers. (x, y do not depend on z.) */
+   * depth range then only has to span the receivers. (x, y do not depend on z.) The camera
+   * depth prepass clips at the near plane, as the lit pass it serves does. */
   if (gl_Position.w > 0.0) {
     gl_Position.z = max(gl_Position.z, -gl_Position.w);
   }
+#endif
 }

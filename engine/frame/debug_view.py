@@ -12,7 +12,9 @@ Each view shows numbers the engine itself used for the frame, not a second compu
 * SAMPLES: the samples each pixel was shaded in (its accumulated weight against the running
   totals of the samples' weights: ``Film.samples_array``);
 * NOISE: the error estimate of adaptive sampling's check (``Film.error_array``), in units of
-  the Noise Threshold.
+  the Noise Threshold;
+* WORLD_AO: the world's visibility from the ambient occlusion (``world_ao.py``), written by the
+  lit pass's ``DEBUG_LIT`` variant with ``WORLD_AO`` (every sample occluded), in grey.
 
 ``DebugImage.values`` holds those numbers per pixel (tests read them); ``image`` is what is
 shown: the values through a colour scale with a legend strip along the bottom, ``legend`` says
@@ -102,11 +104,18 @@ def _compose(values, covered, color_of, strip_of, special=None):
     return np.concatenate([rgb, np.ones((height, width, 1), np.float32)], axis=-1)
 
 
-def lit_view(view, raw):
+def lit_view(view, raw, occluded=True):
     """A lit debug view from the lit pass's ``DEBUG_LIT`` output ``raw`` (height, width, 4):
-    lights evaluated, 1 + cascade, texel density, coverage."""
+    lights evaluated, 1 + cascade, texel density, coverage; for WORLD_AO the world's
+    visibility, coverage (``occluded`` False: no occlusion ran, every point sees all of it)."""
     item = DEBUG_VIEW[view]
     covered = raw[..., 3] > 0.5
+    if view == "WORLD_AO":
+        values = np.clip(raw[..., 0], 0.0, 1.0).astype(np.float32) if occluded else np.ones(covered.shape, np.float32)
+        image = _compose(
+            values, covered, lambda v: np.repeat(v[..., None], 3, -1), lambda t: np.repeat(t[..., None], 3, -1)
+        )
+        return DebugImage(view, values, image.astype(np.float32), f"{item.label}: {item.legend}", covered)
     if view == "LIGHT_COST":
         values = raw[..., 0].astype(np.float32)
         hi = max(1.0, float(values[covered].max()) if covered.any() else 1.0)

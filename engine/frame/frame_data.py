@@ -130,6 +130,26 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "max_filter_radius": max_filter_radius(tile_size),
         "tile_size": tile_size,
         "atlas_columns": atlas_columns,
+        "ao_projection": (0.0, 0.0, 0.0, 0.0),
+        "ao_projection_w": (0.0, 0.0, 0.0, 0.0),
+        "ao_viewport": (1.0, 1.0),
+        "ao_distance": 0.0,
+        "ao_jitter": (0.0, 0.0),
+    }
+
+
+def ao_row(projection, size, distance, jitter):
+    """The frame row's WORLD_AO fields (``lib/gtao.glsl``): the terms of the raster camera's
+    ``projection`` that take a view depth at a pixel to a view-space position and back, the
+    film's ``size`` (width, height), the distance in world units and the sample's ``jitter``
+    (``sampling.ao_jitter``)."""
+    p = np.asarray(projection, np.float64)
+    return {
+        "ao_projection": (p[0, 0], p[1, 1], p[0, 2], p[1, 2]),
+        "ao_projection_w": (p[0, 3], p[1, 3], p[3, 2], p[3, 3]),
+        "ao_viewport": (float(size[0]), float(size[1])),
+        "ao_distance": float(distance),
+        "ao_jitter": tuple(float(j) for j in jitter),
     }
 
 
@@ -172,6 +192,7 @@ def build_frame_data(
     pilot=False,
     world_sampled=False,
     world_sh=True,
+    world_ao=None,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -187,7 +208,9 @@ def build_frame_data(
     ``world_sampled``: the frame samples the world's light with shadow maps (its settle test
     weighs the world's light), whether or not this sample's directions have maps;
     ``world_sh``: the surfaces take the world's SH light (False: this sample's directions of
-    the world carry all of it, ``world_sampling.world_lights`` with portals)."""
+    the world carry all of it, ``world_sampling.world_lights`` with portals);
+    ``world_ao``: (distance, jitter) when the world's light is occluded by the ambient
+    occlusion over the camera depth prepass (``WORLD_AO``; ``size`` is then the film's)."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings, sample_count)
@@ -208,6 +231,8 @@ def build_frame_data(
     if not world_sh:
         frame["world_color"] = _ZERO
     frame["alpha_offset"] = alpha_offset
+    if world_ao is not None:
+        frame.update(ao_row(camera.projection, size, *world_ao))
     frame["shadowed_count"] = shadowed
     frame["shadowed_mask"] = light_bins.word_masks(0, shadowed, LIGHT_WORDS)
     frame["sampled_count"] = sampled
@@ -236,6 +261,7 @@ def build_frame_data(
             settle,
             pilot,
             world_sampled or any(getattr(lights[i], "world", False) for i in order),
+            world_ao is not None,
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

@@ -8,6 +8,7 @@ from ...shaders.loader import set_uniforms
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
 from .programs import (
+    AO_SAMPLER,
     BACKGROUND,
     JITTER_SIZE,
     SHADOW_SAMPLER,
@@ -34,7 +35,21 @@ class LitPass:
         self.uploaded = 0  # bytes sent to the GPU since creation (uniform blocks, textures of data)
 
     def draw(
-        self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None, target=None
+        self,
+        film,
+        draws,
+        camera,
+        data,
+        atlas,
+        world,
+        settings,
+        aux,
+        emission,
+        stats,
+        origin,
+        masks=None,
+        target=None,
+        ao_depth=None,
     ):
         """Every visible part of ``draws``, grouped by material variant: opaque and
         alpha-hashed parts nearest first, then alpha-blended parts farthest first, blended over
@@ -44,7 +59,8 @@ class LitPass:
         ``target``: the settle test's framebuffer (``Film.settle_framebuffer``; ``data`` built
         with ``settle``): the surfaces the last sample drew (its z-buffer, kept) and any
         dithered or blended one in front of them write their flags, the dithered and blended
-        last, nothing blended."""
+        last, nothing blended. ``ao_depth``: the camera depth prepass
+        (``world_ao.WorldAO.texture``) that a ``WORLD_AO`` variant (``data.defines``) reads."""
         import gpu
 
         if target is not None:
@@ -125,6 +141,8 @@ class LitPass:
             shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
             shader.uniform_sampler("jitter_tex", self._jitter(data.disk_samples))
             shader.uniform_sampler("light_bins", self._bins_texture(data.bins))
+            if defines.get("WORLD_AO"):
+                shader.uniform_sampler(AO_SAMPLER, ao_depth)
             bound["shader"] = shader
             return shader
 

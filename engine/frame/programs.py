@@ -23,6 +23,7 @@ max_filter_radius = lightspace.max_filter_radius
 
 
 SHADOW_SAMPLER = "shadow_atlas"
+AO_SAMPLER = "ao_depth"
 
 LIGHT_STRUCT = Struct(
     "LightData",
@@ -106,6 +107,15 @@ FRAME_STRUCT = Struct(
         ("FLOAT", "max_filter_radius"),  # widest disk kernel, texels
         ("INT", "tile_size"),  # texels per side of the atlas's slots (its widest map)
         ("INT", "atlas_columns"),  # tiles per atlas row
+        # WORLD_AO (lib/gtao.glsl): the raster camera's projection terms that take a view depth
+        # to a position and back (P[0][0], P[1][1], P[0][2], P[1][2] and P[0][3], P[1][3],
+        # P[3][2], P[3][3]), the film's size in pixels, the distance the occlusion looks in
+        # world units, and this sample's rotation of the slices and offset of the steps.
+        ("VEC4", "ao_projection"),
+        ("VEC4", "ao_projection_w"),
+        ("VEC2", "ao_viewport"),
+        ("FLOAT", "ao_distance"),
+        ("VEC2", "ao_jitter"),
     ),
 )
 
@@ -198,11 +208,18 @@ LIT = Program(
         "lib/shadow_filters.glsl",
         "lib/material.glsl",
         "lib/ggx_albedo.glsl",
+        "lib/gtao.glsl",
     ),
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
     push_constants=(("MAT4", "model"), ("IVEC4", "light_mask"), ("INT", "solid")),
-    samplers=(("FLOAT_2D", SHADOW_SAMPLER), ("FLOAT_3D", "jitter_tex"), ("FLOAT_2D", "light_bins")),
+    # ao_depth: with WORLD_AO, the camera depth prepass (``world_ao.WorldAO``), view depth per pixel.
+    samplers=(
+        ("FLOAT_2D", SHADOW_SAMPLER),
+        ("FLOAT_3D", "jitter_tex"),
+        ("FLOAT_2D", "light_bins"),
+        ("FLOAT_2D", AO_SAMPLER),
+    ),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
         (LIGHT_STRUCT, "lights", MAX_LIGHTS),
@@ -400,6 +417,7 @@ SHADOW_DEPTH = Program(
             "HAS_UV": False,
             "RASTER_DEPTH": False,
             "HAIR_STRIP": False,
+            "CAMERA_DEPTH": False,
         }.items()
     ),
 )
@@ -417,6 +435,17 @@ SHADOW_DEPTH_RASTER = replace(
     name="shadow_depth_raster",
     depth_write="",
     defines=tuple({**dict(SHADOW_DEPTH.defines), "RASTER_DEPTH": True}.items()),
+)
+
+
+# The camera depth prepass of the world's ambient occlusion (``world_ao.py``): the same depth
+# pass seen from the camera (its "tile" is the lit pass's raster camera), writing the view depth
+# itself into a float colour target (full float precision at every distance) and clipping at the
+# near plane as the lit pass does instead of pancaking.
+CAMERA_DEPTH = replace(
+    SHADOW_DEPTH,
+    name="camera_depth",
+    defines=tuple({**dict(SHADOW_DEPTH.defines), "CAMERA_DEPTH": True}.items()),
 )
 
 
@@ -555,8 +584,8 @@ CONVERGED_DEPTH = Program(
 
 # Shadow casters with alpha (leaves, fences, glass panes drawn with alpha): a texel is
 # covered in a fraction alpha of the samples (``textured``: the alpha comes from a texture).
-def shadow_cutout_program(depth_format, textured, raster_depth=False):
-    base = shadow_program(depth_format, raster_depth)
+def shadow_cutout_program(depth_format, textured, raster_depth=False, camera=False):
+    base = shadow_program(depth_format, raster_depth, camera)
     program = replace(
         base,
         libs=base.libs + ("lib/material.glsl",),
@@ -572,10 +601,10 @@ def shadow_cutout_program(depth_format, textured, raster_depth=False):
     return _with_features(program, features, f"{base.name}_alpha_tex")
 
 
-def shadow_hair_program(depth_format, raster_depth=False):
+def shadow_hair_program(depth_format, raster_depth=False, camera=False):
     """The depth pass of hair strips: widened across the strand facing the light (the map's
     eye), by the strands' radius or one map texel (``hair_texels``)."""
-    base = shadow_program(depth_format, raster_depth)
+    base = shadow_program(depth_format, raster_depth, camera)
     return replace(
         base,
         name=f"{base.name}_hair",
@@ -585,11 +614,11 @@ def shadow_hair_program(depth_format, raster_depth=False):
     )
 
 
-def shadow_tree_program(depth_format, tree, raster_depth=False):
+def shadow_tree_program(depth_format, tree, raster_depth=False, camera=False):
     """The alpha cut-out of a caster whose alpha a compiled node tree gives (``tree``:
     ``nodetree.CompiledTree`` without FRAME in its needs): the tree runs in the depth pass,
     with the surface data it reads, so a procedural alpha casts the shadow it draws."""
-    base = shadow_program(depth_format, raster_depth)
+    base = shadow_program(depth_format, raster_depth, camera)
     program = replace(
         base,
         libs=base.libs + ("lib/material.glsl",),
@@ -637,9 +666,12 @@ WORLD_REDUCE = Program(
 )
 
 
-def shadow_program(depth_format, raster_depth=False):
+def shadow_program(depth_format, raster_depth=False, camera=False):
     """The depth pass of a map stored as ``depth_format``; ``raster_depth``: the tile is
-    orthographic, so a depth-buffer map takes the rasterised depth as it is."""
+    orthographic, so a depth-buffer map takes the rasterised depth as it is. ``camera``: the
+    camera depth prepass instead (``CAMERA_DEPTH``; the format does not matter)."""
+    if camera:
+        return CAMERA_DEPTH
     if not DEPTH_FORMAT[depth_format].depth_only:
         return SHADOW_DEPTH
     return SHADOW_DEPTH_RASTER if raster_depth else SHADOW_DEPTH_ONLY
@@ -678,6 +710,7 @@ def lit_defines(
     settle=False,
     pilot=False,
     world_lights=False,
+    world_ao=False,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -698,7 +731,9 @@ def lit_defines(
     at most SETTLE_REACH texels around a point in a map; ``pilot``: a frame's pilot sample
     (``PILOT_SAMPLE``), which reads moving lights' maps with one bilinear lookup.
     ``world_lights``: some lights are directions of the world's light (``WORLD_LIGHTS``,
-    ``world_sampling.py``), which add their light less the SH light's share."""
+    ``world_sampling.py``), which add their light less the SH light's share.
+    ``world_ao``: the world's light is occluded by screen-space ground-truth ambient occlusion
+    over the camera depth prepass (``WORLD_AO``, ``lib/gtao.glsl``, ``world_ao.py``)."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -730,6 +765,7 @@ def lit_defines(
         "SETTLE_TEST": bool(settle),
         "PILOT_SAMPLE": bool(pilot),
         "WORLD_LIGHTS": bool(world_lights),
+        "WORLD_AO": bool(world_ao),
         "SETTLE_REACH": SETTLE_REACH,
         "SETTLE_GRID": SETTLE_GRID,
     }

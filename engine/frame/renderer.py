@@ -27,6 +27,7 @@ from .programs import MAX_LIGHTS
 from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
+from .world_ao import WorldAO
 from .world_light import world_light
 from .world_sampling import needs_directions, portal_cones, world_lights
 
@@ -56,6 +57,7 @@ class Renderer:
         self.film = Film(self.shaders, pool)
         self.shadow_pass = ShadowPass(pool)
         self.lit_pass = LitPass(self.shaders, self.materials, self.textures)
+        self.world_ao = WorldAO(pool)  # the camera depth prepass of the world's ambient occlusion
         self.post = post_stack()
         self._last_plan = None  # the last sample's shadow plan (the SHADOW_MAPS view)
         self._last_data = None  # and its frame data (light bins, light order)
@@ -157,6 +159,22 @@ class Renderer:
                 f"Penumbra: {len(snapshot.lights)} lights; only the {room} that contribute most to the view are lit"
             )
         debug = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
+        # The world's ambient occlusion (``sampling.world_ao_sample``): which samples, how far;
+        # none where light portals send the world's directions into every sample.
+        ao_world = snapshot.world if snapshot.world is not None else snapshot.world_color
+        ao_distance = None
+
+        def world_ao(s):
+            nonlocal ao_distance
+            if cones or not sampling.world_ao_sample(s, accumulate, settings, ao_world, debug.id):
+                return None
+            if ao_distance is None:
+                ao_distance = sampling.world_ao_distance(settings, corners_of(draws)) if draws else 0.0
+            return (ao_distance, sampling.ao_jitter(s)) if ao_distance > 0.0 else None
+
+        # A sample with ambient occlusion (a frame's first) takes no directions of the world:
+        # the directions' sequence starts at the next one.
+        first_directions = 1 if directions and accumulate and world_ao(0) is not None else 0
         # A lit debug view's values are not colour: no noise estimate of theirs ends a frame.
         adaptive = adaptive if accumulate and not debug.lit else None
         noise = adaptive is not None and adaptive.threshold > 0.0
@@ -209,7 +227,9 @@ class Renderer:
                     dataclasses.replace(lt, sampled=True, jittered=jitter) if i in moving else lt
                     for i, lt in enumerate(lights)
                 ]
-                self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True)
+                self._sample(
+                    draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True, ao=world_ao(0)
+                )
                 with clock.stage("settle"):
                     stats.pixels_settled = settle_pixels(
                         self, draws, snapshot, settings, adaptive, sample_count, aux, emission
@@ -227,8 +247,9 @@ class Renderer:
                 sampling.light_at_sample(lt, i, s, sample_count, jitter, progressive=noise) if i in moving else lt
                 for i, lt in enumerate(lights)
             ]
-            if directions:
-                sample_lights += world_lights(snapshot.world, s * directions, directions, cones=cones)
+            if directions and s >= first_directions:
+                index = (s - first_directions) * directions
+                sample_lights += world_lights(snapshot.world, index, directions, cones=cones)
                 stats.world_directions += directions
             clock.end()
             alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
@@ -244,6 +265,7 @@ class Renderer:
                 stats,
                 alpha_offset,
                 sample_count if accumulate else 1,
+                ao=world_ao(s),
             )
             clock.begin("accumulate")
             if accumulate:
@@ -279,14 +301,18 @@ class Renderer:
         clock.begin("post")
         debug_image = None
         if debug.id != "NONE":  # the view instead of the image (and instead of the post stack)
-            debug_image = self._debug_view(debug.id, accumulate, settings)
+            debug_image = self._debug_view(debug.id, accumulate, settings, stats.ao_prepasses > 0)
             color = debug_view.upload(debug_image, settings.pixel_scale)
             stats.debug_legend = debug_image.legend
         else:
             color = self._post_pass(settings, stats)
         stats.shadow_bytes = self.shadows.memory_bytes if plan is not None and plan.tiles else 0
         stats.texture_bytes = (
-            film.target_bytes(aux, accumulate) + stats.shadow_bytes + film.post_ctx.memory_bytes + self.textures.bytes
+            film.target_bytes(aux, accumulate)
+            + stats.shadow_bytes
+            + film.post_ctx.memory_bytes
+            + self.textures.bytes
+            + (self.world_ao.memory_bytes if stats.ao_prepasses else 0)
         )
         clock.end()
         stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
@@ -319,10 +345,13 @@ class Renderer:
         alpha_offset=0.5,
         sample_count=1,
         pilot=False,
+        ao=None,
     ):
         """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
         does not move between samples keeps its map), then the lit pass seen through
-        ``view_camera``. Returns the shadow plan."""
+        ``view_camera``. ``ao``: (distance, jitter) when the sample occludes the world's light
+        (``sampling.world_ao_sample``): the camera depth prepass is drawn first through the lit
+        pass's raster camera (``world_ao.py``). Returns the shadow plan."""
         film = self.film
         width, height = film.size
         lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats)
@@ -353,9 +382,22 @@ class Renderer:
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
         )
         self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
+        if ao is not None:
+            with self._clock.stage("world ao"):
+                self.world_ao.draw(
+                    draws,
+                    raster_camera,
+                    film.size,
+                    self._origin,
+                    self.shaders,
+                    self.materials,
+                    self.textures,
+                    stats,
+                    alpha_offset,
+                )
         with self._clock.stage("lit pass"):
             data = self._lit(
-                draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot
+                draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot, ao=ao
             )
         self._last_data = data
         stats.binned = data.bins is not None
@@ -375,10 +417,15 @@ class Renderer:
         sample_count=1,
         pilot=False,
         target=None,
+        ao=None,
     ):
         """The lit pass of the last sample's cameras (``_last_cameras``) with ``lights`` and the
         maps of ``plan``; ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
-        variant drawn into it, ``settle.py``). Returns the frame data it drew with."""
+        variant drawn into it, ``settle.py``; never occluded); ``ao``: (distance, jitter) of
+        the world's ambient occlusion over the prepass just drawn, or None. Returns the frame
+        data it drew with."""
+        if target is not None:
+            ao = None
         film = self.film
         raster_camera, view_camera, rects = self._last_cameras
         atlas = self.shadows if plan is not None and plan.tiles else None
@@ -401,12 +448,26 @@ class Renderer:
             pilot=pilot,
             world_sampled=self._world_sampled,
             world_sh=self._world_sh or not any(getattr(lt, "world", False) for lt in lights),
+            world_ao=ao,
         )
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
         world = (snapshot.world, snapshot.world_color)
         self.lit_pass.draw(
-            film, seen, view_camera, data, atlas, world, settings, aux, emission, stats, self._origin, masks, target
+            film,
+            seen,
+            view_camera,
+            data,
+            atlas,
+            world,
+            settings,
+            aux,
+            emission,
+            stats,
+            self._origin,
+            masks,
+            target,
+            ao_depth=self.world_ao.texture if ao is not None else None,
         )
         return data
 
@@ -426,14 +487,15 @@ class Renderer:
             target=target,
         )
 
-    def _debug_view(self, view, accumulate, settings):
-        """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``)."""
+    def _debug_view(self, view, accumulate, settings, occluded=False):
+        """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``);
+        ``occluded``: its samples ran the world's ambient occlusion (WORLD_AO)."""
         from .film import texture_array
 
         film = self.film
         width, height = film.size
         if DEBUG_VIEW[view].lit:
-            return debug_view.lit_view(view, texture_array(film.color, 4))
+            return debug_view.lit_view(view, texture_array(film.color, 4), occluded)
         if view == "SAMPLES":
             samples = film.samples_array() if accumulate else np.ones((height, width), np.float32)
             return debug_view.samples_view(samples)
@@ -481,3 +543,4 @@ class Renderer:
             return
         self.film.release()
         self.shadows.free()
+        self.world_ao.release()

@@ -107,6 +107,10 @@ class FrameStats:
     debug_legend: str = ""  # a debug view's legend: what its colours mean (``debug_view``)
     binned: bool = False  # the lit pass looped over each screen bin's lights only
     shadow_draws: int = 0  # of ``draws``, the draw calls into shadow maps
+    # Camera depth prepasses drawn for the world's ambient occlusion (``world_ao``) and their
+    # draw calls; counted apart, not in ``passes`` and ``draws``.
+    ao_prepasses: int = 0
+    ao_draws: int = 0
     upload_bytes: int = 0  # bytes sent to the GPU: uniform blocks, batches built, textures of data
     cpu_seconds: dict = field(default_factory=dict)  # stage -> render-thread CPU seconds (``StageClock.cpu``)
     gpu_seconds: dict = field(default_factory=dict)  # stage -> seconds waiting on the GPU (with a fence only)
