@@ -49,6 +49,14 @@ def disk_samples(settings, sample_count=1):
     return int(np.clip(per_sample // RING * RING, RING, MAX_DISK_SAMPLES))
 
 
+def indirect_samples(settings):
+    """Reflective shadow-map texels each pixel gathers per light and sample, with Light Paths
+    > Diffuse Bounces at 1 (0: no bounce)."""
+    if int(getattr(settings, "indirect_bounces", 0)) < 1:
+        return 0
+    return int(np.clip(int(getattr(settings, "indirect_samples", 16)), 1, 256))
+
+
 def select_lights(lights, camera_position, limit):
     """At most ``limit`` lights, the ones whose light reaches the camera's surroundings most
     (sun: its strength; others: power over the squared distance to the camera), in their
@@ -128,6 +136,7 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "max_filter_radius": max_filter_radius(tile_size),
         "tile_size": tile_size,
         "atlas_columns": atlas_columns,
+        "sample_index": 0,
     }
 
 
@@ -160,6 +169,8 @@ def build_frame_data(
     sample_count=1,
     settle=False,
     pilot=False,
+    sample_index=0,
+    rsm=False,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -171,7 +182,10 @@ def build_frame_data(
     ``alpha_offset``: this sample's shift of the alpha-hash threshold ((s + 0.5) / N);
     ``origin``: the frame origin: every position the GPU gets is relative to it;
     ``sample_count``: the frame's samples, which share the disk filters' taps; ``settle``:
-    for the settle test's variant (``settle.py``); ``pilot``: for a frame's pilot sample."""
+    for the settle test's variant (``settle.py``); ``pilot``: for a frame's pilot sample;
+    ``sample_index``: this sample's index in its frame; ``rsm``: the atlas holds reflective
+    shadow maps (``indirect_samples``): the variant gathers one diffuse bounce from them when
+    some light has a map (``INDIRECT_RSM`` in its defines)."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings, sample_count)
@@ -190,6 +204,9 @@ def build_frame_data(
         for k in range(1, 9):
             frame[f"world_sh{k}"] = (*sh[k], 0.0)
     frame["alpha_offset"] = alpha_offset
+    frame["sample_index"] = int(sample_index)
+    # One diffuse bounce from the maps' reflective targets: only where some light has a map.
+    indirect = indirect_samples(settings) if rsm and shadowed > 0 else 0
     frame["shadowed_count"] = shadowed
     frame["shadowed_mask"] = light_bins.word_masks(0, shadowed, LIGHT_WORDS)
     frame["sampled_count"] = sampled
@@ -217,6 +234,7 @@ def build_frame_data(
             DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].lit and not settle,
             settle,
             pilot,
+            indirect,
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

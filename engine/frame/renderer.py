@@ -222,6 +222,7 @@ class Renderer:
                 stats,
                 alpha_offset,
                 sample_count if accumulate else 1,
+                sample_index=s,
             )
             clock.begin("accumulate")
             if accumulate:
@@ -297,6 +298,7 @@ class Renderer:
         alpha_offset=0.5,
         sample_count=1,
         pilot=False,
+        sample_index=0,
     ):
         """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
         does not move between samples keeps its map), then the lit pass seen through
@@ -333,7 +335,18 @@ class Renderer:
         self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
         with self._clock.stage("lit pass"):
             data = self._lit(
-                draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot
+                draws,
+                lights,
+                plan,
+                snapshot,
+                settings,
+                aux,
+                emission,
+                stats,
+                alpha_offset,
+                sample_count,
+                pilot,
+                sample_index=sample_index,
             )
         self._last_data = data
         stats.binned = data.bins is not None
@@ -353,6 +366,7 @@ class Renderer:
         sample_count=1,
         pilot=False,
         target=None,
+        sample_index=0,
     ):
         """The lit pass of the last sample's cameras (``_last_cameras``) with ``lights`` and the
         maps of ``plan``; ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
@@ -377,6 +391,8 @@ class Renderer:
             sample_count=sample_count,
             settle=target is not None,
             pilot=pilot,
+            sample_index=sample_index,
+            rsm=atlas is not None and atlas.rsm,
         )
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None

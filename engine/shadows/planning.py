@@ -304,6 +304,7 @@ def plan_shadows(
     receivers=None,
     density=None,
     known_sizes=None,
+    reflective=False,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -322,6 +323,9 @@ def plan_shadows(
     frame's first plan): those lights are planned once, at those sizes, with no density pass;
     so every sample of a frame draws a light's maps at one size, and planning a further
     sample costs one fit per map, not two.
+    ``reflective``: the maps are also reflective shadow maps (the diffuse bounce), whose
+    texels are the senders of bounced light: every box counts as a caster (flat ones too), so
+    a map covers every visible receiver its light reaches, not only those a caster can shadow.
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
@@ -339,6 +343,8 @@ def plan_shadows(
 
     def flat_free_of(light):
         """Flat boxes that shadow nothing under ``light`` (None: not tested)."""
+        if reflective:  # every lit surface sends light: none is left out
+            return np.zeros(len(corners), dtype=bool) if light.type == "SUN" and view_corners is not None else None
         if light.type != "SUN":
             return lightspace.flat_casters_without_shadow(corners, position=light.position)
         return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
