@@ -686,6 +686,18 @@ void main()
   }
 #  endif
 #endif
+#if INDIRECT_RSM && !SETTLE_TEST && !DEBUG_LIT
+  {
+    /* One diffuse bounce from the lights' reflective shadow maps (lib/indirect_rsm.glsl),
+     * reflected by the diffuse lobe(s). */
+    vec3 bounced = indirect_rsm(s.P, s.N, v_view_depth) / M_PI;
+#  if NODE_LOBES == 2
+    color += (s.w.x * s.albedo + s.w.y * s.albedo_b) * bounced;
+#  else
+    color += s.albedo * bounced;
+#  endif
+  }
+#endif
   color += emission;
 #if HOLDOUT
   out_color = vec4(0.0); /* Object > Visibility > Holdout: a hole in the film */
@@ -709,6 +721,9 @@ void main()
    * weighs against the threshold like any light's spread: a dim world under bright lights
    * still settles, a world that lights the pixel keeps it sampling. */
   settle_spread += dot(max(world_term, vec3(0.0)), vec3(1.0));
+#  endif
+#  if INDIRECT_RSM
+  settled = false; /* the bounce is sampled anew in every sample */
 #  endif
 #  if NODE_PROCEDURAL
   /* Procedural textures are evaluated at each sample's point, unfiltered: one sample cannot

@@ -8,6 +8,10 @@
  * the lit pass's hash, so a dithered surface covers the same pixels as in the lit pass. */
 void main()
 {
+#if RSM_MATERIAL
+  vec3 rsm_base = material.base_color.rgb;
+  float rsm_metal = material.metallic;
+#endif
 #if ALPHA_CUTOUT
   float coverage = material.alpha;
 #  if NODE_TREE
@@ -22,6 +26,10 @@ void main()
     vec4 spec = vec4(0.04);
     vec3 emission = vec3(0.0), normal = vec3(0.0);
     node_tree(front ? Nt : -Nt, V, front, base, rough, metal, spec, coverage, emission, normal);
+#    if RSM_MATERIAL
+    rsm_base = base.rgb;
+    rsm_metal = metal;
+#    endif
   }
 #  endif
 #  if TEX_ALPHA
@@ -29,6 +37,25 @@ void main()
 #  endif
   if (coverage <= fract(pixel_hash(gl_FragCoord.xy) + alpha_offset)) {
     discard;
+  }
+#endif
+#if RSM_OUTPUT
+  {
+    /* Reflective shadow maps (lib/indirect_rsm.glsl): the diffuse albedo (base colour times
+     * 1 - metallic, bounded to half-float range) and the normal on the side the light sees
+     * (meshes are two-sided); hair strips (no RSM_MATERIAL) reflect nothing. */
+    vec3 toward = v_rsm_to_light;
+    float nl = length(v_rsm_normal);
+    vec3 n = (nl > 1e-20) ? v_rsm_normal / nl : normalize(toward);
+    n = (dot(n, toward) < 0.0) ? -n : n;
+#  if RSM_MATERIAL
+    vec3 albedo = clamp(rsm_base, vec3(0.0), vec3(1e4)) * (1.0 - clamp(rsm_metal, 0.0, 1.0));
+    albedo = (any(isnan(albedo))) ? vec3(0.0) : albedo;
+#  else
+    vec3 albedo = vec3(0.0);
+#  endif
+    out_rsm_flux = vec4(albedo, 1.0);
+    out_rsm_normal = vec4(n, 0.0);
   }
 #endif
 #if CAMERA_DEPTH

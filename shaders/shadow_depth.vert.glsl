@@ -25,6 +25,17 @@ void main()
   }
 #endif
   v_distance = -view_pos.z;
+#if RSM_OUTPUT
+  {
+    /* Reflective shadow maps: the world normal (the model's cofactor, as mesh.vert) and the
+     * direction towards the light, turned to world space (the view is rigid). */
+    mat3 mr = mat3(model);
+    mat3 cr = mat3(cross(mr[1], mr[2]), cross(mr[2], mr[0]), cross(mr[0], mr[1]));
+    v_rsm_normal = cr * nor * (dot(mr[0], cr[0]) < 0.0 ? -1.0 : 1.0);
+    vec3 toward = (tile.proj_tex[2][3] == 0.0) ? vec3(0.0, 0.0, 1.0) : -view_pos.xyz;
+    v_rsm_to_light = transpose(mat3(tile.view)) * toward;
+  }
+#endif
 #if HAS_UV
   v_uv = uv;
 #endif

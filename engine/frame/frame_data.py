@@ -49,6 +49,14 @@ def disk_samples(settings, sample_count=1):
     return int(np.clip(per_sample // RING * RING, RING, MAX_DISK_SAMPLES))
 
 
+def indirect_samples(settings):
+    """Reflective shadow-map texels each pixel gathers per light and sample, with Light Paths
+    > Diffuse Bounces at 1 (0: no bounce)."""
+    if int(getattr(settings, "indirect_bounces", 0)) < 1:
+        return 0
+    return int(np.clip(int(getattr(settings, "indirect_samples", 16)), 1, 256))
+
+
 def select_lights(lights, camera_position, limit):
     """At most ``limit`` lights, the ones whose light reaches the camera's surroundings most
     (sun: its strength; others: power over the squared distance to the camera), in their
@@ -135,6 +143,7 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "ao_viewport": (1.0, 1.0),
         "ao_distance": 0.0,
         "ao_jitter": (0.0, 0.0),
+        "sample_index": 0,
     }
 
 
@@ -193,6 +202,8 @@ def build_frame_data(
     world_sampled=False,
     world_sh=True,
     world_ao=None,
+    sample_index=0,
+    rsm=False,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -210,7 +221,10 @@ def build_frame_data(
     ``world_sh``: the surfaces take the world's SH light (False: this sample's directions of
     the world carry all of it, ``world_sampling.world_lights`` with portals);
     ``world_ao``: (distance, jitter) when the world's light is occluded by the ambient
-    occlusion over the camera depth prepass (``WORLD_AO``; ``size`` is then the film's)."""
+    occlusion over the camera depth prepass (``WORLD_AO``; ``size`` is then the film's);
+    ``sample_index``: this sample's index in its frame; ``rsm``: the atlas holds reflective
+    shadow maps (``indirect_samples``): the variant gathers one diffuse bounce from them when
+    some light has a map (``INDIRECT_RSM`` in its defines)."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings, sample_count)
@@ -233,6 +247,9 @@ def build_frame_data(
     frame["alpha_offset"] = alpha_offset
     if world_ao is not None:
         frame.update(ao_row(camera.projection, size, *world_ao))
+    frame["sample_index"] = int(sample_index)
+    # One diffuse bounce from the maps' reflective targets: only where some light has a map.
+    indirect = indirect_samples(settings) if rsm and shadowed > 0 else 0
     frame["shadowed_count"] = shadowed
     frame["shadowed_mask"] = light_bins.word_masks(0, shadowed, LIGHT_WORDS)
     frame["sampled_count"] = sampled
@@ -262,6 +279,7 @@ def build_frame_data(
             pilot,
             world_sampled or any(getattr(lights[i], "world", False) for i in order),
             world_ao is not None,
+            indirect,
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

@@ -11,6 +11,8 @@ from .programs import (
     AO_SAMPLER,
     BACKGROUND,
     JITTER_SIZE,
+    RSM_FLUX_SAMPLER,
+    RSM_NORMAL_SAMPLER,
     SHADOW_SAMPLER,
     image_premultiplied_bits,
     lit_program,
@@ -120,9 +122,12 @@ class LitPass:
         # Strand-shaped hair: half a pixel's width per unit of clip w (the camera's y scale).
         hair_pixel = 1.0 / max(abs(float(camera.projection[1, 1])) * height, 1e-30)
 
+        # One diffuse bounce from the atlas's reflective targets (frame_data: some light has a map).
+        rsm = bool(data.defines.get("INDIRECT_RSM"))
+
         def bind(features, with_aux, tree):
             program = lit_program(
-                frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux, tree
+                frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux, tree, rsm
             )
             defines = data.defines
             if bool(defines.get("AUX_OUTPUTS")) != with_aux:
@@ -143,6 +148,9 @@ class LitPass:
             shader.uniform_sampler("light_bins", self._bins_texture(data.bins))
             if defines.get("WORLD_AO"):
                 shader.uniform_sampler(AO_SAMPLER, ao_depth)
+            if rsm:
+                shader.uniform_sampler(RSM_FLUX_SAMPLER, atlas.flux)
+                shader.uniform_sampler(RSM_NORMAL_SAMPLER, atlas.normal)
             bound["shader"] = shader
             return shader
 

@@ -116,6 +116,7 @@ FRAME_STRUCT = Struct(
         ("VEC2", "ao_viewport"),
         ("FLOAT", "ao_distance"),
         ("VEC2", "ao_jitter"),
+        ("INT", "sample_index"),  # this sample's index in its frame (the bounce's sequence, INDIRECT_RSM)
     ),
 )
 
@@ -237,6 +238,8 @@ LIT = Program(
             **material_defines(frozenset()),
             "EMISSION_OUTPUT": False,
             "COUNT_SHADED": False,
+            "INDIRECT_RSM": False,
+            "RSM_SAMPLES": 1,
         }.items()
     ),
 )
@@ -359,16 +362,63 @@ LIT_COLOR_COUNTED = replace(
 )
 
 
-def lit_program(features=frozenset(), aux=True, emission=False, counted=False, tree=None):
+def lit_program(features=frozenset(), aux=True, emission=False, counted=False, tree=None, rsm=False):
     """The lit pass program of a material variant (``Material.features``, plus "HOLDOUT");
     ``emission``: the variant also writes the Emission pass's target; ``counted`` (colour
     only): it also writes the shading count (``LIT_COLOR_COUNTED``); ``tree``: the
-    material's ``nodetree.CompiledTree`` (its feature NODES_<key> names the variant)."""
+    material's ``nodetree.CompiledTree`` (its feature NODES_<key> names the variant);
+    ``rsm``: it also gathers one diffuse bounce from the lights' reflective shadow maps
+    (``with_rsm_gather``; the frame's defines carry INDIRECT_RSM)."""
     base = LIT_EMIT if emission else (LIT if aux else (LIT_COLOR_COUNTED if counted else LIT_COLOR))
+    if rsm:
+        base = with_rsm_gather(base)
     if not features:
         return base
     program = _with_features(base, features, f"{base.name}_{'_'.join(sorted(features)).lower()}")
     return with_tree(program, tree) if tree is not None else program
+
+
+# Reflective shadow maps (Dachsbacher and Stamminger 2005): with Light Paths > Diffuse Bounces
+# at 1 the shadow atlas has two more colour targets of its size, per texel the diffuse albedo
+# of the surface the light sees there (rgb) and its world normal turned towards the light
+# (xyz), both RGBA16F. The light's irradiance there is evaluated when the lit pass gathers
+# (from the texel's depth), so the stored values stay within half-float range at any light
+# strength and scene scale.
+RSM_FLUX_SAMPLER = "rsm_flux"
+RSM_NORMAL_SAMPLER = "rsm_normal"
+RSM_FORMAT = "RGBA16F"
+RSM_TEXEL_BYTES = 16  # both targets
+
+
+def with_rsm_gather(program):
+    """A lit program that also reads the atlas's reflective targets (lib/indirect_rsm.glsl)."""
+    return replace(
+        program,
+        name=f"{program.name}_rsm",
+        libs=program.libs + ("lib/indirect_rsm.glsl",),
+        samplers=program.samplers + (("FLOAT_2D", RSM_FLUX_SAMPLER), ("FLOAT_2D", RSM_NORMAL_SAMPLER)),
+    )
+
+
+def with_rsm_output(program, material=True):
+    """A depth-pass program that also writes a reflective shadow map's albedo and normal
+    (``RSM_OUTPUT``); ``material``: it reads the caster's MaterialData block for the albedo
+    (hair strips do not: they reflect nothing into the bounce)."""
+    vertex_in = program.vertex_in
+    if not any(name == "nor" for _t, name in vertex_in):
+        vertex_in = vertex_in[:1] + MESH_VERTEX_IN[1:] + vertex_in[1:]
+    blocks = program.uniform_blocks
+    if material and not any(name == "material" for _s, name, _c in blocks):
+        blocks = blocks + ((MATERIAL_STRUCT, "material", 0),)
+    return replace(
+        program,
+        name=f"{program.name}_rsm",
+        vertex_in=vertex_in,
+        varyings=program.varyings + (("smooth", "VEC3", "v_rsm_normal"), ("smooth", "VEC3", "v_rsm_to_light")),
+        uniform_blocks=blocks,
+        outputs=program.outputs + (("VEC4", "out_rsm_flux"), ("VEC4", "out_rsm_normal")),
+        defines=program.defines + (("RSM_OUTPUT", True), ("RSM_MATERIAL", bool(material))),
+    )
 
 
 # Per-draw values a compiled tree may read (set like ``model``): the object's texture space
@@ -418,6 +468,8 @@ SHADOW_DEPTH = Program(
             "RASTER_DEPTH": False,
             "HAIR_STRIP": False,
             "CAMERA_DEPTH": False,
+            "RSM_OUTPUT": False,
+            "RSM_MATERIAL": False,
         }.items()
     ),
 )
@@ -436,6 +488,8 @@ SHADOW_DEPTH_RASTER = replace(
     depth_write="",
     defines=tuple({**dict(SHADOW_DEPTH.defines), "RASTER_DEPTH": True}.items()),
 )
+# (Reflective shadow maps: each of these, and the cut-out and hair programs below, gets its
+# ``with_rsm_output`` variant, with ``rsm`` in the functions that choose them.)
 
 
 # The camera depth prepass of the world's ambient occlusion (``world_ao.py``): the same depth
@@ -584,7 +638,9 @@ CONVERGED_DEPTH = Program(
 
 # Shadow casters with alpha (leaves, fences, glass panes drawn with alpha): a texel is
 # covered in a fraction alpha of the samples (``textured``: the alpha comes from a texture).
-def shadow_cutout_program(depth_format, textured, raster_depth=False, camera=False):
+def shadow_cutout_program(depth_format, textured, raster_depth=False, camera=False, rsm=False):
+    if rsm:
+        return with_rsm_output(shadow_cutout_program(depth_format, textured, raster_depth))
     base = shadow_program(depth_format, raster_depth, camera)
     program = replace(
         base,
@@ -601,9 +657,11 @@ def shadow_cutout_program(depth_format, textured, raster_depth=False, camera=Fal
     return _with_features(program, features, f"{base.name}_alpha_tex")
 
 
-def shadow_hair_program(depth_format, raster_depth=False, camera=False):
+def shadow_hair_program(depth_format, raster_depth=False, camera=False, rsm=False):
     """The depth pass of hair strips: widened across the strand facing the light (the map's
     eye), by the strands' radius or one map texel (``hair_texels``)."""
+    if rsm:
+        return with_rsm_output(shadow_hair_program(depth_format, raster_depth), material=False)
     base = shadow_program(depth_format, raster_depth, camera)
     return replace(
         base,
@@ -614,10 +672,13 @@ def shadow_hair_program(depth_format, raster_depth=False, camera=False):
     )
 
 
-def shadow_tree_program(depth_format, tree, raster_depth=False, camera=False):
+def shadow_tree_program(depth_format, tree, raster_depth=False, camera=False, rsm=False):
     """The alpha cut-out of a caster whose alpha a compiled node tree gives (``tree``:
     ``nodetree.CompiledTree`` without FRAME in its needs): the tree runs in the depth pass,
-    with the surface data it reads, so a procedural alpha casts the shadow it draws."""
+    with the surface data it reads, so a procedural alpha casts the shadow it draws (and,
+    with ``rsm``, the base colour it gives bounces)."""
+    if rsm:
+        return with_rsm_output(shadow_tree_program(depth_format, tree, raster_depth))
     base = shadow_program(depth_format, raster_depth, camera)
     program = replace(
         base,
@@ -666,12 +727,15 @@ WORLD_REDUCE = Program(
 )
 
 
-def shadow_program(depth_format, raster_depth=False, camera=False):
+def shadow_program(depth_format, raster_depth=False, camera=False, rsm=False):
     """The depth pass of a map stored as ``depth_format``; ``raster_depth``: the tile is
     orthographic, so a depth-buffer map takes the rasterised depth as it is. ``camera``: the
-    camera depth prepass instead (``CAMERA_DEPTH``; the format does not matter)."""
+    camera depth prepass instead (``CAMERA_DEPTH``; the format does not matter); ``rsm``: it
+    also writes the reflective shadow map's targets (``with_rsm_output``)."""
     if camera:
         return CAMERA_DEPTH
+    if rsm:
+        return with_rsm_output(shadow_program(depth_format, raster_depth))
     if not DEPTH_FORMAT[depth_format].depth_only:
         return SHADOW_DEPTH
     return SHADOW_DEPTH_RASTER if raster_depth else SHADOW_DEPTH_ONLY
@@ -711,6 +775,7 @@ def lit_defines(
     pilot=False,
     world_lights=False,
     world_ao=False,
+    indirect_samples=0,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -733,7 +798,11 @@ def lit_defines(
     ``world_lights``: some lights are directions of the world's light (``WORLD_LIGHTS``,
     ``world_sampling.py``), which add their light less the SH light's share.
     ``world_ao``: the world's light is occluded by screen-space ground-truth ambient occlusion
-    over the camera depth prepass (``WORLD_AO``, ``lib/gtao.glsl``, ``world_ao.py``)."""
+    over the camera depth prepass (``WORLD_AO``, ``lib/gtao.glsl``, ``world_ao.py``).
+    ``indirect_samples`` > 0: the variant gathers one diffuse bounce from the reflective
+    shadow maps of the lights with maps, that many texels per light and sample
+    (``INDIRECT_RSM``, lib/indirect_rsm.glsl; only with ``lit_program(rsm=True)``); 0 adds no
+    define, so a frame without the bounce compiles exactly what it did before."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -742,7 +811,9 @@ def lit_defines(
     sampled_n, shadowed_n, total_n = light_counts if light_counts is not None else (0, 1, 2)
     gather = bool(filt.pcf_taps and pcf_spacing == 1.0 and DEPTH_FORMAT[depth_format].channels == 1)
     weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
+    indirect = {"INDIRECT_RSM": True, "RSM_SAMPLES": int(indirect_samples)} if indirect_samples > 0 else {}
     return {
+        **indirect,
         **depth_defines(depth_format),
         "SHADOW_FILTER": SHADOW_FILTER.define(shadow_filter),
         "SPECULAR_MODEL": SPECULAR_MODEL.define(specular_model),

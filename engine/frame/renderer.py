@@ -266,6 +266,7 @@ class Renderer:
                 alpha_offset,
                 sample_count if accumulate else 1,
                 ao=world_ao(s),
+                sample_index=s,
             )
             clock.begin("accumulate")
             if accumulate:
@@ -346,6 +347,7 @@ class Renderer:
         sample_count=1,
         pilot=False,
         ao=None,
+        sample_index=0,
     ):
         """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
         does not move between samples keeps its map), then the lit pass seen through
@@ -397,7 +399,19 @@ class Renderer:
                 )
         with self._clock.stage("lit pass"):
             data = self._lit(
-                draws, lights, plan, snapshot, settings, aux, emission, stats, alpha_offset, sample_count, pilot, ao=ao
+                draws,
+                lights,
+                plan,
+                snapshot,
+                settings,
+                aux,
+                emission,
+                stats,
+                alpha_offset,
+                sample_count,
+                pilot,
+                sample_index=sample_index,
+                ao=ao,
             )
         self._last_data = data
         stats.binned = data.bins is not None
@@ -418,6 +432,7 @@ class Renderer:
         pilot=False,
         target=None,
         ao=None,
+        sample_index=0,
     ):
         """The lit pass of the last sample's cameras (``_last_cameras``) with ``lights`` and the
         maps of ``plan``; ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
@@ -449,6 +464,8 @@ class Renderer:
             world_sampled=self._world_sampled,
             world_sh=self._world_sh or not any(getattr(lt, "world", False) for lt in lights),
             world_ao=ao,
+            sample_index=sample_index,
+            rsm=atlas is not None and atlas.rsm,
         )
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None

@@ -13,6 +13,8 @@ from ..enums import DEPTH_FORMAT
 from ..gpu_pool import new_texture
 from ..shadows.planning import pack_tiles
 from .programs import (
+    RSM_FORMAT,
+    RSM_TEXEL_BYTES,
     SCALED_COPY,
     TILE_STRUCT,
     depth_defines,
@@ -52,6 +54,10 @@ class Caster:
     triangles: int = 0  # triangles of ``batches`` (drawn whole)
     level: int = None  # drawn into this map at a level of detail (``_at_level``), else None
     hair: str = None  # hair strips (Render > Curves > Shape: STRAND or STRIP), drawn by ``shadow_hair_program``
+    # Reflective shadow maps (``ShadowAtlas.render`` with ``rsm``): ``batches`` drawn per material
+    # part, (batch, material UBO) each, and what their albedo depends on (the tile's key).
+    rsm_parts: list = None
+    rsm_key: tuple = ()
 
 
 def _crosses_near(fit, casters):
@@ -90,13 +96,24 @@ class ShadowAtlas:
     slot) and one slot more at most: a FLOAT32 atlas is a depth texture the depth pass writes
     directly (4 bytes a texel, nothing else); FLOAT16 and RGBA8 maps are drawn in one
     slot-sized scratch target (colour and depth) and copied into a colour atlas of their own
-    format (2 or 4 bytes a texel)."""
+    format (2 or 4 bytes a texel).
+
+    With ``rsm`` (Light Paths > Diffuse Bounces 1) the atlas is also a set of reflective
+    shadow maps (Dachsbacher and Stamminger 2005): two RGBA16F targets of its size hold per
+    texel the diffuse albedo and the light-facing world normal of the surface the map sees
+    there (``programs.with_rsm_output``), 16 bytes a texel more, drawn in the same pass as the
+    depth (a FLOAT32 atlas's framebuffer gets them as colour attachments; other formats draw
+    them in the scratch target and copy them like the depth). Without it nothing changes."""
 
     def __init__(self, pool=None):
         self.size = 0
         self.count = 0
         self.columns = 1
         self.depth_format = "FLOAT32"
+        self.rsm = False  # the atlas has the reflective targets
+        self.flux = None  # (rsm) albedo of the surface each texel sees, RGBA16F
+        self.normal = None  # (rsm) its world normal, turned towards the light, RGBA16F
+        self._rsm_framebuffers = ()  # (rsm, not FLOAT32) the targets the scratch is copied into
         self._pool = pool  # a gpu_pool.TexturePool the atlas texture comes from and goes back to
         self.texture = None
         self._framebuffer = None
@@ -112,38 +129,57 @@ class ShadowAtlas:
         rows = max(1, math.ceil(count / columns))
         return columns, rows
 
-    def ensure(self, size, count, depth_format):
+    def ensure(self, size, count, depth_format, rsm=False):
         import gpu
 
         count = max(1, count)
         columns, rows = self.grid(count)
+        rsm = bool(rsm)
         if (
             self.texture is not None
-            and (self.size, self.columns, self.depth_format) == (size, columns, depth_format)
+            and (self.size, self.columns, self.depth_format, self.rsm) == (size, columns, depth_format, rsm)
             and self.count >= count
         ):
             return
         self.free()
         self.size, self.count, self.columns, self.depth_format = size, columns * rows, columns, depth_format
+        self.rsm = rsm
         dims = (columns * size, rows * size)
         fmt = DEPTH_FORMAT[depth_format]
         # Read with texelFetch only, so the sampler's filter mode never matters. A pooled
         # texture holds another render's maps: every map is drawn before it is read.
         self.texture = new_texture(self._pool, dims, fmt.texture)
+        extra = ()
+        if rsm:
+            self.flux = new_texture(self._pool, dims, RSM_FORMAT)
+            self.normal = new_texture(self._pool, dims, RSM_FORMAT)
+            extra = (self.flux, self.normal)
         if fmt.depth_only:
-            self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.texture)
+            if extra:
+                self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.texture, color_slots=extra)
+            else:
+                self._framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.texture)
         else:
             self._framebuffer = gpu.types.GPUFrameBuffer(color_slots=(self.texture,))
             color = gpu.types.GPUTexture((size, size), format=fmt.texture)
             depth = gpu.types.GPUTexture((size, size), format="DEPTH_COMPONENT32F")
-            self._scratch = (color, depth, gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=(color,)))
+            scratch = [color]
+            if rsm:
+                scratch += [gpu.types.GPUTexture((size, size), format=RSM_FORMAT) for _ in range(2)]
+                self._rsm_framebuffers = tuple(gpu.types.GPUFrameBuffer(color_slots=(t,)) for t in extra)
+            self._scratch = (
+                color,
+                depth,
+                gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=tuple(scratch)),
+                tuple(scratch[1:]),
+            )
         self._contents = {}
 
     @property
     def memory_bytes(self):
         if self.texture is None:
             return 0
-        texel = DEPTH_FORMAT[self.depth_format].bytes
+        texel = DEPTH_FORMAT[self.depth_format].bytes + (RSM_TEXEL_BYTES if self.rsm else 0)
         scratch = 0 if self._scratch is None else self.size * self.size * (texel + 4)
         return self.texture.width * self.texture.height * texel + scratch
 
@@ -151,20 +187,22 @@ class ShadowAtlas:
         """Drop the GPU objects (inside a GPU context); the atlas texture goes to the pool."""
         self._framebuffer = None
         self._scratch = None
+        self._rsm_framebuffers = ()
         self._copy_batch = None
         if self._pool is not None:
-            self._pool.give([self.texture])
-        self.texture = None
+            self._pool.give([t for t in (self.texture, self.flux, self.normal) if t is not None])
+        self.texture = self.flux = self.normal = None
+        self.rsm = False
         self._ubos = []
         self._contents = {}
         self.size = self.count = 0
         self.columns = 1
 
-    def place(self, plan, depth_format):
+    def place(self, plan, depth_format, rsm=False):
         """Pack the plan's maps (``pack_tiles``), make the atlas hold them and set each tile's
-        ``origin``."""
+        ``origin``; ``rsm``: with the reflective targets."""
         slot, count, where = pack_tiles([t.size for t in plan.tiles])
-        self.ensure(slot, count, depth_format)
+        self.ensure(slot, count, depth_format, rsm)
         for tile, (index, x, y) in zip(plan.tiles, where, strict=True):
             tile.origin = ((index % self.columns) * self.size + x, (index // self.columns) * self.size + y)
 
@@ -189,12 +227,13 @@ class ShadowAtlas:
 
         depth_only = DEPTH_FORMAT[self.depth_format].depth_only
         defines = depth_defines(self.depth_format)
+        rsm = self.rsm
 
         def program(raster):  # raster: an orthographic tile of a depth-buffer map
-            return shaders.get(shadow_program(self.depth_format, raster), defines)
+            return shaders.get(shadow_program(self.depth_format, raster, rsm=rsm), defines)
 
         def cutout(textured, raster):  # compiled only when a caster has alpha
-            return shaders.get(shadow_cutout_program(self.depth_format, textured, raster), defines)
+            return shaders.get(shadow_cutout_program(self.depth_format, textured, raster, rsm=rsm), defines)
 
         work = []
         for index, tile in enumerate(plan.tiles):
@@ -211,6 +250,8 @@ class ShadowAtlas:
                 tile.origin,
                 cull_front,
                 tuple((c.identity, c.cull_back) for c in casters),
+                # The reflective targets hold the casters' albedo as well.
+                tuple(c.rsm_key for c in casters) if rsm else None,
                 # Alpha casters cover other texels in each sample: such a map is redrawn per sample.
                 alpha_offset if any(c.cutouts for c in casters) else None,
             )
@@ -224,7 +265,10 @@ class ShadowAtlas:
         cleared = depth_only and len(work) == len(plan.tiles) and 2 * used >= self.count * self.size**2
         if cleared:
             with self._framebuffer.bind():
-                self._framebuffer.clear(depth=1.0)
+                if rsm:
+                    self._framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                else:
+                    self._framebuffer.clear(depth=1.0)
         for index, tile, casters, key in work:
             (x0, y0), n = tile.origin, tile.size
             target = self._framebuffer if depth_only else self._scratch[2]
@@ -234,7 +278,10 @@ class ShadowAtlas:
                     if not cleared:
                         gpu.state.scissor_set(x0, y0, n, n)
                         gpu.state.scissor_test_set(True)
-                        target.clear(depth=1.0)
+                        if rsm:
+                            target.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                        else:
+                            target.clear(depth=1.0)
                         gpu.state.scissor_test_set(False)
                 else:
                     gpu.state.viewport_set(0, 0, n, n)
@@ -269,6 +316,14 @@ class ShadowAtlas:
                     else:
                         gpu.state.face_culling_set("NONE")
                     shader.uniform_float("model", caster.model)
+                    if rsm and caster.rsm_parts is not None:  # per material: its albedo
+                        for batch, material_ubo in caster.rsm_parts:
+                            shader.uniform_block("material", material_ubo)
+                            batch.draw(shader)
+                            stats.draws += 1
+                            stats.shadow_draws += 1
+                        stats.shadow_triangles += caster.triangles
+                        continue
                     for batch in caster.batches:
                         batch.draw(shader)
                         stats.draws += 1
@@ -277,7 +332,7 @@ class ShadowAtlas:
                 gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
                 strips = [c for c in casters if c.hair is not None]
                 if strips:
-                    hair = shaders.get(shadow_hair_program(self.depth_format, raster), defines)
+                    hair = shaders.get(shadow_hair_program(self.depth_format, raster, rsm=rsm), defines)
                     hair.bind()
                     hair.uniform_block("tile", tile_ubo)
                     for caster in strips:
@@ -291,7 +346,9 @@ class ShadowAtlas:
                 for caster in casters:
                     for batch, material_ubo, texture, tree in caster.cutouts:
                         if tree is not None:
-                            cut = shaders.get(shadow_tree_program(self.depth_format, tree.tree, raster), defines)
+                            cut = shaders.get(
+                                shadow_tree_program(self.depth_format, tree.tree, raster, rsm=rsm), defines
+                            )
                             cut.bind()
                             cut.uniform_block("node_constants", tree.constants)
                             for i, image in enumerate(tree.images):
@@ -320,6 +377,8 @@ class ShadowAtlas:
                 gpu.state.depth_mask_set(False)
             if not depth_only:
                 self._copy_scratch(x0, y0, n, shaders)
+                for src, fb in zip(self._scratch[3], self._rsm_framebuffers, strict=True):
+                    self._copy_scratch(x0, y0, n, shaders, src, fb)
                 stats.passes += 1
             self._contents[index] = key
             stats.shadow_simplified += sum(1 for c in casters if c.level is not None)
@@ -327,17 +386,18 @@ class ShadowAtlas:
             stats.shadow_maps += 1
             stats.shadow_texels += n * n
 
-    def _copy_scratch(self, x0, y0, n, shaders):
+    def _copy_scratch(self, x0, y0, n, shaders, src=None, framebuffer=None):
         import gpu
         from gpu_extras.batch import batch_for_shader
 
         shader = shaders.get(SCALED_COPY)
         if self._copy_batch is None:
             self._copy_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
-        with self._framebuffer.bind():
+        framebuffer = self._framebuffer if framebuffer is None else framebuffer
+        with framebuffer.bind():
             gpu.state.viewport_set(x0, y0, n, n)
             shader.bind()
             shader.uniform_int("origin", (x0, y0))
             shader.uniform_float("scale", 1.0)
-            shader.uniform_sampler("src_color", self._scratch[0])
+            shader.uniform_sampler("src_color", self._scratch[0] if src is None else src)
             self._copy_batch.draw(shader)

@@ -7,14 +7,17 @@ import dataclasses
 import numpy as np
 
 from ..scene import simplify
+from ..scene.materials import Material
 from ..shadows import lightspace
 from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, plan_shadows
 from . import sampling
 from .draw_list import corners_of
+from .frame_data import indirect_samples
 from .programs import image_premultiplied_bits
 from .shadow_maps import Caster, ShadowAtlas, TreeCutout
 
 UNSET = object()  # ``ShadowPass.depth_range`` before this frame's first plan
+_DEFAULT_MATERIAL = Material()  # the albedo of a caster without material parts (reflective maps)
 
 
 class ShadowPass:
@@ -22,7 +25,7 @@ class ShadowPass:
         self.atlas = ShadowAtlas(pool)
         self.depth_range = UNSET  # the frame's visible depth range, once a plan computed it
         self._receivers = None  # and what the camera sees (lightspace.visible_receivers)
-        self._casters = (None, None)  # (the frame's draw list, what each draw casts): once a frame
+        self._casters = (None, None, False)  # (the frame's draw list, what each draw casts, rsm): once a frame
         self._sizes = None  # {light index: map sizes} of the frame's first plan (``keep_sizes``)
         self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
 
@@ -32,7 +35,7 @@ class ShadowPass:
         a multi-sample frame; 0 for one sample), so maps are planned for all of them."""
         self.depth_range = UNSET
         self._receivers = None
-        self._casters = (None, None)
+        self._casters = (None, None, False)
         self._sizes = None
         self.reach = float(reach)
 
@@ -52,7 +55,9 @@ class ShadowPass:
 
     def plan(self, draws, lights, camera, settings, size, map_size=None, sizes=None):
         """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
-        (width, height), with maps of ``map_size`` (default: the setting)."""
+        (width, height), with maps of ``map_size`` (default: the setting). With the diffuse
+        bounce (``indirect_samples``) maps hold every visible surface the light reaches, not
+        only those a caster can shadow (``plan_shadows(reflective=True)``)."""
         corners = corners_of(draws)
         if self.reach > 0.0 and size is not None:
             projection, size = sampling.widened_projection(camera.projection, self.reach, *size)
@@ -78,6 +83,7 @@ class ShadowPass:
             density=_density(camera, settings, size),
             known_sizes=sizes,
             world_map_size=getattr(settings, "world_map_size", None),
+            reflective=indirect_samples(settings) > 0,
         )
 
     def draw(
@@ -120,21 +126,37 @@ class ShadowPass:
                         tile.casters = np.array(
                             [c for c in tile.casters if blockers.links(draws[c].instance.names)], dtype=np.int64
                         )
-        self.atlas.place(plan, settings.shadow_depth_format)
-        if self._casters[0] is not draws:  # what each draw casts is the frame's, not the sample's
-            self._casters = (draws, [caster(d, materials, textures) for d in draws])
+        rsm = indirect_samples(settings) > 0
+        self.atlas.place(plan, settings.shadow_depth_format, rsm)
+        if self._casters[0] is not draws or self._casters[2] != rsm:  # the frame's, not the sample's
+            self._casters = (draws, [caster(d, materials, textures, rsm) for d in draws], rsm)
         casters = self._casters[1]
-        levels = map_levels(plan, draws, casters, batches, float(getattr(settings, "shadow_caster_detail", 0.0)))
+        # Reflective maps draw each caster per material (its albedo): whole, not simplified.
+        detail = 0.0 if rsm else float(getattr(settings, "shadow_caster_detail", 0.0))
+        levels = map_levels(plan, draws, casters, batches, detail)
         self.atlas.render(plan, casters, shaders, settings.shadow_cull_front, stats, alpha_offset, origin, levels)
         return plan
 
 
-def caster(d, materials, textures):
+def caster(d, materials, textures, rsm=False):
     """What draw ``d`` draws into shadow maps (``shadow_maps.Caster``), or None when it casts
     no shadow (Ray Visibility > Shadow off). Parts with alpha cover each map texel in a
-    fraction alpha of the samples (``shadow_maps.ShadowAtlas.render``)."""
+    fraction alpha of the samples (``shadow_maps.ShadowAtlas.render``). ``rsm``: reflective
+    maps, whose opaque parts are drawn per material with its MaterialData (the albedo)."""
     if not d.instance.shadow:
         return None
+    out = _caster(d, materials, textures)
+    if rsm and out is not None and out.hair is None:
+        whole = len(out.batches) == 1 and out.batches[0] is d.whole
+        parts = [(b, d.material(i)) for i, b in d.parts if whole or any(b is x for x in out.batches)]
+        if not parts:  # no material part: the default material's albedo
+            parts = [(b, _DEFAULT_MATERIAL) for b in out.batches]
+        out.rsm_parts = [(b, materials.get(m)) for b, m in parts]
+        out.rsm_key = tuple((tuple(m.base_color), m.metallic) for _b, m in parts)
+    return out
+
+
+def _caster(d, materials, textures):
     if d.instance.hair is not None:  # hair strips: widened toward the light (``shadow_hair_program``)
         identity = (*d.identity, d.instance.hair)
         return Caster([d.whole], d.model, d.det, identity, triangles=d.triangles, hair=d.instance.hair)

@@ -305,6 +305,7 @@ def plan_shadows(
     density=None,
     known_sizes=None,
     world_map_size=None,
+    reflective=False,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -325,6 +326,9 @@ def plan_shadows(
     sample costs one fit per map, not two. A direction of the world's light (``light.world``)
     gets one map fitted to everything the camera sees (no cascades) of at most
     ``world_map_size`` texels a side.
+    ``reflective``: the maps are also reflective shadow maps (the diffuse bounce), whose
+    texels are the senders of bounced light: every box counts as a caster (flat ones too), so
+    a map covers every visible receiver its light reaches, not only those a caster can shadow.
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
@@ -342,6 +346,8 @@ def plan_shadows(
 
     def flat_free_of(light):
         """Flat boxes that shadow nothing under ``light`` (None: not tested)."""
+        if reflective:  # every lit surface sends light: none is left out
+            return np.zeros(len(corners), dtype=bool) if light.type == "SUN" and view_corners is not None else None
         if light.type != "SUN":
             return lightspace.flat_casters_without_shadow(corners, position=light.position)
         return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
