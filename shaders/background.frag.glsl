@@ -1,6 +1,7 @@
 /* The world's Environment Texture behind the scene: the view ray of each pixel (through the
  * inverse view-projection) looked up in the equirectangular image as Blender maps it,
- * u = atan2(y, -x) / 2pi + 0.5, v = atan2(z, hypot(x, y)) / pi + 0.5, times the Background
+ * u = 0.5 - atan2(y, x) / 2pi, v = atan2(z, hypot(x, y)) / pi + 0.5 (Cycles'
+ * direction_to_equirectangular), times the Background
  * strength. */
 void main()
 {
@@ -10,7 +11,7 @@ void main()
   vec3 d = far.xyz / far.w - near.xyz / near.w;
   float len = length(d);
   d = (len > 0.0) ? d / len : vec3(0.0, 0.0, 1.0);
-  vec2 uv = vec2(atan(d.y, -d.x) / (2.0 * M_PI) + 0.5, atan(d.z, length(d.xy)) / M_PI + 0.5);
+  vec2 uv = vec2(0.5 - atan(d.y, d.x) / (2.0 * M_PI), atan(d.z, length(d.xy)) / M_PI + 0.5);
   /* The footprint from pixel to pixel, across the seam at u = 0 / 1 taken the short way round
    * (else the seam's pixels would read the smallest mip level). */
   vec2 dx = dFdx(uv);

@@ -66,6 +66,9 @@ void main()
 #  endif
 #else
   float d = clamp((v_distance - tile.near) / (tile.far - tile.near), 0.0, 1.0);
+  /* The scratch z-buffer tests this same depth: the rasterised one is bent across a caster
+   * that crosses the near plane (pancaked per vertex, shadow_depth.vert). */
+  gl_FragDepth = d;
   out_depth = encode_depth(d);
 #endif
 }

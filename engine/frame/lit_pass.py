@@ -235,6 +235,10 @@ class LitPass:
             return
         if not np.all(np.isfinite(inverse)):
             return
+        if world.rotation is not None:  # a Mapping node turns the image: rays in the image's frame
+            turn = np.eye(4)
+            turn[:3, :3] = world.rotation
+            inverse = turn @ inverse
         film.fullscreen(
             BACKGROUND,
             film.fb_color,

@@ -10,6 +10,7 @@ pixels are never read into Python, and an F12 render of a large HDRI pays a pass
 
 import dataclasses
 
+from ..scene.materials import equirect_sh
 from ..scene.textures import world_background
 from .programs import WORLD_REDUCE
 
@@ -25,6 +26,8 @@ def world_light(world, textures, shaders):
 
     sh = textures.world_sh(world.image, reduce) * world.strength
     env = textures.world_env(world.image)
+    if world.rotation is not None and env is not None:  # a Mapping node turns the image
+        sh = equirect_sh(env, world.rotation) * world.strength
     env = env * world.strength if env is not None else None
     return dataclasses.replace(world, sh=sh, background=world_background(sh), env=env)
 

@@ -62,8 +62,10 @@ class WorldDistribution:
     proportion to luminance per solid angle of its environment image ``env`` (h, w, 3), row 0
     at the bottom, or uniformly for a constant world (``env`` None)."""
 
-    def __init__(self, sh, env=None, cones=()):
+    def __init__(self, sh, env=None, cones=(), rotation=None):
         self.sh = np.nan_to_num(np.asarray(sh, np.float64), posinf=0.0, neginf=0.0)
+        # world direction -> the image's (an Environment Texture's Mapping), or None
+        self.rotation = None if rotation is None else np.asarray(rotation, np.float64)
         # (unit axis, cos of the half-angle) of each portal's cone (``portal_cones``).
         self.cones = [(np.asarray(a, np.float64), float(c)) for a, c in cones if -1.0 <= c < 1.0]
         self.env = None
@@ -129,8 +131,10 @@ class WorldDistribution:
 
     def _texel(self, d):
         h, w = self.env.shape[:2]
+        if self.rotation is not None:
+            d = d @ self.rotation.T
         x, y, z = d[:, 0], d[:, 1], d[:, 2]
-        u = np.arctan2(y, -x) / (2.0 * math.pi) + 0.5
+        u = 0.5 - np.arctan2(y, x) / (2.0 * math.pi)
         v = np.arctan2(z, np.hypot(x, y)) / math.pi + 0.5
         return np.clip((v * h).astype(np.int64), 0, h - 1), np.clip((u * w).astype(np.int64), 0, w - 1)
 
@@ -181,9 +185,10 @@ class WorldDistribution:
         fc = np.clip((b - clo) / np.maximum(chi - clo, 1e-300), 0.0, 1.0)
         sin_lat = self.sin_edges[r] + fr * (self.sin_edges[r + 1] - self.sin_edges[r])
         lat = np.arcsin(np.clip(sin_lat, -1.0, 1.0))
-        lon = ((c + fc) / w - 0.5) * 2.0 * math.pi
+        lon = (0.5 - (c + fc) / w) * 2.0 * math.pi  # atan2(y, x)
         cl = np.cos(lat)
-        return np.stack([-np.cos(lon) * cl, np.sin(lon) * cl, np.sin(lat)], axis=-1)
+        d = np.stack([np.cos(lon) * cl, np.sin(lon) * cl, np.sin(lat)], axis=-1)
+        return d if self.rotation is None else d @ self.rotation  # the image's direction -> the world's
 
 
 def _in_cone(axis, cos_max, a, b):
@@ -249,7 +254,10 @@ def distribution(world, cones=()):
     key = tuple((tuple(np.round(a, 12)), round(c, 12)) for a, c in cones)
     cached = getattr(world, "_distribution", None)
     if cached is None or cached[0] != key:
-        cached = (key, WorldDistribution(world.sh, getattr(world, "env", None), cones))
+        cached = (
+            key,
+            WorldDistribution(world.sh, getattr(world, "env", None), cones, getattr(world, "rotation", None)),
+        )
         object.__setattr__(world, "_distribution", cached)
     return cached[1]
 

@@ -646,6 +646,9 @@ class World:
     image: str | None = None  # an Environment Texture image drawn behind the scene
     strength: float = 1.0  # its Background strength
     env: np.ndarray | None = None  # the image box-filtered to at most 128 x 64, times strength (world_light)
+    # The Environment Texture's Mapping rotation: world direction -> the image's direction (3, 3),
+    # None for none.
+    rotation: np.ndarray | None = None
 
     @property
     def mean(self):
@@ -682,21 +685,24 @@ def sh_basis(d):
     )
 
 
-def equirect_sh(rgb):
+def equirect_sh(rgb, rotation=None):
     """SH coefficients (9, 3) of an equirectangular radiance image ``rgb`` (h, w, 3), row 0
-    at the bottom (Blender's pixel order), as Blender maps it: u = atan2(y, -x) / 2pi + 0.5,
-    v = atan2(z, hypot(x, y)) / pi + 0.5."""
+    at the bottom (Blender's pixel order), as Blender maps it: u = 0.5 - atan2(y, x) / 2pi,
+    v = atan2(z, hypot(x, y)) / pi + 0.5. ``rotation`` (3, 3): world direction -> the
+    image's (an Environment Texture's Mapping); the SH are of the world's directions."""
     h, w = rgb.shape[:2]
     v = (np.arange(h) + 0.5) / h
     u = (np.arange(w) + 0.5) / w
     lat = (v - 0.5) * math.pi  # elevation
-    lon = (u - 0.5) * 2.0 * math.pi  # atan2(y, -x)
+    lon = (0.5 - u) * 2.0 * math.pi  # atan2(y, x)
     cl = np.cos(lat)[:, None]
     d = np.stack(
-        [-np.cos(lon)[None, :] * cl, np.sin(lon)[None, :] * cl, np.broadcast_to(np.sin(lat)[:, None], (h, w))],
+        [np.cos(lon)[None, :] * cl, np.sin(lon)[None, :] * cl, np.broadcast_to(np.sin(lat)[:, None], (h, w))],
         axis=-1,
     )
     solid_angle = (2.0 * math.pi / w) * (math.pi / h) * np.broadcast_to(cl, (h, w))
+    if rotation is not None:
+        d = d @ np.asarray(rotation, np.float64)  # the image's direction -> the world's (R^T d)
     basis = sh_basis(d)  # (h, w, 9)
     return np.einsum("hwk,hwc,hw->kc", basis, rgb.astype(np.float64), solid_angle)
 
@@ -706,6 +712,45 @@ def _linked_outputs(tree, idname, socket, targets=None):
     outputs = [n for n in tree.nodes if n.bl_idname == idname]
     active = [n for n in outputs if n.is_active_output and (targets is None or n.target in targets)] or outputs
     return any(socket in out.inputs and _source(out.inputs[socket])[0] is not None for out in active)
+
+
+def _environment_rotation(world, env, messages):
+    """The rotation (3, 3, world direction -> the image's) an Environment Texture ``env`` reads
+    its image with: a Mapping node's Rotation on its Vector (Point, Vector and Normal rotate the
+    direction, Texture by the inverse); None without one. What else feeds the vector (a
+    Mapping's Location or Scale, another node) is named in ``messages``."""
+    socket = env.inputs.get("Vector") if hasattr(env.inputs, "get") else None
+    node, _ = _source(socket) if socket is not None else (None, None)
+    if node is None:
+        return None
+    if node.bl_idname != "ShaderNodeMapping":
+        if node.bl_idname != "ShaderNodeTexCoord":
+            messages.append(
+                f"world '{world.name}': the Environment Texture's Vector from '{node.bl_label}' is not drawn"
+            )
+        return None
+    from mathutils import Euler
+
+    rotation = node.inputs["Rotation"]
+    if rotation.is_linked or any(node.inputs[k].is_linked for k in ("Location", "Scale") if k in node.inputs):
+        messages.append(f"world '{world.name}': a linked input of the Mapping node is not drawn (its value is used)")
+    kind = node.vector_type
+    if (
+        kind == "POINT"
+        and "Location" in node.inputs
+        and any(abs(v) > 0.0 for v in node.inputs["Location"].default_value)
+    ):
+        messages.append(f"world '{world.name}': the Mapping node's Location is not drawn (only its Rotation)")
+    if (
+        kind != "NORMAL"
+        and "Scale" in node.inputs
+        and any(abs(v - 1.0) > 0.0 for v in node.inputs["Scale"].default_value)
+    ):
+        messages.append(f"world '{world.name}': the Mapping node's Scale is not drawn (only its Rotation)")
+    m = np.array(Euler(tuple(rotation.default_value), "XYZ").to_matrix(), np.float64)
+    if not np.all(np.isfinite(m)):
+        return None
+    return m.T if kind == "TEXTURE" else m
 
 
 def world_from_blender(scene):
@@ -756,9 +801,17 @@ def _world_surface(scene):
     if src.bl_idname == "ShaderNodeTexEnvironment" and src.image is not None and all(src.image.size):
         if src.projection != "EQUIRECTANGULAR":
             messages.append(f"world '{world.name}': {src.projection} projection (read as equirectangular)")
+        rotation = _environment_rotation(world, src, messages)
         # Its light (sh) is projected from the image's GPU texture by the renderer
         # (frame/world_light.py): no pixel is read here.
-        return World(sh=None, background=None, messages=tuple(messages), image=src.image.name_full, strength=strength)
+        return World(
+            sh=None,
+            background=None,
+            messages=tuple(messages),
+            image=src.image.name_full,
+            strength=strength,
+            rotation=rotation,
+        )
     if src.bl_idname == "ShaderNodeRGB":
         return World.constant(np.array(out.default_value[:3]) * strength, messages)
     messages.append(f"world '{world.name}': Color from a '{src.bl_label}' node (the world's viewport colour is used)")

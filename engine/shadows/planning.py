@@ -431,6 +431,8 @@ def plan_shadows(
         world = getattr(light, "world", False)
         known = known_sizes.get(i) if known_sizes is not None and not world else None
         largest = min(map_size, max(1, int(world_map_size))) if world and world_map_size else map_size
+        if world:
+            known = [largest] * 6  # a direction of the world is drawn once: one fit, no density pass
         tiles, mode = light_tiles(light, list(known) if known else [largest] * 6, flat_free, memo)
         # A map needs no more texels than the pixels it shadows can show (density): each map
         # (cascade, cube face) of the light is planned again at the size it needs. A sun

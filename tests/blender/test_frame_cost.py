@@ -96,16 +96,27 @@ def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_c
     further samples fit each map once (the frame's first plan fixes their sizes); no batch or
     material block is built again, and what a further sample uploads is its uniform blocks
     and light bins, a few KiB, whatever the scene's size."""
-    with counting_fits() as fits:
-        results = {}
-        for samples in (2, 10):
-            del fits[:]
-            stats, counters, after = _render(gpu_call, demo, samples)
-            results[samples] = (len(fits), stats, counters, after)
+
+    def count(world_shadows):
+        demo.penumbra.world_shadows = world_shadows
+        with counting_fits() as fits:
+            results = {}
+            for samples in (2, 10):
+                del fits[:]
+                stats, counters, after = _render(gpu_call, demo, samples)
+                results[samples] = (len(fits), stats, counters, after)
+        return results
+
+    results = count(False)
     (fits2, stats2, *_), (fits10, stats10, counters, after) = results[2], results[10]
     maps = stats10.shadow_maps // stats10.samples  # maps drawn per sample (every light moves)
     assert maps >= 2
     assert fits10 - fits2 == 8 * maps, (fits2, fits10, maps)
+    # The world's directions (World > Shadows): one fit each, no density pass.
+    world = count(True)
+    directions = demo.penumbra.world_samples
+    assert world[10][1].world_directions - world[2][1].world_directions == 8 * directions
+    assert world[10][0] - world[2][0] == 8 * (maps + directions), (world[2][0], world[10][0])
     assert after == counters  # no batch, no material block made again
     per_sample = (stats10.upload_bytes - stats2.upload_bytes) / 8
     assert 0 < per_sample < 32 * 1024, per_sample

@@ -29,6 +29,10 @@ def _render(engine, samples=8, edit=None, **kw):
     engines.configure(scene, engine)
     if engine == "PENUMBRA":
         scene.penumbra.render_samples = samples
+        # Against EEVEE, which does not occlude the world's light by the strands (with
+        # Penumbra's world shadows the dense patch is 0.07 in display against EEVEE's 0.16).
+        scene.penumbra.world_shadows = False
+        scene.penumbra.world_ao = False
     return render(scene)["Combined"]
 
 

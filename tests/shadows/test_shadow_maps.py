@@ -167,3 +167,33 @@ def test_no_lit_seam_where_a_shadow_crosses_cube_faces(penumbra, analytic_shadow
     assert columns.max() - columns.min() > 0.8 * 12.0 / 15.0 * 224  # from about x = -6 to 6
     assert (visibility[core] > 0.1).sum() == 0, np.sort(visibility[core])[-10:]
     assert iou((visibility < 0.5)[on_plane], shadowed[on_plane]) > 0.95
+
+
+@pytest.mark.parametrize("depth_format", ["FLOAT32", "FLOAT16"])
+def test_a_sun_shining_up_from_under_the_ground_is_blocked_by_it(penumbra, depth_format):
+    """A sun below the horizon (as half the world's directions are): the ground between it and
+    a box's front face shadows the face. The ground crosses the map's near plane; flattened
+    onto it per vertex its depth was bent and it shadowed nothing (the face was as lit as with
+    no shadow at all)."""
+    from mathutils import Vector
+
+    def frame(use_shadow):
+        scene = scenes.empty_scene(96, 54)
+        mat = scenes.white()
+        scenes.plane(scene, size=30.0, mat=mat)
+        scenes.box(scene, center=(0.0, 0.0, 0.5), size=(1.0, 1.0, 1.0), mat=mat)
+        scenes.look_at(scene, (0.0, -6.0, 2.0), (0.0, 0.0, 0.5))
+        sun = scenes.light(scene, "Sun", "SUN", 3.0, use_shadow=use_shadow)
+        toward = Vector((0.0, -0.3, -1.0)).normalized()  # the sun is below and in front
+        sun.rotation_euler = (-toward).to_track_quat("-Z", "Y").to_euler()
+        scene.penumbra.shadow_depth_format = depth_format
+        return render(scene)["Combined"][..., 0]
+
+    open_face = frame(False)
+    lit = open_face > 0.1  # only the box's front face faces a sun from below
+    assert lit.sum() > 100
+    shadowed = frame(True)[lit]
+    # All dark but for the face's bottom row, where it meets the ground within the biases
+    # (measured: 7/8 of the face 0, that row 0.05-0.7 of the light).
+    assert np.mean(shadowed < 0.01 * open_face[lit].mean()) > 0.8, np.unique(shadowed.round(3))
+    assert shadowed.mean() < 0.1 * open_face[lit].mean()

@@ -1,0 +1,122 @@
+"""The world's directions (``engine/frame/world_sampling.py``), in numpy: what they estimate
+converges to the integrals they stand for, their probabilities are densities, and extreme
+worlds stay finite."""
+
+import math
+
+import numpy as np
+import pytest
+
+from devkit.session import load_penumbra
+
+load_penumbra()
+from penumbra.engine.frame import world_sampling as ws  # noqa: E402
+from penumbra.engine.scene.materials import World, equirect_sh  # noqa: E402
+
+
+def _grid(h=64, w=128):
+    """Directions of an equirectangular grid (h, w, 3) as Blender maps it, and each texel's
+    solid angle (h, w)."""
+    v = (np.arange(h) + 0.5) / h
+    u = (np.arange(w) + 0.5) / w
+    lat = (v - 0.5) * math.pi
+    lon = (0.5 - u) * 2.0 * math.pi
+    cl = np.cos(lat)[:, None]
+    d = np.stack(
+        [np.cos(lon)[None, :] * cl, np.sin(lon)[None, :] * cl, np.broadcast_to(np.sin(lat)[:, None], (h, w))], -1
+    )
+    edges = np.sin((np.arange(h + 1) / h - 0.5) * math.pi)
+    return d, np.broadcast_to((2.0 * math.pi / w) * np.diff(edges)[:, None], (h, w))
+
+
+def _sun_sky(h=64, w=128, peak=50.0):
+    d, _ = _grid(h, w)
+    sun = np.array([0.3, -0.4, 0.866])
+    sun /= np.linalg.norm(sun)
+    return 0.2 * (d[..., 2:3] > 0.0) + peak * (d @ sun > 0.995)[..., None] * np.array([1.0, 0.9, 0.8])
+
+
+def _estimate(dist, normal, n=1 << 14):
+    d = dist.directions(ws.sequence_points(0, n))
+    return (dist.radiance(d) * np.maximum(d @ normal, 0.0)[:, None] / dist.pdf(d)[:, None]).mean(0)
+
+
+def test_a_constant_world_gives_pi_times_its_radiance_on_any_facing():
+    world = World.constant((0.5, 0.6, 0.7))
+    dist = ws.WorldDistribution(world.sh)
+    for normal in ([0, 0, 1], [1, 0, 0], [0.6, -0.8, 0.0]):
+        np.testing.assert_allclose(
+            _estimate(dist, np.array(normal, float)), np.array([0.5, 0.6, 0.7]) * math.pi, rtol=2e-3
+        )
+
+
+@pytest.mark.parametrize("rotation_z", [0.0, 70.0])
+def test_an_image_world_estimates_its_irradiance_and_its_pdf_is_a_density(rotation_z):
+    """With a sun blob 250x the sky, drawn by luminance (and turned by a Mapping rotation), the
+    estimate of the irradiance on a tilted facing is within 1 % of the image's exact sum."""
+    c, s = math.cos(math.radians(rotation_z)), math.sin(math.radians(rotation_z))
+    rotation = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    env = _sun_sky()
+    dist = ws.WorldDistribution(equirect_sh(env, rotation), env, rotation=rotation)
+    d, solid = _grid()
+    world_d = d.reshape(-1, 3) @ rotation  # the image's directions in the world
+    np.testing.assert_allclose((dist.pdf(world_d) * solid.ravel()).sum(), 1.0, rtol=1e-9)
+    normal = np.array([0.0, 0.6, 0.8])
+    exact = (env.reshape(-1, 3) * np.maximum(world_d @ normal, 0.0)[:, None] * solid.reshape(-1, 1)).sum(0)
+    np.testing.assert_allclose(_estimate(dist, normal), exact, rtol=0.01)
+    # Directions gather where the image is bright: the sun's texels get their share of its
+    # luminance of the directions drawn by luminance (the rest are uniform over the sphere).
+    drawn = dist.directions(ws.sequence_points(0, 4096))
+    r, col = dist._texel(drawn)
+    flux = (env @ [0.2126, 0.7152, 0.0722]) * solid
+    share = (1.0 - ws.UNIFORM_SHARE) * flux[env[..., 0] > 10.0].sum() / flux.sum()
+    assert abs((env[r, col, 0] > 10.0).mean() - share) < 0.03, share
+
+
+def test_with_a_constant_world_an_unshadowed_direction_adds_nothing():
+    """The control variate: a direction's light equals its SH baseline, so where nothing blocks
+    it the sum is exactly the SH light already drawn."""
+    lights = ws.world_lights(World.constant((1.0, 0.9, 0.8)), 0, 4)
+    for light in lights:
+        np.testing.assert_array_equal(light.color, light.world_baseline)
+        assert light.world and light.type == "SUN" and light.use_shadow
+
+
+def test_portal_cones_gather_directions_and_keep_a_density():
+    """A window portal: three quarters of the directions fall in its cone, the density still
+    integrates to 1 over the sphere, and the directions carry the world's whole light."""
+    matrix = np.eye(4)
+    matrix[:3, 3] = (0.0, 2.5, 1.4)
+    cones = ws.portal_cones([(matrix, 1.6, 1.4)], np.array([-2.0, -2.5, 0.0]), np.array([2.0, 2.5, 2.8]))
+    assert len(cones) == 1 and 0.0 < cones[0][1] < 1.0
+    dist = ws.WorldDistribution(World.constant((1.0, 1.0, 1.0)).sh, cones=cones)
+    d, solid = _grid(256, 512)
+    np.testing.assert_allclose((dist.pdf(d.reshape(-1, 3)) * solid.ravel()).sum(), 1.0, rtol=2e-3)
+    drawn = dist.directions(ws.sequence_points(0, 2048))
+    axis, cos_max = cones[0]
+    assert (drawn @ axis >= cos_max).mean() > 0.75
+    lights = ws.world_lights(World.constant((1.0, 1.0, 1.0)), 0, 4, cones=cones)
+    assert all(not np.any(light.world_baseline) for light in lights)
+
+
+@pytest.mark.parametrize(
+    "env",
+    [np.zeros((1, 1, 3)), np.full((1, 1, 3), 1e6), np.full((2, 4, 3), np.nan), np.full((64, 128, 3), np.inf)],
+    ids=["black 1x1", "1e6 1x1", "NaN", "inf"],
+)
+def test_extreme_images_give_finite_directions(env):
+    clean = np.nan_to_num(env, nan=0.0, posinf=0.0)
+    world = World(sh=equirect_sh(clean), background=None, env=env)
+    for light in ws.world_lights(world, 0, 8):
+        assert np.all(np.isfinite(light.color)) and np.all(np.isfinite(light.world_baseline))
+        assert np.all(np.isfinite(light.matrix)) and abs(np.linalg.norm(light.direction) - 1.0) < 1e-9
+
+
+def test_a_black_world_or_the_setting_off_samples_nothing():
+    from types import SimpleNamespace
+
+    on = SimpleNamespace(world_shadows=True)
+    assert not ws.needs_directions(World.constant((0.0, 0.0, 0.0)), on)
+    assert not ws.needs_directions(World.constant((1.0, 1.0, 1.0)), SimpleNamespace(world_shadows=False))
+    assert not ws.needs_directions(None, on)
+    assert ws.needs_directions(World.constant((1e-3, 0.0, 0.0)), on)
