@@ -52,13 +52,23 @@ void main()
 #endif
   vec4 t = tile.proj_tex * view_pos;
   gl_Position = vec4(2.0 * t.xyz - t.w, t.w);
-#if !CAMERA_DEPTH
+#if !CAMERA_DEPTH && RASTER_DEPTH
   /* Pancaking: a caster nearer the light than the tile's near plane is flattened onto it
    * (depth 0) instead of clipped away, so it still occludes what is behind it; the tile's
-   * depth range then only has to span the receivers. (x, y do not depend on z.) The camera
-   * depth prepass clips at the near plane, as the lit pass it serves does. */
+   * depth range then only has to span the receivers. (x, y do not depend on z.) Per vertex
+   * this is exact only for triangles wholly nearer: a tile with a caster that crosses the
+   * plane takes the variant below (shadow_maps.py _crosses_near). The camera depth prepass
+   * clips at the near plane, as the lit pass it serves does. */
   if (gl_Position.w > 0.0) {
     gl_Position.z = max(gl_Position.z, -gl_Position.w);
   }
+#elif !CAMERA_DEPTH
+  /* The fragment writes its own depth, clamped to the tile's range (shadow_depth.frag): exact
+   * pancaking before the near plane, and nothing clipped in depth at all, for clipping
+   * against a plane computes where triangles end from the vertices' depths, and a caster
+   * that crosses the near plane would have lost the part of it the far plane cut at the
+   * wrong place (a ground under light from below it, missing beneath the boxes on it).
+   * Behind a perspective light (w < 0) triangles are still clipped. */
+  gl_Position.z = 0.0;
 #endif
 }

@@ -133,3 +133,38 @@ def test_the_background_follows_cycles_equirectangular_mapping(penumbra):
         ws.use_engine(scene, engine, samples=4) if engine == "CYCLES" else ws.use_engine(scene, engine)
         images[engine] = ws.render_display(scene)
     assert ws.mae(images["PENUMBRA"], images["CYCLES"]) < 0.01
+
+
+@pytest.mark.parametrize(("width", "height", "strength"), [(1, 1, 1.0), (2, 1, 1e6), (8192, 4, 1.0), (64, 32, 0.0)])
+def test_extreme_environment_images_render_finite(penumbra, gpu_call, width, height, strength):
+    """HDRIs of 1x1 to 8k wide, strength 0 to 1e6, through the world's sampled directions and
+    its ambient occlusion (4 samples): every pixel is finite, a black one costs no direction."""
+    import bpy
+
+    scene = ws.build("sky_outdoor", 48, 27)
+    image = bpy.data.images.new("extreme_sky", width, height, alpha=True, float_buffer=True)
+    rng = np.random.default_rng(width)
+    image.pixels.foreach_set(
+        np.concatenate([rng.random((width * height, 3)) * 4.0, np.ones((width * height, 1))], 1)
+        .astype(np.float32)
+        .ravel()
+    )
+    tree = scene.world.node_tree
+    bg = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBackground")
+    env = tree.nodes.new("ShaderNodeTexEnvironment")
+    env.image = image
+    tree.links.new(env.outputs["Color"], bg.inputs["Color"])
+    bg.inputs["Strength"].default_value = strength
+    scene.penumbra.render_samples = 4
+
+    def job(engine, depsgraph):
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        out = engine.render_frame(
+            depsgraph, camera_from_scene(depsgraph, scene, 48, 27), 48, 27, samples=(0, 4), sample_count=4
+        )
+        return out.stats, out.color_array().copy()
+
+    stats, color = gpu_call(job)
+    assert np.all(np.isfinite(color))
+    assert (stats.world_directions == 0) == (strength == 0.0), stats.world_directions
