@@ -260,8 +260,34 @@ DEBUG_VIEW = Enum(
                 "(ambient occlusion off or a black world)",
             },
         ),
+        (
+            "WORLD_LIGHT",
+            "World Light",
+            "The light the world alone gives each pixel, with its visibility (its sampled shadow maps, the "
+            "ambient occlusion of a frame's first sample), averaged over the frame's samples",
+            8,
+            {
+                "lit": True,
+                "term": 1,
+                "legend": "the world's light alone, with its visibility, in the render's colours",
+            },
+        ),
+        (
+            "INDIRECT",
+            "Indirect Light",
+            "The light of the one diffuse bounce alone (Light Paths > Diffuse Bounces 1), averaged over the "
+            "frame's samples",
+            9,
+            {
+                "lit": True,
+                "term": 2,
+                "legend": "the diffuse bounce alone, in the render's colours; black with Diffuse Bounces 0",
+            },
+        ),
     ),
     # lit: the lit pass writes the view's values instead of colour (the DEBUG_LIT variant);
-    # legend: what the colours mean (the viewport's text and the render report).
-    fact_defaults={"lit": False, "legend": ""},
+    # term: instead, the lit pass writes one term of its colour alone (DEBUG_TERM: 1 the world's
+    # light, 2 the diffuse bounce); legend: what the colours mean (the viewport's text and the
+    # render report).
+    fact_defaults={"lit": False, "term": 0, "legend": ""},
 )

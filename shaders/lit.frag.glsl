@@ -76,6 +76,11 @@ struct Surface {
 
 #define NO_SHADOW -1
 
+#if DEBUG_TERM
+/* The WORLD_LIGHT (1) and INDIRECT (2) debug views: the one term of the colour they show. */
+vec3 debug_term = vec3(0.0);
+#endif
+
 #if TERMINATOR_OFFSET
 /* Cycles' smooth-surface offset at this fragment (engine/scene/terminator.py smooth_offset):
  * the interpolated normal times the height of the parabola through the triangle's vertex
@@ -350,10 +355,14 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
     reflected += (s.w.y * cosine_b) *
                  lobe_brdf(s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b, s.alpha_b, to_light, NdotL_b, L);
   }
-  color += (L.color * visibility - world_light * L.world_baseline) * irradiance * reflected;
+  vec3 added = (L.color * visibility - world_light * L.world_baseline) * irradiance * reflected;
 #else
   vec3 E = (L.color * visibility - world_light * L.world_baseline) * (irradiance * cosine);
-  color += E * lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
+  vec3 added = E * lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
+#endif
+  color += added;
+#if DEBUG_TERM == 1
+  debug_term += world_light * added;
 #endif
 }
 
@@ -611,6 +620,9 @@ void main()
   color = lobe_weights.x * color + lobe_weights.y * color_b;
 #endif
   float arriving = 0.0, unshadowed = 0.0;
+#if DEBUG_TERM == 1
+  debug_term += color; /* the world's SH light (with its ambient occlusion) */
+#endif
 #if SETTLE_TEST && WORLD_LIGHTS
   vec3 world_term = color; /* the world's light, unshadowed (lobe_setup) */
 #endif
@@ -692,9 +704,13 @@ void main()
      * reflected by the diffuse lobe(s). */
     vec3 bounced = indirect_rsm(s.P, s.N, v_view_depth) / M_PI;
 #  if NODE_LOBES == 2
-    color += (s.w.x * s.albedo + s.w.y * s.albedo_b) * bounced;
+    bounced *= s.w.x * s.albedo + s.w.y * s.albedo_b;
 #  else
-    color += s.albedo * bounced;
+    bounced *= s.albedo;
+#  endif
+    color += bounced;
+#  if DEBUG_TERM == 2
+    debug_term += bounced;
 #  endif
   }
 #endif
@@ -706,6 +722,9 @@ void main()
   out_color = vec4(color * a, a); /* premultiplied, blended over what is behind */
 #else
   out_color = vec4(color, 1.0);
+#endif
+#if DEBUG_TERM && !HOLDOUT
+  out_color = vec4(debug_term, 1.0); /* the WORLD_LIGHT or INDIRECT debug view */
 #endif
 #if DEBUG_LIT && WORLD_AO
   out_color = vec4(debug_world_ao, 0.0, 0.0, 1.0); /* the WORLD_AO debug view: the world's visibility */

@@ -13,6 +13,8 @@ Each view shows numbers the engine itself used for the frame, not a second compu
   totals of the samples' weights: ``Film.samples_array``);
 * NOISE: the error estimate of adaptive sampling's check (``Film.error_array``), in units of
   the Noise Threshold;
+* WORLD_LIGHT, INDIRECT: the world's light alone (with its visibility) and the diffuse bounce
+  alone, in colour: the lit pass's ``DEBUG_TERM`` variant writes that term of its colour.
 * WORLD_AO: the world's visibility from the ambient occlusion (``world_ao.py``), written by the
   lit pass's ``DEBUG_LIT`` variant with ``WORLD_AO`` (every sample occluded), in grey.
 
@@ -110,6 +112,11 @@ def lit_view(view, raw, occluded=True):
     visibility, coverage (``occluded`` False: no occlusion ran, every point sees all of it)."""
     item = DEBUG_VIEW[view]
     covered = raw[..., 3] > 0.5
+    if item.term:  # WORLD_LIGHT, INDIRECT: one term of the colour, shown as colour
+        rgb = np.nan_to_num(raw[..., :3]).astype(np.float32)
+        image = np.concatenate([rgb, np.ones(covered.shape + (1,), np.float32)], axis=-1)
+        values = (rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32)).astype(np.float32)  # luminance
+        return DebugImage(view, values, image, f"{item.label}: {item.legend}", covered)
     if view == "WORLD_AO":
         values = np.clip(raw[..., 0], 0.0, 1.0).astype(np.float32) if occluded else np.ones(covered.shape, np.float32)
         image = _compose(

@@ -176,6 +176,12 @@ def shading_order(lights, plan):
     return sampled + others + rest, len(sampled), len(mapped)
 
 
+def _debug_lit(settings):
+    """Whether the lit pass writes a lit debug view's values (not a term of its colour)."""
+    view = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
+    return view.lit and not view.term
+
+
 def _adds_nothing(light):
     """A direction of the world's light that, unshadowed, gives what the SH light gave."""
     baseline = getattr(light, "world_baseline", None)
@@ -257,6 +263,7 @@ def build_frame_data(
     bins = None
     if rects is not None and should_bin(lights):
         bins = light_bins.bin_masks([rects[i] for i in order], size[0], size[1], LIGHT_WORDS)
+    term = 0 if settle else DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].term
     return FrameData(
         frame=FRAME_STRUCT.pack([frame]),
         lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i), origin) for i in order], MAX_LIGHTS),
@@ -274,12 +281,13 @@ def build_frame_data(
             sampled > 0,
             (sampled, shadowed, len(order)),
             any(light.receivers is not None for light in lights),
-            DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].lit and not settle,
+            _debug_lit(settings) and not settle,
             settle,
             pilot,
             world_sampled or any(getattr(lights[i], "world", False) for i in order),
             world_ao is not None,
             indirect,
+            term,
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

@@ -776,6 +776,7 @@ def lit_defines(
     world_lights=False,
     world_ao=False,
     indirect_samples=0,
+    debug_term=0,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -802,7 +803,10 @@ def lit_defines(
     ``indirect_samples`` > 0: the variant gathers one diffuse bounce from the reflective
     shadow maps of the lights with maps, that many texels per light and sample
     (``INDIRECT_RSM``, lib/indirect_rsm.glsl; only with ``lit_program(rsm=True)``); 0 adds no
-    define, so a frame without the bounce compiles exactly what it did before."""
+    define, so a frame without the bounce compiles exactly what it did before.
+    ``debug_term``: the variant writes one term of its colour alone (``DEBUG_TERM``: 1 the
+    world's light with its visibility, 2 the diffuse bounce; the WORLD_LIGHT and INDIRECT
+    debug views)."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -837,6 +841,7 @@ def lit_defines(
         "PILOT_SAMPLE": bool(pilot),
         "WORLD_LIGHTS": bool(world_lights),
         "WORLD_AO": bool(world_ao),
+        "DEBUG_TERM": int(debug_term),
         "SETTLE_REACH": SETTLE_REACH,
         "SETTLE_GRID": SETTLE_GRID,
     }

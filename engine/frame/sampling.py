@@ -489,7 +489,7 @@ def world_ao_sample(s, accumulate, settings, world, debug="NONE"):
         return False
     if debug == "WORLD_AO":
         return True
-    if DEBUG_VIEW[debug].lit:
+    if DEBUG_VIEW[debug].lit and not DEBUG_VIEW[debug].term:
         return False  # the other lit debug views show the lights' numbers, not the world's
     return not accumulate or s == 0
 

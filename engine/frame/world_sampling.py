@@ -23,6 +23,10 @@ with a uniform share of the sphere so every direction where ``L_sh`` is not zero
 drawn (defensive importance sampling, Hesterberg 1995); a constant world is drawn uniformly.
 The points are a (0, 2)-sequence (van der Corput, Sobol' 2), digitally shifted, so the
 directions of any first 2^k samples are stratified and a progressive viewport frame stays so.
+
+Cycles' light portals (``portal_cones``) gather three quarters of the directions in cones
+through them; such a frame gives the directions the world's whole light (no control variate:
+inside a room the SH light would almost all be subtracted again).
 """
 
 import math
