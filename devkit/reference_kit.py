@@ -253,18 +253,8 @@ def bunny(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
 
 
 def suzanne(width=DETAILED_WIDTH, height=DETAILED_HEIGHT):
-    import bmesh
-
     scene, grey, far = _big_stage(width, height)
-    me = bpy.data.meshes.new("Suzanne")
-    bm = bmesh.new()
-    bmesh.ops.create_monkey(bm)
-    bmesh.ops.subdivide_edges(bm, edges=bm.edges[:], cuts=1, use_grid_fill=True, smooth=1.0)
-    bmesh.ops.triangulate(bm, faces=[f for f in bm.faces if len(f.verts) > 4])
-    bm.to_mesh(me)
-    bm.free()
-    for poly in me.polygons:
-        poly.use_smooth = True
+    me = scenes.smooth_monkey_mesh("Suzanne")
     ob = scenes.link(scene, bpy.data.objects.new("Suzanne", me))
     # Suzanne faces -Y; standing 1 m tall on the ground, her face towards the camera.
     ob.scale = (0.5, 0.5, 0.5)

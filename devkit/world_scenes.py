@@ -159,17 +159,7 @@ def _linear_colorspace(image):
 def monkey(scene, name, location, height, rotation_z, mat):
     """Smooth Suzanne (bmesh's monkey, subdivided once: about 3,900 triangles) standing on
     the ground ``height`` tall, facing -Y turned by ``rotation_z``."""
-    import bmesh
-
-    me = bpy.data.meshes.new(name)
-    bm = bmesh.new()
-    bmesh.ops.create_monkey(bm)
-    bmesh.ops.subdivide_edges(bm, edges=bm.edges[:], cuts=1, use_grid_fill=True, smooth=1.0)
-    bmesh.ops.triangulate(bm, faces=[f for f in bm.faces if len(f.verts) > 4])
-    bm.to_mesh(me)
-    bm.free()
-    for poly in me.polygons:
-        poly.use_smooth = True
+    me = scenes.smooth_monkey_mesh(name)
     zs = np.array([v.co.z for v in me.vertices])
     scale = height / float(zs.max() - zs.min())
     ob = scenes.link(scene, bpy.data.objects.new(name, me))

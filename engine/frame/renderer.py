@@ -31,6 +31,21 @@ from .world_ao import WorldAO
 from .world_light import world_light
 from .world_sampling import needs_directions, portal_cones, world_lights
 
+
+@dataclasses.dataclass(frozen=True)
+class SampleSpec:
+    """What varies from sample to sample of a frame, for ``Renderer._sample`` and ``_lit``:
+    the alpha-hash offset ((s + 1/2) / N), the frame's samples (which share the disk filters'
+    taps), whether it is the frame's pilot, the world's ambient occlusion ((distance, jitter)
+    or None) and its index in the frame."""
+
+    alpha_offset: float = 0.5
+    sample_count: int = 1
+    pilot: bool = False
+    ao: tuple = None
+    index: int = 0
+
+
 # While the view moves, a frame's maps keep the sizes of the last navigation frame that
 # planned them afresh, this many frames ago at most (``Renderer.render``'s ``navigating``).
 NAVIGATION_REPLAN = 8
@@ -227,9 +242,8 @@ class Renderer:
                     dataclasses.replace(lt, sampled=True, jittered=jitter) if i in moving else lt
                     for i, lt in enumerate(lights)
                 ]
-                self._sample(
-                    draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot=True, ao=world_ao(0)
-                )
+                pilot = SampleSpec(pilot=True, ao=world_ao(0))
+                self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot)
                 with clock.stage("settle"):
                     stats.pixels_settled = settle_pixels(
                         self, draws, snapshot, settings, adaptive, sample_count, aux, emission
@@ -252,22 +266,14 @@ class Renderer:
                 sample_lights += world_lights(snapshot.world, index, directions, cones=cones)
                 stats.world_directions += directions
             clock.end()
-            alpha_offset = (s + 0.5) / sample_count if accumulate else 0.5
-            plan = self._sample(
-                draws,
-                sample_lights,
-                camera,
-                view_camera,
-                snapshot,
-                settings,
-                aux,
-                emission,
-                stats,
-                alpha_offset,
-                sample_count if accumulate else 1,
+            spec = SampleSpec(
+                alpha_offset=(s + 0.5) / sample_count if accumulate else 0.5,
+                sample_count=sample_count if accumulate else 1,
                 ao=world_ao(s),
-                sample_index=s,
+                index=s,
             )
+            passes = (snapshot, settings, aux, emission, stats)
+            plan = self._sample(draws, sample_lights, camera, view_camera, *passes, spec)
             clock.begin("accumulate")
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
@@ -332,28 +338,12 @@ class Renderer:
             out.depth_data, out.normal_data = film.centre
         return out
 
-    def _sample(
-        self,
-        draws,
-        lights,
-        camera,
-        view_camera,
-        snapshot,
-        settings,
-        aux,
-        emission,
-        stats,
-        alpha_offset=0.5,
-        sample_count=1,
-        pilot=False,
-        ao=None,
-        sample_index=0,
-    ):
-        """One sample: shadow maps (planned from the unjittered ``camera``, so a light that
-        does not move between samples keeps its map), then the lit pass seen through
-        ``view_camera``. ``ao``: (distance, jitter) when the sample occludes the world's light
-        (``sampling.world_ao_sample``): the camera depth prepass is drawn first through the lit
-        pass's raster camera (``world_ao.py``). Returns the shadow plan."""
+    def _sample(self, draws, lights, camera, view_camera, snapshot, settings, aux, emission, stats, spec):
+        """One sample (``spec``, a ``SampleSpec``): shadow maps (planned from the unjittered
+        ``camera``, so a light that does not move between samples keeps its map), then the lit
+        pass seen through ``view_camera``. With ``spec.ao`` the camera depth prepass of the
+        world's ambient occlusion is drawn first through the lit pass's raster camera
+        (``world_ao.py``). Returns the shadow plan."""
         film = self.film
         width, height = film.size
         lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats)
@@ -371,7 +361,7 @@ class Renderer:
             self.textures,
             self.batches,
             self._origin,
-            alpha_offset,
+            spec.alpha_offset,
         )
         self._clock.end()
         self._last_plan = plan
@@ -384,7 +374,7 @@ class Renderer:
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
         )
         self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
-        if ao is not None:
+        if spec.ao is not None:
             with self._clock.stage("world ao"):
                 self.world_ao.draw(
                     draws,
@@ -395,52 +385,20 @@ class Renderer:
                     self.materials,
                     self.textures,
                     stats,
-                    alpha_offset,
+                    spec.alpha_offset,
                 )
         with self._clock.stage("lit pass"):
-            data = self._lit(
-                draws,
-                lights,
-                plan,
-                snapshot,
-                settings,
-                aux,
-                emission,
-                stats,
-                alpha_offset,
-                sample_count,
-                pilot,
-                sample_index=sample_index,
-                ao=ao,
-            )
+            data = self._lit(draws, lights, plan, snapshot, settings, aux, emission, stats, spec)
         self._last_data = data
         stats.binned = data.bins is not None
         return plan
 
-    def _lit(
-        self,
-        draws,
-        lights,
-        plan,
-        snapshot,
-        settings,
-        aux,
-        emission,
-        stats,
-        alpha_offset=0.5,
-        sample_count=1,
-        pilot=False,
-        target=None,
-        ao=None,
-        sample_index=0,
-    ):
+    def _lit(self, draws, lights, plan, snapshot, settings, aux, emission, stats, spec, target=None):
         """The lit pass of the last sample's cameras (``_last_cameras``) with ``lights`` and the
-        maps of ``plan``; ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
-        variant drawn into it, ``settle.py``; never occluded); ``ao``: (distance, jitter) of
-        the world's ambient occlusion over the prepass just drawn, or None. Returns the frame
-        data it drew with."""
-        if target is not None:
-            ao = None
+        maps of ``plan``, for sample ``spec`` (``SampleSpec``; its ``ao`` over the prepass just
+        drawn); ``target``: the settle test's framebuffer (the ``SETTLE_TEST`` variant drawn
+        into it, ``settle.py``; never occluded). Returns the frame data it drew with."""
+        ao = spec.ao if target is None else None
         film = self.film
         raster_camera, view_camera, rects = self._last_cameras
         atlas = self.shadows if plan is not None and plan.tiles else None
@@ -456,15 +414,15 @@ class Renderer:
             aux_outputs=aux and target is None,
             rects=rects,
             size=film.size,
-            alpha_offset=alpha_offset,
+            alpha_offset=spec.alpha_offset,
             origin=self._origin,
-            sample_count=sample_count,
+            sample_count=spec.sample_count,
             settle=target is not None,
-            pilot=pilot,
+            pilot=spec.pilot,
             world_sampled=self._world_sampled,
             world_sh=self._world_sh or not any(getattr(lt, "world", False) for lt in lights),
             world_ao=ao,
-            sample_index=sample_index,
+            sample_index=spec.index,
             rsm=atlas is not None and atlas.rsm,
         )
         seen = [d for d in draws if d.instance.camera]
@@ -491,18 +449,9 @@ class Renderer:
     def settle_test(self, draws, snapshot, settings, sample_count, target):
         """The settle test's variant of the lit pass into ``target`` over the last sample's
         surfaces, cameras, maps and lights (``settle.py``); its draws are not the frame's."""
-        self._lit(
-            draws,
-            self._last_lights,
-            self._last_plan,
-            snapshot,
-            settings,
-            False,
-            False,
-            FrameStats(),
-            sample_count=sample_count,
-            target=target,
-        )
+        spec = SampleSpec(sample_count=sample_count)
+        lights, plan = self._last_lights, self._last_plan
+        self._lit(draws, lights, plan, snapshot, settings, False, False, FrameStats(), spec, target)
 
     def _debug_view(self, view, accumulate, settings, occluded=False):
         """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``);

@@ -60,6 +60,32 @@ class Caster:
     rsm_key: tuple = ()
 
 
+def draw_cutout(program, batch, material_ubo, texture, tree, tile_ubo, alpha_offset, model, origin=None):
+    """Draw one alpha cut-out part (``Caster.cutouts``: its batch, material block, (alpha
+    texture, premultiplied bits) or None, ``TreeCutout`` or None) with ``program`` (the
+    cut-out or node-tree depth program of the map, or of the camera depth prepass) into the
+    tile of ``tile_ubo`` at this sample's ``alpha_offset``. ``origin``: the frame origin a
+    compiled tree's ORIGIN reads."""
+    program.bind()
+    if tree is not None:
+        program.uniform_block("node_constants", tree.constants)
+        for i, image in enumerate(tree.images):
+            program.uniform_sampler(f"node_image_{i}", image)
+        uniforms = dict(tree.uniforms)
+        if "ORIGIN" in tree.tree.needs:
+            o = origin if origin is not None else (0.0, 0.0, 0.0)
+            uniforms["node_origin"] = tuple(float(x) for x in o)
+        set_uniforms(program, uniforms)
+    program.uniform_block("tile", tile_ubo)
+    program.uniform_float("alpha_offset", alpha_offset)
+    program.uniform_float("model", model)
+    program.uniform_block("material", material_ubo)
+    if texture is not None:
+        program.uniform_sampler("tex_alpha", texture[0])
+        set_uniforms(program, {"image_premultiplied": texture[1]})
+    batch.draw(program)
+
+
 def _crosses_near(fit, casters):
     """Whether a caster's bounds cross the near plane of ``fit`` (some corners nearer the light
     than it, some beyond)."""
@@ -349,26 +375,11 @@ class ShadowAtlas:
                             cut = shaders.get(
                                 shadow_tree_program(self.depth_format, tree.tree, raster, rsm=rsm), defines
                             )
-                            cut.bind()
-                            cut.uniform_block("node_constants", tree.constants)
-                            for i, image in enumerate(tree.images):
-                                cut.uniform_sampler(f"node_image_{i}", image)
-                            uniforms = dict(tree.uniforms)
-                            if "ORIGIN" in tree.tree.needs:
-                                o = origin if origin is not None else (0.0, 0.0, 0.0)
-                                uniforms["node_origin"] = tuple(float(x) for x in o)
-                            set_uniforms(cut, uniforms)
                         else:
                             cut = cutout(texture is not None, raster)
-                            cut.bind()
-                        cut.uniform_block("tile", tile_ubo)
-                        cut.uniform_float("alpha_offset", alpha_offset)
-                        cut.uniform_float("model", caster.model)
-                        cut.uniform_block("material", material_ubo)
-                        if texture is not None:
-                            cut.uniform_sampler("tex_alpha", texture[0])
-                            set_uniforms(cut, {"image_premultiplied": texture[1]})
-                        batch.draw(cut)
+                        draw_cutout(
+                            cut, batch, material_ubo, texture, tree, tile_ubo, alpha_offset, caster.model, origin
+                        )
                         stats.draws += 1
                         stats.shadow_draws += 1
                 gpu.state.face_culling_set("NONE")

@@ -21,7 +21,6 @@ and follow the film's size; final renders take them from the texture pool and gi
 
 import numpy as np
 
-from ...shaders.loader import set_uniforms
 from ..gpu_pool import new_texture
 from ..shadows import lightspace
 from .programs import (
@@ -33,6 +32,7 @@ from .programs import (
     shadow_program,
     shadow_tree_program,
 )
+from .shadow_maps import draw_cutout
 from .shadow_pass import _tree_cutout
 
 
@@ -180,26 +180,11 @@ class WorldAO:
                 for batch, cull, material_ubo, texture, tree in parts[id(d)][1]:
                     culling(cull, d.det)
                     if tree is not None:
-                        cut = shaders.get(shadow_tree_program("FLOAT32", tree.tree, camera=True), defines)
-                        cut.bind()
-                        cut.uniform_block("node_constants", tree.constants)
-                        for i, image in enumerate(tree.images):
-                            cut.uniform_sampler(f"node_image_{i}", image)
-                        uniforms = dict(tree.uniforms)
-                        if "ORIGIN" in tree.tree.needs:
-                            uniforms["node_origin"] = tuple(float(x) for x in origin)
-                        set_uniforms(cut, uniforms)
+                        program = shadow_tree_program("FLOAT32", tree.tree, camera=True)
                     else:
-                        cut = shaders.get(shadow_cutout_program("FLOAT32", texture is not None, camera=True), defines)
-                        cut.bind()
-                    cut.uniform_block("tile", self._ubo)
-                    cut.uniform_float("alpha_offset", alpha_offset)
-                    cut.uniform_float("model", d.model)
-                    cut.uniform_block("material", material_ubo)
-                    if texture is not None:
-                        cut.uniform_sampler("tex_alpha", texture[0])
-                        set_uniforms(cut, {"image_premultiplied": texture[1]})
-                    batch.draw(cut)
+                        program = shadow_cutout_program("FLOAT32", texture is not None, camera=True)
+                    cut = shaders.get(program, defines)
+                    draw_cutout(cut, batch, material_ubo, texture, tree, self._ubo, alpha_offset, d.model, origin)
                     bound["draws"] += 1
             gpu.state.face_culling_set("NONE")
             gpu.state.front_facing_set(False)
