@@ -428,22 +428,9 @@ class Renderer:
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
         world = (snapshot.world, snapshot.world_color)
-        self.lit_pass.draw(
-            film,
-            seen,
-            view_camera,
-            data,
-            atlas,
-            world,
-            settings,
-            aux,
-            emission,
-            stats,
-            self._origin,
-            masks,
-            target,
-            ao_depth=self.world_ao.texture if ao is not None else None,
-        )
+        ao_depth = self.world_ao.texture if ao is not None else None
+        passes = (settings, aux, emission, stats, self._origin, masks, target)
+        self.lit_pass.draw(film, seen, view_camera, data, atlas, world, *passes, ao_depth=ao_depth)
         return data
 
     def settle_test(self, draws, snapshot, settings, sample_count, target):
