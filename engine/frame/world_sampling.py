@@ -45,13 +45,6 @@ _LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 _SCRAMBLE = (0x6C8E9CF5, 0x2545F491)  # digital shifts of the two coordinates
 
 
-def world_radiance(world):
-    """The world's mean radiance (rgb), 0 for no world."""
-    if world is None:
-        return np.zeros(3)
-    return np.nan_to_num(np.asarray(world.mean, np.float64), posinf=0.0, neginf=0.0)
-
-
 def needs_directions(world, settings):
     """Whether the world's light is sampled with shadow maps this frame: World > Shadows on,
     and a world that gives any light (a black world costs nothing)."""
@@ -273,7 +266,8 @@ def world_lights(world, index, count, name="World", cones=()):
     its ``world_baseline`` the same of the SH radiance. With light portals (``cones``) the
     directions gather in the portals' cones and carry the world's whole light (baseline 0):
     inside a room the SH light would have to be almost all subtracted again, which only adds
-    noise, so such a frame lights surfaces with these directions alone (``control_variate``)."""
+    noise, so such a frame lights surfaces with these directions alone (``build_frame_data``'s
+    ``world_sh`` False)."""
     dist = distribution(world, cones)
     d = dist.directions(sequence_points(index, count))
     pdf = np.maximum(dist.pdf(d), 1e-30)
