@@ -120,3 +120,24 @@ def test_a_black_world_or_the_setting_off_samples_nothing():
     assert not ws.needs_directions(World.constant((1.0, 1.0, 1.0)), SimpleNamespace(world_shadows=False))
     assert not ws.needs_directions(None, on)
     assert ws.needs_directions(World.constant((1e-3, 0.0, 0.0)), on)
+
+
+def test_portal_cones_at_their_extremes():
+    """A zero-size portal, a portal at the box's centre (its +Z half-space), a non-finite
+    portal matrix and a non-finite box: every cone is a valid cone or is left out."""
+    lo, hi = np.array([-1.0, -1.0, 0.0]), np.array([1.0, 1.0, 2.0])
+    point = np.eye(4)
+    point[:3, 3] = (0.0, 3.0, 1.0)
+    centred = np.eye(4)
+    centred[:3, 3] = (0.0, 0.0, 1.0)
+    broken = np.full((4, 4), np.nan)
+    cones = ws.portal_cones([(point, 0.0, 0.0), (centred, 1.0, 1.0), (broken, 1.0, 1.0)], lo, hi)
+    assert len(cones) == 2
+    for axis, cos_max in cones:
+        assert abs(np.linalg.norm(axis) - 1.0) < 1e-12 and 0.0 <= cos_max < 1.0
+    np.testing.assert_allclose(cones[1][0], (0.0, 0.0, 1.0))
+    assert cones[1][1] == pytest.approx(0.0, abs=1e-12)  # a whole half-space
+    assert ws.portal_cones([(point, 1.0, 1.0)], lo, np.array([np.inf, 1.0, 2.0])) == []
+    dist = ws.WorldDistribution(World.constant((1.0, 1.0, 1.0)).sh, cones=cones)
+    d = dist.directions(ws.sequence_points(0, 256))
+    assert np.all(np.isfinite(d)) and np.all(np.isfinite(dist.pdf(d))) and np.all(dist.pdf(d) > 0.0)
