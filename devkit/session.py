@@ -60,13 +60,83 @@ def run_result(script, timeout=300):
     import json
     import subprocess
 
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+    env = dict(os.environ)
+    env[LIGHT_CHECK_ENV] = "child"  # the child checks its frames too (``load_penumbra``)
+    proc = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env
+    )
     log = proc.stderr[-3000:]
     assert proc.returncode == 0, log
     assert "Traceback" not in proc.stderr, log
+    assert LIGHT_CHECK_MARK not in proc.stderr, log
     line = next((ln for ln in proc.stdout.splitlines() if ln.startswith("RESULT ")), None)
     assert line is not None, proc.stdout[-2000:] + log
     return json.loads(line[len("RESULT ") :]), proc.stdout + proc.stderr
+
+
+# Light is never negative and never NaN: the suite checks every frame Penumbra renders (its
+# Combined, the image after the post stack) once, here, rather than in each test.
+LIGHT_CHECK_ENV = "PENUMBRA_LIGHT_CHECK"
+LIGHT_CHECK_MARK = "PENUMBRA LIGHT CHECK FAILED"
+light_check_failures = []  # one line per frame that broke it since the last ``take_light_failures``
+
+
+def light_check_failure(color):
+    """Why ``color`` (an RGBA array of a frame's Combined) breaks the invariant, or None: any
+    value not finite, or any colour channel below zero by more than float rounding (a
+    millionth of the frame's largest value, at least 1e-6)."""
+    import numpy as np
+
+    a = np.asarray(color, np.float32)
+    if a.size == 0:
+        return None
+    finite = np.isfinite(a)
+    if not finite.all():
+        return f"{int((~finite).any(axis=-1).sum())} pixels not finite"
+    rgb = a[..., :3]
+    tolerance = 1e-6 * max(1.0, float(np.abs(rgb).max()))
+    low = rgb < -tolerance
+    if low.any():
+        return f"{int(low.any(axis=-1).sum())} pixels below zero (lowest {float(rgb.min()):.4g})"
+    return None
+
+
+def install_light_check():
+    """Check the Combined of every frame Penumbra's renderer makes from now on
+    (``Renderer.render``, which the viewport, F12, batch renders and the engine core all go
+    through): a frame that breaks it adds a line to ``light_check_failures`` (and, in a child
+    process, prints LIGHT_CHECK_MARK on stderr, which ``run_result`` fails on). Idempotent."""
+    module = load_penumbra()
+    from penumbra.engine.frame import renderer as renderer_module
+    from penumbra.engine.frame.film import texture_array
+
+    cls = renderer_module.Renderer
+    if getattr(cls.render, "_light_checked", False):
+        return
+    render = cls.render
+
+    def checked_render(self, *args, **kwargs):
+        out = render(self, *args, **kwargs)
+        if getattr(out, "debug", None) is None and out.color is not None:
+            why = light_check_failure(texture_array(out.color, 4))
+            if why is not None:
+                line = f"a {out.width}x{out.height} frame: {why}"
+                light_check_failures.append(line)
+                if os.environ.get(LIGHT_CHECK_ENV) == "child":
+                    print(f"{LIGHT_CHECK_MARK}: {line}", file=sys.stderr)
+        return out
+
+    checked_render._light_checked = True
+    checked_render.__doc__ = render.__doc__
+    cls.render = checked_render
+    return module
+
+
+def take_light_failures():
+    """The failures recorded since the last call, and forget them."""
+    taken = list(light_check_failures)
+    light_check_failures.clear()
+    return taken
 
 
 def load_penumbra():
@@ -79,6 +149,8 @@ def load_penumbra():
     module = importlib.util.module_from_spec(spec)
     sys.modules["penumbra"] = module
     spec.loader.exec_module(module)
+    if os.environ.get(LIGHT_CHECK_ENV) == "child":
+        install_light_check()
     return module
 
 

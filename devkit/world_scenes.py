@@ -1,5 +1,5 @@
-"""Scenes lit by the world alone (no lamps), their Cycles references, and the measurement the
-world-light bench and tests share::
+"""Scenes lit by the world (alone but for ``glossy_spheres``' sun), their Cycles references,
+and the measurement the world-light bench and tests share::
 
     scene = world_scenes.build("window_room", 160, 90)
     ref = world_scenes.cycles_reference("window_room", samples=256, width=160, height=90)
@@ -15,6 +15,10 @@ sky_outdoor_hdri   the same under a procedural equirectangular sky (a horizon-to
                    gradient, a dim ground half and a sun blob 35 deg up), made in numpy and
                    read through an Environment Texture whose vector comes from a Mapping
                    node rotating it 70 deg about Z
+glossy_spheres     five spheres of Principled roughness 0.15 to 0.5 (coloured, IOR 1.5) on a
+                   grey ground under a dim uniform sky (0.6, 0.7, 0.9) x 0.3 and a sun 40 deg
+                   up: the world's light is a small share, its glossy reflections of the
+                   ground are blocked (where an estimator that subtracts went negative)
 window_room        a closed 4 x 5 x 2.8 m room of 0.2 m thick, overlapping boxes (no seam
                    lets light through) with one 1.6 x 1.4 m window in the +Y wall, a uniform
                    sky of strength 4 outside, a table and a sphere by the window; the camera
@@ -234,6 +238,26 @@ def sky_outdoor_hdri(scene):
     return _outdoor_objects(scene)
 
 
+GLOSSY_ROUGHNESS = (0.15, 0.2, 0.3, 0.4, 0.5)
+GLOSSY_SKY = ((0.6, 0.7, 0.9), 0.3)
+
+
+def glossy_spheres(scene):
+    """Glossy spheres on a ground under a dim sky and a sun (see the module's table)."""
+    uniform_sky(scene, *GLOSSY_SKY)
+    scenes.plane(scene, "Ground", size=40.0, mat=principled("Ground", (0.5, 0.5, 0.5), 0.6))
+    colours = ((0.2, 0.35, 0.8), (0.8, 0.25, 0.2), (0.85, 0.75, 0.3), (0.3, 0.7, 0.4), (0.7, 0.7, 0.7))
+    for k, (rough, colour) in enumerate(zip(GLOSSY_ROUGHNESS, colours, strict=True)):
+        x = (k - 2) * 1.15
+        scenes.uv_sphere(
+            scene, f"Sphere{k}", center=(x, 0.3 * (k % 2), 0.5), radius=0.5, mat=principled(f"Glossy{k}", colour, rough)
+        )
+    scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(50.0), 0.0, math.radians(30.0)), angle=0.02)
+    cam = scenes.look_at(scene, (0.0, -6.0, 2.4), (0.0, 0.2, 0.4), lens=35.0)
+    cam.data.clip_end = 100.0
+    return scene
+
+
 def _span_box(scene, name, lo, hi, mat):
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     return scenes.box(scene, name, center=tuple((lo + hi) / 2), size=tuple(hi - lo), mat=mat)
@@ -277,7 +301,12 @@ def window_room(scene):
     return scene
 
 
-SCENES = {"sky_outdoor": sky_outdoor, "sky_outdoor_hdri": sky_outdoor_hdri, "window_room": window_room}
+SCENES = {
+    "sky_outdoor": sky_outdoor,
+    "sky_outdoor_hdri": sky_outdoor_hdri,
+    "glossy_spheres": glossy_spheres,
+    "window_room": window_room,
+}
 INDOOR = ("window_room",)  # scenes where the bounce matters (a Cycles reference with one bounce)
 
 

@@ -4,7 +4,8 @@
  * (Cycles leaves alpha out; here a transparent film's edges count too). A pixel converges when
  * the error of every pixel of its 3x3 neighbourhood is below the threshold (Cycles dilates
  * the unconverged pixels likewise), and once converged it stays so. With ERROR_OUTPUT it writes
- * the estimate instead (the NOISE debug view). */
+ * the estimate instead (the NOISE debug view). With WORLD_RATIO both means take the world's
+ * light through its ratio, so the noise of its directions counts. */
 
 /* The error estimate of pixel q (0 for a pixel with no samples yet). */
 float pixel_error(ivec2 q)
@@ -15,6 +16,13 @@ float pixel_error(ivec2 q)
   }
   vec4 I = texelFetch(accum, q, 0) / n;
   vec4 A = texelFetch(half_accum, q, 0) / n;
+#if WORLD_RATIO
+  /* The world's light through its ratio in both means (lib/world_ratio.glsl): the SH light
+   * by lobe of all samples, the sums of all samples and of every other one. */
+  vec3 u_d = texelFetch(world_diffuse, q, 0).rgb / n, u_s = texelFetch(world_specular, q, 0).rgb / n;
+  I = world_ratio_apply(I, u_d, u_s, texelFetch(world_sums, q, 0));
+  A = world_ratio_apply(A, u_d, u_s, texelFetch(half_world_sums, q, 0));
+#endif
   vec4 d = abs(I - A);
   return (d.r + d.g + d.b + d.a) / (0.0001 + sqrt(max(I.r + I.g + I.b, 0.0)));
 }

@@ -76,6 +76,44 @@ struct Surface {
 
 #define NO_SHADOW -1
 
+/* WORLD_RATIO (a frame that samples the world's light with shadow-mapped directions and
+ * lights surfaces with its SH light, frame/world_sampling.py): the world's light is U x S per
+ * lobe (Heitz, Hill and McGuire 2018, "Combining Analytic Direct Illumination and Stochastic
+ * Shadows"): U the SH light unshadowed (lobe_setup), diffuse U_d and specular U_s, S the ratio
+ * of the directions' sums N of f cos V L / p and D of f cos L / p over the frame's samples,
+ * f the lobe's BSDF, so a glossy lobe weighs its own shadow and its few bright directions do
+ * not spot the diffuse light. The colour carries U whole; WORLD_RATIO_OUT 1 also writes U_d,
+ * U_s and the sums (N_d, D_d, N_s, D_s), which the film accumulates with the colour's weights
+ * and divides at resolve (lib/world_ratio.glsl): colour - U_d (1 - S_d) - U_s (1 - S_s), in
+ * [colour - U, colour], never below zero. A sample with ambient occlusion adds its visibility
+ * as one sample's worth of the sums. WORLD_RATIO_OUT 2 (blended surfaces) takes its own ratio
+ * within the sample and writes what it leaves of the light behind it. */
+#ifndef WORLD_RATIO
+#  define WORLD_RATIO 0
+#endif
+#ifndef WORLD_RATIO_OUT
+#  define WORLD_RATIO_OUT 0
+#endif
+#if WORLD_RATIO
+vec4 world_sums = vec4(0.0); /* (N_d, D_d, N_s, D_s) of this sample's directions */
+vec3 world_part_d = vec3(0.0), world_part_s = vec3(0.0); /* the last lobe_setup's U by lobe */
+vec2 world_part_vis = vec2(1.0); /* and its ambient occlusion (diffuse, specular) */
+
+/* One sample's worth of the sums from the last lobe_setup's ambient occlusion. */
+vec4 world_ao_sums()
+{
+  float d = world_luminance(world_part_d), sp = world_luminance(world_part_s);
+  return vec4(world_part_vis.x * d, d, world_part_vis.y * sp, sp);
+}
+
+/* A direction's (diffuse, specular) f cos L / p for one lobe, in luminance. */
+vec2 world_direction_weights(vec3 E, vec3 albedo, vec3 f, float cosine, LightData L)
+{
+  vec3 fd = albedo / M_PI * L.diffuse_factor;
+  return cosine * vec2(world_luminance(E * fd), world_luminance(E * max(f - fd, vec3(0.0))));
+}
+#endif
+
 #if DEBUG_TERM
 /* The WORLD_LIGHT (1) and INDIRECT (2) debug views: the one term of the colour they show. */
 vec3 debug_term = vec3(0.0);
@@ -335,10 +373,34 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
     settle_light(L, s, to_light, irradiance, NgdotL);
   }
 #endif
+#if WORLD_RATIO
+  if (L.world != 0) {
+    /* A direction of the world's light adds to the ratio's sums (WORLD_RATIO above), by
+     * lobe: diffuse and specular, each weighted by its own f cos L / p. */
+    vec3 E = L.color * irradiance;
+    vec2 w = vec2(0.0);
+#  if NODE_LOBES == 2
+    if (NdotL > 0.0) {
+      vec3 f = lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
+      w += s.w.x * world_direction_weights(E, s.albedo, f, cosine_a, L);
+    }
+    if (NdotL_b > 0.0) {
+      vec3 f = lobe_brdf(s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b, s.alpha_b, to_light, NdotL_b, L);
+      w += s.w.y * world_direction_weights(E, s.albedo_b, f, cosine_b, L);
+    }
+#  else
+    vec3 f = lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
+    w = world_direction_weights(E, s.albedo, f, cosine, L);
+#  endif
+    w = max(w, vec2(0.0));
+    world_sums += vec4(visibility * w.x, w.x, visibility * w.y, w.y);
+    return;
+  }
+#endif
 #if WORLD_LIGHTS
-  /* A direction of the world's light (frame/world_sampling.py): its light less the SH light's
-   * share, which the world already gave this surface unshadowed; not part of the Shadow pass
-   * (the lights' alone, as Cycles'). */
+  /* A direction of the world's light carrying its whole light (with light portals: the SH
+   * light is then not given, frame/world_sampling.py); not part of the Shadow pass (the
+   * lights' alone, as Cycles'). */
   float world_light = float(L.world);
 #else
   const float world_light = 0.0;
@@ -355,9 +417,9 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
     reflected += (s.w.y * cosine_b) *
                  lobe_brdf(s.N_b, s.V, s.albedo_b, s.f0_b, s.shininess_b, s.alpha_b, to_light, NdotL_b, L);
   }
-  vec3 added = (L.color * visibility - world_light * L.world_baseline) * irradiance * reflected;
+  vec3 added = (L.color * visibility) * irradiance * reflected;
 #else
-  vec3 E = (L.color * visibility - world_light * L.world_baseline) * (irradiance * cosine);
+  vec3 E = (L.color * visibility) * (irradiance * cosine);
   vec3 added = E * lobe_brdf(s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha, to_light, NdotL, L);
 #endif
   color += added;
@@ -415,9 +477,16 @@ vec3 world_light(vec3 N, vec3 V, vec3 albedo, vec3 f0, float rough, vec2 ab)
   float t = rough * rough;
   vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
   vec3 specular = radiance * (f0 * ab.x + ab.y);
-#if WORLD_AO
+#if WORLD_AO && WORLD_RATIO
+  /* The occlusion goes into the ratio's sums (main), the colour keeps U whole. */
+  world_part_vis = vec2(world_visibility, gtao_specular(world_visibility, max(dot(N, V), 0.0), t));
+#elif WORLD_AO
   diffuse *= world_visibility;
   specular *= gtao_specular(world_visibility, max(dot(N, V), 0.0), t);
+#endif
+#if WORLD_RATIO
+  world_part_d = diffuse;
+  world_part_s = specular;
 #endif
   return diffuse + specular;
 }
@@ -521,6 +590,16 @@ void main()
     discard;
   }
 #endif
+#if EMISSION_ONLY
+  /* The Emission pass drawn apart, over the z-buffer the lit pass left (a frame whose other
+   * targets leave its own no room: lit_pass.py). */
+#  if HOLDOUT
+  out_color = vec4(0.0);
+#  else
+  out_color = vec4(emission, 1.0);
+#  endif
+  return;
+#endif
 
   Surface s;
   s.P = v_world;
@@ -602,6 +681,12 @@ void main()
   float debug_world_ao = world_visibility;
 #endif
   vec3 color = lobe_setup(base.rgb, rough, metal, spec_f0, s.N, s.V, s.albedo, s.f0, s.shininess, s.alpha);
+#if WORLD_RATIO
+  vec3 world_d = world_part_d, world_s = world_part_s; /* U by lobe (both lobes' summed) */
+#  if WORLD_AO
+  vec4 ao_sums = world_ao_sums();
+#  endif
+#endif
 #if NODE_LOBES == 2
   /* The second lobe: its own normal where the tree gives one, else the first lobe's. */
 #  if NODE_NORMAL
@@ -618,8 +703,19 @@ void main()
                             s.alpha_b);
   s.w = lobe_weights;
   color = lobe_weights.x * color + lobe_weights.y * color_b;
+#  if WORLD_RATIO
+  world_d = lobe_weights.x * world_d + lobe_weights.y * world_part_d;
+  world_s = lobe_weights.x * world_s + lobe_weights.y * world_part_s;
+#    if WORLD_AO
+  ao_sums = lobe_weights.x * ao_sums + lobe_weights.y * world_ao_sums();
+#    endif
+#  endif
 #endif
   float arriving = 0.0, unshadowed = 0.0;
+#if WORLD_RATIO && WORLD_AO
+  /* A sample with ambient occlusion: its visibility is one sample's worth of the sums. */
+  world_sums += ao_sums;
+#endif
 #if DEBUG_TERM == 1
   debug_term += color; /* the world's SH light (with its ambient occlusion) */
 #endif
@@ -714,6 +810,13 @@ void main()
 #  endif
   }
 #endif
+#if WORLD_RATIO && WORLD_RATIO_OUT != 1
+  /* No film sums for this surface (a blended one): its own ratio within this sample. */
+  color = world_ratio_apply(vec4(color, 1.0), world_d, world_s, world_sums).rgb;
+#  if DEBUG_TERM == 1
+  debug_term = world_ratio_apply(vec4(debug_term, 1.0), world_d, world_s, world_sums).rgb;
+#  endif
+#endif
   color += emission;
 #if HOLDOUT
   out_color = vec4(0.0); /* Object > Visibility > Holdout: a hole in the film */
@@ -756,14 +859,14 @@ void main()
   out_color = vec4(settled ? 1.0 : 0.0, settle_spread, 0.0, 1.0);
 #endif
 #if AUX_OUTPUTS
-  out_depth = v_view_depth;
   /* A ratio of weighted sums lies in [0, 1] but for rounding (a division need not be
    * correctly rounded: w / w may be 1.0000001). */
   out_shadow = (unshadowed > 0.0) ? clamp(arriving / unshadowed, 0.0, 1.0) : 1.0;
 #  if NODE_LOBES == 2
-  out_normal = vec4((s.w.y > s.w.x) ? s.N_b : N, 0.0); /* the heavier lobe's */
+  out_normal = vec4((s.w.y > s.w.x) ? s.N_b : N, v_view_depth); /* the heavier lobe's; w: the Depth pass */
 #  else
-  out_normal = vec4(N, 0.0); /* world-space shading normal, facing the camera (Normal pass) */
+  /* world-space shading normal, facing the camera (Normal pass); w: view depth (Depth pass) */
+  out_normal = vec4(N, v_view_depth);
 #  endif
 #endif
 #if EMISSION_OUTPUT
@@ -772,6 +875,23 @@ void main()
 #  else
   out_emission = vec4(emission, 1.0); /* the Emission pass: what the surface emits */
 #  endif
+#endif
+#if WORLD_RATIO_OUT == 1
+  /* The SH light by lobe that the colour carries, and the ratio's sums (none in a hole, nor
+   * in the INDIRECT view's image, which has no world light, nor in a lit debug view's). */
+#  if HOLDOUT || DEBUG_TERM == 2 || DEBUG_LIT || !WORLD_RATIO
+  out_world_diffuse = vec4(0.0, 0.0, 0.0, 1.0);
+  out_world_specular = vec4(0.0, 0.0, 0.0, 1.0);
+  out_world_sums = vec4(0.0);
+#  else
+  out_world_diffuse = vec4(world_d, 1.0);
+  out_world_specular = vec4(world_s, 1.0);
+  out_world_sums = world_sums;
+#  endif
+#elif WORLD_RATIO_OUT == 2
+  /* Blended over the surface behind: its unshadowed world light is seen through 1 - alpha. */
+  out_world_diffuse = vec4(0.0, 0.0, 0.0, out_color.a);
+  out_world_specular = vec4(0.0, 0.0, 0.0, out_color.a);
 #endif
 #if COUNT_SHADED
   out_shaded = 1.0; /* this pixel was shaded in this sample (programs.LIT_COLOR_COUNTED) */

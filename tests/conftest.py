@@ -19,6 +19,27 @@ def penumbra():
     module.unregister()
 
 
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers",
+        "negative_inputs: the test's scenes have negative inputs on purpose (colours, strengths), "
+        "so the light check (Combined >= 0) does not apply to its frames",
+    )
+
+
+@pytest.fixture(autouse=True)
+def light_is_never_negative(request):
+    """Every frame Penumbra renders in a test (in this process or a child of ``run_result``)
+    has a finite Combined >= 0 within float rounding (``session.install_light_check``); a test
+    whose scenes have negative inputs on purpose says so with ``negative_inputs``."""
+    session.install_light_check()
+    session.take_light_failures()
+    yield
+    failures = session.take_light_failures()
+    if failures and request.node.get_closest_marker("negative_inputs") is None:
+        pytest.fail("light check: " + "; ".join(failures[:5]), pytrace=False)
+
+
 @pytest.fixture(scope="session")
 def gpu_call(penumbra):
     """``gpu_call(fn)``: run ``fn(engine, depsgraph)`` in a GPU context, on the current scene

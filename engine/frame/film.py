@@ -11,8 +11,6 @@ from ..gpu_pool import new_texture
 from ..post.base import PostContext
 from .programs import (
     CONVERGED_DEPTH,
-    CONVERGENCE,
-    CONVERGENCE_ERROR,
     MASKED_COPY,
     MASKED_COPY_SHADOW_WEIGHT,
     MASKED_COPY_WEIGHT,
@@ -24,6 +22,8 @@ from .programs import (
     SETTLED_COPY,
     WEIGHTED_RESOLVE,
     WEIGHTED_RESOLVE_SHADOW,
+    WORLD_RATIO_RESOLVE,
+    convergence_program,
 )
 from .sampling import THRESHOLD_SCALE
 from .stats import StageClock
@@ -32,7 +32,7 @@ from .stats import StageClock
 @dataclass
 class FrameOutput:
     color: object  # GPUTexture, scene-linear RGBA float
-    depth: object  # GPUTexture, view-space distance along the camera axis
+    depth: object  # GPUTexture RGBA: w the view-space distance along the camera axis (the normal target)
     shadow: object  # GPUTexture, fraction of direct light not blocked (1 for background)
     stats: object  # stats.FrameStats
     width: int
@@ -61,10 +61,15 @@ class FrameOutput:
     def depth_array(self):
         if self.depth_data is not None:
             return self.depth_data
-        return texture_array(self.depth, 1)[..., 0]
+        return texture_array(self.depth, 4)[..., 3]
 
     def shadow_array(self):
         return texture_array(self.shadow, 1)[..., 0]
+
+
+def _clear_zero(texture):
+    """``texture`` (RGBA or RG float) cleared to 0 in every channel."""
+    texture.clear(format="FLOAT", value=(0.0, 0.0) if texture.format == "RG32F" else (0.0, 0.0, 0.0, 0.0))
 
 
 def gpu_framebuffer(texture):
@@ -100,7 +105,12 @@ class Film:
     converged pixels in a mask (``mask``). Once a pixel converged, later samples add nothing to
     it (``accumulate`` writes through the mask, with each pixel's own weight in a weight
     target), the lit pass does not shade it (``mask_depth``) and ``resolve`` divides by each
-    pixel's weight. Until then every step is the plain accumulation's, to the bit."""
+    pixel's weight. Until then every step is the plain accumulation's, to the bit.
+
+    The world's light as a ratio (``begin(..., world_ratio=True)``, lit.frag.glsl WORLD_RATIO):
+    the lit pass also writes the SH light by lobe and the ratio's sums (``world_targets``);
+    each is accumulated with the colour's weights, the sums also every other sample for the
+    noise estimate, and ``resolve`` shadows the SH light in the colour by their ratio."""
 
     def __init__(self, shaders, pool=None):
         self.shaders = shaders
@@ -130,6 +140,12 @@ class Film:
         # for every pixel it shades; ``shaded_total`` adds them over the frame's samples.
         self.count_shaded = False
         self.shaded = self.fb_counted = self.shaded_total = self._shaded_total_fb = None
+        # The world ratio's targets (``world_targets``): per sample, accumulated, the sums'
+        # every-other-sample accumulation, and the lit pass's framebuffers that include them.
+        self.world_ratio = False
+        self.world = self._world_accum = None
+        self._world_half = None
+        self._world_fbs = {}
 
     # --- targets --------------------------------------------------------------------------
 
@@ -148,11 +164,13 @@ class Film:
             self.post_ctx = PostContext(self.shaders, width, height, texture_pool=self.pool)
             self.size = (width, height)
         if aux and self.fb is None:
-            self.depth = new_texture(self.pool, (width, height), "R32F")
+            # The normal target carries the view depth in w (Blender's gpu module binds at most
+            # six colour targets: the world ratio's two need the room).
             self.shadow = new_texture(self.pool, (width, height), "R32F")
-            self.normal = new_texture(self.pool, (width, height), "RGBA16F")
+            self.normal = new_texture(self.pool, (width, height), "RGBA32F")
+            self.depth = self.normal
             self.fb = gpu.types.GPUFrameBuffer(
-                depth_slot=self.zbuffer, color_slots=(self.color, self.depth, self.shadow, self.normal)
+                depth_slot=self.zbuffer, color_slots=(self.color, self.shadow, self.normal)
             )
         if self.count_shaded and self.fb_counted is None:
             self.shaded = new_texture(self.pool, (width, height), "R32F")
@@ -164,28 +182,81 @@ class Film:
             self.emission = new_texture(self.pool, (width, height), "RGBA32F")
             self.fb_emit = gpu.types.GPUFrameBuffer(
                 depth_slot=self.zbuffer,
-                color_slots=(self.color, self.depth, self.shadow, self.normal, self.emission),
+                color_slots=(self.color, self.shadow, self.normal, self.emission),
             )
 
-    def clear(self, background, aux, emission):
+    def world_targets(self):
+        """The world ratio's per-sample targets (the SH light diffuse and specular with
+        coverage, the sums N_d, D_d, N_s, D_s), made at this size on first use."""
+        if self.world is None:
+            self.world = [new_texture(self.pool, self.size, "RGBA32F") for _ in range(3)]
+        return self.world
+
+    def lit_framebuffer(self, aux, emission, counted, world_ratio):
+        """The lit pass's framebuffer: colour and z-buffer, with ``aux`` the depth, shadow and
+        normal passes, with ``emission`` the Emission pass, ``counted`` (colour only) the
+        shading count; ``world_ratio``: then the world ratio's three targets."""
+        fb = self.fb_emit if emission else (self.fb if aux else (self.fb_counted if counted else self.fb_color))
+        if not world_ratio:
+            return fb
+        import gpu
+
+        key = (aux, emission, counted)
+        if key not in self._world_fbs:
+            if emission:
+                slots = (self.color, self.shadow, self.normal, self.emission)
+            elif aux:
+                slots = (self.color, self.shadow, self.normal)
+            else:
+                slots = (self.color, self.shaded) if counted else (self.color,)
+            self._world_fbs[key] = gpu.types.GPUFrameBuffer(
+                depth_slot=self.zbuffer, color_slots=slots + tuple(self.world_targets())
+            )
+        return self._world_fbs[key]
+
+    def emission_framebuffer(self):
+        """The Emission pass's target over the z-buffer (its own draw: ``LitPass.draw``)."""
+        import gpu
+
+        if "emission" not in self._world_fbs:
+            self._world_fbs["emission"] = gpu.types.GPUFrameBuffer(
+                depth_slot=self.zbuffer, color_slots=(self.emission,)
+            )
+        return self._world_fbs["emission"]
+
+    def blend_framebuffer(self, world_ratio):
+        """The framebuffer blended surfaces draw into: colour, and with ``world_ratio`` the SH
+        light targets (which they attenuate)."""
+        if not world_ratio:
+            return self.fb_color
+        import gpu
+
+        if "blend" not in self._world_fbs:
+            slots = (self.color, *self.world_targets()[:2])
+            self._world_fbs["blend"] = gpu.types.GPUFrameBuffer(depth_slot=self.zbuffer, color_slots=slots)
+        return self._world_fbs["blend"]
+
+    def clear(self, background, aux, emission, world_ratio=False):
         """Every target the lit pass writes, cleared to what the background is: ``background``
         colour (premultiplied), and for the passes an "infinitely" far depth (as Blender's own
         Depth pass), full light, no normal, no emission."""
         self.color.clear(format="FLOAT", value=background)
         if aux:
-            self.depth.clear(format="FLOAT", value=(1e10,))
             self.shadow.clear(format="FLOAT", value=(1.0,))
-            self.normal.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+            self.normal.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 1e10))
         if emission:
             self.emission.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
         if self.shaded is not None:
             self.shaded.clear(format="FLOAT", value=(0.0,))
+        if world_ratio:
+            for target in self.world_targets():
+                _clear_zero(target)
 
     def target_bytes(self, aux, accumulate):
         """Bytes per pixel of the frame's targets: colour, z-buffer, and with ``aux`` depth,
         shadow and normal; accumulation adds colour (and shadow); adaptive sampling its second
         accumulation, two masks and, once some pixel converged, the weights."""
-        per_pixel = 16 + 4 + (4 + 4 + 8 if aux else 0)
+        per_pixel = 16 + 4 + (4 + 16 if aux else 0)
         if accumulate:
             per_pixel += 16 + (4 if aux else 0)
             if self.tracking:
@@ -194,18 +265,23 @@ class Film:
                 per_pixel += 4 + 4 + (4 if self._weight is not None else 0)
             if self._settle is not None:
                 per_pixel += 16
+            if self.world_ratio:
+                per_pixel += 6 * 16 + (16 if self.tracking else 0)
         return per_pixel * self.size[0] * self.size[1]
 
     # --- samples --------------------------------------------------------------------------
 
-    def begin(self, aux, emission, fresh, adaptive=False, settle=False):
+    def begin(self, aux, emission, fresh, adaptive=False, settle=False, world_ratio=False):
         """Before a multi-sample frame's samples: the accumulation targets, cleared when the
         frame starts afresh (``fresh``); ``adaptive``: the frame estimates each pixel's error
         (from a fresh start on); ``settle``: pixels may settle (``settle``), so the converged
-        masks exist."""
+        masks exist; ``world_ratio``: the frame's world light is a ratio (its targets too)."""
         self._ensure_accumulation(aux)
+        self.world_ratio = bool(world_ratio)
         if fresh:
             self._begin_adaptive(adaptive, settle)
+            if self.world_ratio:
+                self._begin_world_ratio()
             if self.shaded_total is not None:
                 self.shaded_total.clear(format="FLOAT", value=(0.0,))
             self._accum_color.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
@@ -239,6 +315,11 @@ class Film:
             self.fullscreen(
                 SCALED_COPY, self._shaded_total_fb, {"src_color": self.shaded}, {"scale": 1.0}, "ADDITIVE_PREMULT"
             )
+        if self.world_ratio:
+            for source, (_target, framebuffer) in zip(self.world_targets(), self._world_accum, strict=True):
+                self._copy(framebuffer, source, weight, mask)
+            if self.tracking and sample % 2 == 1:
+                self._copy(self._world_half[1], self.world[2], 2.0 * weight, mask)
         self._weight_sum += weight
         self.sample_weights.append(float(weight))
 
@@ -254,7 +335,8 @@ class Film:
         """Keep the centred sample's depth and normal (a multi-sample frame's Depth and Normal
         passes are that sample's, not an average)."""
         with self.clock.waiting():
-            self.centre = (texture_array(self.depth, 1)[..., 0].copy(), texture_array(self.normal, 4).copy())
+            normal = texture_array(self.normal, 4).copy()
+            self.centre = (normal[..., 3].copy(), normal)
 
     def resolve(self, aux, emission):
         """The filtered average (accumulation / total weight) into the colour (and shadow,
@@ -274,12 +356,50 @@ class Film:
             if emission:
                 accum, _accum_fb, resolve_fb = self._emission_targets
                 self.fullscreen(WEIGHTED_RESOLVE, resolve_fb, {"src_color": accum, "weight": self._weight}, {})
-            return
+        else:
+            inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
+            self._scaled_copy(self._resolve_fb[1], (self._accum_color, self._accum_shadow), inverse, aux, resolve=True)
+            if emission:
+                accum, _accum_fb, resolve_fb = self._emission_targets
+                self.fullscreen(SCALED_COPY, resolve_fb, {"src_color": accum}, {"scale": inverse})
+        if self.world_ratio:
+            self._resolve_world_ratio()
+
+    def _resolve_world_ratio(self):
+        """The colour resolved anew with the world's light through its ratio (over the shadow
+        and Emission passes the plain resolve wrote)."""
+        per_pixel = self._weight is not None
         inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
-        self._scaled_copy(self._resolve_fb[1], (self._accum_color, self._accum_shadow), inverse, aux, resolve=True)
-        if emission:
-            accum, _accum_fb, resolve_fb = self._emission_targets
-            self.fullscreen(SCALED_COPY, resolve_fb, {"src_color": accum}, {"scale": inverse})
+        samplers = {
+            "src_color": self._accum_color,
+            "weight": self._weight if per_pixel else self._accum_color,
+            **self._world_samplers(),
+        }
+        uniforms = {"scale": inverse, "per_pixel": 1.0 if per_pixel else 0.0}
+        self.fullscreen(WORLD_RATIO_RESOLVE, gpu_framebuffer(self.color), samplers, uniforms)
+
+    def _world_samplers(self):
+        names = ("world_diffuse", "world_specular", "world_sums")
+        return {name: target for name, (target, _fb) in zip(names, self._world_accum, strict=True)}
+
+    def _begin_world_ratio(self):
+        """A fresh frame whose world light is a ratio: its accumulations (and, when the noise
+        is estimated, the sums' every-other-sample one) at this size, cleared."""
+        import gpu
+
+        size = self.size
+        if self._world_accum is None or (self._world_accum[0][0].width, self._world_accum[0][0].height) != size:
+            self._give([t for t, _fb in self._world_accum or ()] + [self._world_half[0] if self._world_half else None])
+            self._world_half = None
+            targets = [new_texture(self.pool, size, "RGBA32F") for _ in range(3)]
+            self._world_accum = [(t, gpu.types.GPUFrameBuffer(color_slots=(t,))) for t in targets]
+        if self.tracking and self._world_half is None:
+            half = new_texture(self.pool, size, "RGBA32F")
+            self._world_half = (half, gpu.types.GPUFrameBuffer(color_slots=(half,)))
+        for target, _fb in self._world_accum:
+            _clear_zero(target)
+        if self.tracking:
+            _clear_zero(self._world_half[0])
 
     # --- adaptive sampling ----------------------------------------------------------------
 
@@ -359,6 +479,10 @@ class Film:
                 copies.append((self._accum_shadow, self.shadow))
             if emission and self._emission_targets is not None:
                 copies.append((self._emission_targets[0], self.emission))
+            if self.world_ratio:
+                copies += [
+                    (target, source) for (target, _fb), source in zip(self._world_accum, self.world, strict=True)
+                ]
             for target, source in copies:
                 framebuffer = gpu_framebuffer(target)
                 scale = self._weight_sum  # the first sample's weight, which the pilot takes over
@@ -382,8 +506,15 @@ class Film:
             "weight_sum": float(self._weight_sum),
             "per_pixel": 1.0 if self._weight is not None else 0.0,
         }
-        self.fullscreen(CONVERGENCE, self._mask_fbs[dst], samplers, uniforms)
+        samplers.update(self._convergence_world_samplers())
+        self.fullscreen(convergence_program(False, self.world_ratio), self._mask_fbs[dst], samplers, uniforms)
         return self._take_mask(dst)
+
+    def _convergence_world_samplers(self):
+        """The world ratio's accumulations the convergence check reads (none without it)."""
+        if not self.world_ratio:
+            return {}
+        return {**self._world_samplers(), "half_world_sums": self._world_half[0]}
 
     def _take_mask(self, dst):
         """Mask ``dst`` becomes the converged mask; returns its count (and from the first
@@ -443,7 +574,8 @@ class Film:
             "weight_sum": float(self._weight_sum),
             "per_pixel": 1.0 if self._weight is not None else 0.0,
         }
-        self.fullscreen(CONVERGENCE_ERROR, framebuffer, samplers, uniforms)
+        samplers.update(self._convergence_world_samplers())
+        self.fullscreen(convergence_program(True, self.world_ratio), framebuffer, samplers, uniforms)
         values = texture_array(target, 1)[..., 0].copy()
         self._give([target])
         return values
@@ -572,7 +704,6 @@ class Film:
             [
                 self.color,
                 self.zbuffer,
-                self.depth,
                 self.shadow,
                 self.normal,
                 self.emission,
@@ -585,8 +716,13 @@ class Film:
                 self.shaded,
                 self.shaded_total,
                 self._settle[1] if self._settle else None,
+                *(self.world or ()),
+                *(t for t, _fb in self._world_accum or ()),
+                self._world_half[0] if self._world_half else None,
             ]
         )
+        self.world = self._world_accum = self._world_half = None
+        self._world_fbs = {}
         self._settle = None
         self.fb = self.fb_color = self.fb_emit = self._accum_fb = self._resolve_fb = None
         self._half = self._half_fb = self._masks = self._mask_fbs = self._weight = None

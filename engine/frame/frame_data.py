@@ -108,7 +108,6 @@ def light_row(light, shadow=None, origin=_ZERO):
         "offset_scale": light.offset_scale,
         "cascade_splits": (list(shadow.splits) + [3.0e38] * 4)[:4] if shadow and shadow.splits else (3.0e38,) * 4,
         "cascade_blend": (list(shadow.blend) + [0.0] * 4)[:4] if shadow and shadow.blend else (0.0,) * 4,
-        "world_baseline": light.world_baseline if light.world_baseline is not None else _ZERO,
         "world": int(light.world),
     }
 
@@ -167,12 +166,12 @@ def shading_order(lights, plan):
     map first, then the other lights with a map, then the rest (each group in its own order).
     The lit pass runs a shadow filter only in its first two loops, so a light without a map
     never pays for one. A direction of the world's light without a map (nothing casts a
-    shadow from it) whose light equals its SH baseline adds nothing and is left out. Returns
-    (order, number sampled, number with maps)."""
+    shadow from it) stays: it adds its unblocked light to both of the world ratio's sums.
+    Returns (order, number sampled, number with maps)."""
     mapped = [i for i in range(len(lights)) if i in plan.lights]
     sampled = [i for i in mapped if lights[i].sampled]
     others = [i for i in mapped if not lights[i].sampled]
-    rest = [i for i in range(len(lights)) if i not in plan.lights and not _adds_nothing(lights[i])]
+    rest = [i for i in range(len(lights)) if i not in plan.lights]
     return sampled + others + rest, len(sampled), len(mapped)
 
 
@@ -180,12 +179,6 @@ def _debug_lit(settings):
     """Whether the lit pass writes a lit debug view's values (not a term of its colour)."""
     view = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
     return view.lit and not view.term
-
-
-def _adds_nothing(light):
-    """A direction of the world's light that, unshadowed, gives what the SH light gave."""
-    baseline = getattr(light, "world_baseline", None)
-    return bool(getattr(light, "world", False)) and baseline is not None and np.array_equal(light.color, baseline)
 
 
 def build_frame_data(
@@ -210,6 +203,7 @@ def build_frame_data(
     world_ao=None,
     sample_index=0,
     rsm=False,
+    world_ratio=False,
 ):
     """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
@@ -230,7 +224,9 @@ def build_frame_data(
     occlusion over the camera depth prepass (``WORLD_AO``; ``size`` is then the film's);
     ``sample_index``: this sample's index in its frame; ``rsm``: the atlas holds reflective
     shadow maps (``indirect_samples``): the variant gathers one diffuse bounce from them when
-    some light has a map (``INDIRECT_RSM`` in its defines)."""
+    some light has a map (``INDIRECT_RSM`` in its defines); ``world_ratio``: the frame's
+    world directions shadow the SH light as a ratio the film accumulates (``WORLD_RATIO``;
+    never in the settle test's variant)."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
     disk = disk_samples(settings, sample_count)
@@ -288,6 +284,7 @@ def build_frame_data(
             world_ao is not None,
             indirect,
             term,
+            world_ratio=world_ratio and not settle,
         ),
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,

@@ -14,6 +14,9 @@ from .programs import (
     RSM_FLUX_SAMPLER,
     RSM_NORMAL_SAMPLER,
     SHADOW_SAMPLER,
+    WORLD_RATIO_BLENDED,
+    WORLD_RATIO_OPAQUE,
+    emission_program,
     image_premultiplied_bits,
     lit_program,
     terminator_uniforms,
@@ -76,11 +79,16 @@ class LitPass:
         bg = (0.0, 0.0, 0.0, 0.0) if transparent else (*map(float, world_color[:3]), 1.0)
         emission = aux and emission
         counted = film.fb_counted is not None and not aux and target is None  # the shading count of tests
-        fb = film.fb_emit if emission else (film.fb if aux else (film.fb_counted if counted else film.fb_color))
+        # The world's light as a ratio (lit.frag.glsl WORLD_RATIO): its targets beside the pass's.
+        ratio = bool(data.defines.get("WORLD_RATIO")) and target is None
+        # Blender's gpu module binds six colour targets: with the world ratio's three, the
+        # Emission pass is drawn apart, over the z-buffer the lit pass leaves.
+        emission_apart = ratio and emission
+        fb = film.lit_framebuffer(aux, emission and not emission_apart, counted, ratio)
         if target is not None:
             fb = target
         else:
-            film.clear(bg, aux, emission)
+            film.clear(bg, aux, emission, ratio)
         # Adaptive sampling: where a pixel converged the nearest depth goes first, so nothing
         # (surface or world) is drawn there; the pixel is not shaded again.
         converged = film.mask is not None and target is None
@@ -125,10 +133,19 @@ class LitPass:
         # One diffuse bounce from the atlas's reflective targets (frame_data: some light has a map).
         rsm = bool(data.defines.get("INDIRECT_RSM"))
 
-        def bind(features, with_aux, tree):
-            program = lit_program(
-                frozenset(features), with_aux, emission and with_aux, bound["counted"] and not with_aux, tree, rsm
-            )
+        def bind(features, with_aux, tree, ratio_mode, emission_only=False):
+            if emission_only:
+                program = emission_program(frozenset(features), tree)
+            else:
+                program = lit_program(
+                    frozenset(features),
+                    with_aux,
+                    emission and with_aux and not emission_apart,
+                    bound["counted"] and not with_aux,
+                    tree,
+                    rsm,
+                    ratio_mode if ratio else 0,
+                )
             defines = data.defines
             if bool(defines.get("AUX_OUTPUTS")) != with_aux:
                 # Blended surfaces of a frame with passes draw into the colour target alone.
@@ -164,7 +181,7 @@ class LitPass:
                     solid_found[shader] = False
             return solid_found[shader]
 
-        def draw(entries, with_aux):
+        def draw(entries, with_aux, ratio_mode=WORLD_RATIO_OPAQUE, emission_only=False):
             last = None
             for features, _rank, d, batch, mat in entries:
                 # Material › Backface Culling › Camera: faces turned away are not drawn (the
@@ -175,7 +192,7 @@ class LitPass:
                     gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
                     gpu.state.front_facing_set(culling[1])
                     bound["culling"] = culling
-                shader = bind(features, with_aux, mat.tree)
+                shader = bind(features, with_aux, mat.tree, ratio_mode, emission_only)
                 if last is not d or bound.get("model_shader") is not shader:
                     shader.uniform_float("model", d.model)
                     if solid_uniform(shader):  # compiled out where no light reads it
@@ -208,15 +225,22 @@ class LitPass:
             gpu.state.depth_test_set("LESS_EQUAL")
             gpu.state.depth_mask_set(target is None)
             draw(opaque, aux)
+        if emission_apart and opaque:
+            bound["shader"], bound["counted"] = None, False
+            with film.emission_framebuffer().bind():
+                gpu.state.viewport_set(0, 0, width, height)
+                gpu.state.depth_test_set("LESS_EQUAL")
+                gpu.state.depth_mask_set(False)
+                draw(opaque, False, emission_only=True)
         if blended:
             bound["shader"] = None
             bound["counted"] = False  # blended surfaces draw into the colour target alone
-            with (film.fb_color if target is None else target).bind():
+            with (film.blend_framebuffer(ratio) if target is None else target).bind():
                 gpu.state.viewport_set(0, 0, width, height)
                 gpu.state.depth_test_set("LESS_EQUAL")
                 gpu.state.depth_mask_set(False)
                 gpu.state.blend_set("ALPHA_PREMULT" if target is None else "NONE")
-                draw(blended, False)
+                draw(blended, False, WORLD_RATIO_BLENDED)
                 gpu.state.blend_set("NONE")
         gpu.state.face_culling_set("NONE")
         gpu.state.front_facing_set(False)

@@ -51,11 +51,10 @@ LIGHT_STRUCT = Struct(
         ("FLOAT", "offset_scale"),  # multiplies the normal offset (besides bias_scale)
         ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
         ("VEC4", "cascade_blend"),  # CASCADE: depth before each end over which the next one fades in
-        # A direction of the world's light (frame/world_sampling.py): ``color`` and this are the
-        # world's radiance and its SH radiance from it, over its probability; the light adds
-        # color x visibility - world_baseline (the SH light was given unshadowed).
-        ("VEC3", "world_baseline"),
-        ("INT", "world"),  # 1: a direction of the world's light
+        # 1: a direction of the world's light (frame/world_sampling.py), ``color`` its radiance
+        # over its probability: it adds to the world ratio's sums (lit.frag.glsl WORLD_RATIO),
+        # or with light portals its light itself.
+        ("INT", "world"),
     ),
 )
 
@@ -210,6 +209,7 @@ LIT = Program(
         "lib/material.glsl",
         "lib/ggx_albedo.glsl",
         "lib/gtao.glsl",
+        "lib/world_ratio.glsl",
     ),
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
@@ -227,7 +227,8 @@ LIT = Program(
         (TILE_STRUCT, "shadow_tiles", MAX_SHADOW_TILES),
         (MATERIAL_STRUCT, "material", 0),
     ),
-    outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth"), ("FLOAT", "out_shadow"), ("VEC4", "out_normal")),
+    # out_normal: the shading normal (xyz) and the view depth (w): the Normal and Depth passes.
+    outputs=(("VEC4", "out_color"), ("FLOAT", "out_shadow"), ("VEC4", "out_normal")),
     defines=tuple(
         {
             **_ENUM_DEFINES,
@@ -237,6 +238,7 @@ LIT = Program(
             "LIGHT_WORDS": LIGHT_WORDS,
             **material_defines(frozenset()),
             "EMISSION_OUTPUT": False,
+            "EMISSION_ONLY": False,
             "COUNT_SHADED": False,
             "INDIRECT_RSM": False,
             "RSM_SAMPLES": 1,
@@ -362,16 +364,48 @@ LIT_COLOR_COUNTED = replace(
 )
 
 
-def lit_program(features=frozenset(), aux=True, emission=False, counted=False, tree=None, rsm=False):
+# The world's light as a ratio (lit.frag.glsl WORLD_RATIO): after the targets of the pass, the
+# SH light by lobe (diffuse, specular: rgb, coverage) and the ratio's sums (N_d, D_d, N_s, D_s),
+# which the film accumulates (``Film.world_targets``); blended surfaces write only the first two
+# (what they leave of the light behind them).
+WORLD_RATIO_OUTPUTS = (("VEC4", "out_world_diffuse"), ("VEC4", "out_world_specular"), ("VEC4", "out_world_sums"))
+WORLD_RATIO_OPAQUE, WORLD_RATIO_BLENDED = 1, 2
+
+
+def with_world_ratio(program, mode):
+    """``program`` writing the world ratio's targets: ``mode`` WORLD_RATIO_OPAQUE (all three)
+    or WORLD_RATIO_BLENDED (the SH lights, blended); 0: ``program`` itself."""
+    if not mode:
+        return program
+    outputs = WORLD_RATIO_OUTPUTS if mode == WORLD_RATIO_OPAQUE else WORLD_RATIO_OUTPUTS[:2]
+    return replace(
+        program,
+        name=f"{program.name}_ratio{mode}",
+        outputs=program.outputs + outputs,
+        defines=program.defines + (("WORLD_RATIO_OUT", int(mode)),),
+    )
+
+
+def emission_program(features=frozenset(), tree=None):
+    """The lit program of a material variant that writes only what the surface emits, as its
+    colour (``EMISSION_ONLY``): the Emission pass of a frame whose lit pass has no room left
+    for its target (the world ratio's three take it; Blender's gpu module binds six)."""
+    base = lit_program(features, aux=False, tree=tree)
+    return replace(base, name=f"{base.name}_emission_only", defines=base.defines + (("EMISSION_ONLY", True),))
+
+
+def lit_program(features=frozenset(), aux=True, emission=False, counted=False, tree=None, rsm=False, ratio=0):
     """The lit pass program of a material variant (``Material.features``, plus "HOLDOUT");
     ``emission``: the variant also writes the Emission pass's target; ``counted`` (colour
     only): it also writes the shading count (``LIT_COLOR_COUNTED``); ``tree``: the
     material's ``nodetree.CompiledTree`` (its feature NODES_<key> names the variant);
     ``rsm``: it also gathers one diffuse bounce from the lights' reflective shadow maps
-    (``with_rsm_gather``; the frame's defines carry INDIRECT_RSM)."""
+    (``with_rsm_gather``; the frame's defines carry INDIRECT_RSM); ``ratio``: it writes the
+    world ratio's targets (``with_world_ratio``)."""
     base = LIT_EMIT if emission else (LIT if aux else (LIT_COLOR_COUNTED if counted else LIT_COLOR))
     if rsm:
         base = with_rsm_gather(base)
+    base = with_world_ratio(base, ratio)
     if not features:
         return base
     program = _with_features(base, features, f"{base.name}_{'_'.join(sorted(features)).lower()}")
@@ -588,10 +622,44 @@ CONVERGENCE = Program(
         ("FLOAT_2D", "weight"),
     ),
     outputs=(("VEC4", "out_color"),),
+    libs=("lib/world_ratio.glsl",),
 )
-CONVERGENCE = replace(CONVERGENCE, defines=(("ERROR_OUTPUT", False),))
+CONVERGENCE = replace(CONVERGENCE, defines=(("ERROR_OUTPUT", False), ("WORLD_RATIO", False)))
 # The NOISE debug view: each pixel's error estimate as the check reads it (``Film.error_array``).
-CONVERGENCE_ERROR = replace(CONVERGENCE, name="convergence_error", defines=(("ERROR_OUTPUT", True),))
+CONVERGENCE_ERROR = replace(
+    CONVERGENCE, name="convergence_error", defines=(("ERROR_OUTPUT", True), ("WORLD_RATIO", False))
+)
+# The world's light as a ratio (``Film.world_targets``): the accumulations of its SH light by
+# lobe and of its sums, and the every-other-sample accumulation of the sums.
+_WORLD_RATIO_SAMPLERS = (("FLOAT_2D", "world_diffuse"), ("FLOAT_2D", "world_specular"), ("FLOAT_2D", "world_sums"))
+
+
+def convergence_program(error_output=False, world_ratio=False):
+    """The convergence check (or, ``error_output``, its estimate for the NOISE view); with
+    ``world_ratio`` both means it compares take the world's light through its ratio."""
+    base = CONVERGENCE_ERROR if error_output else CONVERGENCE
+    if not world_ratio:
+        return base
+    return replace(
+        base,
+        name=f"{base.name}_ratio",
+        samplers=base.samplers + _WORLD_RATIO_SAMPLERS + (("FLOAT_2D", "half_world_sums"),),
+        defines=(("ERROR_OUTPUT", bool(error_output)), ("WORLD_RATIO", True)),
+    )
+
+
+# The resolve of a frame with the world's light as a ratio: colour - U_d (1 - S_d) - U_s (1 - S_s)
+# from the accumulations, over the total weight (``scale``) or each pixel's (per_pixel > 0.5).
+WORLD_RATIO_RESOLVE = Program(
+    name="world_ratio_resolve",
+    vertex="fullscreen.vert.glsl",
+    fragment="world_ratio.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "scale"), ("FLOAT", "per_pixel")),
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "weight")) + _WORLD_RATIO_SAMPLERS,
+    outputs=(("VEC4", "out_color"),),
+    libs=("lib/world_ratio.glsl",),
+)
 # Settling (``engine/frame/settle.py``): the settle test's flags and the image so far give the
 # pixels no later sample can change; they join the converged mask.
 SETTLE = Program(
@@ -777,6 +845,7 @@ def lit_defines(
     world_ao=False,
     indirect_samples=0,
     debug_term=0,
+    world_ratio=False,
 ):
     """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
     kernel (compiled in as constants, so its loops unroll), the disk size and early-out
@@ -806,7 +875,8 @@ def lit_defines(
     define, so a frame without the bounce compiles exactly what it did before.
     ``debug_term``: the variant writes one term of its colour alone (``DEBUG_TERM``: 1 the
     world's light with its visibility, 2 the diffuse bounce; the WORLD_LIGHT and INDIRECT
-    debug views)."""
+    debug views). ``world_ratio``: the world's directions shadow its SH light as a ratio
+    accumulated in the film (``WORLD_RATIO``, lit.frag.glsl) rather than adding to the colour."""
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -841,6 +911,7 @@ def lit_defines(
         "PILOT_SAMPLE": bool(pilot),
         "WORLD_LIGHTS": bool(world_lights),
         "WORLD_AO": bool(world_ao),
+        "WORLD_RATIO": bool(world_ratio),
         "DEBUG_TERM": int(debug_term),
         "SETTLE_REACH": SETTLE_REACH,
         "SETTLE_GRID": SETTLE_GRID,

@@ -84,6 +84,7 @@ class Renderer:
         self._navigation = None  # (key, map sizes, frames) of the frames drawn while the view moves
         self._world_sampled = False  # the current frame samples the world's light with maps
         self._world_sh = True  # its surfaces take the world's SH light (not with light portals)
+        self._world_ratio = False  # and its directions shadow that light as a ratio (film.py)
 
     @property
     def shadows(self):
@@ -165,15 +166,19 @@ class Renderer:
                 box = corners_of(seen).reshape(-1, 3)
                 cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
         directions = int(settings.world_samples) if sampled_world and (accumulate or cones) else 0
+        debug = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
         self._world_sampled = directions > 0
         self._world_sh = not cones
+        # Without portals the directions shadow the SH light as a ratio of their sums over the
+        # frame's samples (never negative; lit.frag.glsl WORLD_RATIO); with portals they carry
+        # the whole light, f cos V L / p, never negative either.
+        self._world_ratio = directions > 0 and not cones
         room = MAX_LIGHTS - directions
         lights = select_lights(snapshot.lights, camera.position, room)
         if len(lights) < len(snapshot.lights):
             stats.messages.append(
                 f"Penumbra: {len(snapshot.lights)} lights; only the {room} that contribute most to the view are lit"
             )
-        debug = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
         # The world's ambient occlusion (``sampling.world_ao_sample``): which samples, how far;
         # none where light portals send the world's directions into every sample.
         ao_world = snapshot.world if snapshot.world is not None else snapshot.world_color
@@ -206,7 +211,14 @@ class Renderer:
                 self._navigation = (nav_key, None, 1) if navigating else None
         if accumulate:
             # The NOISE view shows the estimate even where no threshold uses it.
-            film.begin(aux, emission, fresh=start == 0, adaptive=noise or debug.id == "NOISE", settle=settle)
+            film.begin(
+                aux,
+                emission,
+                fresh=start == 0,
+                adaptive=noise or debug.id == "NOISE",
+                settle=settle,
+                world_ratio=self._world_ratio,
+            )
         plan = None
         moving = set()
         # With map jitter every shadowed light changes from sample to sample (its maps' texel
@@ -424,6 +436,7 @@ class Renderer:
             world_ao=ao,
             sample_index=spec.index,
             rsm=atlas is not None and atlas.rsm,
+            world_ratio=self._world_ratio,
         )
         seen = [d for d in draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None

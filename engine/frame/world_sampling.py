@@ -1,32 +1,33 @@
 """The world's light with visibility: directions sampled from the world's light, each a sun
 with its own shadow map (numpy only; no bpy, no gpu).
 
-The lit pass lights every surface with the world's SH light, unshadowed (``lights.glsl``
+The lit pass lights every surface with the world's SH light, unshadowed (``lit.frag.glsl``
 ``world_light``). Each sample adds a few directions of the world as suns whose shadow maps
-say what blocks them; each such sun adds, per surface point,
+say what blocks them; each such sun adds to two sums per surface point and lobe (diffuse,
+specular),
 
-    f(w) cos(w) (V(w) L(w) - L_sh(w)) / (p(w) K)
+    N += f(w) cos(w) V(w) L(w) / (p(w) K)        D += f(w) cos(w) L(w) / (p(w) K)
 
-where ``L`` is the world's radiance, ``L_sh`` its order-2 SH radiance (the light the lit pass
-already gave, unshadowed), ``V`` the visibility from the sun's map, ``p`` the probability the
-direction was drawn with and ``K`` the directions per sample. Its mean over the frame's
-samples is the world's direct light with visibility minus the SH light's unshadowed
-irradiance: with the SH term it sums to the world's direct light with visibility, which is
-what Cycles renders with no bounces (a control variate: where nothing blocks a uniform world,
-the two cancel exactly and the open ground has no noise at all). The SH diffuse term is
-exactly the integral of ``L_sh`` against the clamped cosine (Funk-Hecke), so the estimate is
-unbiased for diffuse surfaces whatever the world's image holds.
+where ``L`` is the world's radiance, ``V`` the visibility from the sun's map, ``p`` the
+probability the direction was drawn with and ``K`` the directions per sample. The film
+accumulates both over the frame's samples with the colour's weights and shadows the SH light
+by their ratio at resolve: the world's light is U N / D per lobe (Heitz, Hill and McGuire
+2018), U the SH light. N / D lies in [0, 1], so the light lies in [0, U]: never negative,
+exact where nothing blocks (an open ground has no noise at all), and consistent: as the
+samples grow it tends to U x (the lobe's light with visibility over its light without), which
+is Cycles' direct light with no bounces where U is the lobe's unshadowed light. Its bias is
+the SH light's error in that proportion (docs/design.md has it measured).
 
 Directions are drawn in proportion to the world's luminance per solid angle (an Environment
 Texture's image, box-filtered to at most 128 x 64 texels: ``TextureCache.world_env``), mixed
-with a uniform share of the sphere so every direction where ``L_sh`` is not zero can be
+with a uniform share of the sphere so every direction where the world gives light can be
 drawn (defensive importance sampling, Hesterberg 1995); a constant world is drawn uniformly.
 The points are a (0, 2)-sequence (van der Corput, Sobol' 2), digitally shifted, so the
 directions of any first 2^k samples are stratified and a progressive viewport frame stays so.
 
 Cycles' light portals (``portal_cones``) gather three quarters of the directions in cones
-through them; such a frame gives the directions the world's whole light (no control variate:
-inside a room the SH light would almost all be subtracted again).
+through them; such a frame gives the directions the world's whole light, f cos V L / p (no
+SH light: inside a room a ratio of a few directions to the sky's SH light says little).
 """
 
 import math
@@ -262,18 +263,17 @@ def distribution(world, cones=()):
 def world_lights(world, index, count, name="World", cones=()):
     """The ``count`` world directions of one sample, as suns (``extract.Light`` with
     ``world`` set): directions ``index`` .. ``index + count - 1`` of the frame's sequence.
-    Each sun's colour is the world's radiance from it over (its probability x ``count``),
-    its ``world_baseline`` the same of the SH radiance. With light portals (``cones``) the
-    directions gather in the portals' cones and carry the world's whole light (baseline 0):
-    inside a room the SH light would have to be almost all subtracted again, which only adds
-    noise, so such a frame lights surfaces with these directions alone (``build_frame_data``'s
-    ``world_sh`` False)."""
+    Each sun's colour is the world's radiance from it over (its probability x ``count``):
+    without portals the lit pass adds f cos V L / p and f cos L / p of it to the ratio that
+    shadows the SH light (lit.frag.glsl WORLD_RATIO). With light portals (``cones``) the
+    directions gather in the portals' cones and carry the world's whole light: inside a room
+    the ratio of a few directions to the sky's SH light says little, so such a frame lights
+    surfaces with these directions alone (``build_frame_data``'s ``world_sh`` False)."""
     dist = distribution(world, cones)
     d = dist.directions(sequence_points(index, count))
     pdf = np.maximum(dist.pdf(d), 1e-30)
     scale = 1.0 / (pdf * count)
     radiance = dist.radiance(d) * scale[:, None]
-    baseline = dist.sh_radiance(d) * scale[:, None] if not cones else np.zeros_like(radiance)
     lights = []
     for k in range(count):
         matrix = np.eye(4)
@@ -288,7 +288,6 @@ def world_lights(world, index, count, name="World", cones=()):
                 use_shadow=True,
                 name=f"{name} {k + 1}",
                 world=True,
-                world_baseline=baseline[k],
             )
         )
     return lights

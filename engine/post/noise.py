@@ -2,12 +2,13 @@
 
 Each ``size`` x ``size`` cell of pixels (anchored at pixel (0, 0)) draws, per channel, a value
 ``g`` uniform in (-1, 1) from an integer hash of (cell x, cell y, frame, seed, channel), and
-the colour becomes ``c + amount * g``: additive, zero-mean grain of the same strength in
-shadows and highlights. The result is not clamped, so dark pixels may go slightly negative
-and the image mean is preserved. ``monochrome`` uses channel 0's value for R, G and B. Alpha
-is untouched. The hash is PCG (O'Neill's permuted congruential output function) chained over
-the inputs; ``grain_reference`` is its numpy twin. A point layer: it shares a pass with its
-neighbours.
+the colour becomes ``c + min(amount, c) * g``: additive, zero-mean grain of the same strength
+wherever the channel is at least ``amount``, and no stronger than the channel itself where it
+is darker, so light never goes negative (a channel at or below zero takes no grain) and the
+image mean is preserved. ``monochrome`` uses channel 0's value for R, G and B. Alpha is
+untouched. The hash is PCG (O'Neill's permuted congruential output function) chained over
+the inputs; ``grain_reference`` is its numpy twin and ``apply_reference`` the whole layer's.
+A point layer: it shares a pass with its neighbours.
 """
 
 from ..settings import Param
@@ -42,6 +43,15 @@ def grain_reference(width, height, frame, size=1, seed=0, monochrome=False):
     return out
 
 
+def apply_reference(image, amount, grain):
+    """The layer's output for ``image`` (h, w, 4) and ``grain_reference``'s ``grain``, in float64."""
+    import numpy as np
+
+    out = np.asarray(image, np.float64).copy()
+    out[..., :3] += np.minimum(float(amount), np.maximum(out[..., :3], 0.0)) * grain
+    return out
+
+
 class Noise(PointEffect):
     id = "NOISE"
     label = "Noise"
@@ -54,7 +64,7 @@ class Noise(PointEffect):
             "amount",
             "FLOAT",
             0.05,
-            "Grain strength: each channel moves by up to this much",
+            "Grain strength: each channel moves by up to this much (and never below zero)",
             min=0.0,
             max=1000.0,
             soft_max=1.0,

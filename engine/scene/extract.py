@@ -194,10 +194,8 @@ class Light:
     blockers: LinkSet | None = None  # shadow linking: what casts its shadow (None: everything)
     name: str = ""  # the light object's name (what the SHADOW_MAPS debug view labels its maps with)
     # A direction of the world's light (``frame/world_sampling.py``): a sun whose ``color`` is
-    # the world's radiance from it over its probability, and ``world_baseline`` the same of the
-    # world's SH radiance, which the lit pass already gives every surface unshadowed.
+    # the world's radiance from it over its probability.
     world: bool = False
-    world_baseline: np.ndarray | None = None
 
     @property
     def spot_axes(self):

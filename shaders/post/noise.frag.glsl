@@ -34,5 +34,6 @@ vec4 noise_point(vec4 c, int o)
   else {
     g = vec3(noise_grain(cell, 0u, frame, seed), noise_grain(cell, 1u, frame, seed), noise_grain(cell, 2u, frame, seed));
   }
-  return vec4(c.rgb + amount * g, c.a);
+  /* No stronger than the channel itself: light never goes negative, the mean stays. */
+  return vec4(c.rgb + min(vec3(amount), max(c.rgb, vec3(0.0))) * g, c.a);
 }

@@ -453,6 +453,7 @@ def test_images_drawn_in_part_are_named(penumbra, gpu_call, capfd):
     assert "Penumbra: image 'Tiles' has UDIM tiles: only tile 1001 is drawn" in out
 
 
+@pytest.mark.negative_inputs  # a texel of -inf, on purpose
 def test_bad_texture_inputs_render_finite_with_messages(penumbra, capfd):
     """A float image with NaN/Inf texels, an image whose file is missing, and a mesh without
     the UV map a texture asks for: the frame is finite, the missing image draws magenta (as in

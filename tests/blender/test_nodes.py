@@ -47,6 +47,7 @@ def _assert_close(image, expected, grid, names, atol=2e-3, rtol=2e-3):
     assert not failed, f"modes off: {failed}; worst {np.abs(got - expected).max():.4g}"
 
 
+@pytest.mark.negative_inputs  # node outputs below zero on purpose (Subtract, Sine, curves, ...)
 def test_math_every_operation(penumbra):
     """Math with A = 4u - 2, B = 4v - 1.9, C = 0.5 (pixel centres avoid whole numbers and
     ties between A and B): every
@@ -81,6 +82,7 @@ def _uv_vector(cell, su=4.0, ou=-2.0, sv=4.0, ov=-1.9, z=0.7):
     return _combine(cell, node_scenes.uv_input(cell, 0, su, ou), node_scenes.uv_input(cell, 1, sv, ov), z)
 
 
+@pytest.mark.negative_inputs  # node outputs below zero on purpose (Subtract, Sine, curves, ...)
 def test_vector_math_every_operation(penumbra):
     """Vector Math with A = (4u - 2, 4v - 1.9, 0.7), B = (0.5, -1.3, 2), C = (0.3, 1, -1),
     Scale 1.5 (Refract's eta 0.6): every operation's Vector (or Value, for Dot Product,
@@ -109,6 +111,7 @@ def test_vector_math_every_operation(penumbra):
     _assert_close(image, _per_plane(grid, ref), grid, VECTOR_MATH_OPS)
 
 
+@pytest.mark.negative_inputs  # node outputs below zero on purpose (Subtract, Sine, curves, ...)
 def test_mix_color_every_blend_mode(penumbra):
     """Mix (Color) of A = (u, v, 0.3) and B = (0.6, 0.2 + 0.6 v, 0.9 u) at factor 0.7, every
     blend mode, the result clamped in every other mode: the numpy reference within 2e-3."""
@@ -138,6 +141,7 @@ def test_mix_color_every_blend_mode(penumbra):
     _assert_close(image, _per_plane(grid, ref), grid, BLEND_MODES)
 
 
+@pytest.mark.negative_inputs  # node outputs below zero on purpose (Subtract, Sine, curves, ...)
 def test_map_range_clamp_and_float_mix(penumbra):
     """Map Range (each interpolation, clamped and not, from [0.2, 0.8] to [-1, 2], 3 steps), and
     the reversed source range; Clamp (Min Max and Range with min > max); Mix (Float) and Mix
@@ -325,6 +329,7 @@ def _planes_xy(grid):
     return [tuple(cell.ob.location[:2]) for cell in grid.cells]
 
 
+@pytest.mark.negative_inputs  # node outputs below zero on purpose (Subtract, Sine, curves, ...)
 def test_coordinates_and_geometry(penumbra):
     """Texture Coordinate (every output), Geometry, Object Info Location, UV Map and Mapping
     (each type, rotated and scaled) on planes facing the camera: the analytic value at each
@@ -617,6 +622,7 @@ def test_bad_trees_fall_back_by_input_with_one_message(penumbra, capfd):
     assert out.count("Light Path") == 1, out
 
 
+@pytest.mark.negative_inputs  # node outputs below zero on purpose (Subtract, Sine, curves, ...)
 def test_extreme_inputs_draw_finite(penumbra):
     """NaN, +-1e30 and zero or negative scales through Math, Vector Math, Mapping, Color Ramp
     and Map Range: every pixel finite."""
@@ -986,6 +992,7 @@ def test_object_info_colour_alpha_and_random(penumbra):
     assert len({round(r, 3) for r in randoms}) == 2 and all(0.0 < r < 1.0 for r in randoms)
 
 
+@pytest.mark.negative_inputs  # node outputs below zero on purpose (Subtract, Sine, curves, ...)
 def test_rgb_curves_and_float_curve(penumbra):
     """Float Curve (an S-curve, Factor 0.8) and RGB Curves (a combined curve, a red curve, Fac
     1) on x = 1.6u - 0.3 (past both ends of the curves): Blender's own curve evaluation at

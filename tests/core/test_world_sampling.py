@@ -73,12 +73,12 @@ def test_an_image_world_estimates_its_irradiance_and_its_pdf_is_a_density(rotati
     assert abs((env[r, col, 0] > 10.0).mean() - share) < 0.03, share
 
 
-def test_with_a_constant_world_an_unshadowed_direction_adds_nothing():
-    """The control variate: a direction's light equals its SH baseline, so where nothing blocks
-    it the sum is exactly the SH light already drawn."""
+def test_a_constant_world_direction_carries_its_radiance_over_its_probability():
+    """Drawn uniformly (p = 1 / 4 pi), each of K directions carries L 4 pi / K: what the lit
+    pass weighs the world ratio's sums with; never negative."""
     lights = ws.world_lights(World.constant((1.0, 0.9, 0.8)), 0, 4)
     for light in lights:
-        np.testing.assert_array_equal(light.color, light.world_baseline)
+        np.testing.assert_allclose(light.color, np.array([1.0, 0.9, 0.8]) * 4.0 * np.pi / 4, rtol=1e-9)
         assert light.world and light.type == "SUN" and light.use_shadow
 
 
@@ -96,7 +96,9 @@ def test_portal_cones_gather_directions_and_keep_a_density():
     axis, cos_max = cones[0]
     assert (drawn @ axis >= cos_max).mean() > 0.75
     lights = ws.world_lights(World.constant((1.0, 1.0, 1.0)), 0, 4, cones=cones)
-    assert all(not np.any(light.world_baseline) for light in lights)
+    drawn = np.array([light.direction for light in lights])
+    expected = 1.0 / (dist.pdf(-drawn) * 4)  # a sun's direction is where it shines: away from d
+    np.testing.assert_allclose([light.color[0] for light in lights], expected, rtol=1e-9)
 
 
 @pytest.mark.parametrize(
@@ -108,7 +110,7 @@ def test_extreme_images_give_finite_directions(env):
     clean = np.nan_to_num(env, nan=0.0, posinf=0.0)
     world = World(sh=equirect_sh(clean), background=None, env=env)
     for light in ws.world_lights(world, 0, 8):
-        assert np.all(np.isfinite(light.color)) and np.all(np.isfinite(light.world_baseline))
+        assert np.all(np.isfinite(light.color)) and np.all(light.color >= 0.0)
         assert np.all(np.isfinite(light.matrix)) and abs(np.linalg.norm(light.direction) - 1.0) < 1e-9
 
 

@@ -7,6 +7,7 @@ running Blender line; so does the reference here."""
 
 import bpy
 import numpy as np
+import pytest
 
 from devkit import engines
 from devkit import texture_reference as ref
@@ -159,6 +160,7 @@ def _modes():
     return modes
 
 
+@pytest.mark.negative_inputs  # texture outputs below zero on purpose (Musgrave-like noise, Wave, ...)
 def test_compiled_textures_match_numpy_per_pixel(penumbra):
     """Noise (every type, 1-4D, Normalize, Distortion, Fac and Color), Voronoi (every feature
     and metric, 1-4D, fractal, each output), White Noise (1-4D, Value and Color), Wave, Magic and

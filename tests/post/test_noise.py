@@ -6,7 +6,7 @@ from devkit.post import hdr_image, layer, run_layers, run_stack
 
 
 def test_noise_is_deterministic_per_frame_and_matches_reference(penumbra, gpu_call):
-    from penumbra.engine.post.noise import grain_reference
+    from penumbra.engine.post.noise import apply_reference, grain_reference
 
     img = hdr_image(40, 50, 8)
     grain = layer("NOISE", amount=0.2, size=1, monochrome=False, seed=3)
@@ -15,8 +15,7 @@ def test_noise_is_deterministic_per_frame_and_matches_reference(penumbra, gpu_ca
     assert np.mean(a[..., :3] != c[..., :3]) > 0.99  # another frame gives other grain
     assert stats.post_passes == 1
     for out, frame in ((a, 7), (c, 8), (d, -5)):
-        ref = img.astype(np.float64)
-        ref[..., :3] += 0.2 * grain_reference(50, 40, frame, 1, 3, False)
+        ref = apply_reference(img, 0.2, grain_reference(50, 40, frame, 1, 3, False))
         # One float32 addition: measured 1.6e-6 absolute on a 34.0 pixel, i.e. half an ulp.
         np.testing.assert_allclose(out, ref, rtol=1e-7, atol=1e-6)
     np.testing.assert_array_equal(a[..., 3], img[..., 3])
@@ -58,17 +57,32 @@ def test_noise_size_monochrome_and_seed(penumbra, gpu_call):
     assert np.mean(seeds[0] != seeds[1]) > 0.7  # alpha (untouched) is a quarter of the values
 
 
+def test_noise_never_takes_light_below_zero(penumbra, gpu_call):
+    """Grain on black and on a dark ramp: no channel goes below zero, black stays black, and
+    the grain is still zero-mean where the image is darker than it (no brightening)."""
+    h, w = 128, 128
+    img = np.zeros((h, w, 4), np.float32)
+    img[..., 3] = 1.0
+    img[:, w // 2 :, :3] = 0.02  # right half: darker than the grain's amount
+    out, _ = run_stack(gpu_call, img, [layer("NOISE", amount=0.3, size=1, monochrome=False)], frames=[5])[0]
+    assert float(out[..., :3].min()) >= 0.0
+    np.testing.assert_array_equal(out[:, : w // 2, :3], 0.0)
+    dark = out[:, w // 2 :, :3].astype(np.float64)
+    # Grain of amplitude 0.02 (the channel's own value): uniform in (0, 0.04), mean 0.02 within
+    # 5 sigma of the mean of its draws.
+    assert dark.max() <= 0.04 + 1e-7
+    assert abs(dark.mean() - 0.02) < 5 * 0.02 / np.sqrt(3 * dark.size)
+
+
 def test_noise_extremes(penumbra, gpu_call):
-    from penumbra.engine.post.noise import grain_reference
+    from penumbra.engine.post.noise import apply_reference, grain_reference
 
     img = hdr_image(16, 16, 9)
     same, stats = run_layers(gpu_call, img, [layer("NOISE", amount=0.0, monochrome=False)])
     np.testing.assert_array_equal(same, img)
     assert stats.post_passes == 0
     loud, _ = run_stack(gpu_call, img, [layer("NOISE", amount=10.0, size=1, monochrome=False)], frames=[42])[0]
-    ref = img.astype(np.float64)
-    ref[..., :3] += 10.0 * grain_reference(16, 16, 42)
-    np.testing.assert_allclose(loud, ref, atol=1e-5)
+    np.testing.assert_allclose(loud, apply_reference(img, 10.0, grain_reference(16, 16, 42)), atol=1e-5)
     one_cell, _ = run_layers(gpu_call, img * 0 + 1, [layer("NOISE", amount=0.5, size=10000, monochrome=False)])
     assert len(np.unique(one_cell[..., 0])) == 1  # grain larger than the image: one value
     pixel = np.array([[[1.0, 1.0, 1.0, 1.0]]], np.float32)

@@ -30,7 +30,7 @@ def _run(gpu_call, image, layers, fuse, monkeypatch):
 
 def _reference(img, layers):
     """The stack's numpy references chained in float64 (finite input)."""
-    from penumbra.engine.post.noise import grain_reference
+    from penumbra.engine.post.noise import apply_reference, grain_reference
     from penumbra.engine.post.scanlines import scanline_darkness, scroll_offset
     from penumbra.engine.post.sepia import sepia_reference
     from penumbra.engine.post.vignette import vignette_factor
@@ -50,7 +50,7 @@ def _reference(img, layers):
             dark = scanline_darkness(np.arange(h), h, p.count, p.thickness, offset, p.antialias)
             e[..., :3] *= (1.0 - p.intensity * dark)[:, None, None]
         elif lay.effect == "NOISE":
-            e[..., :3] += p.amount * grain_reference(w, h, FRAME, p.size, p.seed, p.monochrome)
+            e = apply_reference(c, p.amount, grain_reference(w, h, FRAME, p.size, p.seed, p.monochrome))
         c = c + lay.mix * (e - c) if lay.mix < 1.0 else e
     return c
 
