@@ -8,6 +8,9 @@
  * the lit pass's hash, so a dithered surface covers the same pixels as in the lit pass. */
 void main()
 {
+#if INSTANCED
+  ShadowTile tile = tiles[v_tile]; /* this instance's tile (shadow_depth.vert.glsl) */
+#endif
 #if RSM_MATERIAL
   vec3 rsm_base = material.base_color.rgb;
   float rsm_metal = material.metallic;

@@ -4,6 +4,13 @@
  * world_ao.py), whose tile is the lit pass's raster camera. */
 void main()
 {
+#if INSTANCED
+  /* One draw fills this caster's maps of the sample (shadow_maps.py ShadowAtlas.render):
+   * instance i draws into the tile the instance table names (four to an ivec4). */
+  int slot = instance_base + gl_InstanceID;
+  v_tile = instance_tiles[slot >> 2].tile[slot & 3];
+  ShadowTile tile = tiles[v_tile];
+#endif
   vec4 view_pos = tile.view * (model * vec4(pos, 1.0));
 #if HAIR_STRIP
   {
@@ -52,6 +59,15 @@ void main()
 #endif
   vec4 t = tile.proj_tex * view_pos;
   gl_Position = vec4(2.0 * t.xyz - t.w, t.w);
+#if INSTANCED
+  /* The tile's texture square [0, 1]^2 (homogeneous: 0 <= t.xy <= t.w) onto its place in the
+   * atlas, whose whole extent is the viewport, and nothing drawn outside it. */
+  gl_Position.xy = 2.0 * (vec2(tile.origin) * t.w + t.xy * float(tile.size)) / atlas_size - t.w;
+  gl_ClipDistance[0] = t.x;
+  gl_ClipDistance[1] = t.w - t.x;
+  gl_ClipDistance[2] = t.y;
+  gl_ClipDistance[3] = t.w - t.y;
+#endif
 #if !CAMERA_DEPTH && RASTER_DEPTH
   /* Pancaking: a caster nearer the light than the tile's near plane is flattened onto it
    * (depth 0) instead of clipped away, so it still occludes what is behind it; the tile's

@@ -133,6 +133,11 @@ class LitPass:
         # One diffuse bounce from the atlas's reflective targets (frame_data: some light has a map).
         rsm = bool(data.defines.get("INDIRECT_RSM"))
 
+        # The sample's tile records: the instanced depth pass's block when it holds them.
+        tiles_block = atlas.tiles_block(data.tiles) if atlas is not None else None
+        if tiles_block is None:
+            tiles_block = self._ubo("tiles", data.tiles)
+
         def bind(features, with_aux, tree, ratio_mode, emission_only=False):
             if emission_only:
                 program = emission_program(frozenset(features), tree)
@@ -159,7 +164,7 @@ class LitPass:
             shader.bind()
             shader.uniform_block("frame", self._ubo("frame", data.frame))
             shader.uniform_block("lights", self._ubo("lights", data.lights))
-            shader.uniform_block("shadow_tiles", self._ubo("tiles", data.tiles))
+            shader.uniform_block("shadow_tiles", tiles_block)
             shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
             shader.uniform_sampler("jitter_tex", self._jitter(data.disk_samples))
             shader.uniform_sampler("light_bins", self._bins_texture(data.bins))

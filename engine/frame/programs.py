@@ -504,6 +504,7 @@ SHADOW_DEPTH = Program(
             "CAMERA_DEPTH": False,
             "RSM_OUTPUT": False,
             "RSM_MATERIAL": False,
+            "INSTANCED": False,
         }.items()
     ),
 )
@@ -524,6 +525,35 @@ SHADOW_DEPTH_RASTER = replace(
 )
 # (Reflective shadow maps: each of these, and the cut-out and hair programs below, gets its
 # ``with_rsm_output`` variant, with ``rsm`` in the functions that choose them.)
+
+# Instanced submission (``ShadowAtlas.render``): one draw of a caster's batch fills every map of
+# the sample it is in. Instance i reads the tile ``instance_tiles`` names at instance_base + i
+# (four tile indices to an ivec4) from the array of all the sample's tiles, and is confined to
+# that tile of the atlas by four clip distances (``gpu.state.clip_distances_set``).
+INSTANCE_STRUCT = Struct("InstanceTiles", (("IVEC4", "tile"),))
+# ivec4 rows of one table upload: 512 (caster, map) pairs in 2 KB (a sample uploads the whole
+# block); a sample with more submits in several tables.
+INSTANCE_TABLE_ROWS = 128
+
+
+def instanced_shadow_program(depth_format, raster_depth=False):
+    """``shadow_program``'s depth-buffer map, drawn instanced into every tile of a sample at
+    once (``INSTANCED``): the tiles and the instance table as uniform blocks, the atlas's size
+    and the draw's first table entry as push constants."""
+    base = shadow_program(depth_format, raster_depth)
+    if not DEPTH_FORMAT[depth_format].depth_only:
+        raise ValueError(f"instanced depth pass: {depth_format} maps are drawn tile by tile")
+    return replace(
+        base,
+        name=f"{base.name}_instanced",
+        varyings=base.varyings + (("flat", "INT", "v_tile"),),
+        push_constants=base.push_constants + (("INT", "instance_base"), ("VEC2", "atlas_size")),
+        uniform_blocks=(
+            (TILE_STRUCT, "tiles", MAX_SHADOW_TILES),
+            (INSTANCE_STRUCT, "instance_tiles", INSTANCE_TABLE_ROWS),
+        ),
+        defines=tuple({**dict(base.defines), "INSTANCED": True}.items()),
+    )
 
 
 # The camera depth prepass of the world's ambient occlusion (``world_ao.py``): the same depth

@@ -11,13 +11,15 @@ import numpy as np
 from ...shaders.loader import set_uniforms
 from ..enums import DEPTH_FORMAT
 from ..gpu_pool import new_texture
-from ..shadows.planning import pack_tiles
+from ..shadows.planning import MAX_SHADOW_TILES, pack_tiles
 from .programs import (
+    INSTANCE_TABLE_ROWS,
     RSM_FORMAT,
     RSM_TEXEL_BYTES,
     SCALED_COPY,
     TILE_STRUCT,
     depth_defines,
+    instanced_shadow_program,
     shadow_cutout_program,
     shadow_hair_program,
     shadow_program,
@@ -146,6 +148,8 @@ class ShadowAtlas:
         self._scratch = None  # (colour, depth, framebuffer) of one tile, non-FLOAT32 formats
         self._copy_batch = None
         self._ubos = []
+        self._instanced = {}  # the instanced pass's uniform blocks: name -> (block, bytes)
+        self._tiles_bytes = None  # what its tiles block holds
         self._contents = {}  # tile index -> what its map holds
         self.uploaded = 0  # bytes of tile blocks sent to the GPU since creation
 
@@ -220,6 +224,8 @@ class ShadowAtlas:
         self.texture = self.flux = self.normal = None
         self.rsm = False
         self._ubos = []
+        self._instanced = {}
+        self._tiles_bytes = None
         self._contents = {}
         self.size = self.count = 0
         self.columns = 1
@@ -255,7 +261,9 @@ class ShadowAtlas:
         defines = depth_defines(self.depth_format)
         rsm = self.rsm
 
-        def program(raster):  # raster: an orthographic tile of a depth-buffer map
+        def program(raster, instanced=False):  # raster: an orthographic tile of a depth-buffer map
+            if instanced:
+                return shaders.get(instanced_shadow_program(self.depth_format, raster), defines)
             return shaders.get(shadow_program(self.depth_format, raster, rsm=rsm), defines)
 
         def cutout(textured, raster):  # compiled only when a caster has alpha
@@ -295,6 +303,38 @@ class ShadowAtlas:
                     self._framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
                 else:
                     self._framebuffer.clear(depth=1.0)
+        if depth_only and not rsm:
+            # Depth-buffer maps: each opaque caster batch is drawn once for all the maps of the
+            # sample it is in (instanced); alpha cut-outs and hair strips tile by tile.
+            if not cleared and work:
+                with self._framebuffer.bind():
+                    gpu.state.scissor_test_set(True)
+                    for _index, tile, _casters, _key in work:
+                        gpu.state.viewport_set(*tile.origin, tile.size, tile.size)
+                        gpu.state.scissor_set(*tile.origin, tile.size, tile.size)
+                        self._framebuffer.clear(depth=1.0)
+                    gpu.state.scissor_test_set(False)
+            self._render_instanced(plan, work, shaders, cull_front, stats, origin, program)
+            for index, tile, casters, key in work:
+                if any(c.cutouts or c.hair is not None for c in casters):
+                    (x0, y0), n = tile.origin, tile.size
+                    with self._framebuffer.bind():
+                        gpu.state.viewport_set(x0, y0, n, n)
+                        gpu.state.depth_test_set("LESS")
+                        gpu.state.depth_mask_set(True)
+                        tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(origin)]))
+                        raster = tile.fit.orthographic and not _crosses_near(tile.fit, casters)
+                        self._draw_strips_and_cutouts(
+                            casters, tile_ubo, raster, shaders, defines, cutout, alpha_offset, origin, stats
+                        )
+                        gpu.state.depth_test_set("NONE")
+                        gpu.state.depth_mask_set(False)
+                self._contents[index] = key
+                stats.shadow_simplified += sum(1 for c in casters if c.level is not None)
+                stats.passes += 1
+                stats.shadow_maps += 1
+                stats.shadow_texels += tile.size * tile.size
+            return
         for index, tile, casters, key in work:
             (x0, y0), n = tile.origin, tile.size
             target = self._framebuffer if depth_only else self._scratch[2]
@@ -355,33 +395,9 @@ class ShadowAtlas:
                         stats.draws += 1
                         stats.shadow_draws += 1
                     stats.shadow_triangles += caster.triangles
-                gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
-                strips = [c for c in casters if c.hair is not None]
-                if strips:
-                    hair = shaders.get(shadow_hair_program(self.depth_format, raster, rsm=rsm), defines)
-                    hair.bind()
-                    hair.uniform_block("tile", tile_ubo)
-                    for caster in strips:
-                        hair.uniform_float("model", caster.model)
-                        hair.uniform_float("hair_texels", 1.0 if caster.hair == "STRAND" else 0.0)
-                        for batch in caster.batches:
-                            batch.draw(hair)
-                            stats.draws += 1
-                            stats.shadow_draws += 1
-                        stats.shadow_triangles += caster.triangles
-                for caster in casters:
-                    for batch, material_ubo, texture, tree in caster.cutouts:
-                        if tree is not None:
-                            cut = shaders.get(
-                                shadow_tree_program(self.depth_format, tree.tree, raster, rsm=rsm), defines
-                            )
-                        else:
-                            cut = cutout(texture is not None, raster)
-                        draw_cutout(
-                            cut, batch, material_ubo, texture, tree, tile_ubo, alpha_offset, caster.model, origin
-                        )
-                        stats.draws += 1
-                        stats.shadow_draws += 1
+                self._draw_strips_and_cutouts(
+                    casters, tile_ubo, raster, shaders, defines, cutout, alpha_offset, origin, stats
+                )
                 gpu.state.face_culling_set("NONE")
                 gpu.state.front_facing_set(False)
                 gpu.state.depth_test_set("NONE")
@@ -396,6 +412,148 @@ class ShadowAtlas:
             stats.passes += 1
             stats.shadow_maps += 1
             stats.shadow_texels += n * n
+
+    def _render_instanced(self, plan, work, shaders, cull_front, stats, origin, program):
+        """The opaque casters of the maps in ``work`` into the depth atlas, instanced: one draw
+        per caster batch and group of its maps that share a program (orthographic tiles take
+        the rasterised depth) and face culling, whatever the number of maps. The tiles go in
+        one uniform block, the (caster, map) pairs in an instance table read by instance."""
+        import gpu
+
+        groups = {}  # (raster, culling, model, batches) -> (caster, [tile indices])
+        for index, tile, casters, _key in work:
+            raster = tile.fit.orthographic and not _crosses_near(tile.fit, casters)
+            front = self._facing_light(tile, casters, cull_front, stats)
+            for caster in casters:
+                if caster.hair is not None or not caster.batches:
+                    continue
+                if cull_front or caster.cull_back or id(caster) in front:
+                    culling = ("FRONT" if cull_front else "BACK", caster.det < 0.0)
+                else:
+                    culling = ("NONE", False)
+                key = (raster, culling, id(caster.model), tuple(id(b) for b in caster.batches))
+                groups.setdefault(key, (caster, []))[1].append(index)
+        if not groups:
+            return
+        tiles = TILE_STRUCT.pack([t.record(origin) for t in plan.tiles], MAX_SHADOW_TILES)
+        tiles_ubo = self._instance_ubo("tiles", tiles)
+        order = sorted(groups.items(), key=lambda item: (not item[0][0], item[0][1]))
+        capacity = 4 * INSTANCE_TABLE_ROWS
+        chunks, chunk, used = [], [], 0
+        for key, (caster, indices) in order:
+            for start in range(0, len(indices), capacity):
+                part = indices[start : start + capacity]
+                if used + len(part) > capacity:
+                    chunks.append(chunk)
+                    chunk, used = [], 0
+                chunk.append((key[0], key[1], caster, part, used))
+                used += len(part)
+        chunks.append(chunk)
+        width, height = self.texture.width, self.texture.height
+        with self._framebuffer.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            gpu.state.depth_test_set("LESS")
+            gpu.state.depth_mask_set(True)
+            gpu.state.clip_distances_set(4)
+            for chunk in chunks:
+                table = np.zeros(4 * INSTANCE_TABLE_ROWS, np.int32)
+                flat = [i for *_head, part, _base in chunk for i in part]
+                table[: len(flat)] = flat
+                table_ubo = self._instance_ubo("table", table)
+                bound, culling_now = None, None
+                for raster, culling, caster, part, base in chunk:
+                    if bound is not raster:
+                        shader = program(raster, instanced=True)
+                        shader.bind()
+                        shader.uniform_block("tiles", tiles_ubo)
+                        shader.uniform_block("instance_tiles", table_ubo)
+                        shader.uniform_float("atlas_size", (float(width), float(height)))
+                        bound = raster
+                    if culling != culling_now:
+                        gpu.state.face_culling_set(culling[0])
+                        gpu.state.front_facing_set(culling[1])
+                        culling_now = culling
+                    shader.uniform_float("model", caster.model)
+                    shader.uniform_int("instance_base", base)
+                    for batch in caster.batches:
+                        batch.draw_instanced(shader, instance_start=0, instance_count=len(part))
+                        stats.draws += 1
+                        stats.shadow_draws += 1
+                    stats.shadow_triangles += caster.triangles * len(part)
+            gpu.state.clip_distances_set(0)
+            gpu.state.face_culling_set("NONE")
+            gpu.state.front_facing_set(False)
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+
+    @staticmethod
+    def _facing_light(tile, casters, cull_front, stats):
+        """The closed casters wholly in front of the tile's light (w > 0 at every corner: no
+        clipping, and the light outside them): they cast with their faces toward the light."""
+        closed = [c for c in casters if c.closed] if not cull_front else []
+        if not closed:
+            return set()
+        w_row = tile.fit.view_proj[3]
+        ok = np.all(np.stack([c.corners for c in closed]) @ w_row[:3] + w_row[3] > 0.0, axis=1)
+        stats.closed_culled += int(np.count_nonzero(ok))
+        return {id(c) for c, inside in zip(closed, ok, strict=True) if inside}
+
+    def tiles_block(self, packed):
+        """The instanced pass's block of the sample's tiles when it holds ``packed`` (the lit
+        pass's ``FrameData.tiles``: the same records), so the lit pass binds it rather than
+        uploading the same bytes again; else None."""
+        block = self._instanced.get("tiles")
+        if block is None or self._tiles_bytes != np.ascontiguousarray(packed).tobytes():
+            return None
+        return block[0]
+
+    def _instance_ubo(self, name, data):
+        """The instanced pass's uniform block ``name`` (the tiles, the instance table) holding
+        ``data``, made on first use and updated after."""
+        import gpu
+
+        raw = np.ascontiguousarray(data).tobytes()
+        if name == "tiles":
+            if raw == self._tiles_bytes and name in self._instanced:
+                return self._instanced[name][0]
+            self._tiles_bytes = raw
+        self.uploaded += len(raw)
+        ubo = self._instanced.get(name)
+        if ubo is None or ubo[1] != len(raw):
+            self._instanced[name] = (gpu.types.GPUUniformBuf(raw), len(raw))
+        else:
+            ubo[0].update(raw)
+        return self._instanced[name][0]
+
+    def _draw_strips_and_cutouts(
+        self, casters, tile_ubo, raster, shaders, defines, cutout, alpha_offset, origin, stats
+    ):
+        """A tile's hair strips and alpha cut-outs (both sides cast), with the tile's block bound."""
+        import gpu
+
+        gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
+        strips = [c for c in casters if c.hair is not None]
+        if strips:
+            hair = shaders.get(shadow_hair_program(self.depth_format, raster, rsm=self.rsm), defines)
+            hair.bind()
+            hair.uniform_block("tile", tile_ubo)
+            for caster in strips:
+                hair.uniform_float("model", caster.model)
+                hair.uniform_float("hair_texels", 1.0 if caster.hair == "STRAND" else 0.0)
+                for batch in caster.batches:
+                    batch.draw(hair)
+                    stats.draws += 1
+                    stats.shadow_draws += 1
+                stats.shadow_triangles += caster.triangles
+        for caster in casters:
+            for batch, material_ubo, texture, tree in caster.cutouts:
+                if tree is not None:
+                    cut = shaders.get(shadow_tree_program(self.depth_format, tree.tree, raster, rsm=self.rsm), defines)
+                else:
+                    cut = cutout(texture is not None, raster)
+                draw_cutout(cut, batch, material_ubo, texture, tree, tile_ubo, alpha_offset, caster.model, origin)
+                stats.draws += 1
+                stats.shadow_draws += 1
 
     def _copy_scratch(self, x0, y0, n, shaders, src=None, framebuffer=None):
         import gpu

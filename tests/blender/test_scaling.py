@@ -239,8 +239,12 @@ def test_a_frame_compiles_only_the_programs_it_draws_with(penumbra, gpu_call):
 
     first, names, again = gpu_call(job)
     assert first == len(names) and again == 0
-    # The sun's tile is orthographic (rasterised depth), the spot's perspective (gl_FragDepth).
-    assert [n for n in names if n.startswith("shadow")] == ["shadow_depth_only", "shadow_depth_raster"]
+    # The sun's tile is orthographic (rasterised depth), the spot's perspective (gl_FragDepth),
+    # both drawn instanced.
+    assert [n for n in names if n.startswith("shadow")] == [
+        "shadow_depth_only_instanced",
+        "shadow_depth_raster_instanced",
+    ]
     assert [n for n in names if n.startswith("lit")] == ["lit"]
 
 
@@ -268,7 +272,7 @@ def test_orthographic_tiles_rasterise_the_depth_the_fragment_stage_would_write(p
         return image, depth.astype(np.float32).copy(), names
 
     image, depth, names = gpu_call(job)
-    assert {"shadow_depth_raster", "shadow_depth_raster_alpha"} <= names
+    assert {"shadow_depth_raster_instanced", "shadow_depth_raster_alpha"} <= names
     monkeypatch.setattr(lightspace.Fit, "orthographic", property(lambda self: False))
     ref_image, ref_depth, ref_names = gpu_call(job)
     assert not any("raster" in n for n in ref_names)
