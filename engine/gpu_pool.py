@@ -130,3 +130,31 @@ def clear():
 
 
 atexit.register(clear)
+
+
+class UniformBlocks:
+    """Named uniform blocks of one owner (a pass), each made on first use and updated in place
+    after (made anew when its size changes). Unlike textures they are not pooled: they are
+    small, and each pass keeps its own between frames."""
+
+    def __init__(self):
+        self._blocks = {}  # name -> (GPUUniformBuf, bytes)
+
+    def get(self, name, raw):
+        """The block ``name`` holding ``raw`` (bytes)."""
+        import gpu
+
+        block = self._blocks.get(name)
+        if block is None or block[1] != len(raw):
+            block = self._blocks[name] = (gpu.types.GPUUniformBuf(raw), len(raw))
+        else:
+            block[0].update(raw)
+        return block[0]
+
+    def peek(self, name):
+        """The block ``name`` as last set, or None."""
+        block = self._blocks.get(name)
+        return None if block is None else block[0]
+
+    def clear(self):
+        self._blocks = {}

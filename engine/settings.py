@@ -450,8 +450,9 @@ SCENE_PARAMS = (
         "world_samples",
         "INT",
         4,
-        "Directions of the world's light per sample, each with its own shadow map (importance-sampled from "
-        "the world's light, stratified over the frame's samples)",
+        "Directions of the world's light per sample at most, each with its own shadow map (importance-sampled "
+        "from the world's light, stratified over the frame's samples); a world that gives under half the light "
+        "reaching the view takes fewer, in proportion, one at least",
         min=1,
         max=16,
         label="Directions per Sample",

@@ -22,6 +22,8 @@ from .programs import (
     SETTLED_COPY,
     WEIGHTED_RESOLVE,
     WEIGHTED_RESOLVE_SHADOW,
+    WORLD_RATIO_COPY,
+    WORLD_RATIO_COPY_MASKED,
     WORLD_RATIO_RESOLVE,
     convergence_program,
 )
@@ -65,6 +67,9 @@ class FrameOutput:
 
     def shadow_array(self):
         return texture_array(self.shadow, 1)[..., 0]
+
+
+_WORLD_NAMES = ("world_diffuse", "world_specular", "world_sums")  # the world ratio's targets, in order
 
 
 def _clear_zero(texture):
@@ -145,6 +150,7 @@ class Film:
         self.world_ratio = False
         self.world = self._world_accum = None
         self._world_half = None
+        self._world_accum_fb = None
         self._world_fbs = {}
 
     # --- targets --------------------------------------------------------------------------
@@ -249,8 +255,13 @@ class Film:
         if self.shaded is not None:
             self.shaded.clear(format="FLOAT", value=(0.0,))
         if world_ratio:
-            for target in self.world_targets():
-                _clear_zero(target)
+            self.world_targets()
+            if "clear" not in self._world_fbs:
+                import gpu
+
+                self._world_fbs["clear"] = gpu.types.GPUFrameBuffer(color_slots=tuple(self.world))
+            with self._world_fbs["clear"].bind():  # one clear of all three
+                self._world_fbs["clear"].clear(color=(0.0, 0.0, 0.0, 0.0))
 
     def target_bytes(self, aux, accumulate):
         """Bytes per pixel of the frame's targets: colour, z-buffer, and with ``aux`` depth,
@@ -316,8 +327,13 @@ class Film:
                 SCALED_COPY, self._shaded_total_fb, {"src_color": self.shaded}, {"scale": 1.0}, "ADDITIVE_PREMULT"
             )
         if self.world_ratio:
-            for source, (_target, framebuffer) in zip(self.world_targets(), self._world_accum, strict=True):
-                self._copy(framebuffer, source, weight, mask)
+            samplers = {name: source for name, source in zip(_WORLD_NAMES, self.world_targets(), strict=True)}
+            if mask is not None:
+                samplers["converged"] = mask
+            else:
+                samplers["converged"] = self.world[2]  # bound, never read
+            program = WORLD_RATIO_COPY if mask is None else WORLD_RATIO_COPY_MASKED
+            self.fullscreen(program, self._world_accum_fb, samplers, {"scale": weight}, "ADDITIVE_PREMULT")
             if self.tracking and sample % 2 == 1:
                 self._copy(self._world_half[1], self.world[2], 2.0 * weight, mask)
         self._weight_sum += weight
@@ -379,8 +395,7 @@ class Film:
         self.fullscreen(WORLD_RATIO_RESOLVE, gpu_framebuffer(self.color), samplers, uniforms)
 
     def _world_samplers(self):
-        names = ("world_diffuse", "world_specular", "world_sums")
-        return {name: target for name, (target, _fb) in zip(names, self._world_accum, strict=True)}
+        return {name: target for name, (target, _fb) in zip(_WORLD_NAMES, self._world_accum, strict=True)}
 
     def _begin_world_ratio(self):
         """A fresh frame whose world light is a ratio: its accumulations (and, when the noise
@@ -393,6 +408,7 @@ class Film:
             self._world_half = None
             targets = [new_texture(self.pool, size, "RGBA32F") for _ in range(3)]
             self._world_accum = [(t, gpu.types.GPUFrameBuffer(color_slots=(t,))) for t in targets]
+            self._world_accum_fb = gpu.types.GPUFrameBuffer(color_slots=tuple(targets))
         if self.tracking and self._world_half is None:
             half = new_texture(self.pool, size, "RGBA32F")
             self._world_half = (half, gpu.types.GPUFrameBuffer(color_slots=(half,)))
@@ -721,7 +737,7 @@ class Film:
                 self._world_half[0] if self._world_half else None,
             ]
         )
-        self.world = self._world_accum = self._world_half = None
+        self.world = self._world_accum = self._world_half = self._world_accum_fb = None
         self._world_fbs = {}
         self._settle = None
         self.fb = self.fb_color = self.fb_emit = self._accum_fb = self._resolve_fb = None

@@ -5,6 +5,7 @@ Environment Texture behind it."""
 import numpy as np
 
 from ...shaders.loader import set_uniforms
+from ..gpu_pool import UniformBlocks
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
 from .programs import (
@@ -32,7 +33,7 @@ class LitPass:
         self.shaders = shaders
         self.materials = materials
         self.textures = textures
-        self._ubos = {}
+        self._ubos = UniformBlocks()
         self._jitter_tex = None
         self._jitter_dummy = None
         self._bins_tex = None
@@ -283,16 +284,9 @@ class LitPass:
         )
 
     def _ubo(self, name, data):
-        import gpu
-
         raw = data.tobytes()
         self.uploaded += len(raw)
-        ubo = self._ubos.get(name)
-        if ubo is None or ubo[1] != len(raw):
-            self._ubos[name] = (gpu.types.GPUUniformBuf(raw), len(raw))
-        else:
-            ubo[0].update(raw)
-        return self._ubos[name][0]
+        return self._ubos.get(name, raw)
 
     def _jitter(self, samples):
         """The jittered-disk texture: (JITTER_SIZE, JITTER_SIZE, samples / 2) RGBA, two 2-D

@@ -678,6 +678,20 @@ def convergence_program(error_output=False, world_ratio=False):
     )
 
 
+# A sample's world ratio targets added to their accumulations in one pass, where not converged
+# (WITH_MASK, ``converged`` then bound).
+WORLD_RATIO_COPY = Program(
+    name="world_ratio_copy",
+    vertex="fullscreen.vert.glsl",
+    fragment="world_ratio_copy.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "scale"),),
+    samplers=_WORLD_RATIO_SAMPLERS + (("FLOAT_2D", "converged"),),
+    outputs=WORLD_RATIO_OUTPUTS,
+    defines=(("WITH_MASK", False),),
+)
+WORLD_RATIO_COPY_MASKED = replace(WORLD_RATIO_COPY, name="world_ratio_copy_masked", defines=(("WITH_MASK", True),))
+
 # The resolve of a frame with the world's light as a ratio: colour - U_d (1 - S_d) - U_s (1 - S_s)
 # from the accumulations, over the total weight (``scale``) or each pixel's (per_pixel > 0.5).
 WORLD_RATIO_RESOLVE = Program(

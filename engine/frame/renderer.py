@@ -29,7 +29,7 @@ from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
 from .world_ao import WorldAO
 from .world_light import world_light
-from .world_sampling import needs_directions, portal_cones, world_lights
+from .world_sampling import directions_per_sample, light_share, needs_directions, portal_cones, world_lights
 
 
 @dataclasses.dataclass(frozen=True)
@@ -166,6 +166,14 @@ class Renderer:
                 box = corners_of(seen).reshape(-1, 3)
                 cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
         directions = int(settings.world_samples) if sampled_world and (accumulate or cones) else 0
+        if directions and not cones:
+            # The world's light costs what it adds: directions in proportion to its share of
+            # the light reaching what the camera sees (world_sampling.light_share).
+            seen = [d for d in draws if d.instance.camera]
+            if seen:
+                box = corners_of(seen).reshape(-1, 3)
+                share = light_share(snapshot.world, snapshot.lights, 0.5 * (box.min(axis=0) + box.max(axis=0)))
+                directions = directions_per_sample(share, directions)
         debug = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
         self._world_sampled = directions > 0
         self._world_sh = not cones

@@ -10,7 +10,7 @@ import numpy as np
 
 from ...shaders.loader import set_uniforms
 from ..enums import DEPTH_FORMAT
-from ..gpu_pool import new_texture
+from ..gpu_pool import UniformBlocks, new_texture
 from ..shadows.planning import MAX_SHADOW_TILES, pack_tiles
 from .programs import (
     INSTANCE_TABLE_ROWS,
@@ -148,7 +148,7 @@ class ShadowAtlas:
         self._scratch = None  # (colour, depth, framebuffer) of one tile, non-FLOAT32 formats
         self._copy_batch = None
         self._ubos = []
-        self._instanced = {}  # the instanced pass's uniform blocks: name -> (block, bytes)
+        self._instanced = UniformBlocks()  # the instanced pass's blocks: the tiles, the instance table
         self._tiles_bytes = None  # what its tiles block holds
         self._contents = {}  # tile index -> what its map holds
         self.uploaded = 0  # bytes of tile blocks sent to the GPU since creation
@@ -224,7 +224,7 @@ class ShadowAtlas:
         self.texture = self.flux = self.normal = None
         self.rsm = False
         self._ubos = []
-        self._instanced = {}
+        self._instanced = UniformBlocks()
         self._tiles_bytes = None
         self._contents = {}
         self.size = self.count = 0
@@ -502,28 +502,21 @@ class ShadowAtlas:
         """The instanced pass's block of the sample's tiles when it holds ``packed`` (the lit
         pass's ``FrameData.tiles``: the same records), so the lit pass binds it rather than
         uploading the same bytes again; else None."""
-        block = self._instanced.get("tiles")
+        block = self._instanced.peek("tiles")
         if block is None or self._tiles_bytes != np.ascontiguousarray(packed).tobytes():
             return None
-        return block[0]
+        return block
 
     def _instance_ubo(self, name, data):
         """The instanced pass's uniform block ``name`` (the tiles, the instance table) holding
         ``data``, made on first use and updated after."""
-        import gpu
-
         raw = np.ascontiguousarray(data).tobytes()
         if name == "tiles":
-            if raw == self._tiles_bytes and name in self._instanced:
-                return self._instanced[name][0]
+            if raw == self._tiles_bytes and self._instanced.peek(name) is not None:
+                return self._instanced.peek(name)
             self._tiles_bytes = raw
         self.uploaded += len(raw)
-        ubo = self._instanced.get(name)
-        if ubo is None or ubo[1] != len(raw):
-            self._instanced[name] = (gpu.types.GPUUniformBuf(raw), len(raw))
-        else:
-            ubo[0].update(raw)
-        return self._instanced[name][0]
+        return self._instanced.get(name, raw)
 
     def _draw_strips_and_cutouts(
         self, casters, tile_ubo, raster, shaders, defines, cutout, alpha_offset, origin, stats

@@ -46,6 +46,45 @@ _LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 _SCRAMBLE = (0x6C8E9CF5, 0x2545F491)  # digital shifts of the two coordinates
 
 
+# A world that gives at least this share of the light reaching the view takes every direction
+# per sample (World > Directions per Sample); below it, directions in proportion.
+FULL_SHARE = 0.5
+
+
+def light_share(world, lights, centre):
+    """The world's share of the light reaching a surface at ``centre`` (the middle of what the
+    camera sees) that faces each source: its irradiance from the SH light's brightest axis
+    (pi x radiance, luminance) against each lamp's unshadowed irradiance there (Blender's
+    conventions, lights.glsl: a sun's strength, P / (4 pi (d^2 + r^2)) for points and spots,
+    cones ignored, P / (pi d^2) for areas). 1 without lamps; 0 for a black world."""
+    axes = np.array([[0, 0, 1], [0, 0, -1], [1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0]], np.float64)
+    sh = np.nan_to_num(np.asarray(world.sh, np.float64), posinf=0.0, neginf=0.0)
+    world_e = math.pi * float(np.max(np.maximum(sh_basis(axes) @ sh, 0.0) @ _LUMINANCE))
+    lamps = 0.0
+    centre = np.asarray(centre, np.float64)
+    for light in lights:
+        power = float(np.nan_to_num(np.asarray(light.color, np.float64) @ _LUMINANCE, posinf=1e30))
+        if light.type == "SUN":
+            lamps += max(power, 0.0)
+            continue
+        d2 = float(np.sum((np.asarray(light.position, np.float64) - centre) ** 2))
+        if light.type == "AREA":
+            lamps += max(power, 0.0) / (math.pi * max(d2, 1e-12))
+        else:
+            lamps += max(power, 0.0) / (4.0 * math.pi * max(d2 + light.radius**2, 1e-12))
+    total = world_e + lamps
+    return world_e / total if total > 0.0 and math.isfinite(total) else (1.0 if lamps == 0.0 else 0.0)
+
+
+def directions_per_sample(share, most):
+    """Directions of the world per sample for its ``share`` of the light: all ``most`` from
+    FULL_SHARE on (a sky-lit scene), in proportion below, at least one (its shadows are still
+    what lights the lamps' shadows)."""
+    if most <= 0:
+        return 0
+    return int(min(most, max(1, math.ceil(most * share / FULL_SHARE - 1e-9))))
+
+
 def needs_directions(world, settings):
     """Whether the world's light is sampled with shadow maps this frame: World > Shadows on,
     and a world that gives any light (a black world costs nothing)."""

@@ -62,7 +62,7 @@ def test_world_directions_add_maps_but_no_draw_calls_per_map(penumbra, gpu_call)
     fragment's depth: two groups at most), never one per map."""
     stats = {}
     for directions in (1, 4):
-        scene = _scene()
+        scene = _scene(sun=False)  # lit by the sky alone: it takes every direction it is given
         ws.uniform_sky(scene, ws.SKY_COLOR, 0.5)
         scene.penumbra.world_samples = directions
         scene.penumbra.world_ao = False
@@ -73,6 +73,21 @@ def test_world_directions_add_maps_but_no_draw_calls_per_map(penumbra, gpu_call)
     assert stats[4].shadow_maps >= stats[1].shadow_maps + 3 * 4 - 1, (stats[1].shadow_maps, stats[4].shadow_maps)
     assert stats[4].shadow_draws <= stats[1].shadow_draws + batches * 4, (stats[1].shadow_draws, stats[4].shadow_draws)
     assert stats[4].shadow_draws <= 2 * batches * 4, stats[4].shadow_draws
+
+
+def test_world_directions_follow_the_worlds_share_of_the_light(penumbra, gpu_call):
+    """A sky alone takes the 4 directions per sample it is given; under a sun 20 times its
+    irradiance, one (its shadows are still all that lights the sun's shadows); a black world
+    none (``world_sampling.light_share``)."""
+    counts = {}
+    for name, sky, sun in (("sky", 0.5, False), ("sun", 0.05, True), ("black", 0.0, True)):
+        scene = _scene(sun=sun)
+        ws.uniform_sky(scene, (1.0, 1.0, 1.0), sky)
+        scene.penumbra.world_samples = 4
+        scene.penumbra.world_ao = False
+        scene.penumbra.use_adaptive_sampling = False
+        counts[name] = _frame_stats(gpu_call, scene, samples=4)[0].world_directions
+    assert counts == {"sky": 16, "sun": 4, "black": 0}, counts
 
 
 def test_sixteen_samples_issue_at_most_sixteen_times_one_samples_calls(penumbra, gpu_call):

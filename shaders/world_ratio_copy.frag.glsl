@@ -1,0 +1,15 @@
+/* The world ratio's three per-sample targets (the SH light diffuse and specular, the sums)
+ * times ``scale`` into their accumulations in one pass (programs.WORLD_RATIO_COPY; the blend
+ * state adds); WITH_MASK: not where the pixel converged (adaptive sampling). */
+void main()
+{
+  ivec2 p = ivec2(gl_FragCoord.xy);
+#if WITH_MASK
+  if (texelFetch(converged, p, 0).r > 0.5) {
+    discard;
+  }
+#endif
+  out_world_diffuse = scale * texelFetch(world_diffuse, p, 0);
+  out_world_specular = scale * texelFetch(world_specular, p, 0);
+  out_world_sums = scale * texelFetch(world_sums, p, 0);
+}
