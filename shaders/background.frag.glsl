@@ -18,6 +18,14 @@ void main()
   vec2 dy = dFdy(uv);
   dx.x -= round(dx.x);
   dy.x -= round(dy.x);
+  /* A texel's width on the sphere shrinks with cos(latitude): near a pole a quad sweeps much
+   * of the image's width but little of the sky, so the longitude footprint is taken at its
+   * width on the sphere. (Taken at its width in the image, it chose the image's coarsest
+   * mips there, which average the ground half in: grey and dark blotches in the two columns
+   * around the zenith of a wide view looking up.) */
+  float width = length(d.xy);
+  dx.x *= width;
+  dy.x *= width;
   vec4 env_color = sample_image_grad(env, uv, dx, dy, ivec4(1, 0, 0, 0), env_premultiplied > 0.5);
   out_color = vec4(strength * env_color.rgb, 1.0);
 }

@@ -135,6 +135,26 @@ def test_the_background_follows_cycles_equirectangular_mapping(penumbra):
     assert ws.mae(images["PENUMBRA"], images["CYCLES"]) < 0.01
 
 
+def test_the_background_at_a_wide_angle_near_the_zenith_is_cycles(penumbra):
+    """A 120-degree view looking 60 degrees up through the rotated HDRI sky: the zenith's
+    columns read the sky at its width on the sphere (they had taken the image's coarsest mips,
+    which average the ground in: 0.15 per column off Cycles). Within 0.002 MAE of Cycles and
+    no column beyond 0.01 (measured 7e-5 and 2.4e-4)."""
+    import math
+
+    scene = scenes.empty_scene(128, 64)
+    ws.hdri_sky(scene)
+    camera = scenes.camera(scene, (0.0, 0.0, 0.0), (math.radians(150.0), 0.0, math.radians(-40.0)))
+    camera.data.lens_unit = "FOV"
+    camera.data.angle = math.radians(120.0)
+    images = {}
+    for engine in ("CYCLES", "PENUMBRA"):
+        ws.use_engine(scene, engine, samples=16) if engine == "CYCLES" else ws.use_engine(scene, engine)
+        images[engine] = ws.render_display(scene)
+    columns = np.abs(images["PENUMBRA"] - images["CYCLES"]).mean(axis=(0, 2))
+    assert ws.mae(images["PENUMBRA"], images["CYCLES"]) < 0.002 and columns.max() < 0.01, columns.max()
+
+
 @pytest.mark.parametrize(("width", "height", "strength"), [(1, 1, 1.0), (2, 1, 1e6), (8192, 4, 1.0), (64, 32, 0.0)])
 def test_extreme_environment_images_render_finite(penumbra, gpu_call, width, height, strength):
     """HDRIs of 1x1 to 8k wide, strength 0 to 1e6, through the world's sampled directions and
