@@ -25,6 +25,7 @@ class ShadowPass:
         self.atlas = ShadowAtlas(pool)
         self.depth_range = UNSET  # the frame's visible depth range, once a plan computed it
         self._receivers = None  # and what the camera sees (lightspace.visible_receivers)
+        self._sun_parts = None  # and the boxes' parts in its frustum (lightspace.view_parts)
         self._casters = (None, None, False)  # (the frame's draw list, what each draw casts, rsm): once a frame
         self._sizes = None  # {light index: map sizes} of the frame's first plan (``keep_sizes``)
         self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
@@ -35,6 +36,7 @@ class ShadowPass:
         a multi-sample frame; 0 for one sample), so maps are planned for all of them."""
         self.depth_range = UNSET
         self._receivers = None
+        self._sun_parts = None
         self._casters = (None, None, False)
         self._sizes = None
         self.reach = float(reach)
@@ -69,6 +71,9 @@ class ShadowPass:
             # camera and the instances' bounds: once per frame, not per sample.
             self.depth_range = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
             self._receivers = lightspace.visible_receivers(corners, camera.projection @ camera.view)
+        if view_corners is not None and self._sun_parts is None:
+            # Every sun fitted to the whole view (the world's directions too) fits to these.
+            self._sun_parts = lightspace.view_parts(corners, view_corners)
         return plan_shadows(
             lights,
             corners,
@@ -84,6 +89,7 @@ class ShadowPass:
             known_sizes=sizes,
             world_map_size=getattr(settings, "world_map_size", None),
             reflective=indirect_samples(settings) > 0,
+            sun_parts=self._sun_parts,
         )
 
     def draw(

@@ -437,15 +437,26 @@ def _receivers_in_rect(parts, view, lo, hi):
     return np.concatenate(out) if out else np.zeros((0, 3))
 
 
-def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0, flat_free=None):
+def view_parts(corners, view_corners):
+    """The parts of the boxes ``corners`` (N, 8, 3) inside the camera frustum ``view_corners``
+    (``clipped_points`` per box: (parts, seen)): the receivers ``fit_sun_to_view`` fits every
+    sun to, the same whatever the sun's direction, so a frame computes them once."""
+    boxes = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
+    return clipped_points(boxes, hull_planes(view_corners), per_box=True)
+
+
+def fit_sun_to_view(
+    direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0, flat_free=None, parts=None
+):
     """Tight sun fit (a loose box wastes the map's texels; cf. Lauritzen, Salvi and Lefohn 2011,
     "Sample Distribution Shadow Maps"): the map covers only the receivers
     the camera can see that some caster can shadow, and every caster that can shadow them.
     ``corners``: (N, 8, 3) world box corners of all geometry; ``view_corners``: the 8 world
     corners of the camera frustum (or of the slice of it a cascade covers); ``soft``: the
     tangent of the half-angle the filter spreads shadows over (PCSS of a sun's angle; 0 for a
-    fixed kernel). Returns ``(Fit, caster indices)``, or ``None`` when nothing the camera sees
-    can be shadowed.
+    fixed kernel); ``parts``: ``view_parts(corners, view_corners)`` when the caller has them.
+    Returns ``(Fit, caster indices)``, or ``None`` when nothing the camera sees can be
+    shadowed.
 
     Receivers: the part of every box inside the frustum (box ∩ frustum, exact for a ground
     plane under a perspective camera). Casters: every box except flat ones that shadow
@@ -458,7 +469,7 @@ def fit_sun_to_view(direction, corners, view_corners, map_size, padding_texels=2
     if len(boxes) == 0:
         return None
     view = look_at((0.0, 0.0, 0.0), direction)
-    parts, seen = clipped_points(boxes, hull_planes(view_corners), per_box=True)
+    parts, seen = view_parts(boxes, view_corners) if parts is None else parts
     if not seen.any():
         return None
     rls = np.concatenate([p for p in parts if len(p)]) @ view[:3, :3].T + view[:3, 3]

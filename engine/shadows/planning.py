@@ -306,6 +306,7 @@ def plan_shadows(
     known_sizes=None,
     world_map_size=None,
     reflective=False,
+    sun_parts=None,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -329,6 +330,8 @@ def plan_shadows(
     ``reflective``: the maps are also reflective shadow maps (the diffuse bounce), whose
     texels are the senders of bounced light: every box counts as a caster (flat ones too), so
     a map covers every visible receiver its light reaches, not only those a caster can shadow.
+    ``sun_parts``: ``lightspace.view_parts(corners, view_corners)``, when the caller keeps
+    them for the frame (every sun fitted to the whole view reads them; else once a plan).
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
@@ -343,6 +346,7 @@ def plan_shadows(
     hi = corners.max(axis=1)
     everything = np.arange(len(corners))
     dropped = 0
+    memo_parts = [sun_parts]  # what the camera sees of every box, for suns fitted to the whole view
 
     def flat_free_of(light):
         """Flat boxes that shadow nothing under ``light`` (None: not tested)."""
@@ -364,8 +368,16 @@ def plan_shadows(
                 fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), sizes[0])
                 tiles = [Tile(fit, everything)] if fit is not None else []
             elif slices is None or getattr(light, "world", False):
+                if memo_parts[0] is None:
+                    memo_parts[0] = lightspace.view_parts(corners, view_corners)
                 fitted = lightspace.fit_sun_to_view(
-                    light.direction, corners, view_corners, sizes[0], soft=spread, flat_free=flat_free
+                    light.direction,
+                    corners,
+                    view_corners,
+                    sizes[0],
+                    soft=spread,
+                    flat_free=flat_free,
+                    parts=memo_parts[0],
                 )
                 tiles = [Tile(*fitted)] if fitted is not None else []
             else:
