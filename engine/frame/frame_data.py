@@ -19,10 +19,9 @@ from .programs import (
     LIGHT_WORDS,
     MAX_DISK_SAMPLES,
     MAX_LIGHTS,
-    MAX_SHADOW_TILES,
-    TILE_STRUCT,
     lit_defines,
     max_filter_radius,
+    packed_tiles,
 )
 
 _ZERO = np.zeros(3)  # the default frame origin: world space as it is
@@ -263,7 +262,7 @@ def build_frame_data(
     return FrameData(
         frame=FRAME_STRUCT.pack([frame]),
         lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i), origin) for i in order], MAX_LIGHTS),
-        tiles=TILE_STRUCT.pack([t.record(origin) for t in plan.tiles], MAX_SHADOW_TILES),
+        tiles=packed_tiles(plan, origin),
         defines=lit_defines(
             settings.shadow_filter if shadowed > sampled else "NONE",  # no map: no filter code at all
             kernels.pcf_weights(settings.pcf_kernel_size),

@@ -8,6 +8,8 @@ comment.
 
 from dataclasses import replace
 
+import numpy as np
+
 from ...shaders.loader import Program, Struct
 from ..enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
 from ..scene.materials import CHANNELS
@@ -73,6 +75,19 @@ TILE_STRUCT = Struct(
         ("IVEC2", "origin"),  # its lower-left texel in the atlas
     ),
 )
+
+
+def packed_tiles(plan, origin):
+    """The TILE_STRUCT block of ``plan``'s tiles (MAX_SHADOW_TILES elements) with positions
+    relative to ``origin``: packed once per plan and origin, for the instanced depth pass and
+    the lit pass read the same records (a plan's tiles are final once its maps are drawn)."""
+    key = tuple(float(x) for x in np.asarray(origin, np.float64).ravel())
+    memo = getattr(plan, "_packed_tiles", None)
+    if memo is None or memo[0] != key:
+        memo = (key, TILE_STRUCT.pack([t.record(origin) for t in plan.tiles], MAX_SHADOW_TILES))
+        plan._packed_tiles = memo
+    return memo[1]
+
 
 FRAME_STRUCT = Struct(
     "FrameData",

@@ -11,7 +11,7 @@ import numpy as np
 from ...shaders.loader import set_uniforms
 from ..enums import DEPTH_FORMAT
 from ..gpu_pool import UniformBlocks, new_texture
-from ..shadows.planning import MAX_SHADOW_TILES, pack_tiles
+from ..shadows.planning import pack_tiles
 from .programs import (
     INSTANCE_TABLE_ROWS,
     RSM_FORMAT,
@@ -20,6 +20,7 @@ from .programs import (
     TILE_STRUCT,
     depth_defines,
     instanced_shadow_program,
+    packed_tiles,
     shadow_cutout_program,
     shadow_hair_program,
     shadow_program,
@@ -435,7 +436,7 @@ class ShadowAtlas:
                 groups.setdefault(key, (caster, []))[1].append(index)
         if not groups:
             return
-        tiles = TILE_STRUCT.pack([t.record(origin) for t in plan.tiles], MAX_SHADOW_TILES)
+        tiles = packed_tiles(plan, origin)
         tiles_ubo = self._instance_ubo("tiles", tiles)
         order = sorted(groups.items(), key=lambda item: (not item[0][0], item[0][1]))
         capacity = 4 * INSTANCE_TABLE_ROWS
