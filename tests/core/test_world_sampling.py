@@ -11,6 +11,7 @@ from devkit.session import load_penumbra
 
 load_penumbra()
 from penumbra.engine.frame import world_sampling as ws  # noqa: E402
+from penumbra.engine.scene.extract import Light  # noqa: E402
 from penumbra.engine.scene.materials import World, equirect_sh  # noqa: E402
 
 
@@ -143,3 +144,33 @@ def test_portal_cones_at_their_extremes():
     dist = ws.WorldDistribution(World.constant((1.0, 1.0, 1.0)).sh, cones=cones)
     d = dist.directions(ws.sequence_points(0, 256))
     assert np.all(np.isfinite(d)) and np.all(np.isfinite(dist.pdf(d))) and np.all(dist.pdf(d) > 0.0)
+
+
+def test_directions_follow_the_worlds_share_at_its_extremes():
+    """``light_share`` and ``directions_per_sample``: a world alone takes every direction, one
+    under a lamp far brighter than it, none for a black world or a setting of 0; NaN and
+    infinite lamps or a lamp at the centre give a share in [0, 1], never NaN."""
+    sky = World.constant((0.5, 0.5, 0.5))
+    black = World.constant((0.0, 0.0, 0.0))
+
+    def lamp(kind, power, position=(0.0, 0.0, 3.0)):
+        matrix = np.eye(4)
+        matrix[:3, 3] = position
+        return Light(type=kind, color=np.full(3, power), matrix=matrix, radius=0.0, angle=0.0, use_shadow=True)
+
+    centre = np.zeros(3)
+    assert ws.light_share(sky, [], centre) == 1.0
+    assert ws.light_share(black, [lamp("SUN", 3.0)], centre) == 0.0
+    bright = ws.light_share(sky, [lamp("SUN", 1e4)], centre)
+    assert 0.0 < bright < 1e-3
+    for extreme in (
+        lamp("POINT", np.inf),
+        lamp("SPOT", np.nan),
+        lamp("POINT", 100.0, (0.0, 0.0, 0.0)),
+        lamp("AREA", 1.0),
+    ):
+        share = ws.light_share(sky, [extreme], centre)
+        assert 0.0 <= share <= 1.0, share
+    assert [ws.directions_per_sample(s, 4) for s in (1.0, 0.5, 0.25, 0.1, 1e-9, 0.0)] == [4, 4, 2, 1, 1, 1]
+    assert ws.directions_per_sample(0.7, 0) == 0
+    assert ws.directions_per_sample(0.3, 16) == 10
