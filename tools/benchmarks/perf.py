@@ -36,6 +36,9 @@ Sections (``--sections``, all by default):
               Shadows > Caster Detail 0 (every triangle in every map) against the default 2
               map texels, F12 time and triangles drawn into maps, and the image's error
               between the two
+  gpu         the targets a GPU is judged by (issue 39): the demo at 640x360 and 16 samples
+              against EEVEE's 16 (EEVEE in the baseline column), the textured asset at 960x540
+              and 1 sample against Workbench; each with one fenced frame's CPU/GPU split
   materials   16 UV spheres on a ground at 960x540 with constant materials, a 1024² image
               on Base Color, and Base Color + Roughness + a normal map (the textured variants'
               cost against the constant one)
@@ -67,6 +70,7 @@ SECTIONS = (
     "map_detail",
     "triangles",
     "materials",
+    "gpu",
 )
 CSV_FIELDS = ["section", "case", "penumbra_ms", "workbench_ms", "ratio", "note", "runs", "blender"]
 
@@ -97,14 +101,19 @@ def _penumbra(scene):
     engines.configure(scene, "PENUMBRA")
 
 
+def _eevee(scene):
+    engines.configure(scene, "EEVEE")
+
+
 def _render():
     with session.stdout_to_stderr():
         bpy.ops.render.render(write_still=False)
 
 
-def paired(scene, runs):
-    """Median seconds of interleaved F12 renders: {'PENUMBRA': s, 'WORKBENCH': s}."""
-    setups = {"PENUMBRA": _penumbra, "WORKBENCH": _workbench}
+def paired(scene, runs, baseline=None):
+    """Median seconds of interleaved F12 renders: {'PENUMBRA': s, 'WORKBENCH': s} (the second
+    key's engine set up by ``baseline`` when given: EEVEE, say)."""
+    setups = {"PENUMBRA": _penumbra, "WORKBENCH": baseline or _workbench}
     times = {k: [] for k in setups}
     for setup in setups.values():  # warm-up: shader compilation, first allocations
         setup(scene)
@@ -786,6 +795,23 @@ def section_materials(plan):
         t = paired(textured_field(kind), plan["runs"])
         base = base or t["PENUMBRA"]
         rows.append(_row("materials", f"16 spheres, {label}", t, f"{t['PENUMBRA'] / base:.2f}x constant", plan["runs"]))
+    return rows
+
+
+def section_gpu(plan):
+    """The GPU targets: the demo (without post layers) at 640x360 and 16 samples against
+    EEVEE's 16 samples (``engines.EEVEE_SAMPLES``; EEVEE in the baseline column), and the
+    textured asset at 960x540 and 1 sample against Workbench; each with one fenced frame's
+    CPU/GPU split. On llvmpipe these are pixel-bound; on a GPU they are the frame's CPU."""
+    rows = []
+    scene = demo(640, 360)
+    scene.penumbra.render_samples = 16
+    t = paired(scene, plan["runs"], baseline=_eevee)
+    note = "baseline: EEVEE 16 samples; " + cpu_note(_fenced_stats(scene))
+    rows.append(_row("gpu", "demo 640x360, 16 samples (EEVEE: 16 samples)", t, note, plan["runs"]))
+    asset = scenes.textured_asset(960, 540)
+    t = paired(asset, plan["runs"])
+    rows.append(_row("gpu", "textured asset 960x540, 1 sample", t, cpu_note(_fenced_stats(asset)), plan["runs"]))
     return rows
 
 
