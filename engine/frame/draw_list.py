@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scene import simplify
+from ..scene.extract import Light
 from ..scene.materials import Material
 from ..shadows import light_bins, lightspace
 
@@ -184,15 +185,46 @@ def corners_of(draws):
     return np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
 
 
-def lights_in_view(lights, draws, camera, width, height, stats):
-    """The lights that can light a visible surface, with the screen rectangle each can reach
-    (``light_bins.screen_rects``); a light that reaches nothing the camera sees gets no shadow
-    map and no shading."""
-    if not draws or not lights:
-        return lights, None
+def frame_light_rects(lights, draws, camera, width, height, reach=0.0):
+    """The screen rectangles of a frame's lights, once a frame (``light_bins.screen_rects``
+    from the unjittered ``camera``): each light's influence padded by how far its samples move
+    it (``light_bins.light_reach``), every rectangle by ``reach`` pixels (the camera's offsets
+    over the frame's samples). Returns (per light its rectangle or None, the rectangle of a
+    light without influence: a sun, a point, a direction of the world), or None without
+    draws or lights."""
+    if not draws:
+        return None
     corners = np.concatenate([d.corners for d in draws])
     lo, hi = corners.min(axis=0), corners.max(axis=0)
-    rects = light_bins.screen_rects(lights, camera.projection @ camera.view, lo, hi, width, height)
+    stand_in = Light(type="SUN", color=np.zeros(3), matrix=np.eye(4), radius=0.0)
+    rects = light_bins.screen_rects(
+        [*lights, stand_in],
+        camera.projection @ camera.view,
+        lo,
+        hi,
+        width,
+        height,
+        pads=[light_bins.light_reach(lt) for lt in lights] + [0.0],
+        pixel_pad=reach,
+    )
+    return rects[:-1], rects[-1]
+
+
+def lights_in_view(lights, draws, camera, width, height, stats, frame=None):
+    """The lights that can light a visible surface, with the screen rectangle each can reach
+    (``light_bins.screen_rects``); a light that reaches nothing the camera sees gets no shadow
+    map and no shading. ``frame``: ``frame_light_rects`` of the frame's lights, which the
+    first ``len(frame[0])`` of ``lights`` are at this sample (moved within their reach), the
+    rest lights without influence (the world's directions): nothing is computed per sample."""
+    if not draws or not lights:
+        return lights, None
+    if frame is not None:
+        known, anywhere = frame
+        rects = [known[i] if i < len(known) else anywhere for i in range(len(lights))]
+    else:
+        corners = np.concatenate([d.corners for d in draws])
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        rects = light_bins.screen_rects(lights, camera.projection @ camera.view, lo, hi, width, height)
     keep = [i for i, r in enumerate(rects) if r is not None]
     stats.lights_out_of_view = len(lights) - len(keep)
     return [lights[i] for i in keep], [rects[i] for i in keep]

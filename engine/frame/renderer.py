@@ -18,7 +18,7 @@ from ..shadows import lightspace
 from ..shadows.planning import frame_sizes
 from . import debug_view, sampling
 from .batches import Batches
-from .draw_list import corners_of, draw_list, light_masks, lights_in_view
+from .draw_list import corners_of, draw_list, frame_light_rects, light_masks, lights_in_view
 from .film import Film, FrameOutput
 from .frame_data import build_frame_data, select_lights
 from .lit_pass import LitPass
@@ -81,6 +81,7 @@ class Renderer:
         self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
         self._clock = StageClock()  # the current frame's (``render``)
         self._frame_plan = None  # (key, moving lights, map sizes) of the frame's first call
+        self._frame_rects = None  # draw_list.frame_light_rects of the frame being rendered
         self._navigation = None  # (key, map sizes, frames) of the frames drawn while the view moves
         self._world_sampled = False  # the current frame samples the world's light with maps
         self._world_sh = True  # its surfaces take the world's SH light (not with light portals)
@@ -248,6 +249,10 @@ class Renderer:
                     moving |= {i for i in first.lights if i < len(lights)}
                 self._frame_plan = (frame_key, moving, self.shadow_pass.sizes)
         stats.lights_sampled = len(moving)
+        # Which part of the screen each light can reach: once a frame, padded by how far its
+        # samples move it and by the camera's pixel offsets (light bins, lights out of view).
+        reach = max(float(settings.filter_size), 0.0) if accumulate else 0.0
+        self._frame_rects = frame_light_rects(lights, draws, camera, width, height, reach)
         if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + adaptive.time_limit
         pixels = width * height
@@ -366,7 +371,7 @@ class Renderer:
         (``world_ao.py``). Returns the shadow plan."""
         film = self.film
         width, height = film.size
-        lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats)
+        lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats, self._frame_rects)
         self._last_lights = lights
         self._clock.begin("shadow pass")
         plan = self.shadow_pass.draw(

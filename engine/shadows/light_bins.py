@@ -111,38 +111,67 @@ def polytope_vertices(planes, tolerance):
     return x[inside]
 
 
-def screen_rects(lights, view_proj, lo, hi, width, height):
+def light_reach(light):
+    """How far (world units) the points a light is sampled at lie from its centre: a spot's or
+    point's radius (its ball), half an area light's diagonal (its own axes carry the object's
+    scale); 0 for suns, whose samples turn the direction, which bounds nothing here."""
+    if light.type == "AREA":
+        m = np.asarray(light.matrix, np.float64)
+        half = 0.5 * (np.linalg.norm(m[:3, 0]) * abs(light.size_x) + np.linalg.norm(m[:3, 1]) * abs(light.size_y))
+        return float(half) if math.isfinite(half) else math.inf
+    if light.type in ("SPOT", "POINT"):
+        return max(float(light.radius), 0.0)
+    return 0.0
+
+
+def screen_rects(lights, view_proj, lo, hi, width, height, pads=None, pixel_pad=0):
     """Per light, the pixel rectangle (x0, y0, x1, y1) (end exclusive) it can light, or None
-    when it reaches no visible surface. ``lo``/``hi``: the box around everything drawn."""
+    when it reaches no visible surface. ``lo``/``hi``: the box around everything drawn.
+    ``pads``: per light, how far (world units) its sampled points may lie from its centre
+    (``light_reach``): every plane of its influence moves out by that much, so the rectangle
+    holds what the light reaches from any of them (a plane n . x <= n . p through a point p of
+    the light becomes n . x <= n . p + |p' - p| for every p' within the pad). ``pixel_pad``:
+    pixels more on every side (the camera's per-sample offsets). Lights without influence
+    planes (suns, points, the world's directions) reach the same polytope: it is computed once."""
     vp = np.asarray(view_proj, np.float64)
     frustum = frustum_planes(vp)
     scene = box_planes(lo, hi)
     scale = float(np.max(np.abs(np.concatenate([lo, hi])))) if np.all(np.isfinite([lo, hi])) else 0.0
     full = (0, 0, width, height)
-    rects = []
-    for light in lights:
-        influence = influence_planes(light)
-        planes = np.concatenate([influence, scene, frustum])
+    grow = 1 + max(int(math.ceil(pixel_pad)), 0) if math.isfinite(pixel_pad) else width + height
+    everywhere = []  # the rectangle of a light without influence planes, once computed
+
+    def rect_of(planes):
         if not np.all(np.isfinite(planes)):
-            rects.append(full)
-            continue
+            return full
         tolerance = 1e-6 * (1.0 + scale + np.abs(planes[:, 3]).max())
         verts = polytope_vertices(planes, tolerance)
         if len(verts) == 0:
-            rects.append(None)
-            continue
+            return None
         clip = np.c_[verts, np.ones(len(verts))] @ vp.T
         w = clip[:, 3]
         if np.any(w <= 0) or not np.all(np.isfinite(clip)):
-            rects.append(full)  # numerically at the camera: keep it everywhere
-            continue
+            return full  # numerically at the camera: keep it everywhere
         px = (clip[:, 0] / w * 0.5 + 0.5) * width
         py = (clip[:, 1] / w * 0.5 + 0.5) * height
-        x0 = int(np.clip(math.floor(px.min()) - 1, 0, width))
-        x1 = int(np.clip(math.ceil(px.max()) + 1, 0, width))
-        y0 = int(np.clip(math.floor(py.min()) - 1, 0, height))
-        y1 = int(np.clip(math.ceil(py.max()) + 1, 0, height))
-        rects.append((x0, y0, x1, y1) if x1 > x0 and y1 > y0 else None)
+        x0 = int(np.clip(math.floor(px.min()) - grow, 0, width))
+        x1 = int(np.clip(math.ceil(px.max()) + grow, 0, width))
+        y0 = int(np.clip(math.floor(py.min()) - grow, 0, height))
+        y1 = int(np.clip(math.ceil(py.max()) + grow, 0, height))
+        return (x0, y0, x1, y1) if x1 > x0 and y1 > y0 else None
+
+    rects = []
+    for k, light in enumerate(lights):
+        influence = influence_planes(light)
+        if len(influence) == 0:
+            if not everywhere:
+                everywhere.append(rect_of(np.concatenate([scene, frustum])))
+            rects.append(everywhere[0])
+            continue
+        if pads is not None and pads[k]:
+            influence = influence.copy()
+            influence[:, 3] += pads[k]
+        rects.append(rect_of(np.concatenate([influence, scene, frustum])))
     return rects
 
 

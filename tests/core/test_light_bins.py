@@ -108,3 +108,45 @@ def test_degenerate_inputs_never_drop_a_light_that_may_reach():
     rects = light_bins.screen_rects([spot, nan_spot], vp, lo, hi, W, H)
     assert rects[0] is not None and (rects[0][2] - rects[0][0]) * (rects[0][3] - rects[0][1]) > 0.3 * W * H
     assert rects[1] is not None  # unknown reach: kept, conservatively
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_frames_rectangles_hold_every_samples(seed):
+    """Rectangles computed once a frame (``draw_list.frame_light_rects``: influence padded by
+    ``light_reach``, rectangles by the filter's pixel reach) contain each sample's own, with
+    the light at a point of itself and the camera offset by up to that reach."""
+    from types import SimpleNamespace
+
+    from penumbra.engine.frame import sampling
+    from penumbra.engine.frame.draw_list import frame_light_rects, lights_in_view
+
+    rng = np.random.default_rng(100 + seed)
+    lo, hi = np.array([-8.0, -8.0, 0.0]), np.array([8.0, 8.0, 3.0])
+    lights = [
+        _light("SPOT", rng.uniform(-6, 6, 3) + (0, 0, 5), rng.normal(size=3) + (0, 0, -2), rng.uniform(0.2, 1.5))
+        for _ in range(4)
+    ] + [_light("AREA", rng.uniform(-6, 6, 3) + (0, 0, 2), rng.normal(size=3))]
+    lights = [
+        lt.__class__(**{**lt.__dict__, "radius": 0.8, "size": 2.0, "size_x": 2.0, "size_y": 1.0}) for lt in lights
+    ]
+    eye = rng.uniform(-4, 4, 3) + (0, -12, 8)
+    view = lightspace.look_at(eye, -eye)
+    proj = lightspace.perspective(math.radians(50), W / H, 0.1, 100.0)
+    camera = SimpleNamespace(projection=proj, view=view)
+    draws = [SimpleNamespace(corners=lightspace.box_corners(lo, hi))]
+    reach, count = 1.5, 16
+    frame = frame_light_rects(lights, draws, camera, W, H, reach)
+    stats = SimpleNamespace(lights_out_of_view=0)
+    for s in range(1, count):
+        dx, dy, _ = sampling.pixel_offset(s, reach)
+        jittered = SimpleNamespace(projection=sampling.jittered_projection(proj, dx, dy, W, H), view=view)
+        moved = [sampling.light_at_sample(lt, i, s, count) for i, lt in enumerate(lights)]
+        own = light_bins.screen_rects(moved, jittered.projection @ view, lo, hi, W, H)
+        kept, held = lights_in_view(moved, draws, jittered, W, H, stats, frame)
+        position = {id(lt): k for k, lt in enumerate(kept)}
+        for light, r in zip(moved, own):
+            if r is None:
+                continue
+            assert id(light) in position, f"{light.type}: reaches {r} in sample {s} but the frame drops it"
+            x0, y0, x1, y1 = held[position[id(light)]]
+            assert x0 <= r[0] and y0 <= r[1] and x1 >= r[2] and y1 >= r[3], f"sample {s}: {r} not in {held}"
