@@ -242,8 +242,8 @@ class Renderer:
                 moving, sizes = self._frame_plan[1:]
                 self.shadow_pass.use_sizes(sizes)
             else:
-                first = self.shadow_pass.plan(draws, lights, camera, settings, film.size)
-                self.shadow_pass.keep_sizes(first, settings)
+                first = self.shadow_pass.first_plan(draws, lights, camera, settings, film.size, accumulate)
+                self.shadow_pass.keep_sizes(first, settings, lights)
                 moving = sampling.sampled_lights(lights, first, every=jitter)
                 if jitter:
                     moving |= {i for i in first.lights if i < len(lights)}

@@ -3,13 +3,14 @@ apply shadow linking to each map's casters, and draw the maps whose content chan
 atlas (``shadow_maps.ShadowAtlas``)."""
 
 import dataclasses
+import math
 
 import numpy as np
 
 from ..scene import simplify
 from ..scene.materials import Material
 from ..shadows import lightspace
-from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, plan_shadows
+from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, frame_tiles, plan_shadows
 from . import sampling
 from .draw_list import corners_of
 from .frame_data import indirect_samples
@@ -28,6 +29,7 @@ class ShadowPass:
         self._sun_parts = None  # and the boxes' parts in its frustum (lightspace.view_parts)
         self._casters = (None, None, False)  # (the frame's draw list, what each draw casts, rsm): once a frame
         self._sizes = None  # {light index: map sizes} of the frame's first plan (``keep_sizes``)
+        self._derived = None  # {light index: (mode, tiles)} of its suns, which later samples shear
         self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
 
     def begin_frame(self, reach=0.0):
@@ -39,23 +41,43 @@ class ShadowPass:
         self._sun_parts = None
         self._casters = (None, None, False)
         self._sizes = None
+        self._derived = None
         self.reach = float(reach)
 
-    def keep_sizes(self, plan, settings):
+    def keep_sizes(self, plan, settings, lights):
         """The frame's later samples draw each light's maps at the sizes of ``plan`` (the
-        frame's plan with every light at its centre): planned once a sample, not twice."""
+        frame's plan with every light at its centre, ``first_plan``): planned once a sample,
+        not twice; and its suns' maps sheared to each sample's direction, not fitted again."""
         self._sizes = frame_sizes(plan, max(1, int(settings.shadow_map_size)))
+        self._derived = frame_tiles(plan, lights)
 
     @property
     def sizes(self):
-        """The frame's map sizes (``keep_sizes``), or None."""
-        return self._sizes
+        """The frame's map sizes and derived suns (``keep_sizes``), or None."""
+        return None if self._sizes is None else (self._sizes, self._derived)
 
     def use_sizes(self, sizes):
-        """A later call of the same frame: the map sizes its first call kept."""
-        self._sizes = sizes
+        """A later call of the same frame: what its first call kept (``sizes``: the property's
+        value, or a navigation frame's map sizes alone)."""
+        if isinstance(sizes, tuple):
+            self._sizes, self._derived = sizes
+        else:
+            self._sizes, self._derived = sizes, None
 
-    def plan(self, draws, lights, camera, settings, size, map_size=None, sizes=None):
+    def first_plan(self, draws, lights, camera, settings, size, accumulate):
+        """The frame's plan with every light at its centre. In a frame of several samples a sun
+        with an angle is fitted to hold every direction its samples take (``plan_shadows``'
+        ``cones``), so each sample shears this plan's maps instead of fitting its own."""
+        cones = None
+        if accumulate:
+            cones = {
+                i: math.tan(0.5 * min(max(lt.angle, 0.0), math.pi * 0.99))
+                for i, lt in enumerate(lights)
+                if lt.type == "SUN" and not lt.world and lt.angle > 0.0
+            }
+        return self.plan(draws, lights, camera, settings, size, cones=cones)
+
+    def plan(self, draws, lights, camera, settings, size, map_size=None, sizes=None, cones=None, derived=None):
         """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
         (width, height), with maps of ``map_size`` (default: the setting). With the diffuse
         bounce (``indirect_samples``) maps hold every visible surface the light reaches, not
@@ -90,6 +112,8 @@ class ShadowPass:
             world_map_size=getattr(settings, "world_map_size", None),
             reflective=indirect_samples(settings) > 0,
             sun_parts=self._sun_parts,
+            cones=cones,
+            derived=derived,
         )
 
     def draw(
@@ -99,7 +123,7 @@ class ShadowPass:
         ``materials`` (``MaterialBlocks``) and ``textures`` serve alpha cutouts; ``batches``
         (``Batches``) the casters' levels of detail in each map. Returns the plan."""
         map_size = max(1, int(settings.shadow_map_size))
-        plan = self.plan(draws, lights, camera, settings, size, map_size, self._sizes)
+        plan = self.plan(draws, lights, camera, settings, size, map_size, self._sizes, derived=self._derived)
         if not plan.tiles:
             return plan
         columns, _rows = self.atlas.grid(len(plan.tiles))
@@ -110,7 +134,7 @@ class ShadowPass:
                 "GPU's largest texture"
             )
             map_size = clamped
-            self._sizes = None  # planned afresh at the clamped size
+            self._sizes = self._derived = None  # planned afresh at the clamped size
             plan = self.plan(draws, lights, camera, settings, size, map_size)
         if plan.unshadowed:
             stats.messages.append(

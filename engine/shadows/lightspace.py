@@ -126,13 +126,15 @@ class Fit:
     """A fitted light view: ``view`` (world -> light view), ``proj`` (view -> clip), the linear
     depth range [near, far] along the view axis, and the world size of one texel: constant for
     orthographic maps (``texel``), proportional to distance for perspective ones
-    (``texel_per_distance``)."""
+    (``texel_per_distance``). ``pivot``: the view depth (z) a sun's map is sheared about
+    (``sheared``): the middle of the receivers' depth range."""
 
-    __slots__ = ("view", "proj", "near", "far", "texel", "texel_per_distance")
+    __slots__ = ("view", "proj", "near", "far", "texel", "texel_per_distance", "pivot")
 
-    def __init__(self, view, proj, near, far, texel=0.0, texel_per_distance=0.0):
+    def __init__(self, view, proj, near, far, texel=0.0, texel_per_distance=0.0, pivot=0.0):
         self.view, self.proj, self.near, self.far = view, proj, float(near), float(far)
         self.texel, self.texel_per_distance = float(texel), float(texel_per_distance)
+        self.pivot = float(pivot)
 
     @property
     def view_proj(self):
@@ -152,7 +154,30 @@ def shifted(fit, texels, size):
     shift = np.eye(4)
     shift[0, 3] = 2.0 * float(texels[0]) / size
     shift[1, 3] = 2.0 * float(texels[1]) / size
-    return Fit(fit.view, shift @ fit.proj, fit.near, fit.far, fit.texel, fit.texel_per_distance)
+    return Fit(fit.view, shift @ fit.proj, fit.near, fit.far, fit.texel, fit.texel_per_distance, fit.pivot)
+
+
+def sheared(fit, direction):
+    """A sun's orthographic ``fit`` made to project along ``direction`` instead of its view's
+    axis: the map's x and y slide with view depth z by the direction's slope, x - kx (z - pivot),
+    so every point of a ray along ``direction`` lands on one texel (the oblique projection of a
+    sampled sun, derived from the frame's centred fit instead of fitted again; cf. Heckbert and
+    Herf 1997, who shear a light's projection per sample point). Depth stays the view's z, which
+    grows along the ray as long as the direction points into the map, so the depth test is
+    unchanged; the view matrix stays a rotation (normals and the light's axis read from it).
+    The map covers every receiver and caster of the sampled direction only when ``fit`` was
+    fitted with a ``cone`` at least the direction's slope (``fit_sun_to_view``). Returns ``fit``
+    itself for its own direction (so an unmoved map is reused)."""
+    v = fit.view[:3, :3] @ np.asarray(direction, dtype=np.float64)
+    if not np.all(np.isfinite(v)) or v[2] >= -1e-6:
+        return fit  # not into the map: no oblique projection of it exists
+    kx, ky = float(v[0] / v[2]), float(v[1] / v[2])
+    if kx == 0.0 and ky == 0.0:
+        return fit
+    shear = np.eye(4)
+    shear[0, 2], shear[1, 2] = -kx, -ky
+    shear[0, 3], shear[1, 3] = kx * fit.pivot, ky * fit.pivot
+    return Fit(fit.view, fit.proj @ shear, fit.near, fit.far, fit.texel, fit.texel_per_distance, fit.pivot)
 
 
 def fit_sun_ortho(direction, points, map_size, padding_texels=2.0):
@@ -446,7 +471,7 @@ def view_parts(corners, view_corners):
 
 
 def fit_sun_to_view(
-    direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0, flat_free=None, parts=None
+    direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0, flat_free=None, parts=None, cone=0.0
 ):
     """Tight sun fit (a loose box wastes the map's texels; cf. Lauritzen, Salvi and Lefohn 2011,
     "Sample Distribution Shadow Maps"): the map covers only the receivers
@@ -455,8 +480,11 @@ def fit_sun_to_view(
     corners of the camera frustum (or of the slice of it a cascade covers); ``soft``: the
     tangent of the half-angle the filter spreads shadows over (PCSS of a sun's angle; 0 for a
     fixed kernel); ``parts``: ``view_parts(corners, view_corners)`` when the caller has them.
-    Returns ``(Fit, caster indices)``, or ``None`` when nothing the camera sees can be
-    shadowed.
+    ``cone``: the tangent of the largest angle between ``direction`` and the directions the
+    map will be ``sheared`` to (a sampled sun's half-angle): every receiver and caster is then
+    taken as sliding by ``cone`` x its depth from the fit's pivot, so one fit holds the map
+    of every direction in the cone. Returns ``(Fit, caster indices)``, or ``None`` when
+    nothing the camera sees can be shadowed.
 
     Receivers: the part of every box inside the frustum (box ∩ frustum, exact for a ground
     plane under a perspective camera). Casters: every box except flat ones that shadow
@@ -476,6 +504,15 @@ def fit_sun_to_view(
     lo, hi = rls.min(axis=0), rls.max(axis=0)
     ls = boxes @ view[:3, :3].T + view[:3, 3]
     blo, bhi = ls.min(axis=1), ls.max(axis=1)
+    pivot = 0.5 * float(lo[2] + hi[2])
+    cone = float(cone) if math.isfinite(cone) and cone > 0.0 else 0.0
+    if cone:  # what a sheared map sees of them: each slides by cone x its depth from the pivot
+        slide = cone * float(np.abs(rls[:, 2] - pivot).max())
+        lo[:2] -= slide
+        hi[:2] += slide
+        box_slide = cone * np.maximum(np.abs(blo[:, 2] - pivot), np.abs(bhi[:, 2] - pivot))
+        blo[:, :2] -= box_slide[:, None]
+        bhi[:, :2] += box_slide[:, None]
     # ``flat_free``: the caller's flat_casters_without_shadow for this sun (one per sun, shared by its cascades).
     can_cast = ~(flat_casters_without_shadow(boxes, direction) if flat_free is None else flat_free)
     # Casters: boxes whose footprint overlaps the receivers' rectangle, at any depth towards
@@ -510,7 +547,9 @@ def fit_sun_to_view(
         reach = max_filter_radius(map_size) * texel / float(soft)
         hi[2] = max(hi[2], min(float(bhi[casters, 2].max()), hi[2] + reach))
     scale = float(np.abs(np.concatenate([lo, hi])).max())
-    return _ortho_fit(view, lo, hi, scale, map_size, padding_texels), casters
+    fit = _ortho_fit(view, lo, hi, scale, map_size, padding_texels)
+    fit.pivot = pivot
+    return fit, casters
 
 
 MAX_CASCADES = 4

@@ -307,6 +307,8 @@ def plan_shadows(
     world_map_size=None,
     reflective=False,
     sun_parts=None,
+    cones=None,
+    derived=None,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -332,6 +334,11 @@ def plan_shadows(
     a map covers every visible receiver its light reaches, not only those a caster can shadow.
     ``sun_parts``: ``lightspace.view_parts(corners, view_corners)``, when the caller keeps
     them for the frame (every sun fitted to the whole view reads them; else once a plan).
+    ``cones``: {light index: tangent of the widest angle its samples turn it} for suns: their
+    maps are fitted to hold every direction of that cone (``fit_sun_to_view(cone=)``), as the
+    frame's first plan does for the suns its samples shear. ``derived``: {light index: (mode,
+    tiles of the frame's first plan)}: those suns are not fitted again, each tile is the first
+    plan's ``lightspace.sheared`` to the light's direction (planning a sample costs a shear).
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
@@ -345,7 +352,6 @@ def plan_shadows(
     lo = corners.min(axis=1)
     hi = corners.max(axis=1)
     everything = np.arange(len(corners))
-    dropped = 0
     memo_parts = [sun_parts]  # what the camera sees of every box, for suns fitted to the whole view
 
     def flat_free_of(light):
@@ -356,9 +362,9 @@ def plan_shadows(
             return lightspace.flat_casters_without_shadow(corners, position=light.position)
         return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
 
-    def light_tiles(light, sizes, flat_free, memo):
+    def light_tiles(light, sizes, flat_free, memo, cone=0.0):
         """The tiles of ``light`` (per cascade or cube face: None where it needs no map) and
-        their mode; ``sizes[k]``: texels a side of the k-th one."""
+        their mode; ``sizes[k]``: texels a side of the k-th one; ``cone``: see ``cones``."""
         soft = light.sampled or pcss
         if light.type == "SUN":
             # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
@@ -367,7 +373,7 @@ def plan_shadows(
             if view_corners is None:
                 fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), sizes[0])
                 tiles = [Tile(fit, everything)] if fit is not None else []
-            elif slices is None or getattr(light, "world", False):
+            elif slices is None or light.world:
                 if memo_parts[0] is None:
                     memo_parts[0] = lightspace.view_parts(corners, view_corners)
                 fitted = lightspace.fit_sun_to_view(
@@ -378,11 +384,14 @@ def plan_shadows(
                     soft=spread,
                     flat_free=flat_free,
                     parts=memo_parts[0],
+                    cone=cone,
                 )
                 tiles = [Tile(*fitted)] if fitted is not None else []
             else:
                 fits = [
-                    lightspace.fit_sun_to_view(light.direction, corners, sc, sizes[k], soft=spread, flat_free=flat_free)
+                    lightspace.fit_sun_to_view(
+                        light.direction, corners, sc, sizes[k], soft=spread, flat_free=flat_free, cone=cone
+                    )
                     for k, (sc, _end) in enumerate(slices)
                 ]
                 tiles = [Tile(*f) if f is not None else None for f in fits]
@@ -390,7 +399,7 @@ def plan_shadows(
                 view_corners is not None
                 and slices is not None
                 and len(slices) > 1
-                and not getattr(light, "world", False)
+                and not light.world
             )
             mode = "CASCADE" if cascaded else "SINGLE"
         elif light.type == "SPOT":
@@ -438,14 +447,23 @@ def plan_shadows(
     for i, light in enumerate(lights):
         if not light.use_shadow:
             continue
+        if derived is not None and i in derived and light.type == "SUN" and not light.world:
+            mode, first = derived[i]
+            tiles = [
+                None if t is None else Tile(lightspace.sheared(t.fit, light.direction), t.casters, t.size, held=t.held)
+                for t in first
+            ]
+            _add(plan, i, mode, tiles, slices, depth_range)
+            continue
         flat_free = flat_free_of(light)
         memo = {}
-        world = getattr(light, "world", False)
+        world = light.world
+        cone = cones.get(i, 0.0) if cones is not None and light.type == "SUN" and not world else 0.0
         known = known_sizes.get(i) if known_sizes is not None and not world else None
         largest = min(map_size, max(1, int(world_map_size))) if world and world_map_size else map_size
         if world:
             known = [largest] * 6  # a direction of the world is drawn once: one fit, no density pass
-        tiles, mode = light_tiles(light, list(known) if known else [largest] * 6, flat_free, memo)
+        tiles, mode = light_tiles(light, list(known) if known else [largest] * 6, flat_free, memo, cone)
         # A map needs no more texels than the pixels it shadows can show (density): each map
         # (cascade, cube face) of the light is planned again at the size it needs. A sun
         # fitted to the whole scene (no view corners) keeps its size: it must not depend on
@@ -462,28 +480,44 @@ def plan_shadows(
             per_pixel = density.texels_per_pixel * (1.0 if soft else max(1.0, kernel - 1.0))
             sizes = [largest if t is None else needed_size(t, largest, receivers, density, per_pixel) for t in tiles]
             if min(sizes, default=largest) < largest:
-                smaller, smaller_mode = light_tiles(light, sizes, flat_free, memo)
+                smaller, smaller_mode = light_tiles(light, sizes, flat_free, memo, cone)
                 if [t is None for t in smaller] == [t is None for t in tiles]:
                     tiles, mode = smaller, smaller_mode
-        if not any(t is not None for t in tiles):
-            continue  # no caster in reach: no map at all
-        needed = sum(t is not None for t in tiles)
-        if len(plan.tiles) + needed > MAX_SHADOW_TILES:
-            dropped += 1
-            continue
-        entry = LightShadow(mode)
-        if mode == "CASCADE":
-            entry.splits = tuple(end for _sc, end in slices)
-            entry.blend = cascade_blend([end for _sc, end in slices], depth_range or ())
-        for t in tiles:
-            if t is None:
-                entry.tiles.append(-1)
-            else:
-                entry.tiles.append(len(plan.tiles))
-                plan.tiles.append(t)
-        plan.lights[i] = entry
-    plan.unshadowed = dropped
+        _add(plan, i, mode, tiles, slices, depth_range)
     return plan
+
+
+def _add(plan, index, mode, tiles, slices, depth_range):
+    """Light ``index``'s ``tiles`` (None where it needs no map) into ``plan``: nothing when it
+    has none; counted in ``plan.unshadowed`` when they do not fit in MAX_SHADOW_TILES."""
+    if not any(t is not None for t in tiles):
+        return  # no caster in reach: no map at all
+    needed = sum(t is not None for t in tiles)
+    if len(plan.tiles) + needed > MAX_SHADOW_TILES:
+        plan.unshadowed += 1
+        return
+    entry = LightShadow(mode)
+    if mode == "CASCADE":
+        entry.splits = tuple(end for _sc, end in slices)
+        entry.blend = cascade_blend([end for _sc, end in slices], depth_range or ())
+    for t in tiles:
+        if t is None:
+            entry.tiles.append(-1)
+        else:
+            entry.tiles.append(len(plan.tiles))
+            plan.tiles.append(t)
+    plan.lights[index] = entry
+
+
+def frame_tiles(plan, lights):
+    """{light index: (mode, its tiles or None per map)} of the suns of ``plan`` (a frame's
+    first plan, fitted with ``cones``) other than the world's directions: what the frame's
+    later samples shear (``plan_shadows(derived=)``)."""
+    return {
+        i: (entry.mode, [plan.tiles[t] if t >= 0 else None for t in entry.tiles])
+        for i, entry in plan.lights.items()
+        if i < len(lights) and lights[i].type == "SUN" and not lights[i].world
+    }
 
 
 def frame_sizes(plan, map_size):

@@ -42,11 +42,12 @@ def _render(gpu_call, scene, samples, fenced=False, before=None):
 @contextmanager
 def counting_fits():
     """A list that collects one entry per map fitted (a spot's or a point light's face, a
-    sun's cascade) while the block runs."""
+    sun's cascade) or derived from the frame's plan (a sampled sun's map ``sheared``: its name
+    is 'sheared') while the block runs."""
     from penumbra.engine.shadows import planning
 
     fits = []
-    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view
+    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view, planning.lightspace.sheared
 
     def counted(fn):
         def run(*args, **kwargs):
@@ -57,10 +58,11 @@ def counting_fits():
 
     planning.perspective_tile = counted(original[0])
     planning.lightspace.fit_sun_to_view = counted(original[1])
+    planning.lightspace.sheared = counted(original[2])
     try:
         yield fits
     finally:
-        planning.perspective_tile, planning.lightspace.fit_sun_to_view = original
+        planning.perspective_tile, planning.lightspace.fit_sun_to_view, planning.lightspace.sheared = original
 
 
 @pytest.fixture(scope="module")
@@ -93,7 +95,8 @@ def test_an_unfenced_frame_books_only_its_read_backs_as_gpu_time(demo, gpu_call)
 
 def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_call):
     """Fits of maps (a sun's and a spot's) counted over frames of 2 and 10 samples: the 8
-    further samples fit each map once (the frame's first plan fixes their sizes); no batch or
+    further samples fit each map once (the frame's first plan fixes their sizes), but the
+    sampled sun's, which they shear from the frame's first plan and never fit; no batch or
     material block is built again, and what a further sample uploads is its uniform blocks
     and light bins, a few KiB, whatever the scene's size."""
 
@@ -104,14 +107,16 @@ def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_c
             for samples in (2, 10):
                 del fits[:]
                 stats, counters, after = _render(gpu_call, demo, samples)
-                results[samples] = (len(fits), stats, counters, after)
+                results[samples] = (len(fits), stats, counters, after, fits.count("sheared"))
         return results
 
     results = count(False)
-    (fits2, stats2, *_), (fits10, stats10, counters, after) = results[2], results[10]
+    (fits2, stats2, *_, shears2), (fits10, stats10, counters, after, shears10) = results[2], results[10]
     maps = stats10.shadow_maps // stats10.samples  # maps drawn per sample (every light moves)
     assert maps >= 2
     assert fits10 - fits2 == 8 * maps, (fits2, fits10, maps)
+    suns = (shears10 - shears2) // 8  # the sun's maps: sheared, not fitted
+    assert suns >= 1 and shears10 - shears2 == 8 * suns, (shears2, shears10)
     # The world's directions (World > Shadows): one fit each, no density pass.
     world = count(True)
     # (The demo's dim world gives a small share of its light: fewer directions than the most.)

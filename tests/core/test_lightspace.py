@@ -286,3 +286,48 @@ def test_local_light_maps_crop_to_what_the_camera_sees_and_the_casters_can_shado
         corners, lightspace.perspective(np.radians(40), 1.5, 0.1, 100.0) @ lightspace.look_at((300, 0, 4), (1, 0, -0.2))
     )
     assert perspective_tile(light, down, np.pi / 2, corners, lo, hi, 1024, receivers=away, flat_free=flat_free) is None
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_sheared_sun_map_holds_what_each_sampled_direction_fits(seed):
+    """A sun fitted once with a cone (``fit_sun_to_view(cone=)``) and ``sheared`` to a direction
+    inside it: every point of a ray along that direction lands on one map position, and every
+    receiver the camera sees and every caster that the direction's own fit holds lands inside
+    the sheared map (x, y and depth), so a sample can shear the frame's map instead of fitting."""
+    from penumbra.engine.frame.sampling import concentric_disk
+
+    rng = np.random.default_rng(seed)
+    ground = _flat((-30, -30, 0), (30, 30, 0))
+    boxes = [ground] + [
+        lightspace.box_corners(c - s, c + s)
+        for c, s in zip(rng.uniform((-6, -6, 0.5), (6, 6, 3.0), (8, 3)), rng.uniform(0.2, 1.5, (8, 3)), strict=True)
+    ]
+    corners = np.stack(boxes)
+    view = lightspace.look_at((0, -14, 7), (0, 1, -0.5))
+    frustum = lightspace.frustum_corners(lightspace.perspective(np.radians(50), 1.5, 0.1, 60.0) @ view)
+    sun = lightspace.normalize(rng.uniform((-0.6, -0.6, -1.0), (0.6, 0.6, -0.4)))
+    angle = np.radians(rng.uniform(0.5, 12.0))
+    cone = np.tan(0.5 * angle)
+    centre, _ = lightspace.fit_sun_to_view(sun, corners, frustum, 1024, cone=cone)
+    u = lightspace.normalize(np.cross(sun, (0.3, 0.1, 0.9)))
+    v = np.cross(sun, u)
+    for x, y in [concentric_disk(*p) for p in rng.uniform(0, 1, (6, 2))] + [(1.0, 0.0), (0.0, -1.0)]:
+        d = lightspace.normalize(sun + cone * (x * u + y * v))
+        fit = lightspace.sheared(centre, d)
+        p = rng.uniform((-5, -5, 0), (5, 5, 3), (20, 3))
+        a = lightspace.transform_points(fit.view_proj, p)
+        b = lightspace.transform_points(fit.view_proj, p - 7.0 * d)  # farther up the same ray
+        np.testing.assert_allclose(a[:, :2], b[:, :2], atol=1e-9)
+        assert np.all(b[:, 2] < a[:, 2])  # nearer the light: smaller depth
+        own = lightspace.fit_sun_to_view(d, corners, frustum, 1024)
+        if own is None:
+            continue
+        own_fit, own_casters = own
+        # What the direction's own map spans on its receivers (its rectangle at the receivers'
+        # depths), and its casters' corners below the near plane, must lie in the sheared map.
+        parts, _seen = lightspace.view_parts(corners, frustum)
+        seen = np.concatenate([q for q in parts if len(q)])
+        inside_own = np.all(np.abs(lightspace.transform_points(own_fit.view_proj, seen)[:, :2]) <= 1.0, axis=1)
+        got = lightspace.transform_points(fit.view_proj, seen[inside_own])
+        assert np.all(np.abs(got[:, :2]) <= 1.0 + 1e-9), f"direction {d}: receivers outside the sheared map"
+        assert np.all(got[:, 2] <= 1.0 + 1e-9), f"direction {d}: receivers beyond the sheared map's far plane"
