@@ -9,7 +9,7 @@ import numpy as np
 
 from ..scene import simplify
 from ..scene.materials import Material
-from ..shadows import lightspace
+from ..shadows import light_bins, lightspace
 from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, frame_tiles, plan_shadows
 from . import sampling
 from .draw_list import corners_of
@@ -29,7 +29,8 @@ class ShadowPass:
         self._sun_parts = None  # and the boxes' parts in its frustum (lightspace.view_parts)
         self._casters = (None, None, False)  # (the frame's draw list, what each draw casts, rsm): once a frame
         self._sizes = None  # {light index: map sizes} of the frame's first plan (``keep_sizes``)
-        self._derived = None  # {light index: (mode, tiles)} of its suns, which later samples shear
+        self._derived = None  # {light index: (mode, tiles, position)}: what later samples shear or move
+        self._reaches = None  # {light index: reach} the frame's first plan grew the scene by
         self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
 
     def begin_frame(self, reach=0.0):
@@ -47,9 +48,10 @@ class ShadowPass:
     def keep_sizes(self, plan, settings, lights):
         """The frame's later samples draw each light's maps at the sizes of ``plan`` (the
         frame's plan with every light at its centre, ``first_plan``): planned once a sample,
-        not twice; and its suns' maps sheared to each sample's direction, not fitted again."""
+        not twice; and its lights' maps sheared to each sample's direction (suns) or moved to
+        its point of the light (the others), not fitted again."""
         self._sizes = frame_sizes(plan, max(1, int(settings.shadow_map_size)))
-        self._derived = frame_tiles(plan, lights)
+        self._derived = frame_tiles(plan, lights, self._reaches)
 
     @property
     def sizes(self):
@@ -68,16 +70,24 @@ class ShadowPass:
         """The frame's plan with every light at its centre. In a frame of several samples a sun
         with an angle is fitted to hold every direction its samples take (``plan_shadows``'
         ``cones``), so each sample shears this plan's maps instead of fitting its own."""
-        cones = None
+        cones = reaches = None
         if accumulate:
             cones = {
                 i: math.tan(0.5 * min(max(lt.angle, 0.0), math.pi * 0.99))
                 for i, lt in enumerate(lights)
                 if lt.type == "SUN" and not lt.world and lt.angle > 0.0
             }
-        return self.plan(draws, lights, camera, settings, size, cones=cones)
+            # Spot, point and area lights: planned over everything grown by how far their
+            # samples move them, so each sample moves the map's eye instead of planning one.
+            reaches = {
+                i: light_bins.light_reach(lt) for i, lt in enumerate(lights) if lt.type != "SUN" and not lt.world
+            }
+        self._reaches = reaches
+        return self.plan(draws, lights, camera, settings, size, cones=cones, reaches=reaches)
 
-    def plan(self, draws, lights, camera, settings, size, map_size=None, sizes=None, cones=None, derived=None):
+    def plan(
+        self, draws, lights, camera, settings, size, map_size=None, sizes=None, cones=None, derived=None, reaches=None
+    ):
         """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
         (width, height), with maps of ``map_size`` (default: the setting). With the diffuse
         bounce (``indirect_samples``) maps hold every visible surface the light reaches, not
@@ -114,6 +124,7 @@ class ShadowPass:
             sun_parts=self._sun_parts,
             cones=cones,
             derived=derived,
+            reaches=reaches,
         )
 
     def draw(

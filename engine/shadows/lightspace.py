@@ -180,6 +180,39 @@ def sheared(fit, direction):
     return Fit(fit.view, fit.proj @ shear, fit.near, fit.far, fit.texel, fit.texel_per_distance, fit.pivot)
 
 
+def moved(fit, offset):
+    """A perspective ``fit`` with its eye moved by ``offset`` (world), its axes, window and
+    depth range kept: the off-axis map of a point of a light that the frame planned at its
+    centre (``planning.plan_shadows``' ``reaches``: the plan then holds every point within the
+    light's reach). Returns ``fit`` itself for no move (so an unmoved map is reused)."""
+    offset = np.asarray(offset, dtype=np.float64)
+    if not np.any(offset) or not np.all(np.isfinite(offset)):
+        return fit
+    view = np.array(fit.view, dtype=np.float64)
+    view[:3, 3] -= view[:3, :3] @ offset
+    return Fit(view, fit.proj, fit.near, fit.far, fit.texel, fit.texel_per_distance, fit.pivot)
+
+
+def dilated_boxes(corners, radius):
+    """(n, 8, 3) corners of each box's axis-aligned bounds grown by ``radius``: they hold every
+    point of the box moved by up to ``radius``."""
+    boxes = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
+    if len(boxes) == 0:
+        return boxes
+    lo, hi = boxes.min(axis=1) - radius, boxes.max(axis=1) + radius
+    return np.stack([box_corners(a, b) for a, b in zip(lo, hi, strict=True)])
+
+
+_CUBE = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
+
+
+def dilated_receivers(receivers, radius):
+    """``Receivers`` grown by ``radius``: boxes as ``dilated_boxes``, each convex piece as the
+    hull of a cube of that half-size around each of its points."""
+    pieces = [(np.asarray(p, np.float64)[:, None, :] + radius * _CUBE).reshape(-1, 3) for p in receivers.pieces]
+    return Receivers(dilated_boxes(receivers.whole, radius), pieces)
+
+
 def fit_sun_ortho(direction, points, map_size, padding_texels=2.0):
     """Fit an orthographic light frustum for a sun shining along ``direction`` around ``points``.
 

@@ -309,6 +309,7 @@ def plan_shadows(
     sun_parts=None,
     cones=None,
     derived=None,
+    reaches=None,
 ):
     """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
     instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
@@ -336,9 +337,14 @@ def plan_shadows(
     them for the frame (every sun fitted to the whole view reads them; else once a plan).
     ``cones``: {light index: tangent of the widest angle its samples turn it} for suns: their
     maps are fitted to hold every direction of that cone (``fit_sun_to_view(cone=)``), as the
-    frame's first plan does for the suns its samples shear. ``derived``: {light index: (mode,
-    tiles of the frame's first plan)}: those suns are not fitted again, each tile is the first
-    plan's ``lightspace.sheared`` to the light's direction (planning a sample costs a shear).
+    frame's first plan does for the suns its samples shear. ``reaches``: {light index: how far
+    its sampled points lie from its centre} for spot, point and area lights: their maps are
+    planned over the scene's boxes and receivers grown by that much
+    (``lightspace.dilated_boxes``), so they hold what any of those points needs, from the
+    same window, once the eye moves there (``lightspace.moved``). ``derived``: {light index:
+    (mode, tiles, position) of the frame's first plan}: those lights are not planned again,
+    each tile is the first plan's sheared to the sun's direction or moved to the light's
+    position (planning a sample costs a matrix product).
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
     plan = ShadowPlan()
@@ -362,9 +368,21 @@ def plan_shadows(
             return lightspace.flat_casters_without_shadow(corners, position=light.position)
         return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
 
-    def light_tiles(light, sizes, flat_free, memo, cone=0.0):
+    def grown(memo, reach):
+        """The boxes (corners, lo, hi) and receivers a local light is planned over: the
+        scene's, or grown by ``reach`` (see ``reaches``; kept in the light's ``memo``)."""
+        if not reach > 0.0 or not math.isfinite(reach):
+            return corners, lo, hi, receivers
+        if "grown" not in memo:
+            boxes = lightspace.dilated_boxes(corners, reach)
+            seen = None if receivers is None else lightspace.dilated_receivers(receivers, reach)
+            memo["grown"] = (boxes, boxes.min(axis=1), boxes.max(axis=1), seen)
+        return memo["grown"]
+
+    def light_tiles(light, sizes, flat_free, memo, cone=0.0, reach=0.0):
         """The tiles of ``light`` (per cascade or cube face: None where it needs no map) and
-        their mode; ``sizes[k]``: texels a side of the k-th one; ``cone``: see ``cones``."""
+        their mode; ``sizes[k]``: texels a side of the k-th one; ``cone``: see ``cones``;
+        ``reach``: see ``reaches``."""
         soft = light.sampled or pcss
         if light.type == "SUN":
             # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
@@ -395,30 +413,27 @@ def plan_shadows(
                     for k, (sc, _end) in enumerate(slices)
                 ]
                 tiles = [Tile(*f) if f is not None else None for f in fits]
-            cascaded = (
-                view_corners is not None
-                and slices is not None
-                and len(slices) > 1
-                and not light.world
-            )
+            cascaded = view_corners is not None and slices is not None and len(slices) > 1 and not light.world
             mode = "CASCADE" if cascaded else "SINGLE"
         elif light.type == "SPOT":
             fov = min(light.cone_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
+            boxes, box_lo, box_hi, seen = grown(memo, reach)
             tile = perspective_tile(
                 light.position,
                 light.direction,
                 fov,
-                corners,
-                lo,
-                hi,
+                boxes,
+                box_lo,
+                box_hi,
                 sizes[0],
-                receivers=receivers,
+                receivers=seen,
                 flat_free=flat_free,
                 memo=memo,
             )
             tiles = [tile] if tile is not None else []
             mode = "SINGLE"
         else:  # POINT, AREA
+            boxes, box_lo, box_hi, seen = grown(memo, reach)
             tiles = [
                 None
                 if light.type == "AREA" and behind_area_light(fwd, light.direction)
@@ -426,13 +441,13 @@ def plan_shadows(
                     light.position,
                     fwd,
                     math.pi / 2.0,
-                    corners,
-                    lo,
-                    hi,
+                    boxes,
+                    box_lo,
+                    box_hi,
                     sizes[k],
                     kernel=1.0 if soft else kernel,
                     soft_radius=light.shadow_radius * light.penumbra_scale if soft else 0.0,
-                    receivers=receivers,
+                    receivers=seen,
                     flat_free=flat_free,
                     memo=memo,
                 )
@@ -447,11 +462,15 @@ def plan_shadows(
     for i, light in enumerate(lights):
         if not light.use_shadow:
             continue
-        if derived is not None and i in derived and light.type == "SUN" and not light.world:
-            mode, first = derived[i]
+        if derived is not None and i in derived and not light.world:
+            mode, first, position = derived[i]
+            if light.type == "SUN":
+                fits = [None if t is None else lightspace.sheared(t.fit, light.direction) for t in first]
+            else:
+                offset = light.position - position
+                fits = [None if t is None else lightspace.moved(t.fit, offset) for t in first]
             tiles = [
-                None if t is None else Tile(lightspace.sheared(t.fit, light.direction), t.casters, t.size, held=t.held)
-                for t in first
+                None if t is None else Tile(f, t.casters, t.size, held=t.held) for t, f in zip(first, fits, strict=True)
             ]
             _add(plan, i, mode, tiles, slices, depth_range)
             continue
@@ -459,11 +478,12 @@ def plan_shadows(
         memo = {}
         world = light.world
         cone = cones.get(i, 0.0) if cones is not None and light.type == "SUN" and not world else 0.0
+        reach = reaches.get(i, 0.0) if reaches is not None and light.type != "SUN" else 0.0
         known = known_sizes.get(i) if known_sizes is not None and not world else None
         largest = min(map_size, max(1, int(world_map_size))) if world and world_map_size else map_size
         if world:
             known = [largest] * 6  # a direction of the world is drawn once: one fit, no density pass
-        tiles, mode = light_tiles(light, list(known) if known else [largest] * 6, flat_free, memo, cone)
+        tiles, mode = light_tiles(light, list(known) if known else [largest] * 6, flat_free, memo, cone, reach)
         # A map needs no more texels than the pixels it shadows can show (density): each map
         # (cascade, cube face) of the light is planned again at the size it needs. A sun
         # fitted to the whole scene (no view corners) keeps its size: it must not depend on
@@ -480,7 +500,7 @@ def plan_shadows(
             per_pixel = density.texels_per_pixel * (1.0 if soft else max(1.0, kernel - 1.0))
             sizes = [largest if t is None else needed_size(t, largest, receivers, density, per_pixel) for t in tiles]
             if min(sizes, default=largest) < largest:
-                smaller, smaller_mode = light_tiles(light, sizes, flat_free, memo, cone)
+                smaller, smaller_mode = light_tiles(light, sizes, flat_free, memo, cone, reach)
                 if [t is None for t in smaller] == [t is None for t in tiles]:
                     tiles, mode = smaller, smaller_mode
         _add(plan, i, mode, tiles, slices, depth_range)
@@ -509,14 +529,16 @@ def _add(plan, index, mode, tiles, slices, depth_range):
     plan.lights[index] = entry
 
 
-def frame_tiles(plan, lights):
-    """{light index: (mode, its tiles or None per map)} of the suns of ``plan`` (a frame's
-    first plan, fitted with ``cones``) other than the world's directions: what the frame's
-    later samples shear (``plan_shadows(derived=)``)."""
+def frame_tiles(plan, lights, reaches=None):
+    """{light index: (mode, its tiles or None per map, its position)} of ``plan`` (a frame's
+    first plan, fitted with ``cones`` and ``reaches``): its suns other than the world's
+    directions, and the local lights in ``reaches``; what the frame's later samples shear or
+    move (``plan_shadows(derived=)``)."""
+    reaches = reaches or {}
     return {
-        i: (entry.mode, [plan.tiles[t] if t >= 0 else None for t in entry.tiles])
+        i: (entry.mode, [plan.tiles[t] if t >= 0 else None for t in entry.tiles], lights[i].position)
         for i, entry in plan.lights.items()
-        if i < len(lights) and lights[i].type == "SUN" and not lights[i].world
+        if i < len(lights) and not lights[i].world and (lights[i].type == "SUN" or i in reaches)
     }
 
 

@@ -42,12 +42,13 @@ def _render(gpu_call, scene, samples, fenced=False, before=None):
 @contextmanager
 def counting_fits():
     """A list that collects one entry per map fitted (a spot's or a point light's face, a
-    sun's cascade) or derived from the frame's plan (a sampled sun's map ``sheared``: its name
-    is 'sheared') while the block runs."""
+    sun's cascade) or derived from the frame's plan (a sampled sun's map ``sheared``, a local
+    light's ``moved``: entries named so) while the block runs."""
     from penumbra.engine.shadows import planning
 
     fits = []
-    original = planning.perspective_tile, planning.lightspace.fit_sun_to_view, planning.lightspace.sheared
+    lightspace = planning.lightspace
+    original = planning.perspective_tile, lightspace.fit_sun_to_view, lightspace.sheared, lightspace.moved
 
     def counted(fn):
         def run(*args, **kwargs):
@@ -58,11 +59,12 @@ def counting_fits():
 
     planning.perspective_tile = counted(original[0])
     planning.lightspace.fit_sun_to_view = counted(original[1])
-    planning.lightspace.sheared = counted(original[2])
+    lightspace.sheared = counted(original[2])
+    lightspace.moved = counted(original[3])
     try:
         yield fits
     finally:
-        planning.perspective_tile, planning.lightspace.fit_sun_to_view, planning.lightspace.sheared = original
+        planning.perspective_tile, lightspace.fit_sun_to_view, lightspace.sheared, lightspace.moved = original
 
 
 @pytest.fixture(scope="module")
@@ -93,12 +95,13 @@ def test_an_unfenced_frame_books_only_its_read_backs_as_gpu_time(demo, gpu_call)
     assert set(stats.gpu_seconds) <= {"accumulate", "settle"}, stats.gpu_seconds
 
 
-def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_call):
-    """Fits of maps (a sun's and a spot's) counted over frames of 2 and 10 samples: the 8
-    further samples fit each map once (the frame's first plan fixes their sizes), but the
-    sampled sun's, which they shear from the frame's first plan and never fit; no batch or
-    material block is built again, and what a further sample uploads is its uniform blocks
-    and light bins, a few KiB, whatever the scene's size."""
+def test_a_further_sample_plans_no_light_and_rebuilds_nothing(demo, gpu_call):
+    """Maps (a sun's and a spot's) counted over frames of 2 and 10 samples: the 8 further
+    samples fit none of them, each map is derived from the frame's first plan (the sun's
+    sheared to the sample's direction, the spot's moved to the sample's point of the light),
+    once per sample; the world's directions are fitted once each; no batch or material block
+    is built again, and what a further sample uploads is its uniform blocks and light bins, a
+    few KiB, whatever the scene's size."""
 
     def count(world_shadows):
         demo.penumbra.world_shadows = world_shadows
@@ -107,23 +110,24 @@ def test_a_further_sample_plans_each_light_once_and_rebuilds_nothing(demo, gpu_c
             for samples in (2, 10):
                 del fits[:]
                 stats, counters, after = _render(gpu_call, demo, samples)
-                results[samples] = (len(fits), stats, counters, after, fits.count("sheared"))
+                derived = fits.count("sheared") + fits.count("moved")
+                results[samples] = (len(fits) - derived, stats, counters, after, derived)
         return results
 
     results = count(False)
-    (fits2, stats2, *_, shears2), (fits10, stats10, counters, after, shears10) = results[2], results[10]
+    (fits2, stats2, *_, derived2), (fits10, stats10, counters, after, derived10) = results[2], results[10]
     maps = stats10.shadow_maps // stats10.samples  # maps drawn per sample (every light moves)
     assert maps >= 2
-    assert fits10 - fits2 == 8 * maps, (fits2, fits10, maps)
-    suns = (shears10 - shears2) // 8  # the sun's maps: sheared, not fitted
-    assert suns >= 1 and shears10 - shears2 == 8 * suns, (shears2, shears10)
+    assert fits10 == fits2, (fits2, fits10)  # no fit in a further sample
+    assert derived10 - derived2 == 8 * maps, (derived2, derived10, maps)
     # The world's directions (World > Shadows): one fit each, no density pass.
     world = count(True)
     # (The demo's dim world gives a small share of its light: fewer directions than the most.)
     directions = (world[10][1].world_directions - world[2][1].world_directions) // 8
     assert 1 <= directions <= demo.penumbra.world_samples
     assert world[10][1].world_directions - world[2][1].world_directions == 8 * directions
-    assert world[10][0] - world[2][0] == 8 * (maps + directions), (world[2][0], world[10][0])
+    assert world[10][0] - world[2][0] == 8 * directions, (world[2][0], world[10][0])
+    assert world[10][4] - world[2][4] == 8 * maps, (world[2][4], world[10][4])
     assert after == counters  # no batch, no material block made again
     per_sample = (stats10.upload_bytes - stats2.upload_bytes) / 8
     assert 0 < per_sample < 32 * 1024, per_sample

@@ -6,7 +6,7 @@ import pytest
 from devkit.session import load_penumbra
 
 load_penumbra()
-from penumbra.engine.shadows import lightspace  # noqa: E402
+from penumbra.engine.shadows import light_bins, lightspace  # noqa: E402
 
 
 @pytest.mark.parametrize(
@@ -331,3 +331,60 @@ def test_a_sheared_sun_map_holds_what_each_sampled_direction_fits(seed):
         got = lightspace.transform_points(fit.view_proj, seen[inside_own])
         assert np.all(np.abs(got[:, :2]) <= 1.0 + 1e-9), f"direction {d}: receivers outside the sheared map"
         assert np.all(got[:, 2] <= 1.0 + 1e-9), f"direction {d}: receivers beyond the sheared map's far plane"
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_moved_local_map_holds_what_each_point_of_the_light_plans(seed):
+    """A spot's map planned once over the scene grown by the light's reach
+    (``lightspace.dilated_boxes`` and ``dilated_receivers``, as ``plan_shadows(reaches=)``
+    does) and ``moved`` to a point of the light: every visible receiver the point's own map
+    holds lands inside the moved map (x, y and depth), and its casters are among the planned
+    ones, so a sample can move the frame's map instead of planning its own."""
+    from penumbra.engine.shadows.planning import perspective_tile
+
+    rng = np.random.default_rng(seed)
+    ground = _flat((-20, -20, 0), (20, 20, 0))
+    boxes = [ground] + [
+        lightspace.box_corners(c - s, c + s)
+        for c, s in zip(rng.uniform((-4, -4, 0.3), (4, 4, 2.0), (8, 3)), rng.uniform(0.1, 0.8, (8, 3)), strict=True)
+    ]
+    corners = np.stack(boxes)
+    lo, hi = corners.min(axis=1), corners.max(axis=1)
+    view = lightspace.look_at((0, -12, 6), (0, 1, -0.5))
+    receivers = lightspace.visible_receivers(corners, lightspace.perspective(np.radians(50), 1.5, 0.1, 60.0) @ view)
+    position = rng.uniform((-3, -3, 5), (3, 3, 7))
+    forward = lightspace.normalize(rng.uniform((-0.4, -0.4, -1.0), (0.4, 0.4, -1.0)))
+    fov, size, reach = np.radians(rng.uniform(40, 100)), 1024, rng.uniform(0.1, 1.0)
+    free = lightspace.flat_casters_without_shadow(corners, position=position)
+    grown = lightspace.dilated_boxes(corners, reach)
+    planned = perspective_tile(
+        position,
+        forward,
+        fov,
+        grown,
+        grown.min(axis=1),
+        grown.max(axis=1),
+        size,
+        receivers=lightspace.dilated_receivers(receivers, reach),
+        flat_free=free,
+    )
+    assert planned is not None
+    for _ in range(8):
+        offset = rng.normal(size=3)
+        offset *= reach * rng.uniform(0.0, 1.0) ** (1 / 3) / np.linalg.norm(offset)
+        own = perspective_tile(
+            position + offset, forward, fov, corners, lo, hi, size, receivers=receivers, flat_free=free
+        )
+        if own is None:
+            continue
+        fit = lightspace.moved(planned.fit, offset)
+        assert set(own.casters.tolist()) <= set(planned.casters.tolist())
+        held = (
+            own.held
+            if own.held is not None
+            else np.concatenate(
+                lightspace.pieces_in(light_bins.frustum_planes(own.fit.view_proj), receivers.whole, receivers.pieces)
+            )
+        )
+        ndc = lightspace.transform_points(fit.view_proj, held)
+        assert np.all(np.abs(ndc) <= 1.0 + 1e-6), f"offset {offset}: {np.abs(ndc).max(axis=0)}"
