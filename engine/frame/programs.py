@@ -6,7 +6,7 @@ by construction. Every uniform member is named: no packed vec4 whose meaning liv
 comment.
 """
 
-from dataclasses import replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -884,50 +884,36 @@ SETTLE_REACH = 128
 SETTLE_GRID = 4
 
 
-def lit_defines(
-    shadow_filter,
-    pcf_weights,
-    specular_model,
-    depth_format="FLOAT32",
-    disk_samples=16,
-    early_out=True,
-    aux_outputs=True,
-    binned=False,
-    pcf_spacing=1.0,
-    sampled=False,
-    light_counts=None,
-    light_linking=False,
-    debug=False,
-    settle=False,
-    pilot=False,
-    world_lights=False,
-    world_ao=False,
-    indirect_samples=0,
-    debug_term=0,
-    world_ratio=False,
-):
-    """The lit pass variant's defines. Only what a filter reads varies its variant: the PCF
-    kernel (compiled in as constants, so its loops unroll), the disk size and early-out
-    switch for the disk filters. ``aux_outputs``: the variant also writes depth, shadow and
-    normal (a final render's passes); without them it writes colour only (the viewport).
-    ``binned``: each pixel loops over the lights its screen bin lists (``light_bins``).
-    PCF with taps one texel apart on a one-channel map reads 2x2 texels per fetch (gather).
-    ``sampled``: some lights move between samples and take the PCSS loop.
-    ``light_counts``: (sampled, with maps, all). With at most UNROLLED_LIGHTS lights and no
-    bins the variant calls each light by its constant index, so its data is read at fixed
-    offsets instead of through a loop (about a tenth of the demo's lit pass on llvmpipe);
-    otherwise a class of lights the frame has none of gets no loop (a loop's body costs one
-    masked pass on llvmpipe even when it runs zero times). ``light_linking``: some light
-    lights only some objects; each object's ``light_mask`` says which. ``debug``: the variant
-    writes what a lit debug view shows instead of colour (``DEBUG_LIT``: lights evaluated,
-    sun cascade + 1, texel density of the worst-sampled light, coverage). ``settle``: the
-    variant writes the settle test's flags instead (``SETTLE_TEST``, ``settle.py``), looking
-    at most SETTLE_REACH texels around a point in a map; ``pilot``: a frame's pilot sample
-    (``PILOT_SAMPLE``), which reads moving lights' maps with one bilinear lookup.
-    ``world_lights``: some lights are directions of the world's light (``WORLD_LIGHTS``,
-    ``world_sampling.py``), which add their light less the SH light's share.
-    ``world_ao``: the world's light is occluded by screen-space ground-truth ambient occlusion
-    over the camera depth prepass (``WORLD_AO``, ``lib/gtao.glsl``, ``world_ao.py``).
+@dataclass(frozen=True, kw_only=True)
+class LitVariant:
+    """Which lit-pass program a draw takes: every field named (keyword-only: no variant is
+    built by position) and typed, checked when made (a wrong type or an unknown filter, model
+    or format raises, naming the field), so two swapped switches cannot pass unnoticed.
+    ``defines()`` is the program's defines (``lit_defines``).
+
+    ``shadow_filter``, ``specular_model``, ``depth_format``: names of ``enums``
+    (SHADOW_FILTER, SPECULAR_MODEL, DEPTH_FORMAT). Only what a filter reads varies its
+    variant: the PCF kernel ``pcf_weights`` (compiled in as constants, so its loops unroll),
+    the disk size ``disk_samples`` and the ``early_out`` switch for the disk filters.
+    ``aux_outputs``: the variant also writes depth, shadow and normal (a final render's
+    passes); without them it writes colour only (the viewport). ``binned``: each pixel loops
+    over the lights its screen bin lists (``light_bins``). PCF with taps one texel apart
+    (``pcf_spacing``) on a one-channel map reads 2x2 texels per fetch (gather). ``sampled``:
+    some lights move between samples and take the PCSS loop. ``light_counts``: (sampled,
+    with maps, all). With at most UNROLLED_LIGHTS lights and no bins the variant calls each
+    light by its constant index, so its data is read at fixed offsets instead of through a
+    loop (about a tenth of the demo's lit pass on llvmpipe); otherwise a class of lights the
+    frame has none of gets no loop (a loop's body costs one masked pass on llvmpipe even when
+    it runs zero times). ``light_linking``: some light lights only some objects; each
+    object's ``light_mask`` says which. ``debug``: the variant writes what a lit debug view
+    shows instead of colour (``DEBUG_LIT``: lights evaluated, sun cascade + 1, texel density
+    of the worst-sampled light, coverage). ``settle``: the variant writes the settle test's
+    flags instead (``SETTLE_TEST``, ``settle.py``), looking at most SETTLE_REACH texels
+    around a point in a map; ``pilot``: a frame's pilot sample (``PILOT_SAMPLE``), which reads
+    moving lights' maps with one bilinear lookup. ``world_lights``: some lights are
+    directions of the world's light (``WORLD_LIGHTS``, ``world_sampling.py``).
+    ``world_ao``: the world's light is occluded by screen-space ground-truth ambient
+    occlusion over the camera depth prepass (``WORLD_AO``, ``lib/gtao.glsl``, ``world_ao.py``).
     ``indirect_samples`` > 0: the variant gathers one diffuse bounce from the reflective
     shadow maps of the lights with maps, that many texels per light and sample
     (``INDIRECT_RSM``, lib/indirect_rsm.glsl; only with ``lit_program(rsm=True)``); 0 adds no
@@ -936,6 +922,107 @@ def lit_defines(
     world's light with its visibility, 2 the diffuse bounce; the WORLD_LIGHT and INDIRECT
     debug views). ``world_ratio``: the world's directions shadow its SH light as a ratio
     accumulated in the film (``WORLD_RATIO``, lit.frag.glsl) rather than adding to the colour."""
+
+    shadow_filter: str = "NONE"
+    pcf_weights: tuple = (1.0,)
+    specular_model: str = "GGX"
+    depth_format: str = "FLOAT32"
+    disk_samples: int = 16
+    early_out: bool = True
+    aux_outputs: bool = True
+    binned: bool = False
+    pcf_spacing: float = 1.0
+    sampled: bool = False
+    light_counts: tuple | None = None
+    light_linking: bool = False
+    debug: bool = False
+    settle: bool = False
+    pilot: bool = False
+    world_lights: bool = False
+    world_ao: bool = False
+    indirect_samples: int = 0
+    debug_term: int = 0
+    world_ratio: bool = False
+
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            kind = _VARIANT_KINDS[f.name]
+            if kind is bool:
+                ok = isinstance(value, (bool, np.bool_))
+            elif kind is int:
+                ok = isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+            elif kind is float:
+                ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+                    value, (bool, np.bool_)
+                )
+            elif kind is str:
+                ok = isinstance(value, str) and value in _VARIANT_ENUMS[f.name]
+            elif f.name == "pcf_weights":
+                ok = isinstance(value, tuple) and all(isinstance(w, (int, float, np.floating)) for w in value)
+            else:  # light_counts
+                ok = value is None or (
+                    isinstance(value, tuple)
+                    and len(value) == 3
+                    and all(isinstance(c, (int, np.integer)) and not isinstance(c, bool) for c in value)
+                )
+            if not ok:
+                raise TypeError(f"LitVariant.{f.name}: {value!r} is not a valid {_VARIANT_WANTS[f.name]}")
+
+    def defines(self):
+        """The program's defines (``lit_defines``)."""
+        return lit_defines(self)
+
+
+_VARIANT_KINDS = {
+    "shadow_filter": str,
+    "pcf_weights": tuple,
+    "specular_model": str,
+    "depth_format": str,
+    "disk_samples": int,
+    "early_out": bool,
+    "aux_outputs": bool,
+    "binned": bool,
+    "pcf_spacing": float,
+    "sampled": bool,
+    "light_counts": None,
+    "light_linking": bool,
+    "debug": bool,
+    "settle": bool,
+    "pilot": bool,
+    "world_lights": bool,
+    "world_ao": bool,
+    "indirect_samples": int,
+    "debug_term": int,
+    "world_ratio": bool,
+}
+_VARIANT_ENUMS = {
+    "shadow_filter": SHADOW_FILTER,
+    "specular_model": SPECULAR_MODEL,
+    "depth_format": DEPTH_FORMAT,
+}
+_VARIANT_WANTS = {
+    **{k: v.__name__ for k, v in _VARIANT_KINDS.items() if v is not None},
+    "shadow_filter": "shadow filter",
+    "specular_model": "specular model",
+    "depth_format": "depth format",
+    "pcf_weights": "tuple of weights",
+    "light_counts": "(sampled, with maps, all) tuple of ints, or None",
+}
+
+
+def lit_defines(variant):
+    """The defines of the lit-pass program ``variant`` (a ``LitVariant``)."""
+    if not isinstance(variant, LitVariant):
+        raise TypeError(f"lit_defines takes a LitVariant, not {type(variant).__name__}")
+    v = variant
+    shadow_filter, pcf_weights, depth_format, pcf_spacing = (
+        v.shadow_filter,
+        v.pcf_weights,
+        v.depth_format,
+        v.pcf_spacing,
+    )
+    light_counts, binned, indirect_samples, sampled = v.light_counts, v.binned, v.indirect_samples, v.sampled
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -949,13 +1036,13 @@ def lit_defines(
         **indirect,
         **depth_defines(depth_format),
         "SHADOW_FILTER": SHADOW_FILTER.define(shadow_filter),
-        "SPECULAR_MODEL": SPECULAR_MODEL.define(specular_model),
+        "SPECULAR_MODEL": SPECULAR_MODEL.define(v.specular_model),
         "PCF_RADIUS": len(weights) // 2,
         "PCF_WEIGHTS_LIST": ", ".join(f"{w:.9g}" for w in weights),
-        "DISK_SAMPLES": disk_samples if filt.disk or sampled else 8,
+        "DISK_SAMPLES": v.disk_samples if filt.disk or sampled else 8,
         "SAMPLED_LIGHTS": bool(sampled),
-        "EARLY_OUT": bool(early_out) or not filt.early_out,
-        "AUX_OUTPUTS": bool(aux_outputs),
+        "EARLY_OUT": bool(v.early_out) or not filt.early_out,
+        "AUX_OUTPUTS": bool(v.aux_outputs),
         "LIGHT_BINS": bool(binned),
         "PCF_GATHER": gather,
         "UNROLLED_LIGHTS": unrolled,
@@ -964,14 +1051,14 @@ def lit_defines(
         "SAMPLED_COUNT": counts[0],
         "SHADOWED_COUNT": counts[1],
         "LIGHT_COUNT": counts[2],
-        "LIGHT_LINKING": bool(light_linking),
-        "DEBUG_LIT": bool(debug),
-        "SETTLE_TEST": bool(settle),
-        "PILOT_SAMPLE": bool(pilot),
-        "WORLD_LIGHTS": bool(world_lights),
-        "WORLD_AO": bool(world_ao),
-        "WORLD_RATIO": bool(world_ratio),
-        "DEBUG_TERM": int(debug_term),
+        "LIGHT_LINKING": bool(v.light_linking),
+        "DEBUG_LIT": bool(v.debug),
+        "SETTLE_TEST": bool(v.settle),
+        "PILOT_SAMPLE": bool(v.pilot),
+        "WORLD_LIGHTS": bool(v.world_lights),
+        "WORLD_AO": bool(v.world_ao),
+        "WORLD_RATIO": bool(v.world_ratio),
+        "DEBUG_TERM": int(v.debug_term),
         "SETTLE_REACH": SETTLE_REACH,
         "SETTLE_GRID": SETTLE_GRID,
     }

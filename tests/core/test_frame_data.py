@@ -1,6 +1,7 @@
 """What a frame sends to the GPU, built without one: std140 packing against hand-derived
 offsets, the lit pass's uniform data from a shadow plan, and the shaders' use of the structs."""
 
+import dataclasses
 import math
 import re
 from types import SimpleNamespace
@@ -314,3 +315,60 @@ def test_flat_meshes_are_drawn_after_what_stands_on_them():
         for n, c in (("ground", ground), ("far", far), ("wall", wall), ("near", near))
     ]
     assert [d.name for d in front_to_back(draws, camera)] == ["near", "far", "ground", "wall"]
+
+
+def test_a_lit_variant_is_named_typed_and_every_field_reaches_the_defines():
+    """``programs.LitVariant``: built by keyword only, each field checked (a wrong type or an
+    unknown name raises, naming the field), and no field silently ignored: changing any one
+    (where it applies) changes the program's defines."""
+    LitVariant = programs.LitVariant
+    with pytest.raises(TypeError):
+        LitVariant("PCF")  # by position
+    for field, bad in (
+        ("settle", "yes"),
+        ("world_ratio", 1),
+        ("disk_samples", True),
+        ("shadow_filter", "PCF5"),
+        ("specular_model", 2),
+        ("depth_format", "FLOAT64"),
+        ("light_counts", (1, 2)),
+        ("pcf_weights", [1.0]),
+        ("pcf_spacing", False),
+    ):
+        with pytest.raises(TypeError, match=field):
+            LitVariant(**{field: bad})
+    base = dict(shadow_filter="PCSS", pcf_weights=(1.0,), light_counts=(1, 2, 3))
+    changed = {
+        "shadow_filter": "PCF",
+        "specular_model": "BLINN",
+        "depth_format": "RGBA8",
+        "disk_samples": 32,
+        "early_out": False,
+        "aux_outputs": False,
+        "binned": True,
+        "sampled": True,
+        "light_counts": (0, 1, 1),
+        "light_linking": True,
+        "debug": True,
+        "settle": True,
+        "pilot": True,
+        "world_lights": True,
+        "world_ao": True,
+        "indirect_samples": 4,
+        "debug_term": 1,
+        "world_ratio": True,
+    }
+    # The PCF kernel and its spacing apply to the PCF filter only.
+    pcf = dict(base, shadow_filter="PCF", pcf_weights=(0.25, 0.5, 0.25))
+    cases = [(base, k, v) for k, v in changed.items()] + [
+        (pcf, "pcf_weights", (0.1, 0.2, 0.4, 0.2, 0.1)),
+        (pcf, "pcf_spacing", 2.0),
+    ]
+    fields = {f.name for f in dataclasses.fields(LitVariant)}
+    assert {k for _, k, _ in cases} == fields, fields - {k for _, k, _ in cases}
+    for start, key, value in cases:
+        before = LitVariant(**start).defines()
+        after = LitVariant(**{**start, key: value}).defines()
+        assert before != after, f"LitVariant.{key} = {value!r} changes nothing"
+    with pytest.raises(TypeError):
+        programs.lit_defines("PCF")
