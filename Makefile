@@ -30,12 +30,15 @@ lint:
 	.venv/blender-$(DEMO_LINE)/bin/python -m ruff check .
 	.venv/blender-$(DEMO_LINE)/bin/python -m ruff format --check .
 
-# Lint, then the test suite on every supported Blender line (each in its own venv and process).
+# Lint, then the test suite on every supported Blender line (each in its own venv and process),
+# each line ending with its ten slowest tests and its time.
 test: lint
 	@status=0; for l in $(LINES); do \
 	  tools/setup.sh $$l || exit 1; \
 	  echo "== Blender $$l =="; \
-	  .venv/blender-$$l/bin/python -m pytest -q tests $(PYTEST_ARGS) || status=1; \
+	  start=$$(date +%s); \
+	  .venv/blender-$$l/bin/python -m pytest -q --durations=10 tests $(PYTEST_ARGS) || status=1; \
+	  echo "== Blender $$l: $$(( $$(date +%s) - start )) s =="; \
 	done; exit $$status
 
 # Benchmarks: python -m tools.bench {frame,post,shadows} (see tools/bench.py).
