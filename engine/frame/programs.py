@@ -225,6 +225,13 @@ LIT = Program(
         "lib/ggx_albedo.glsl",
         "lib/gtao.glsl",
         "lib/world_ratio.glsl",
+        # The lit shader by concern (lit.frag.glsl's header), in this order.
+        "lib/lit_surface.glsl",
+        "lib/lit_terminator.glsl",
+        "lib/lit_bsdf.glsl",
+        "lib/lit_world.glsl",
+        "lib/lit_settle.glsl",
+        "lib/lit_lights.glsl",
     ),
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).

@@ -18,7 +18,7 @@ def _interpolated(data, t, bary):
 
 
 def _offset_from_corners(values, n, toward_viewer):
-    """lit.frag.glsl's smooth_surface_offset in numpy."""
+    """lib/lit_terminator.glsl's smooth_surface_offset in numpy."""
     u, v = values["tbary"]
     a, b, c = values["tabc"]
     h = a * u * (u - 1) + (a + b + c) * u * v + b * v * (v - 1)

@@ -1,0 +1,100 @@
+/* The surface's BSDF: Lambert diffuse under a GGX (or normalised Blinn/Phong, SPECULAR_MODEL)
+ * specular layer, as the Principled BSDF layers them; the environment BRDF that weighs the
+ * world's specular and takes the specular layer's energy out of the diffuse one below. */
+
+/* The Principled specular's Fresnel between f0 and 1: the exact dielectric Fresnel of IOR 1.5
+ * remapped from its F0 (0.04) to 1, as Cycles' generalized Schlick Fresnel with a negative
+ * exponent (bsdf_microfacet.h) gives it; Schlick's (1 - cos)^5 falls short of it by up to a
+ * third between 40 and 80 degrees. ``c``: the cosine between the light and the half vector. */
+float fresnel_shape(float c)
+{
+  c = clamp(c, 0.0, 1.0);
+  float g = sqrt(1.25 + c * c); /* eta^2 - 1 + c^2 at eta = 1.5 */
+  float a = (g - c) / (g + c);
+  float b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+  return (0.5 * a * a * (1.0 + b * b) - 0.04) / 0.96;
+}
+
+/* One lobe's BSDF for light from ``to_light`` (N.L > 0): its diffuse and specular parts, each
+ * scaled by the light's factors. */
+vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
+{
+#if SPECULAR_MODEL == SPECULAR_GGX
+  vec3 H = normalize(to_light + V);
+  float NdotH = max(dot(b.N, H), 0.0);
+  float NdotV = max(dot(b.N, V), 1e-4);
+  float a2 = b.alpha * b.alpha;
+  float dd = NdotH * NdotH * (a2 - 1.0) + 1.0;
+  float D = a2 / (M_PI * dd * dd);
+  /* Height-correlated Smith visibility G / (4 N.L N.V). */
+  float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
+  float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
+  float Vis = 0.5 / max(gv + gl, 1e-8);
+  /* Fresnel from f0.rgb towards f90 (f0.a: lobe_setup) along the exact dielectric curve
+   * (fresnel_shape). */
+  float fw = fresnel_shape(dot(to_light, H));
+  vec3 spec = (b.f0.rgb + (b.f0.a - b.f0.rgb) * fw) * (D * Vis);
+  return b.albedo / M_PI * L.diffuse_factor + spec * L.specular_factor;
+#else
+#  if SPECULAR_MODEL == SPECULAR_BLINN
+  vec3 H = normalize(to_light + V);
+  float spec = (b.shininess + 8.0) / (8.0 * M_PI) * pow(max(dot(b.N, H), 0.0), b.shininess);
+#  else
+  vec3 R = reflect(-to_light, b.N);
+  float spec = (b.shininess + 2.0) / (2.0 * M_PI) * pow(max(dot(R, V), 0.0), b.shininess);
+#  endif
+  return b.albedo / M_PI * L.diffuse_factor + b.f0.rgb * spec * L.specular_factor;
+#endif
+}
+
+/* The specular lobe's directional albedo as a scale and bias of f0 (the split sum's
+ * environment BRDF): f0 a + b is what the lobe reflects of light from all directions, the
+ * energy the diffuse layer below does not get and the weight of the world's specular. (E, S)
+ * come from lib/ggx_albedo.glsl (GGX, height-correlated Smith, the Fresnel curve of
+ * fresnel_shape). Multiple scattering between the microfacets adds 1 + F_ms (1 - E) / E (Kulla
+ * and Conty 2017, as Cycles' microfacet_ggx_preserve_energy: F_ms = F_ss E_avg / (1 - F_ss
+ * (1 - E_avg)), F_ss the Fresnel's cosine-weighted mean), for ``f`` the lobe's mean f0. The
+ * bias (the Fresnel rim) is scaled by ``f90``: a surface without specular has none. */
+vec2 env_brdf(float f, float f90, float rough, float NdotV)
+{
+  vec2 es = ggx_albedo(rough, NdotV);
+  float e_avg = ggx_albedo_avg(rough);
+  float f_ss = f + (1.0 - f) * GGX_S_AVG * f90;
+  float f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg));
+  float ms = 1.0 + f_ms * (1.0 - es.x) / max(es.x, 1e-4);
+  return vec2(es.x - es.y, es.y * f90) * ms;
+}
+
+/* One lobe's shading values from its Principled parameters, with normal ``N`` and ``weight``;
+ * ``ab``: its environment BRDF (what the world's specular is weighted by). */
+Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, float weight, out vec2 ab)
+{
+  Lobe b;
+  b.N = N;
+  b.weight = weight;
+  rough = clamp(rough, 0.0, 1.0);
+  b.rough = rough;
+  /* The dielectric's F0 (rgb, tinted) and untinted f0 (a): from IOR, Specular IOR Level and
+   * Specular Tint (node_principled_f0; materials.dielectric_f0 for a read material). */
+  spec = max(spec, vec4(0.0));
+  metal = clamp(metal, 0.0, 1.0);
+  b.albedo = base * (1.0 - metal);
+  /* Schlick's f90: 1, but a surface without specular (f0 ~ 0) has no Fresnel rim either, as
+   * the Principled BSDF at IOR 1 or Specular IOR Level 0 (the tint does not change it: F90 is
+   * white in Blender's generalized Schlick). */
+  float f90 = clamp(50.0 * mix(spec.a, dot(base, vec3(0.3333)), metal), 0.0, 1.0);
+  b.f0 = vec4(mix(spec.rgb, base, metal), f90);
+  float a = max(rough * rough, 0.02);
+  b.shininess = 2.0 / (a * a) - 2.0;
+  b.alpha = max(rough * rough, 0.002);
+
+  /* Energy: light reflected by the specular layer does not reach the diffuse one below (the
+   * Principled BSDF's layering), estimated per pixel from the directional albedo. */
+  float NdotV = max(dot(N, V), 1e-4);
+  ab = env_brdf(dot(b.f0.rgb, vec3(0.3333)), f90, rough, NdotV);
+  /* Metallic mixes a metal and a dielectric; only the dielectric's own specular sits over its
+   * diffuse, per channel (a tinted specular takes its own colour out of the diffuse). */
+  vec2 ab_dielectric = env_brdf(dot(spec.rgb, vec3(0.3333)), clamp(50.0 * spec.a, 0.0, 1.0), rough, NdotV);
+  b.albedo *= clamp(1.0 - (spec.rgb * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
+  return b;
+}

@@ -1,0 +1,149 @@
+/* The world's light on the surface (engine/frame/world_light.py, world_sampling.py, world_ao.py):
+ * diffuse from its spherical-harmonic irradiance, specular (what makes metals look like metal)
+ * from its radiance around the reflected direction, blurred by roughness and weighted by the
+ * environment BRDF.
+ *
+ * WORLD_AO (lib/gtao.glsl): the world's diffuse light is scaled by its visibility from
+ * screen-space ground-truth ambient occlusion over the camera depth prepass, its specular by the
+ * specular occlusion that implies; lights and emission are untouched.
+ *
+ * WORLD_RATIO (a frame that samples the world's light with shadow-mapped directions and lights
+ * surfaces with its SH light, frame/world_sampling.py): the world's light is U x S per lobe
+ * (Heitz, Hill and McGuire 2018, "Combining Analytic Direct Illumination and Stochastic
+ * Shadows"): U the SH light unshadowed, diffuse U_d and specular U_s, S the ratio of the
+ * directions' sums N of f cos V L / p and D of f cos L / p over the frame's samples, f the
+ * lobe's BSDF, so a glossy lobe weighs its own shadow and its few bright directions do not spot
+ * the diffuse light. The colour carries U whole; WORLD_RATIO_OUT 1 also writes U_d, U_s and the
+ * sums (N_d, D_d, N_s, D_s), which the film accumulates with the colour's weights and divides at
+ * resolve (lib/world_ratio.glsl): colour - U_d (1 - S_d) - U_s (1 - S_s), in [colour - U,
+ * colour], never below zero. A sample with ambient occlusion adds its visibility as one
+ * sample's worth of the sums. WORLD_RATIO_OUT 2 (blended surfaces) takes its own ratio within
+ * the sample and writes what it leaves of the light behind it. */
+
+#ifndef WORLD_RATIO
+#  define WORLD_RATIO 0
+#endif
+#ifndef WORLD_RATIO_OUT
+#  define WORLD_RATIO_OUT 0
+#endif
+
+#if DEBUG_TERM
+/* The WORLD_LIGHT (1) and INDIRECT (2) debug views: the one term of the colour they show. */
+vec3 debug_term = vec3(0.0);
+#endif
+
+#if WORLD_RATIO
+vec4 world_sums = vec4(0.0); /* (N_d, D_d, N_s, D_s) of this sample's directions */
+vec3 world_d = vec3(0.0), world_s = vec3(0.0); /* U by lobe, the lobes' summed by weight */
+vec3 world_part_d = vec3(0.0), world_part_s = vec3(0.0); /* the last world_light's U by lobe */
+vec2 world_part_vis = vec2(1.0); /* and its ambient occlusion (diffuse, specular) */
+
+/* One sample's worth of the sums from the last world_light's ambient occlusion. */
+vec4 world_ao_sums()
+{
+  float d = world_luminance(world_part_d), sp = world_luminance(world_part_s);
+  return vec4(world_part_vis.x * d, d, world_part_vis.y * sp, sp);
+}
+
+/* A direction's (diffuse, specular) f cos L / p for one lobe, in luminance. */
+vec2 world_direction_weights(vec3 E, vec3 albedo, vec3 f, float cosine, LightData L)
+{
+  vec3 fd = albedo / M_PI * L.diffuse_factor;
+  return cosine * vec2(world_luminance(E * fd), world_luminance(E * max(f - fd, vec3(0.0))));
+}
+#endif
+
+/* The world's radiance around direction d from its SH coefficients, each band scaled by
+ * g.x (band 1) and g.y (band 2): (1, 1) is the radiance itself, (2/3, 1/4) the cosine-lobe
+ * convolution (irradiance / pi). */
+vec3 world_sh(vec3 d, vec2 g)
+{
+  vec3 r = frame.world_color;
+  r += g.x * 0.4886025 * (frame.world_sh1.xyz * d.y + frame.world_sh2.xyz * d.z + frame.world_sh3.xyz * d.x);
+  r += g.y * (1.0925484 * (frame.world_sh4.xyz * d.x * d.y + frame.world_sh5.xyz * d.y * d.z +
+                           frame.world_sh7.xyz * d.x * d.z) +
+              0.3153916 * frame.world_sh6.xyz * (3.0 * d.z * d.z - 1.0) +
+              0.5462742 * frame.world_sh8.xyz * (d.x * d.x - d.y * d.y));
+  return max(r, vec3(0.0));
+}
+
+#if WORLD_AO
+/* The world's cosine-weighted visibility at the normal of the lobe being lit
+ * (surface_world_light), and the lobes' mean of it (the WORLD_AO debug view). */
+float world_visibility = 1.0;
+float debug_world_ao = 0.0;
+#endif
+
+/* Light from the world on lobe ``b``: diffuse irradiance, and specular radiance around the
+ * reflected direction, wider with roughness, weighted by the environment BRDF ``ab``. With
+ * WORLD_AO the diffuse is scaled by the world's visibility and the specular by the specular
+ * occlusion it implies for this lobe (gtao_specular). */
+vec3 world_light(Lobe b, vec3 V, vec2 ab)
+{
+  vec3 diffuse = b.albedo * world_sh(b.N, vec2(2.0 / 3.0, 0.25));
+  vec3 R = reflect(-V, b.N);
+  float t = b.rough * b.rough;
+  vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
+  vec3 specular = radiance * (b.f0.rgb * ab.x + ab.y);
+#if WORLD_AO && WORLD_RATIO
+  /* The occlusion goes into the ratio's sums (surface_world_light), the colour keeps U whole. */
+  world_part_vis = vec2(world_visibility, gtao_specular(world_visibility, max(dot(b.N, V), 0.0), t));
+#elif WORLD_AO
+  diffuse *= world_visibility;
+  specular *= gtao_specular(world_visibility, max(dot(b.N, V), 0.0), t);
+#endif
+#if WORLD_RATIO
+  world_part_d = diffuse;
+  world_part_s = specular;
+#endif
+  return diffuse + specular;
+}
+
+/* The world's light on every lobe of ``s``, summed by their weights (``ab``: each lobe's
+ * environment BRDF, lobe_setup). With WORLD_AO the horizons are marched once and integrated for
+ * each lobe's normal; with WORLD_RATIO each lobe's U goes into world_d and world_s, and a sample
+ * with ambient occlusion adds its visibility to the sums as one sample's worth. */
+vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
+{
+#if WORLD_AO
+  mat3 ao_rotation = mat3(frame.view);
+  GtaoHorizons ao_horizons = gtao_horizons((frame.view * vec4(s.P, 1.0)).xyz, gl_FragCoord.xy);
+#endif
+  vec3 color = vec3(0.0);
+  for (int k = 0; k < NODE_LOBES; k++) {
+    float w = s.lobe[k].weight;
+#if WORLD_AO
+    world_visibility = gtao_visibility(ao_horizons, normalize(ao_rotation * s.lobe[k].N));
+    debug_world_ao += w * world_visibility;
+#endif
+    color += w * world_light(s.lobe[k], s.V, ab[k]);
+#if WORLD_RATIO
+    world_d += w * world_part_d;
+    world_s += w * world_part_s;
+#  if WORLD_AO
+    world_sums += w * world_ao_sums();
+#  endif
+#endif
+  }
+  return color;
+}
+
+#if WORLD_RATIO
+/* A direction of the world's light (``L.world``) adds to the ratio's sums, by lobe: diffuse and
+ * specular, each weighted by its own f cos L / p. ``cosines``: each lobe's cosine term (0 where
+ * the light is behind it). */
+void world_direction(Surface s, LightData L, vec3 to_light, float irradiance, float visibility,
+                     float NdotL[NODE_LOBES], float cosines[NODE_LOBES])
+{
+  vec3 E = L.color * irradiance;
+  vec2 w = vec2(0.0);
+  for (int k = 0; k < NODE_LOBES; k++) {
+    if (NdotL[k] > 0.0) {
+      vec3 f = lobe_brdf(s.lobe[k], s.V, to_light, NdotL[k], L);
+      w += s.lobe[k].weight * world_direction_weights(E, s.lobe[k].albedo, f, cosines[k], L);
+    }
+  }
+  w = max(w, vec2(0.0));
+  world_sums += vec4(visibility * w.x, w.x, visibility * w.y, w.y);
+}
+#endif
