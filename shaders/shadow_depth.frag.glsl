@@ -62,7 +62,7 @@ void main()
   }
 #endif
 #if CAMERA_DEPTH
-  out_depth = vec4(v_distance); /* the view depth itself, in a float target (world_ao.py) */
+  out_depth = vec4(v_distance); /* the view depth itself, in a float target (world/occlusion.py) */
 #elif DEPTH_FORMAT == DEPTH_FLOAT32
 #  if !RASTER_DEPTH /* orthographic tiles rasterise this depth already (frame/programs.py) */
   gl_FragDepth = clamp((v_distance - tile.near) / (tile.far - tile.near), 0.0, 1.0);

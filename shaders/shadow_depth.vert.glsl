@@ -1,7 +1,7 @@
 /* Light-space depth pass. The tile's proj_tex maps to texture space; clip space is recovered
  * from it (tex.xyz = 0.5 * clip.xyz + 0.5 * clip.w), so one tile record serves both passes.
  * CAMERA_DEPTH: the camera depth prepass of the world's ambient occlusion (engine/frame/
- * world_ao.py), whose tile is the lit pass's raster camera. */
+ * world/occlusion.py), whose tile is the lit pass's raster camera. */
 void main()
 {
 #if INSTANCED

@@ -1,5 +1,5 @@
 /* The world's Environment Texture reduced to the target's size, each target texel the box
- * average of the texels of the image it covers (engine/frame/world_light.py): read from the
+ * average of the texels of the image it covers (engine/frame/world/sh_light.py): read from the
  * coarsest mip level still at least the target's size, up to 16 x 16 texels a target texel.
  * NaN reads as 0 and infinities as the half-float limit, so one bad texel cannot make the
  * world's light infinite. A premultiplied texture (env_premultiplied) is made straight per

@@ -15,7 +15,7 @@ Each view shows numbers the engine itself used for the frame, not a second compu
   the Noise Threshold;
 * WORLD_LIGHT, INDIRECT: the world's light alone (with its visibility) and the diffuse bounce
   alone, in colour: the lit pass's ``DEBUG_TERM`` variant writes that term of its colour.
-* WORLD_AO: the world's visibility from the ambient occlusion (``world_ao.py``), written by the
+* WORLD_AO: the world's visibility from the ambient occlusion (``world/occlusion.py``), written by the
   lit pass's ``DEBUG_LIT`` variant with ``WORLD_AO`` (every sample occluded), in grey.
 
 ``DebugImage.values`` holds those numbers per pixel (tests read them); ``image`` is what is

@@ -218,7 +218,7 @@ def build_frame_data(
     ``world_sampled``: the frame samples the world's light with shadow maps (its settle test
     weighs the world's light), whether or not this sample's directions have maps;
     ``world_sh``: the surfaces take the world's SH light (False: this sample's directions of
-    the world carry all of it, ``world_sampling.world_lights`` with portals);
+    the world carry all of it, ``world.directions.world_lights`` with portals);
     ``world_ao``: (distance, jitter) when the world's light is occluded by the ambient
     occlusion over the camera depth prepass (``WORLD_AO``; ``size`` is then the film's);
     ``sample_index``: this sample's index in its frame; ``rsm``: the atlas holds reflective

@@ -66,7 +66,7 @@ class LitPass:
         with ``settle``): the surfaces the last sample drew (its z-buffer, kept) and any
         dithered or blended one in front of them write their flags, the dithered and blended
         last, nothing blended. ``ao_depth``: the camera depth prepass
-        (``world_ao.WorldAO.texture``) that a ``WORLD_AO`` variant (``data.defines``) reads."""
+        (``world.occlusion.WorldAO.texture``) that a ``WORLD_AO`` variant (``data.defines``) reads."""
         import gpu
 
         if target is not None:

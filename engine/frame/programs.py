@@ -53,7 +53,7 @@ LIGHT_STRUCT = Struct(
         ("FLOAT", "offset_scale"),  # multiplies the normal offset (besides bias_scale)
         ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
         ("VEC4", "cascade_blend"),  # CASCADE: depth before each end over which the next one fades in
-        # 1: a direction of the world's light (frame/world_sampling.py), ``color`` its radiance
+        # 1: a direction of the world's light (frame/world/directions.py), ``color`` its radiance
         # over its probability: it adds to the world ratio's sums (lit.frag.glsl WORLD_RATIO),
         # or with light portals its light itself.
         ("INT", "world"),
@@ -236,7 +236,7 @@ LIT = Program(
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
     push_constants=(("MAT4", "model"), ("IVEC4", "light_mask"), ("INT", "solid")),
-    # ao_depth: with WORLD_AO, the camera depth prepass (``world_ao.WorldAO``), view depth per pixel.
+    # ao_depth: with WORLD_AO, the camera depth prepass (``world.occlusion.WorldAO``), view depth per pixel.
     samplers=(
         ("FLOAT_2D", SHADOW_SAMPLER),
         ("FLOAT_3D", "jitter_tex"),
@@ -578,7 +578,7 @@ def instanced_shadow_program(depth_format, raster_depth=False):
     )
 
 
-# The camera depth prepass of the world's ambient occlusion (``world_ao.py``): the same depth
+# The camera depth prepass of the world's ambient occlusion (``world/occlusion.py``): the same depth
 # pass seen from the camera (its "tile" is the lit pass's raster camera), writing the view depth
 # itself into a float colour target (full float precision at every distance) and clipping at the
 # near plane as the lit pass does instead of pancaking.
@@ -849,7 +849,7 @@ BACKGROUND = Program(
 
 
 # The world's Environment Texture box-filtered to a small image, read back for its SH light
-# (``world_light.py``).
+# (``world/sh_light.py``).
 WORLD_REDUCE = Program(
     name="world_reduce",
     vertex="fullscreen.vert.glsl",
@@ -918,9 +918,9 @@ class LitVariant:
     flags instead (``SETTLE_TEST``, ``settle.py``), looking at most SETTLE_REACH texels
     around a point in a map; ``pilot``: a frame's pilot sample (``PILOT_SAMPLE``), which reads
     moving lights' maps with one bilinear lookup. ``world_lights``: some lights are
-    directions of the world's light (``WORLD_LIGHTS``, ``world_sampling.py``).
+    directions of the world's light (``WORLD_LIGHTS``, ``world/directions.py``).
     ``world_ao``: the world's light is occluded by screen-space ground-truth ambient
-    occlusion over the camera depth prepass (``WORLD_AO``, ``lib/gtao.glsl``, ``world_ao.py``).
+    occlusion over the camera depth prepass (``WORLD_AO``, ``lib/gtao.glsl``, ``world/occlusion.py``).
     ``indirect_samples`` > 0: the variant gathers one diffuse bounce from the reflective
     shadow maps of the lights with maps, that many texels per light and sample
     (``INDIRECT_RSM``, lib/indirect_rsm.glsl; only with ``lit_program(rsm=True)``); 0 adds no

@@ -27,9 +27,9 @@ from .programs import MAX_LIGHTS
 from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
-from .world_ao import WorldAO
-from .world_light import world_light
-from .world_sampling import directions_per_sample, light_share, needs_directions, portal_cones, world_lights
+from .world.directions import directions_per_sample, light_share, needs_directions, portal_cones, world_lights
+from .world.occlusion import WorldAO
+from .world.sh_light import with_sh_light
 
 
 @dataclasses.dataclass(frozen=True)
@@ -148,12 +148,12 @@ class Renderer:
         draws = draw_list(snapshot, self.batches, stats, self._origin, camera, settings, (width, height))
         stats.messages.extend(getattr(snapshot, "messages", ()))
         self.textures.forget(getattr(snapshot, "images_changed", ()))
-        world = world_light(snapshot.world, self.textures, self.shaders)
+        world = with_sh_light(snapshot.world, self.textures, self.shaders)
         if world is not snapshot.world:  # an Environment Texture's light, projected on the GPU
             snapshot = dataclasses.replace(snapshot, world=world, world_color=world.mean)
         start, stop = samples
         accumulate = sample_count > 1
-        # The world's light with visibility (world_sampling.py): a multi-sample frame adds
+        # The world's light with visibility (world/directions.py): a multi-sample frame adds
         # ``world_samples`` directions of it per sample, each a sun with its own map.
         sampled_world = needs_directions(snapshot.world, settings)
         # Light portals: the directions gather where the world's light enters what the camera
@@ -169,7 +169,7 @@ class Renderer:
         directions = int(settings.world_samples) if sampled_world and (accumulate or cones) else 0
         if directions and not cones:
             # The world's light costs what it adds: directions in proportion to its share of
-            # the light reaching what the camera sees (world_sampling.light_share).
+            # the light reaching what the camera sees (world.directions.light_share).
             seen = [d for d in draws if d.instance.camera]
             if seen:
                 box = corners_of(seen).reshape(-1, 3)
@@ -368,7 +368,7 @@ class Renderer:
         ``camera``, so a light that does not move between samples keeps its map), then the lit
         pass seen through ``view_camera``. With ``spec.ao`` the camera depth prepass of the
         world's ambient occlusion is drawn first through the lit pass's raster camera
-        (``world_ao.py``). Returns the shadow plan."""
+        (``world/occlusion.py``). Returns the shadow plan."""
         film = self.film
         width, height = film.size
         lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats, self._frame_rects)
@@ -445,7 +445,7 @@ class Renderer:
             settle=target is not None,
             pilot=spec.pilot,
             world_sampled=self._world_sampled,
-            world_sh=self._world_sh or not any(getattr(lt, "world", False) for lt in lights),
+            world_sh=self._world_sh or not any(lt.world for lt in lights),
             world_ao=ao,
             sample_index=spec.index,
             rsm=atlas is not None and atlas.rsm,

@@ -457,7 +457,7 @@ def adaptive_settings(use, threshold, min_samples, time_limit, sample_count):
     )
 
 
-# The world's ambient occlusion (``world_ao.py``, ``shaders/lib/gtao.glsl``): with World ›
+# The world's ambient occlusion (``world/occlusion.py``, ``shaders/lib/gtao.glsl``): with World ›
 # Ambient Occlusion › Distance at 0 (automatic) it looks this fraction of the diagonal of the
 # bounds of what the frame draws, so it does the same in a scene of millimetres or kilometres.
 AO_AUTO_FRACTION = 0.1
@@ -478,7 +478,7 @@ def world_is_black(world):
 
 def world_ao_sample(s, accumulate, settings, world, debug="NONE"):
     """Whether sample ``s`` of a frame (``accumulate``: one of several samples) occludes the
-    world's light by screen-space ambient occlusion (``world_ao.py``): with World › Ambient
+    world's light by screen-space ambient occlusion (``world/occlusion.py``): with World › Ambient
     Occlusion on and a world that gives light, a one-sample frame (the viewport while the view
     moves, a render of one sample) and the first sample of a frame of several, so the frame's
     first image shows contact shadows at once (a frame's pilot sample stands in for its first,

@@ -220,7 +220,7 @@ def _caster(d, materials, textures):
         if not (mat.uses_alpha and mat.transparent_shadow):
             solid.append(batch)
         elif mat.tree is not None and "FRAME" not in mat.tree.needs:
-            cutouts.append((batch, materials.get(mat), None, _tree_cutout(d, mat, materials, textures)))
+            cutouts.append((batch, materials.get(mat), None, tree_cutout(d, mat, materials, textures)))
         elif "alpha" in mat.textures:
             image = mat.textures["alpha"].image
             bits = image_premultiplied_bits(textures.premultiplied, [("alpha", image)])
@@ -231,7 +231,7 @@ def _caster(d, materials, textures):
     return Caster(solid, d.model, d.det, identity, cutouts, cull_back=cull, triangles=d.triangles)
 
 
-def _tree_cutout(d, mat, materials, textures):
+def tree_cutout(d, mat, materials, textures):
     """What a caster's compiled node tree needs in the depth pass (``shadow_maps.TreeCutout``)."""
     tree = mat.tree
     uniforms = d.tree_uniforms(tree)

@@ -95,7 +95,7 @@ class FrameStats:
     compile_seconds: float = 0.0  # spent compiling those programs (compiled node trees included)
     samples: int = 0  # samples rendered by this call
     lights_sampled: int = 0  # lights that moved between samples (the others kept one map)
-    world_directions: int = 0  # directions of the world's light drawn with shadow maps (world_sampling.py)
+    world_directions: int = 0  # directions of the world's light drawn with shadow maps (world/directions.py)
     cancelled: bool = False  # on_sample asked to stop before the last sample
     stopped: str = ""  # why the frame ended before its last sample: "converged" or "time limit"
     pixels_converged: int = 0  # pixels adaptive sampling stopped (Noise Threshold)

@@ -193,7 +193,7 @@ class Light:
     receivers: LinkSet | None = None  # light linking: what it lights (None: everything)
     blockers: LinkSet | None = None  # shadow linking: what casts its shadow (None: everything)
     name: str = ""  # the light object's name (what the SHADOW_MAPS debug view labels its maps with)
-    # A direction of the world's light (``frame/world_sampling.py``): a sun whose ``color`` is
+    # A direction of the world's light (``frame/world/directions.py``): a sun whose ``color`` is
     # the world's radiance from it over its probability.
     world: bool = False
 

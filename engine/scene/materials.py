@@ -638,7 +638,7 @@ class World:
     """Light from the world: ``sh`` are order-2 spherical-harmonic coefficients (9, 3) of its
     radiance (a constant world has only the first), ``background`` the colour the film shows
     where nothing is drawn. An Environment Texture's world has both None until the renderer
-    projects them from the image's GPU texture (``frame/world_light.py``)."""
+    projects them from the image's GPU texture (``frame/world/sh_light.py``)."""
 
     sh: np.ndarray
     background: np.ndarray
@@ -803,7 +803,7 @@ def _world_surface(scene):
             messages.append(f"world '{world.name}': {src.projection} projection (read as equirectangular)")
         rotation = _environment_rotation(world, src, messages)
         # Its light (sh) is projected from the image's GPU texture by the renderer
-        # (frame/world_light.py): no pixel is read here.
+        # (frame/world/sh_light.py): no pixel is read here.
         return World(
             sh=None,
             background=None,

@@ -123,7 +123,7 @@ class TextureCache:
     def world_env(self, name):
         """The image ``name`` box-filtered as ``world_sh`` projected it (h, w, 3), row 0 at the
         bottom, strength 1: what the world's directions are drawn from
-        (``frame/world_sampling.py``). None before ``world_sh``."""
+        (``frame/world/directions.py``). None before ``world_sh``."""
         return self._env.get(name)
 
     def messages(self):

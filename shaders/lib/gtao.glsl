@@ -8,7 +8,7 @@
 #if WORLD_AO
 /* Screen-space ground-truth ambient occlusion of the world's light (Jimenez, Wu, Pesce and
  * Jarabo 2016, "Practical Realtime Strategies for Accurate Indirect Occlusion"), per fragment
- * of the lit pass, over the camera depth prepass ``ao_depth`` (engine/frame/world_ao.py: the
+ * of the lit pass, over the camera depth prepass ``ao_depth`` (engine/frame/world/occlusion.py: the
  * view depth of every opaque and dithered surface through this sample's raster camera; 0 where
  * there is none).
  *

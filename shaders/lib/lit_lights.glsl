@@ -57,7 +57,7 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
 #endif
 #if WORLD_LIGHTS
   /* A direction of the world's light carrying its whole light (with light portals: the SH
-   * light is then not given, frame/world_sampling.py); not part of the Shadow pass (the
+   * light is then not given, frame/world/directions.py); not part of the Shadow pass (the
    * lights' alone, as Cycles'). */
   float world_light = float(L.world);
 #else

@@ -1,4 +1,4 @@
-/* The world's light on the surface (engine/frame/world_light.py, world_sampling.py, world_ao.py):
+/* The world's light on the surface (engine/frame/world/sh_light.py, world/directions.py, world/occlusion.py):
  * diffuse from its spherical-harmonic irradiance, specular (what makes metals look like metal)
  * from its radiance around the reflected direction, blurred by roughness and weighted by the
  * environment BRDF.
@@ -8,7 +8,7 @@
  * specular occlusion that implies; lights and emission are untouched.
  *
  * WORLD_RATIO (a frame that samples the world's light with shadow-mapped directions and lights
- * surfaces with its SH light, frame/world_sampling.py): the world's light is U x S per lobe
+ * surfaces with its SH light, frame/world/directions.py): the world's light is U x S per lobe
  * (Heitz, Hill and McGuire 2018, "Combining Analytic Direct Illumination and Stochastic
  * Shadows"): U the SH light unshadowed, diffuse U_d and specular U_s, S the ratio of the
  * directions' sums N of f cos V L / p and D of f cos L / p over the frame's samples, f the

@@ -78,7 +78,7 @@ def test_world_directions_add_maps_but_no_draw_calls_per_map(penumbra, gpu_call)
 def test_world_directions_follow_the_worlds_share_of_the_light(penumbra, gpu_call):
     """A sky alone takes the 4 directions per sample it is given; under a sun 20 times its
     irradiance, one (its shadows are still all that lights the sun's shadows); a black world
-    none (``world_sampling.light_share``)."""
+    none (``world.directions.light_share``)."""
     counts = {}
     for name, sky, sun in (("sky", 0.5, False), ("sun", 0.05, True), ("black", 0.0, True)):
         scene = _scene(sun=sun)

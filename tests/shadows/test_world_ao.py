@@ -1,4 +1,4 @@
-"""The world's ambient occlusion (``engine/frame/world_ao.py``, ``shaders/lib/gtao.glsl``):
+"""The world's ambient occlusion (``engine/frame/world/occlusion.py``, ``shaders/lib/gtao.glsl``):
 screen-space ground-truth ambient occlusion of the world's light in one-sample frames and a
 frame's first sample, against the analytic visibility of a floor at the foot of a wall."""
 

@@ -10,12 +10,12 @@ pixels are never read into Python, and an F12 render of a large HDRI pays a pass
 
 import dataclasses
 
-from ..scene.materials import equirect_sh
-from ..scene.textures import world_background
-from .programs import WORLD_REDUCE
+from ...scene.materials import equirect_sh
+from ...scene.textures import world_background
+from ..programs import WORLD_REDUCE
 
 
-def world_light(world, textures, shaders):
+def with_sh_light(world, textures, shaders):
     """``world`` (a ``materials.World``) with its SH light: a world whose Environment Texture's
     light is not yet known (``sh`` None) gets it from ``textures`` (cached per image)."""
     if world is None or world.image is None or world.sh is not None:

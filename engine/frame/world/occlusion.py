@@ -21,9 +21,9 @@ and follow the film's size; final renders take them from the texture pool and gi
 
 import numpy as np
 
-from ..gpu_pool import new_texture
-from ..shadows import lightspace
-from .programs import (
+from ...gpu_pool import new_texture
+from ...shadows import lightspace
+from ..programs import (
     TILE_STRUCT,
     depth_defines,
     image_premultiplied_bits,
@@ -32,8 +32,8 @@ from .programs import (
     shadow_program,
     shadow_tree_program,
 )
-from .shadow_maps import draw_cutout
-from .shadow_pass import _tree_cutout
+from ..shadow_maps import draw_cutout
+from ..shadow_pass import tree_cutout
 
 
 def camera_tile(camera, size, origin):
@@ -69,7 +69,7 @@ def prepass_parts(d, materials, textures):
         if "ALPHA_HASHED" not in features or d.instance.holdout:
             solid.append((batch, cull))
         elif mat.tree is not None and "FRAME" not in mat.tree.needs:
-            cutouts.append((batch, cull, materials.get(mat), None, _tree_cutout(d, mat, materials, textures)))
+            cutouts.append((batch, cull, materials.get(mat), None, tree_cutout(d, mat, materials, textures)))
         elif "alpha" in mat.textures:
             image = mat.textures["alpha"].image
             bits = image_premultiplied_bits(textures.premultiplied, [("alpha", image)])

@@ -34,9 +34,9 @@ import math
 
 import numpy as np
 
-from ..scene.extract import Light
-from ..scene.materials import SH_C0, sh_basis
-from .sampling import radical_inverse, sobol_2
+from ...scene.extract import Light
+from ...scene.materials import SH_C0, sh_basis
+from ..sampling import radical_inverse, sobol_2
 
 # The share of directions drawn uniformly over the sphere (the rest follow the luminance).
 UNIFORM_SHARE = 0.15

@@ -1,4 +1,4 @@
-"""The world's directions (``engine/frame/world_sampling.py``), in numpy: what they estimate
+"""The world's directions (``engine/frame/world/directions.py``), in numpy: what they estimate
 converges to the integrals they stand for, their probabilities are densities, and extreme
 worlds stay finite."""
 
@@ -10,7 +10,7 @@ import pytest
 from devkit.session import load_penumbra
 
 load_penumbra()
-from penumbra.engine.frame import world_sampling as ws  # noqa: E402
+from penumbra.engine.frame.world import directions as ws  # noqa: E402
 from penumbra.engine.scene.extract import Light  # noqa: E402
 from penumbra.engine.scene.materials import World, equirect_sh  # noqa: E402
 
