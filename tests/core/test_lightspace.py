@@ -288,6 +288,16 @@ def test_local_light_maps_crop_to_what_the_camera_sees_and_the_casters_can_shado
     assert perspective_tile(light, down, np.pi / 2, corners, lo, hi, 1024, receivers=away, flat_free=flat_free) is None
 
 
+def _ground_and_boxes(rng, half, centres, sizes, count=8):
+    """(count + 1, 8, 3): a flat ground 2 ``half`` wide and ``count`` boxes, their centres
+    uniform in the box ``centres`` and their half sizes in ``sizes``."""
+    boxes = [_flat((-half, -half, 0), (half, half, 0))] + [
+        lightspace.box_corners(c - s, c + s)
+        for c, s in zip(rng.uniform(*centres, (count, 3)), rng.uniform(*sizes, (count, 3)), strict=True)
+    ]
+    return np.stack(boxes)
+
+
 @pytest.mark.parametrize("seed", range(5))
 def test_a_sheared_sun_map_holds_what_each_sampled_direction_fits(seed):
     """A sun fitted once with a cone (``fit_sun_to_view(cone=)``) and ``sheared`` to a direction
@@ -297,12 +307,7 @@ def test_a_sheared_sun_map_holds_what_each_sampled_direction_fits(seed):
     from penumbra.engine.frame.sampling import concentric_disk
 
     rng = np.random.default_rng(seed)
-    ground = _flat((-30, -30, 0), (30, 30, 0))
-    boxes = [ground] + [
-        lightspace.box_corners(c - s, c + s)
-        for c, s in zip(rng.uniform((-6, -6, 0.5), (6, 6, 3.0), (8, 3)), rng.uniform(0.2, 1.5, (8, 3)), strict=True)
-    ]
-    corners = np.stack(boxes)
+    corners = _ground_and_boxes(rng, 30.0, ((-6, -6, 0.5), (6, 6, 3.0)), (0.2, 1.5))
     view = lightspace.look_at((0, -14, 7), (0, 1, -0.5))
     frustum = lightspace.frustum_corners(lightspace.perspective(np.radians(50), 1.5, 0.1, 60.0) @ view)
     sun = lightspace.normalize(rng.uniform((-0.6, -0.6, -1.0), (0.6, 0.6, -0.4)))
@@ -343,12 +348,7 @@ def test_a_moved_local_map_holds_what_each_point_of_the_light_plans(seed):
     from penumbra.engine.shadows.planning import perspective_tile
 
     rng = np.random.default_rng(seed)
-    ground = _flat((-20, -20, 0), (20, 20, 0))
-    boxes = [ground] + [
-        lightspace.box_corners(c - s, c + s)
-        for c, s in zip(rng.uniform((-4, -4, 0.3), (4, 4, 2.0), (8, 3)), rng.uniform(0.1, 0.8, (8, 3)), strict=True)
-    ]
-    corners = np.stack(boxes)
+    corners = _ground_and_boxes(rng, 20.0, ((-4, -4, 0.3), (4, 4, 2.0)), (0.1, 0.8))
     lo, hi = corners.min(axis=1), corners.max(axis=1)
     view = lightspace.look_at((0, -12, 6), (0, 1, -0.5))
     receivers = lightspace.visible_receivers(corners, lightspace.perspective(np.radians(50), 1.5, 0.1, 60.0) @ view)
