@@ -46,6 +46,18 @@ class SampleSpec:
     index: int = 0
 
 
+@dataclasses.dataclass
+class SampleResult:
+    """What one sample drew: its lights in view (what its plan indexes), its shadow plan, its
+    lit pass's (raster camera, view camera, light rectangles) and frame data. The settle test
+    draws as the pilot's did; the SHADOW_MAPS view shows the last sample's."""
+
+    lights: list
+    plan: object
+    cameras: tuple
+    data: object = None
+
+
 # While the view moves, a frame's maps keep the sizes of the last navigation frame that
 # planned them afresh, this many frames ago at most (``Renderer.render``'s ``navigating``).
 NAVIGATION_REPLAN = 8
@@ -74,10 +86,9 @@ class Renderer:
         self.lit_pass = LitPass(self.shaders, self.materials, self.textures)
         self.world_ao = WorldAO(pool)  # the camera depth prepass of the world's ambient occlusion
         self.post = post_stack()
-        self._last_plan = None  # the last sample's shadow plan (the SHADOW_MAPS view)
-        self._last_data = None  # and its frame data (light bins, light order)
-        self._last_lights = []  # the lights of the last sample (what its shadow plan indexes)
-        self._last_cameras = None  # the last sample's raster and view cameras, its lights' screen rects
+        # What the last frame's last sample drew (``SampleResult``), for inspection: nothing
+        # in a frame reads what an earlier call left here.
+        self.last_sample = None
         self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
         self._clock = StageClock()  # the current frame's (``render``)
         self._frame_plan = None  # (key, moving lights, map sizes) of the frame's first call
@@ -228,7 +239,7 @@ class Renderer:
                 settle=settle,
                 world_ratio=self._world_ratio,
             )
-        plan = None
+        plan = drawn = None
         moving = set()
         # With map jitter every shadowed light changes from sample to sample (its maps' texel
         # grid), so lights with an extent are sampled on it however small their penumbra.
@@ -268,11 +279,14 @@ class Renderer:
                     for i, lt in enumerate(lights)
                 ]
                 pilot = SampleSpec(pilot=True, ao=world_ao(0))
-                self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot)
+                centre = self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot)
                 with clock.stage("settle"):
-                    stats.pixels_settled = settle_pixels(
-                        self, draws, snapshot, settings, adaptive, sample_count, aux, emission
-                    )
+                    # The settle test's variant of the lit pass over the pilot's surfaces,
+                    # cameras, maps and lights, then the film's settle pass (settle.py).
+                    test = SampleSpec(sample_count=sample_count)
+                    target = film.settle_framebuffer()
+                    self._lit(draws, centre, snapshot, settings, False, False, FrameStats(), test, target)
+                    stats.pixels_settled = settle_pixels(film, settings, adaptive, sample_count, aux, emission)
             if accumulate and film.converged >= pixels:
                 stats.stopped = "converged"  # every pixel settled, or a later call of a converged frame
                 break
@@ -298,7 +312,8 @@ class Renderer:
                 index=s,
             )
             passes = (snapshot, settings, aux, emission, stats)
-            plan = self._sample(draws, sample_lights, camera, view_camera, *passes, spec)
+            drawn = self._sample(draws, sample_lights, camera, view_camera, *passes, spec)
+            plan = drawn.plan
             clock.begin("accumulate")
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
@@ -321,6 +336,7 @@ class Renderer:
                 break
             if stats.stopped:
                 break
+        self.last_sample = drawn
         clock.begin("resolve")
         stats.pixels_converged = film.converged if accumulate else 0
         if accumulate and stats.samples:
@@ -333,7 +349,7 @@ class Renderer:
         clock.begin("post")
         debug_image = None
         if debug.id != "NONE":  # the view instead of the image (and instead of the post stack)
-            debug_image = self._debug_view(debug.id, accumulate, settings, stats.ao_prepasses > 0)
+            debug_image = self._debug_view(debug.id, accumulate, settings, drawn, stats.ao_prepasses > 0)
             color = debug_view.upload(debug_image, settings.pixel_scale)
             stats.debug_legend = debug_image.legend
         else:
@@ -368,11 +384,10 @@ class Renderer:
         ``camera``, so a light that does not move between samples keeps its map), then the lit
         pass seen through ``view_camera``. With ``spec.ao`` the camera depth prepass of the
         world's ambient occlusion is drawn first through the lit pass's raster camera
-        (``world/occlusion.py``). Returns the shadow plan."""
+        (``world/occlusion.py``). Returns what it drew (``SampleResult``)."""
         film = self.film
         width, height = film.size
         lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats, self._frame_rects)
-        self._last_lights = lights
         self._clock.begin("shadow pass")
         plan = self.shadow_pass.draw(
             draws,
@@ -389,7 +404,6 @@ class Renderer:
             spec.alpha_offset,
         )
         self._clock.end()
-        self._last_plan = plan
         depth_range = self.shadow_pass.depth_range
         if depth_range is UNSET:  # no shadow plan this frame: the quick, wider bound
             depth_range = lightspace.box_depth_range(camera.projection, camera.view, corners_of(draws), camera.is_ortho)
@@ -398,7 +412,7 @@ class Renderer:
         raster_camera = (
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
         )
-        self._last_cameras = (raster_camera, view_camera, rects)  # the settle test draws as this sample did
+        result = SampleResult(lights, plan, (raster_camera, view_camera, rects))
         if spec.ao is not None:
             with self._clock.stage("world ao"):
                 self.world_ao.draw(
@@ -413,19 +427,20 @@ class Renderer:
                     spec.alpha_offset,
                 )
         with self._clock.stage("lit pass"):
-            data = self._lit(draws, lights, plan, snapshot, settings, aux, emission, stats, spec)
-        self._last_data = data
-        stats.binned = data.bins is not None
-        return plan
+            result.data = self._lit(draws, result, snapshot, settings, aux, emission, stats, spec)
+        stats.binned = result.data.bins is not None
+        return result
 
-    def _lit(self, draws, lights, plan, snapshot, settings, aux, emission, stats, spec, target=None):
-        """The lit pass of the last sample's cameras (``_last_cameras``) with ``lights`` and the
-        maps of ``plan``, for sample ``spec`` (``SampleSpec``; its ``ao`` over the prepass just
-        drawn); ``target``: the settle test's framebuffer (the ``SETTLE_TEST`` variant drawn
-        into it, ``settle.py``; never occluded). Returns the frame data it drew with."""
+    def _lit(self, draws, sample, snapshot, settings, aux, emission, stats, spec, target=None):
+        """The lit pass of ``sample`` (a ``SampleResult``: its lights, the maps of its plan, its
+        cameras and light rectangles), for sample ``spec`` (``SampleSpec``; its ``ao`` over the
+        prepass just drawn); ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
+        variant drawn into it, ``settle.py``; never occluded). Returns the frame data it drew
+        with."""
         ao = spec.ao if target is None else None
         film = self.film
-        raster_camera, view_camera, rects = self._last_cameras
+        lights, plan = sample.lights, sample.plan
+        raster_camera, view_camera, rects = sample.cameras
         atlas = self.shadows if plan is not None and plan.tiles else None
         data = build_frame_data(
             lights,
@@ -459,15 +474,9 @@ class Renderer:
         self.lit_pass.draw(film, seen, view_camera, data, atlas, world, *passes, ao_depth=ao_depth)
         return data
 
-    def settle_test(self, draws, snapshot, settings, sample_count, target):
-        """The settle test's variant of the lit pass into ``target`` over the last sample's
-        surfaces, cameras, maps and lights (``settle.py``); its draws are not the frame's."""
-        spec = SampleSpec(sample_count=sample_count)
-        lights, plan = self._last_lights, self._last_plan
-        self._lit(draws, lights, plan, snapshot, settings, False, False, FrameStats(), spec, target)
-
-    def _debug_view(self, view, accumulate, settings, occluded=False):
+    def _debug_view(self, view, accumulate, settings, last, occluded=False):
         """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``);
+        ``last``: its last sample (``SampleResult``: the SHADOW_MAPS view's plan and lights);
         ``occluded``: its samples ran the world's ambient occlusion (WORLD_AO)."""
         from .film import texture_array
 
@@ -481,12 +490,12 @@ class Renderer:
         if view == "NOISE":
             return debug_view.noise_view(film.error_array() if accumulate else None, film.size)
         atlas = self.shadows
-        plan = self._last_plan
+        plan = last.plan if last is not None else None
         depths = None
         if plan is not None and plan.tiles and atlas.texture is not None:
             channels = DEPTH_FORMAT[atlas.depth_format].channels
             depths = debug_view.atlas_depths(texture_array(atlas.texture, channels), atlas.depth_format)
-        return debug_view.shadow_maps_view(depths, plan, self._last_lights, film.size)
+        return debug_view.shadow_maps_view(depths, plan, last.lights if last is not None else [], film.size)
 
     def _post_pass(self, settings, stats):
         ctx = self.film.post_ctx

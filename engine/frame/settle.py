@@ -69,14 +69,12 @@ def settle_shifts(kept, count, filter_size):
     return tuple(mean_k - mean_n), tuple(second_k - second_n)
 
 
-def settle(renderer, draws, snapshot, settings, adaptive, sample_count, aux=False, emission=False):
-    """Settle the pixels of ``renderer``'s film no later sample can change by
-    ``adaptive.settle``, after the pilot: the settle test's variant of the lit pass over the
-    pilot's surfaces, maps and lights (``Renderer.settle_test``), then the film's settle pass.
-    ``aux``: the frame has the Shadow pass, which must not change either; ``emission``: and
-    the Emission pass. Returns the number of pixels settled."""
-    film = renderer.film
-    renderer.settle_test(draws, snapshot, settings, sample_count, film.settle_framebuffer())
+def settle(film, settings, adaptive, sample_count, aux=False, emission=False):
+    """Settle the pixels of ``film`` no later sample can change by ``adaptive.settle``, once
+    the settle test's variant of the lit pass has drawn its flags over the pilot's surfaces,
+    maps and lights into ``film.settle_framebuffer()`` (``Renderer.render``): the film's settle
+    pass. ``aux``: the frame has the Shadow pass, which must not change either; ``emission``:
+    and the Emission pass. Returns the number of pixels settled."""
     before = film.converged
     film.settle(
         adaptive.settle,

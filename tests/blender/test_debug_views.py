@@ -76,7 +76,7 @@ def test_texel_density_is_the_maps_projection_onto_the_plane(penumbra, gpu_call,
     = p * sqrt(|det|). The tilted sun stretches its texels along one axis by 1/cos(tilt)."""
     scene = _sun_over_plane(tilt=tilt)
     debug, _shown, renderer, _stats, _extras = _frame(gpu_call, scene, "TEXEL_DENSITY")
-    plan = renderer._last_plan
+    plan = renderer.last_sample.plan
     assert len(plan.tiles) == 1
     tile = plan.tiles[0]
     jacobian = 0.5 * tile.size * (tile.fit.proj @ tile.fit.view)[:2, :2]
@@ -106,7 +106,7 @@ def test_cascades_view_is_the_cascade_each_pixel_was_shaded_from(penumbra, gpu_c
     scene.camera.data.clip_end = 300.0
     scene.penumbra.shadow_cascades = 4
     debug, _shown, renderer, _stats, extras = _frame(gpu_call, scene, "CASCADES")
-    plan = renderer._last_plan
+    plan = renderer.last_sample.plan
     (shadow,) = [s for s in plan.lights.values() if s.mode == "CASCADE"]
     splits = np.asarray(shadow.splits, np.float64)
     depth = extras["depth"]
@@ -146,7 +146,7 @@ def test_light_cost_is_each_pixels_light_bin(penumbra, gpu_call):
     scenes.top_camera(scene, ortho_scale=12.0)
     debug, _shown, renderer, stats, _extras = _frame(gpu_call, scene, "LIGHT_COST")
     assert stats.binned
-    bins = renderer._last_data.bins  # (rows, columns, words): light masks as exact integers
+    bins = renderer.last_sample.data.bins  # (rows, columns, words): light masks as exact integers
     counts = np.zeros(bins.shape[:2], np.int64)
     for word in bins.reshape(-1, bins.shape[2]).T.astype(np.uint64):
         counts += np.array([bin(int(v)).count("1") for v in word]).reshape(bins.shape[:2])
@@ -229,7 +229,7 @@ def test_shadow_maps_view_shows_each_map_where_planning_put_it(penumbra, gpu_cal
     scene = _sun_over_plane(size=128)
     scenes.light(scene, "Lamp", "POINT", 100.0, location=(-2.0, -2.0, 3.0))
     debug, shown, renderer, _stats, extras = _frame(gpu_call, scene, "SHADOW_MAPS")
-    plan = renderer._last_plan
+    plan = renderer.last_sample.plan
     atlas = extras["atlas"]
     assert len(debug.tiles) == len(plan.tiles) >= 2
     rows, cols = atlas.shape
