@@ -38,7 +38,7 @@ def reduce_environment(shaders, texture, premultiplied, width, height):
     import gpu
     from gpu_extras.batch import batch_for_shader
 
-    from .film import texture_array
+    from ..film import texture_array
 
     target = gpu.types.GPUTexture((width, height), format="RGBA32F")
     framebuffer = gpu.types.GPUFrameBuffer(color_slots=(target,))
