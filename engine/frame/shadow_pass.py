@@ -79,9 +79,11 @@ class ShadowPass:
             }
             # Spot, point and area lights: planned over everything grown by how far their
             # samples move them, so each sample moves the map's eye instead of planning one.
+            # (A light whose reach is not finite, a degenerate one, is planned every sample.)
             reaches = {
                 i: light_bins.light_reach(lt) for i, lt in enumerate(lights) if lt.type != "SUN" and not lt.world
             }
+            reaches = {i: r for i, r in reaches.items() if math.isfinite(r)}
         self._reaches = reaches
         return self.plan(draws, lights, camera, settings, size, cones=cones, reaches=reaches)
 

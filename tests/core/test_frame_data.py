@@ -372,3 +372,31 @@ def test_a_lit_variant_is_named_typed_and_every_field_reaches_the_defines():
         assert before != after, f"LitVariant.{key} = {value!r} changes nothing"
     with pytest.raises(TypeError):
         programs.lit_defines("PCF")
+
+
+def test_a_frames_first_plan_derives_every_sampled_light_of_finite_reach():
+    """``ShadowPass.first_plan`` plans a multi-sample frame's lights for every sample at once:
+    suns with an angle over their cone, spot, point and area lights over the scene grown by
+    their reach; ``keep_sizes`` then keeps those lights' tiles for the samples to shear or
+    move. A degenerate light (an area light of infinite size: no finite reach) is left to be
+    planned every sample, and a one-sample frame grows nothing."""
+    from penumbra.engine.frame.shadow_pass import ShadowPass
+
+    ground = lightspace.box_corners(np.array([-5.0, -5.0, -0.1]), np.array([5.0, 5.0, 0.0]))
+    caster = lightspace.box_corners(np.array([-0.5, -0.5, 0.5]), np.array([0.5, 0.5, 1.5]))
+    draws = [SimpleNamespace(corners=ground), SimpleNamespace(corners=caster)]
+    huge = _light("AREA", size=1.0, size_x=1.0, size_y=1.0)
+    huge.matrix[0, 0] = np.inf
+    lights = [_light("SPOT"), _light("POINT"), _light("SUN", angle=0.1), huge]
+    shadows = ShadowPass()
+    shadows.begin_frame()
+    plan = shadows.first_plan(draws, lights, _camera(), _settings(), (64, 36), accumulate=True)
+    shadows.keep_sizes(plan, _settings(), lights)
+    derived = shadows.sizes[1]
+    assert {0, 1, 2} <= set(plan.lights) and {0, 1, 2} <= set(derived)
+    assert 3 not in derived
+    assert shadows._reaches[0] == pytest.approx(0.25)
+    one = ShadowPass()
+    one.begin_frame()
+    one.first_plan(draws, lights, _camera(), _settings(), (64, 36), accumulate=False)
+    assert one._reaches is None
