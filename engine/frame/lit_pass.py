@@ -2,6 +2,8 @@
 with the frame's lights and shadow atlas, into the film's targets; and the world's
 Environment Texture behind it."""
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ...shaders.loader import set_uniforms
@@ -41,64 +43,95 @@ class LitPass:
         self.uploaded = 0  # bytes sent to the GPU since creation (uniform blocks, textures of data)
 
     def draw(
-        self,
-        film,
-        draws,
-        camera,
-        data,
-        atlas,
-        world,
-        settings,
-        aux,
-        emission,
-        stats,
-        origin,
-        masks=None,
-        target=None,
-        ao_depth=None,
+        self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None, ao_depth=None
     ):
-        """Every visible part of ``draws``, grouped by material variant: opaque and
-        alpha-hashed parts nearest first, then alpha-blended parts farthest first, blended over
-        them (their depth, normal and shadow stay those of what is behind; EEVEE too keeps
-        blended surfaces out of its depth). ``atlas``: the shadow atlas, or None when no map
-        was planned; ``world``: the snapshot's World (or None) and ``world_color``.
-        ``target``: the settle test's framebuffer (``Film.settle_framebuffer``; ``data`` built
-        with ``settle``): the surfaces the last sample drew (its z-buffer, kept) and any
-        dithered or blended one in front of them write their flags, the dithered and blended
-        last, nothing blended. ``ao_depth``: the camera depth prepass
-        (``world.occlusion.WorldAO.texture``) that a ``WORLD_AO`` variant (``data.defines``) reads."""
+        """The film's lit pass: every visible part of ``draws``, grouped by material variant:
+        opaque and alpha-hashed parts nearest first, then alpha-blended parts farthest first,
+        blended over them (their depth, normal and shadow stay those of what is behind; EEVEE
+        too keeps blended surfaces out of its depth). ``atlas``: the shadow atlas, or None when
+        no map was planned; ``world``: the snapshot's World (or None) and ``world_color``.
+        ``ao_depth``: the camera depth prepass (``world.occlusion.WorldAO.texture``) that a
+        ``WORLD_AO`` variant (``data.defines``) reads."""
         import gpu
 
-        if target is not None:
-            aux = emission = False
         world_data, world_color = world
-        shadow_tex = atlas.texture if atlas is not None else self._shadow_dummy()
         # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
         # A lit debug view's values start at 0 where no surface is (``DEBUG_LIT``).
-        debug = bool(data.defines.get("DEBUG_LIT"))
-        transparent = settings.film_transparent or debug
+        transparent = settings.film_transparent or bool(data.defines.get("DEBUG_LIT"))
         bg = (0.0, 0.0, 0.0, 0.0) if transparent else (*map(float, world_color[:3]), 1.0)
         emission = aux and emission
-        counted = film.fb_counted is not None and not aux and target is None  # the shading count of tests
-        # The world's light as a ratio (lit.frag.glsl WORLD_RATIO): its targets beside the pass's.
-        ratio = bool(data.defines.get("WORLD_RATIO")) and target is None
-        # Blender's gpu module binds six colour targets: with the world ratio's three, the
-        # Emission pass is drawn apart, over the z-buffer the lit pass leaves.
+        counted = film.fb_counted is not None and not aux  # the shading count of tests
+        # The world's light as a ratio (WORLD_RATIO): its targets beside the pass's. Blender's
+        # gpu module binds six colour targets: with the world ratio's three, the Emission pass
+        # is drawn apart, over the z-buffer the lit pass leaves.
+        ratio = bool(data.defines.get("WORLD_RATIO"))
         emission_apart = ratio and emission
         fb = film.lit_framebuffer(aux, emission and not emission_apart, counted, ratio)
-        if target is not None:
-            fb = target
-        else:
-            film.clear(bg, aux, emission, ratio)
+        film.clear(bg, aux, emission, ratio)
         # Adaptive sampling: where a pixel converged the nearest depth goes first, so nothing
         # (surface or world) is drawn there; the pixel is not shaded again.
-        converged = film.mask is not None and target is None
+        converged = film.mask is not None
         if converged:
             film.mask_depth(fb)
-        if target is not None:
-            pass  # the settle test: surfaces only
-        elif world_data is not None and world_data.image is not None and not transparent:
+        if world_data is not None and world_data.image is not None and not transparent:
             self._background(film, world_data, camera, origin, "LESS_EQUAL" if converged else "NONE")
+        opaque, blended, parts = self._entries(draws, camera, atlas, stats, hashed_last=False)
+        submit = _Submission(self, film, camera, data, atlas, origin, masks, ao_depth, parts, stats)
+        submit.emission = emission and not emission_apart
+        submit.counted = counted
+        submit.ratio = ratio
+        width, height = film.size
+        with fb.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            if not converged:
+                fb.clear(depth=1.0)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            submit.draw(opaque, aux)
+        if emission_apart and opaque:
+            submit.rebind(counted=False)
+            with film.emission_framebuffer().bind():
+                gpu.state.viewport_set(0, 0, width, height)
+                gpu.state.depth_test_set("LESS_EQUAL")
+                gpu.state.depth_mask_set(False)
+                submit.draw(opaque, False, emission_only=True)
+        if blended:
+            submit.rebind(counted=False)  # blended surfaces draw into the colour target alone
+            with film.blend_framebuffer(ratio).bind():
+                gpu.state.viewport_set(0, 0, width, height)
+                gpu.state.depth_test_set("LESS_EQUAL")
+                gpu.state.depth_mask_set(False)
+                gpu.state.blend_set("ALPHA_PREMULT")
+                submit.draw(blended, False, WORLD_RATIO_BLENDED)
+                gpu.state.blend_set("NONE")
+        _reset_state(stats)
+
+    def draw_settle_test(self, film, draws, camera, data, atlas, stats, origin, masks, target):
+        """The settle test's variant of the lit pass (``data`` built with ``settle``) into
+        ``target`` (``Film.settle_framebuffer``): the surfaces the pilot drew (its z-buffer,
+        kept) and any dithered or blended one in front of them write their flags, the dithered
+        and blended last, nothing blended."""
+        import gpu
+
+        opaque, blended, parts = self._entries(draws, camera, atlas, stats, hashed_last=True)
+        submit = _Submission(self, film, camera, data, atlas, origin, masks, None, parts, stats)
+        width, height = film.size
+        with target.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(False)
+            gpu.state.blend_set("NONE")
+            submit.draw(opaque, False)
+            if blended:
+                submit.rebind()
+                submit.draw(blended, False, WORLD_RATIO_BLENDED)
+        _reset_state(stats)
+
+    @staticmethod
+    def _entries(draws, camera, atlas, stats, hashed_last):
+        """The parts to draw: (opaque and alpha-hashed entries nearest first, blended entries
+        farthest first, ``_Parts``); an entry is (features, rank, draw, batch, material).
+        ``hashed_last``: alpha-hashed entries after the others (the settle test)."""
         # Closed instances wholly beyond the near plane: from there no back face shows.
         outside = set()
         closed = [d for d in draws if d.closed]
@@ -124,135 +157,9 @@ class LitPass:
                     features = features | {"HAIR"}
                 entry = (features, rank, d, batch, mat)
                 (blended if "ALPHA_BLEND" in features and not d.instance.holdout else opaque).append(entry)
-        opaque.sort(key=lambda e: (target is not None and "ALPHA_HASHED" in e[0], sorted(e[0]), e[1]))
+        opaque.sort(key=lambda e: (hashed_last and "ALPHA_HASHED" in e[0], sorted(e[0]), e[1]))
         blended.sort(key=lambda e: -e[1])
-        width, height = film.size
-        bound = {"shader": None, "counted": counted}
-        # Strand-shaped hair: half a pixel's width per unit of clip w (the camera's y scale).
-        hair_pixel = 1.0 / max(abs(float(camera.projection[1, 1])) * height, 1e-30)
-
-        # One diffuse bounce from the atlas's reflective targets (frame_data: some light has a map).
-        rsm = bool(data.defines.get("INDIRECT_RSM"))
-
-        # The sample's tile records: the instanced depth pass's block when it holds them.
-        tiles_block = atlas.tiles_block(data.tiles) if atlas is not None else None
-        if tiles_block is None:
-            tiles_block = self._ubo("tiles", data.tiles)
-
-        def bind(features, with_aux, tree, ratio_mode, emission_only=False):
-            if emission_only:
-                program = emission_program(frozenset(features), tree)
-            else:
-                program = lit_program(
-                    frozenset(features),
-                    with_aux,
-                    emission and with_aux and not emission_apart,
-                    bound["counted"] and not with_aux,
-                    tree,
-                    rsm,
-                    ratio_mode if ratio else 0,
-                )
-            defines = data.defines
-            if bool(defines.get("AUX_OUTPUTS")) != with_aux:
-                # Blended surfaces of a frame with passes draw into the colour target alone.
-                defines = {**defines, "AUX_OUTPUTS": with_aux}
-            shader = self.shaders.get(program, defines)
-            if bound["shader"] is shader:
-                return shader
-            if tree is not None and "ORIGIN" in tree.needs:
-                shader.bind()
-                shader.uniform_float("node_origin", tuple(float(x) for x in origin))
-            shader.bind()
-            shader.uniform_block("frame", self._ubo("frame", data.frame))
-            shader.uniform_block("lights", self._ubo("lights", data.lights))
-            shader.uniform_block("shadow_tiles", tiles_block)
-            shader.uniform_sampler(SHADOW_SAMPLER, shadow_tex)
-            shader.uniform_sampler("jitter_tex", self._jitter(data.disk_samples))
-            shader.uniform_sampler("light_bins", self._bins_texture(data.bins))
-            if defines.get("WORLD_AO"):
-                shader.uniform_sampler(AO_SAMPLER, ao_depth)
-            if rsm:
-                shader.uniform_sampler(RSM_FLUX_SAMPLER, atlas.flux)
-                shader.uniform_sampler(RSM_NORMAL_SAMPLER, atlas.normal)
-            bound["shader"] = shader
-            return shader
-
-        solid_found = {}
-
-        def solid_uniform(shader):
-            if shader not in solid_found:
-                try:
-                    solid_found[shader] = shader.uniform_from_name("solid") != -1
-                except ValueError:  # Blender raises where GL reports -1
-                    solid_found[shader] = False
-            return solid_found[shader]
-
-        def draw(entries, with_aux, ratio_mode=WORLD_RATIO_OPAQUE, emission_only=False):
-            last = None
-            for features, _rank, d, batch, mat in entries:
-                # Material › Backface Culling › Camera: faces turned away are not drawn (the
-                # winding flips under a mirroring model matrix).
-                cull = (mat.cull_camera or id(d) in outside) and d.instance.hair is None  # strips have no back
-                culling = (cull, cull and d.det < 0.0)
-                if bound.get("culling") != culling:
-                    gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
-                    gpu.state.front_facing_set(culling[1])
-                    bound["culling"] = culling
-                shader = bind(features, with_aux, mat.tree, ratio_mode, emission_only)
-                if last is not d or bound.get("model_shader") is not shader:
-                    shader.uniform_float("model", d.model)
-                    if solid_uniform(shader):  # compiled out where no light reads it
-                        shader.uniform_int("solid", int(id(d) in outside))
-                    if masks is not None:
-                        shader.uniform_int("light_mask", masks[id(d)])
-                    if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
-                        set_uniforms(shader, terminators[id(d)])
-                    if d.instance.hair is not None:
-                        shader.uniform_float("hair_pixel", hair_pixel if d.instance.hair == "STRAND" else 0.0)
-                    last, bound["model_shader"] = d, shader
-                if mat.tree is not None and mat.tree.needs & {"GENERATED", "OBJECT_INFO"}:
-                    set_uniforms(shader, d.tree_uniforms(mat.tree))
-                shader.uniform_block("material", self.materials.get(mat))
-                for channel, ref in mat.textures.items():
-                    shader.uniform_sampler(f"tex_{channel}", self.textures.get(ref.image))
-                if mat.tree is not None:
-                    shader.uniform_block("node_constants", self.materials.constants(mat))
-                    for i, ref in enumerate(mat.tree.images):
-                        shader.uniform_sampler(f"node_image_{i}", self.textures.get(ref.image))
-                if mat.textures or (mat.tree is not None and mat.tree.images):
-                    set_image_flags(shader, mat, self.textures)
-                batch.draw(shader)
-                stats.draws += 1
-
-        with fb.bind():
-            gpu.state.viewport_set(0, 0, width, height)
-            if not converged and target is None:
-                fb.clear(depth=1.0)
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(target is None)
-            draw(opaque, aux)
-        if emission_apart and opaque:
-            bound["shader"], bound["counted"] = None, False
-            with film.emission_framebuffer().bind():
-                gpu.state.viewport_set(0, 0, width, height)
-                gpu.state.depth_test_set("LESS_EQUAL")
-                gpu.state.depth_mask_set(False)
-                draw(opaque, False, emission_only=True)
-        if blended:
-            bound["shader"] = None
-            bound["counted"] = False  # blended surfaces draw into the colour target alone
-            with (film.blend_framebuffer(ratio) if target is None else target).bind():
-                gpu.state.viewport_set(0, 0, width, height)
-                gpu.state.depth_test_set("LESS_EQUAL")
-                gpu.state.depth_mask_set(False)
-                gpu.state.blend_set("ALPHA_PREMULT" if target is None else "NONE")
-                draw(blended, False, WORLD_RATIO_BLENDED)
-                gpu.state.blend_set("NONE")
-        gpu.state.face_culling_set("NONE")
-        gpu.state.front_facing_set(False)
-        gpu.state.depth_test_set("NONE")
-        gpu.state.depth_mask_set(False)
-        stats.passes += 1
+        return opaque, blended, _Parts(outside, terminators)
 
     def _background(self, film, world, camera, origin, depth_test="NONE"):
         """The world's Environment Texture behind the scene (``programs.BACKGROUND``)."""
@@ -339,3 +246,138 @@ def set_image_flags(shader, mat, textures):
     set_uniforms(
         shader, {"image_premultiplied": image_premultiplied_bits(textures.premultiplied, channels, tree_images)}
     )
+
+
+@dataclass
+class _Parts:
+    """What ``LitPass._entries`` found of the draws: closed instances whose back faces never
+    show (``outside``, by id) and each draw's Shadow Terminator uniforms."""
+
+    outside: set
+    terminators: dict
+
+
+def _reset_state(stats):
+    """The GPU state a lit pass leaves as it found it; one pass more in ``stats``."""
+    import gpu
+
+    gpu.state.face_culling_set("NONE")
+    gpu.state.front_facing_set(False)
+    gpu.state.depth_test_set("NONE")
+    gpu.state.depth_mask_set(False)
+    stats.passes += 1
+
+
+class _Submission:
+    """One lit pass's draw calls: each entry's program bound once while it stays the same, its
+    frame, light and tile blocks, its maps and textures, its per-object push constants.
+    ``emission``, ``counted`` and ``ratio``: what the film's targets take (the settle test's
+    take none of them); ``rebind()`` before drawing into other targets."""
+
+    def __init__(self, lit, film, camera, data, atlas, origin, masks, ao_depth, parts, stats):
+        self.lit, self.data, self.atlas, self.origin = lit, data, atlas, origin
+        self.masks, self.ao_depth, self.parts, self.stats = masks, ao_depth, parts, stats
+        self.shadow_tex = atlas.texture if atlas is not None else lit._shadow_dummy()
+        self.emission = self.counted = self.ratio = False
+        # One diffuse bounce from the atlas's reflective targets (frame_data: some light has a map).
+        self.rsm = bool(data.defines.get("INDIRECT_RSM"))
+        # The sample's tile records: the instanced depth pass's block when it holds them.
+        tiles = atlas.tiles_block(data.tiles) if atlas is not None else None
+        self.tiles = tiles if tiles is not None else lit._ubo("tiles", data.tiles)
+        # Strand-shaped hair: half a pixel's width per unit of clip w (the camera's y scale).
+        self.hair_pixel = 1.0 / max(abs(float(camera.projection[1, 1])) * film.size[1], 1e-30)
+        self.shader = self.model_shader = self.culling = None
+        self.solid = {}
+
+    def rebind(self, counted=None):
+        """Bind afresh at the next draw (other targets); ``counted``: whether they count."""
+        self.shader = None
+        if counted is not None:
+            self.counted = counted
+
+    def bind(self, features, with_aux, tree, ratio_mode, emission_only=False):
+        lit, data = self.lit, self.data
+        if emission_only:
+            program = emission_program(frozenset(features), tree)
+        else:
+            program = lit_program(
+                frozenset(features),
+                with_aux,
+                self.emission and with_aux,
+                self.counted and not with_aux,
+                tree,
+                self.rsm,
+                ratio_mode if self.ratio else 0,
+            )
+        defines = data.defines
+        if bool(defines.get("AUX_OUTPUTS")) != with_aux:
+            # Blended surfaces of a frame with passes draw into the colour target alone.
+            defines = {**defines, "AUX_OUTPUTS": with_aux}
+        shader = lit.shaders.get(program, defines)
+        if self.shader is shader:
+            return shader
+        if tree is not None and "ORIGIN" in tree.needs:
+            shader.bind()
+            shader.uniform_float("node_origin", tuple(float(x) for x in self.origin))
+        shader.bind()
+        shader.uniform_block("frame", lit._ubo("frame", data.frame))
+        shader.uniform_block("lights", lit._ubo("lights", data.lights))
+        shader.uniform_block("shadow_tiles", self.tiles)
+        shader.uniform_sampler(SHADOW_SAMPLER, self.shadow_tex)
+        shader.uniform_sampler("jitter_tex", lit._jitter(data.disk_samples))
+        shader.uniform_sampler("light_bins", lit._bins_texture(data.bins))
+        if defines.get("WORLD_AO"):
+            shader.uniform_sampler(AO_SAMPLER, self.ao_depth)
+        if self.rsm:
+            shader.uniform_sampler(RSM_FLUX_SAMPLER, self.atlas.flux)
+            shader.uniform_sampler(RSM_NORMAL_SAMPLER, self.atlas.normal)
+        self.shader = shader
+        return shader
+
+    def _has_solid(self, shader):
+        if shader not in self.solid:
+            try:
+                self.solid[shader] = shader.uniform_from_name("solid") != -1
+            except ValueError:  # Blender raises where GL reports -1
+                self.solid[shader] = False
+        return self.solid[shader]
+
+    def draw(self, entries, with_aux, ratio_mode=WORLD_RATIO_OPAQUE, emission_only=False):
+        import gpu
+
+        lit, outside, terminators = self.lit, self.parts.outside, self.parts.terminators
+        last = None
+        for features, _rank, d, batch, mat in entries:
+            # Material › Backface Culling › Camera: faces turned away are not drawn (the
+            # winding flips under a mirroring model matrix).
+            cull = (mat.cull_camera or id(d) in outside) and d.instance.hair is None  # strips have no back
+            culling = (cull, cull and d.det < 0.0)
+            if self.culling != culling:
+                gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
+                gpu.state.front_facing_set(culling[1])
+                self.culling = culling
+            shader = self.bind(features, with_aux, mat.tree, ratio_mode, emission_only)
+            if last is not d or self.model_shader is not shader:
+                shader.uniform_float("model", d.model)
+                if self._has_solid(shader):  # compiled out where no light reads it
+                    shader.uniform_int("solid", int(id(d) in outside))
+                if self.masks is not None:
+                    shader.uniform_int("light_mask", self.masks[id(d)])
+                if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
+                    set_uniforms(shader, terminators[id(d)])
+                if d.instance.hair is not None:
+                    shader.uniform_float("hair_pixel", self.hair_pixel if d.instance.hair == "STRAND" else 0.0)
+                last, self.model_shader = d, shader
+            if mat.tree is not None and mat.tree.needs & {"GENERATED", "OBJECT_INFO"}:
+                set_uniforms(shader, d.tree_uniforms(mat.tree))
+            shader.uniform_block("material", lit.materials.get(mat))
+            for channel, ref in mat.textures.items():
+                shader.uniform_sampler(f"tex_{channel}", lit.textures.get(ref.image))
+            if mat.tree is not None:
+                shader.uniform_block("node_constants", lit.materials.constants(mat))
+                for i, ref in enumerate(mat.tree.images):
+                    shader.uniform_sampler(f"node_image_{i}", lit.textures.get(ref.image))
+            if mat.textures or (mat.tree is not None and mat.tree.images):
+                set_image_flags(shader, mat, lit.textures)
+            batch.draw(shader)
+            self.stats.draws += 1

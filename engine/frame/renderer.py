@@ -470,8 +470,11 @@ class Renderer:
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
         world = (snapshot.world, snapshot.world_color)
         ao_depth = self.world_ao.texture if ao is not None else None
-        passes = (settings, aux, emission, stats, self._origin, masks, target)
-        self.lit_pass.draw(film, seen, view_camera, data, atlas, world, *passes, ao_depth=ao_depth)
+        if target is not None:
+            self.lit_pass.draw_settle_test(film, seen, view_camera, data, atlas, stats, self._origin, masks, target)
+        else:
+            passes = (settings, aux, emission, stats, self._origin, masks)
+            self.lit_pass.draw(film, seen, view_camera, data, atlas, world, *passes, ao_depth=ao_depth)
         return data
 
     def _debug_view(self, view, accumulate, settings, last, occluded=False):
