@@ -129,6 +129,7 @@ class Program:
     defines: tuple = ()  # (name, value) every variant gets: enum values, fixed sizes
     depth_write: str = ""  # 'ANY' etc. when the fragment stage writes gl_FragDepth
     generated: str = ""  # fragment-stage GLSL written by Python (a compiled node tree), after the libs
+    entry_libs: tuple = ()  # fragment-stage libraries after the generated code (what calls into it)
 
 
 def _read(rel):
@@ -136,10 +137,12 @@ def _read(rel):
 
 
 def program_sources(program):
-    """The (vertex, fragment) GLSL text, libraries first, in the order the program lists them."""
+    """The (vertex, fragment) GLSL text, libraries first, in the order the program lists them;
+    the fragment stage: libs, generated code, entry libs, the stage file."""
     vlibs = "".join(_read(p) + "\n" for p in program.vertex_libs)
     flibs = "".join(_read(p) + "\n" for p in program.libs)
-    return vlibs + _read(program.vertex), flibs + program.generated + "\n" + _read(program.fragment)
+    entry = "".join(_read(p) + "\n" for p in program.entry_libs)
+    return vlibs + _read(program.vertex), flibs + program.generated + "\n" + entry + _read(program.fragment)
 
 
 def _format_define(value):

@@ -21,8 +21,10 @@ from .programs import (
     WORLD_RATIO_OPAQUE,
     emission_program,
     image_premultiplied_bits,
+    lit_entry,
     lit_program,
     terminator_uniforms,
+    with_entry,
 )
 
 
@@ -279,6 +281,7 @@ class _Submission:
         self.masks, self.ao_depth, self.parts, self.stats = masks, ao_depth, parts, stats
         self.shadow_tex = atlas.texture if atlas is not None else lit._shadow_dummy()
         self.emission = self.counted = self.ratio = False
+        self.entry = lit_entry(data.defines)  # the colour, the settle test's flags or a debug view's
         # One diffuse bounce from the atlas's reflective targets (frame_data: some light has a map).
         self.rsm = bool(data.defines.get("INDIRECT_RSM"))
         # The sample's tile records: the instanced depth pass's block when it holds them.
@@ -309,6 +312,7 @@ class _Submission:
                 self.rsm,
                 ratio_mode if self.ratio else 0,
             )
+            program = with_entry(program, self.entry)
         defines = data.defines
         if bool(defines.get("AUX_OUTPUTS")) != with_aux:
             # Blended surfaces of a frame with passes draw into the colour target alone.

@@ -220,6 +220,7 @@ LIT = Program(
         "lib/common.glsl",
         "lib/lights.glsl",
         "lib/depth_encoding.glsl",
+        "lib/lit_debug.glsl",
         "lib/shadow_filters.glsl",
         "lib/material.glsl",
         "lib/ggx_albedo.glsl",
@@ -232,7 +233,10 @@ LIT = Program(
         "lib/lit_world.glsl",
         "lib/lit_settle.glsl",
         "lib/lit_lights.glsl",
+        "lib/lit_outputs.glsl",
     ),
+    # The material at the fragment and the surface from it: after a compiled tree's code.
+    entry_libs=("lib/lit_inputs.glsl",),
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
     push_constants=(("MAT4", "model"), ("IVEC4", "light_mask"), ("INT", "solid")),
@@ -414,6 +418,27 @@ def emission_program(features=frozenset(), tree=None):
     for its target (the world ratio's three take it; Blender's gpu module binds six)."""
     base = lit_program(features, aux=False, tree=tree)
     return replace(base, name=f"{base.name}_emission_only", defines=base.defines + (("EMISSION_ONLY", True),))
+
+
+# The lit pass's entry shaders over the same libraries (lit.frag.glsl's header): the surface's
+# colour, the settle test's flags, a debug view's values.
+LIT_ENTRIES = {"surface": "lit.frag.glsl", "settle": "lit_settle.frag.glsl", "debug": "lit_debug.frag.glsl"}
+
+
+def lit_entry(defines):
+    """Which entry shader (LIT_ENTRIES) the lit pass's ``defines`` (``lit_defines``) take."""
+    if defines.get("SETTLE_TEST"):
+        return "settle"
+    if defines.get("DEBUG_LIT") or defines.get("DEBUG_TERM"):
+        return "debug"
+    return "surface"
+
+
+def with_entry(program, entry):
+    """``program`` (a lit program) with entry shader ``entry`` (a key of LIT_ENTRIES)."""
+    if entry == "surface":
+        return program
+    return replace(program, name=f"{program.name}_{entry}", fragment=LIT_ENTRIES[entry])
 
 
 def lit_program(features=frozenset(), aux=True, emission=False, counted=False, tree=None, rsm=False, ratio=0):

@@ -5,15 +5,15 @@ filter's offsets), where each light with an extent shines from, and how each map
 is shifted. After the first sample (or Min Samples, when set), one pass asks of every pixel
 whether any of these could move it by the Noise Threshold, in Cycles' error units:
 
-* **Lights.** The settle test's variant of the lit pass (``SETTLE_TEST``,
-  ``lit.frag.glsl`` and ``lib/shadow_filters.glsl``) runs over the surfaces the sample drew,
-  with each light at its whole size: a moving light's visibility must be the same from every
-  point of it and on every map shift (the map's region the light's whole width around the
-  point shows no occluder at all, or occluders everywhere), no facet may turn across the
-  light, and the light the surface reflects may change only a little over the light's
-  extent (it moves the light by its radius each way: highlights and close lights do not
-  settle). Dithered and blended surfaces never settle (what is behind them shows in some
-  samples). A pixel needs its neighbourhood settled as far as the pixel filter reaches
+* **Lights.** The settle test's entry shader over the lit pass's libraries (``SETTLE_TEST``,
+  ``lit_settle.frag.glsl``, ``lib/lit_settle.glsl``, ``lib/shadow_filters.glsl``) runs over
+  the surfaces the sample drew, with each light at its whole size: a moving light's visibility
+  must be the same from every point of it and on every map shift (the map's region the light's
+  whole width around the point shows no occluder at all, or occluders everywhere), no facet
+  may turn across the light, and the light the surface reflects may change only a little over
+  the light's extent (it moves the light by its radius each way: highlights and close lights
+  do not settle). Dithered and blended surfaces never settle (what is behind them shows in
+  some samples). A pixel needs its neighbourhood settled as far as the pixel filter reaches
   (``flag_reach``: 2 pixels each way at the default 1.5).
 * **The pixel filter.** For an image smooth over the pixel, the samples taken so far average
   to the whole frame's filtered value up to gradient . (mean offset difference) + 1/2 Hessian :

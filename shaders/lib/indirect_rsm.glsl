@@ -189,4 +189,15 @@ vec3 indirect_rsm(vec3 P, vec3 N, float view_depth)
   return E;
 }
 
+/* One diffuse bounce on the surface ``s`` (lib/lit_surface.glsl), reflected by its diffuse
+ * lobe(s). */
+vec3 surface_bounce(Surface s)
+{
+  vec3 albedo = vec3(0.0);
+  for (int k = 0; k < NODE_LOBES; k++) {
+    albedo += s.lobe[k].weight * s.lobe[k].albedo;
+  }
+  return indirect_rsm(s.P, s.lobe[0].N, v_view_depth) / M_PI * albedo;
+}
+
 #endif

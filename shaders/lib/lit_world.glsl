@@ -27,11 +27,6 @@
 #  define WORLD_RATIO_OUT 0
 #endif
 
-#if DEBUG_TERM
-/* The WORLD_LIGHT (1) and INDIRECT (2) debug views: the one term of the colour they show. */
-vec3 debug_term = vec3(0.0);
-#endif
-
 #if WORLD_RATIO
 vec4 world_sums = vec4(0.0); /* (N_d, D_d, N_s, D_s) of this sample's directions */
 vec3 world_d = vec3(0.0), world_s = vec3(0.0); /* U by lobe, the lobes' summed by weight */
@@ -69,9 +64,8 @@ vec3 world_sh(vec3 d, vec2 g)
 
 #if WORLD_AO
 /* The world's cosine-weighted visibility at the normal of the lobe being lit
- * (surface_world_light), and the lobes' mean of it (the WORLD_AO debug view). */
+ * (surface_world_light). */
 float world_visibility = 1.0;
-float debug_world_ao = 0.0;
 #endif
 
 /* Light from the world on lobe ``b``: diffuse irradiance, and specular radiance around the
@@ -114,7 +108,9 @@ vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
     float w = s.lobe[k].weight;
 #if WORLD_AO
     world_visibility = gtao_visibility(ao_horizons, normalize(ao_rotation * s.lobe[k].N));
+#  if DEBUG_LIT
     debug_world_ao += w * world_visibility;
+#  endif
 #endif
     color += w * world_light(s.lobe[k], s.V, ab[k]);
 #if WORLD_RATIO

@@ -45,17 +45,6 @@ int cube_face(vec3 d)
 /* Texels per side of the map being read (ShadowTile.size), set by shadow_visibility. */
 int tile_texels = 1;
 
-#if DEBUG_LIT
-/* What the lit debug views show (programs.lit_defines ``debug``), set as the lights are
- * evaluated: lights evaluated, 1 + the cascade of the first cascaded sun looked up, and the
- * map texels per screen pixel of the worst-sampled light (0: no map looked up). The pixel's
- * footprint (world-space derivatives of P) comes from main, where derivatives are defined. */
-float debug_lights = 0.0;
-float debug_cascade = 0.0;
-float debug_density = 0.0;
-vec3 debug_dPdx = vec3(0.0), debug_dPdy = vec3(0.0);
-#endif
-
 /* 1 when ref is in front of the stored depth at integer texel st of the tile. Texels outside
  * the tile are lit: nothing was fitted to cast there. */
 float shadow_tap(ivec2 origin, ivec2 st, float ref)

@@ -161,8 +161,9 @@ _VARIABLES = {"frame": programs.FRAME_STRUCT, "L": programs.LIGHT_STRUCT, "T": p
 
 
 def test_scene_shaders_read_only_fields_their_structs_declare():
-    sources = [ROOT / "shaders" / p for p in ("lit.frag.glsl", "mesh.vert.glsl", "shadow_depth.vert.glsl",
-                                              "shadow_depth.frag.glsl")]  # fmt: skip
+    entries = ("lit.frag.glsl", "lit_settle.frag.glsl", "lit_debug.frag.glsl")
+    stages = entries + ("mesh.vert.glsl", "shadow_depth.vert.glsl", "shadow_depth.frag.glsl")
+    sources = [ROOT / "shaders" / p for p in stages]
     sources += sorted((ROOT / "shaders" / "lib").glob("*.glsl"))
     used = 0
     for path in sources:

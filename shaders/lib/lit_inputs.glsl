@@ -1,0 +1,107 @@
+/* The lit entry shaders' common start (lit.frag.glsl, lit_settle.frag.glsl, lit_debug.frag.glsl):
+ * the material at this fragment and the surface with its lobes. After the compiled node tree's
+ * code (programs.LIT ``entry_libs``), which material_inputs calls. */
+
+/* The material's parameters at this fragment: the MaterialData block, its image textures and
+ * colour attribute, or its compiled node tree (engine/scene/nodetree.py), which gives every
+ * parameter; with NODE_LOBES == 2 both lobes' and their weights (shaders/nodes/shader.glsl). */
+struct MaterialInputs {
+  vec4 base;
+  float rough, metal, coverage;
+  vec3 emission;
+  vec4 spec_f0;     /* the dielectric's F0 (lobe_setup) */
+  vec3 tree_normal; /* the tree's shading normal (NODE_NORMAL) */
+#if NODE_LOBES == 2
+  vec4 base_b;
+  float rough_b, metal_b;
+  vec4 spec_f0_b;
+  vec3 tree_normal_b;
+  vec2 weights;
+#endif
+};
+
+MaterialInputs material_inputs()
+{
+  MaterialInputs m;
+  m.base = material.base_color;
+  m.rough = material.roughness;
+  m.metal = material.metallic;
+  m.coverage = material.alpha;
+  m.emission = material.emission;
+  m.spec_f0 = material.specular;
+  m.tree_normal = vec3(0.0);
+#if NODE_LOBES == 2
+  m.base_b = m.base;
+  m.rough_b = m.rough;
+  m.metal_b = m.metal;
+  m.spec_f0_b = m.spec_f0;
+  m.tree_normal_b = vec3(0.0);
+  m.weights = vec2(1.0, 0.0);
+#endif
+#if NODE_TREE
+  vec3 V = (frame.is_ortho != 0) ? -frame.camera_forward : normalize(frame.camera_position - v_world);
+  vec3 Nt = v_normal;
+  float l = length(Nt);
+  Nt = (l > 1e-20) ? Nt / l : vec3(0.0, 0.0, 1.0);
+  bool front = dot(Nt, V) >= 0.0;
+#  if NODE_LOBES == 2
+  node_closure_resolve_lobes(node_tree_closure(front ? Nt : -Nt, V, front), m.base, m.rough, m.metal, m.spec_f0,
+                             m.coverage, m.emission, m.tree_normal, m.base_b, m.rough_b, m.metal_b, m.spec_f0_b,
+                             m.tree_normal_b, m.weights);
+#  else
+  node_tree(front ? Nt : -Nt, V, front, m.base, m.rough, m.metal, m.spec_f0, m.coverage, m.emission, m.tree_normal);
+#  endif
+#endif
+#if TEX_BASE_COLOR
+  m.base *= SAMPLE_COLOR(base_color, v_uv);
+#endif
+#if HAS_VCOL && !NODE_TREE
+  m.base *= v_color;
+#endif
+#if TEX_ROUGHNESS
+  m.rough *= SAMPLE_VALUE(roughness, v_uv);
+#endif
+#if TEX_METALLIC
+  m.metal *= SAMPLE_VALUE(metallic, v_uv);
+#endif
+#if TEX_ALPHA
+  m.coverage *= SAMPLE_VALUE(alpha, v_uv);
+#endif
+#if TEX_EMISSION
+  m.emission *= SAMPLE_COLOR(emission, v_uv).rgb;
+#endif
+  return m;
+}
+
+/* The surface at this fragment and its lobes from the material ``m``; ``ab``: each lobe's
+ * environment BRDF (what the world's specular is weighted by). */
+Surface surface_setup(MaterialInputs m, out vec2 ab[NODE_LOBES])
+{
+  Surface s;
+  vec3 N = surface_geometry(s);
+  terminator_setup(s);
+  N = shading_normal(N, m.tree_normal, s);
+#if NODE_LOBES == 2
+  s.lobe[0] = lobe_setup(m.base.rgb, m.rough, m.metal, m.spec_f0, N, s.V, m.weights.x, ab[0]);
+  /* The second lobe: its own normal where the tree gives one, else the first lobe's. */
+  s.lobe[1] = lobe_setup(m.base_b.rgb, m.rough_b, m.metal_b, m.spec_f0_b, shading_normal(N, m.tree_normal_b, s), s.V,
+                         m.weights.y, ab[1]);
+#else
+  s.lobe[0] = lobe_setup(m.base.rgb, m.rough, m.metal, m.spec_f0, N, s.V, 1.0, ab[0]);
+#endif
+  return s;
+}
+
+/* Whether the alpha mode drops this fragment: Hashed (EEVEE's Dithered) covers a pixel in a
+ * fraction alpha of the samples (stratified over the frame's samples by frame.alpha_offset);
+ * Blend drops only alpha 0 (the rest is blended by coverage, lit_outputs.glsl surface_color). */
+bool coverage_discards(float coverage)
+{
+#if ALPHA_MODE == 1
+  return coverage <= fract(pixel_hash(gl_FragCoord.xy) + frame.alpha_offset);
+#elif ALPHA_MODE == 2
+  return coverage <= 0.0;
+#else
+  return false;
+#endif
+}

@@ -1,0 +1,44 @@
+/* A lit debug view (engine/frame/debug_view.py): the lit pass's libraries evaluated as for the
+ * colour, writing instead what lib/lit_debug.glsl recorded, through the same film targets.
+ *   DEBUG_LIT            lights evaluated, sun cascade + 1, texel density of the worst-sampled
+ *                        light (LIGHT_COST, CASCADES, TEXEL_DENSITY)
+ *   DEBUG_LIT, WORLD_AO  the world's visibility (WORLD_AO)
+ *   DEBUG_TERM 1         the world's light with its visibility (WORLD_LIGHT)
+ *   DEBUG_TERM 2         the diffuse bounce (INDIRECT) */
+
+void main()
+{
+  MaterialInputs m = material_inputs();
+  if (coverage_discards(m.coverage)) {
+    discard;
+  }
+  vec2 ab[NODE_LOBES];
+  Surface s = surface_setup(m, ab);
+#if DEBUG_LIT
+  debug_dPdx = dFdx(s.P);
+  debug_dPdy = dFdy(s.P);
+#endif
+  vec3 color = surface_world_light(s, ab);
+#if DEBUG_TERM == 1
+  debug_term += color;
+#endif
+  float arriving = 0.0, unshadowed = 0.0;
+  lights_on(s, color, arriving, unshadowed); /* the world's directions add to debug_term */
+#if DEBUG_TERM == 2 && INDIRECT_RSM
+  debug_term += surface_bounce(s);
+#endif
+#if DEBUG_TERM == 1 && WORLD_RATIO && WORLD_RATIO_OUT != 1
+  debug_term = world_ratio_apply(vec4(debug_term, 1.0), world_d, world_s, world_sums).rgb;
+#endif
+
+#if DEBUG_LIT && WORLD_AO
+  vec4 shown = vec4(debug_world_ao, 0.0, 0.0, 1.0);
+#elif DEBUG_LIT
+  vec4 shown = vec4(debug_lights, debug_cascade, debug_density, 1.0);
+#elif HOLDOUT
+  vec4 shown = vec4(0.0);
+#else
+  vec4 shown = vec4(debug_term, 1.0);
+#endif
+  write_passes(shown, s, arriving, unshadowed, m.emission, HOLDOUT == 0 && DEBUG_LIT == 0 && DEBUG_TERM == 1);
+}

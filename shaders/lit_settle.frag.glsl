@@ -1,0 +1,21 @@
+/* The settle test (engine/frame/settle.py, lib/lit_settle.glsl): the lit pass's libraries over
+ * the surfaces a frame's pilot sample drew, lights at their centres, writing per pixel whether
+ * a later sample could change it through a light, and how far its light is from the light's
+ * average over each extent (settle_flags). No colour, no passes. */
+
+void main()
+{
+  MaterialInputs m = material_inputs();
+#if ALPHA_MODE != 0
+  if (m.coverage <= 0.0) {
+    discard; /* never drawn; where it covers some samples, it marks the pixel unsettled */
+  }
+#endif
+  vec2 ab[NODE_LOBES];
+  Surface s = surface_setup(m, ab);
+  vec3 world_term = surface_world_light(s, ab); /* the world's light, unshadowed */
+  vec3 color = world_term;
+  float arriving = 0.0, unshadowed = 0.0;
+  lights_on(s, color, arriving, unshadowed); /* add_light records each light's flags */
+  out_color = settle_flags(world_term, m.coverage);
+}
