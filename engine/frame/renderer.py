@@ -58,6 +58,76 @@ class SampleResult:
     data: object = None
 
 
+@dataclasses.dataclass
+class FramePlan:
+    """What ``Renderer.render``'s plan stage decided for one frame (``_plan``, ``_plan_samples``):
+    the later stages read this and their own arguments, nothing an earlier call left behind.
+
+    ``snapshot``: the scene (its world with the SH light of an Environment Texture);
+    ``draws``: the draw list, positions relative to ``origin``; ``lights``: those it lights
+    with; ``directions``: directions of the world's light per sample with maps, gathered in
+    the light portals' ``cones`` when there are any; ``moving``: indices of the lights that
+    move between samples (``jitter``: every light with a map does); ``rects``: each light's
+    screen rectangle for the whole frame (``draw_list.frame_light_rects``); ``adaptive``,
+    ``noise``, ``settle`` and ``deadline``: what may end the frame early."""
+
+    snapshot: object
+    camera: object
+    settings: object
+    size: tuple
+    origin: np.ndarray
+    draws: list
+    lights: list
+    aux: bool
+    emission: bool
+    sample_count: int
+    debug: object  # the DEBUG_VIEW entry
+    directions: int = 0
+    cones: list = dataclasses.field(default_factory=list)
+    first_directions: int = 0  # the first sample that takes directions (after one with AO)
+    adaptive: object = None
+    noise: bool = False
+    settle: bool = False
+    deadline: float | None = None
+    jitter: bool = False
+    moving: set = dataclasses.field(default_factory=set)
+    rects: object = None
+    _ao_distance: float | None = None
+
+    @property
+    def accumulate(self):
+        return self.sample_count > 1
+
+    @property
+    def world_sampled(self):
+        """The frame samples the world's light with maps."""
+        return self.directions > 0
+
+    @property
+    def world_sh(self):
+        """Its surfaces take the world's SH light (not with light portals)."""
+        return not self.cones
+
+    @property
+    def world_ratio(self):
+        """Without portals the directions shadow the SH light as a ratio of their sums over
+        the frame's samples (never negative; lit_world.glsl WORLD_RATIO); with portals they
+        carry the whole light, f cos V L / p, never negative either."""
+        return self.directions > 0 and not self.cones
+
+    def world_ao(self, s):
+        """Sample ``s``'s ambient occlusion of the world (``sampling.world_ao_sample``):
+        (distance, jitter), or None: not this sample, or none where light portals send the
+        world's directions into every sample."""
+        snapshot = self.snapshot
+        world = snapshot.world if snapshot.world is not None else snapshot.world_color
+        if self.cones or not sampling.world_ao_sample(s, self.accumulate, self.settings, world, self.debug.id):
+            return None
+        if self._ao_distance is None:
+            self._ao_distance = sampling.world_ao_distance(self.settings, corners_of(self.draws)) if self.draws else 0.0
+        return (self._ao_distance, sampling.ao_jitter(s)) if self._ao_distance > 0.0 else None
+
+
 # While the view moves, a frame's maps keep the sizes of the last navigation frame that
 # planned them afresh, this many frames ago at most (``Renderer.render``'s ``navigating``).
 NAVIGATION_REPLAN = 8
@@ -89,14 +159,12 @@ class Renderer:
         # What the last frame's last sample drew (``SampleResult``), for inspection: nothing
         # in a frame reads what an earlier call left here.
         self.last_sample = None
-        self._origin = np.zeros(3)  # the frame origin (``render``): positions reach the GPU relative to it
         self._clock = StageClock()  # the current frame's (``render``)
-        self._frame_plan = None  # (key, moving lights, map sizes) of the frame's first call
-        self._frame_rects = None  # draw_list.frame_light_rects of the frame being rendered
-        self._navigation = None  # (key, map sizes, frames) of the frames drawn while the view moves
-        self._world_sampled = False  # the current frame samples the world's light with maps
-        self._world_sh = True  # its surfaces take the world's SH light (not with light portals)
-        self._world_ratio = False  # and its directions shadow that light as a ratio (film.py)
+        # Kept between calls, keyed by what decides them: (key, moving lights, map sizes) of a
+        # frame's first call, for its later calls (the viewport's refinement); (key, map sizes,
+        # frames) of the frames drawn while the view moves.
+        self._frame_plan = None
+        self._navigation = None
 
     @property
     def shadows(self):
@@ -135,90 +203,135 @@ class Renderer:
         when there is no time limit: a frame stays a function of the scene and its settings.
         ``navigating``: a one-sample frame while the view moves; its lights' maps keep the
         sizes a navigation frame planned at most NAVIGATION_REPLAN frames before (one fit per
-        map, not two), and the frame after the view stops plans afresh."""
+        map, not two), and the frame after the view stops plans afresh.
+
+        The frame's stages, in order: plan (``_plan``: what the frame draws, its lights and
+        the world's, which lights move and their maps' sizes), then per sample the settle test
+        once (``_settle``), the sample (``_sample_at``: shadow maps, lit pass, accumulate),
+        then resolve (``_resolve``) and post (``_post``). Each takes the ``FramePlan`` and
+        what it needs besides; none reads what an earlier call left on the renderer."""
         stats = FrameStats()
         clock = StageClock(self.wait_gpu if self.fence_stages else None)
-        uploaded_before = self._uploaded()
-        compiled_before = self.shaders.compiled
-        seconds_before = self.shaders.compile_seconds
-        self._clock = clock
-        self.film.clock = clock
-        clock.begin("prepare")
+        counters = (self._uploaded(), self.shaders.compiled, self.shaders.compile_seconds)
+        self._clock = self.film.clock = clock
+        with clock.stage("prepare"):
+            frame = self._plan(snapshot, camera, settings, (width, height), aux, emission, samples, sample_count, stats)
+            self._plan_samples(frame, samples[0], adaptive, deadline, navigating, stats)
+        drawn = None
+        pixels = width * height
+        for s in range(*samples):
+            if frame.settle and s == 1:
+                self._settle(frame, stats)
+            if frame.accumulate and self.film.converged >= pixels:
+                stats.stopped = "converged"  # every pixel settled, or a later call of a converged frame
+                break
+            drawn = self._sample_at(frame, s, stats)
+            if frame.deadline is not None and frame.accumulate and not stats.stopped:
+                self.film.finish()  # the sample's GPU work done, so the clock counts it
+                if sampling.clock() >= frame.deadline:
+                    stats.stopped = "time limit"
+            if on_sample is not None and on_sample(s + 1) is False:
+                stats.cancelled = True
+                break
+            if stats.stopped:
+                break
+        self.last_sample = drawn
+        with clock.stage("resolve"):
+            self._resolve(frame, drawn, stats)
+        with clock.stage("post"):
+            color, debug_image = self._post(frame, drawn, stats)
+        stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
+        stats.cpu_seconds, stats.gpu_seconds = clock.cpu, clock.gpu
+        stats.upload_bytes = self._uploaded() - counters[0]
+        stats.shaders_compiled = self.shaders.compiled - counters[1]
+        stats.compile_seconds = self.shaders.compile_seconds - counters[2]
+        return self._output(frame, color, debug_image, stats)
+
+    def _plan(self, snapshot, camera, settings, size, aux, emission, samples, sample_count, stats):
+        """The plan stage: what the frame draws (the draw list, relative to the frame origin),
+        the world's light (its SH light, directions per sample, light portals), the lights it
+        lights with and the film it draws into. Returns the ``FramePlan`` the later stages read."""
+        width, height = size
+        accumulate = sample_count > 1
         # A multi-sample frame's pixel offsets reach Filter Size pixels beyond the image: its
         # maps are planned for what those samples see too.
-        self.shadow_pass.begin_frame(max(float(settings.filter_size), 0.0) if sample_count > 1 else 0.0)
+        self.shadow_pass.begin_frame(max(float(settings.filter_size), 0.0) if accumulate else 0.0)
         emission = bool(emission and aux)
-        film = self.film
-        film.ensure(width, height, aux, emission)
+        self.film.ensure(width, height, aux, emission)
         # The frame origin: the GPU gets every position relative to the camera (model matrices,
         # lights, the camera's and each map's view), computed here in float64, so a scene far
         # from the world origin keeps float32's precision where it is seen. Maps do not depend
         # on it (each is drawn and read through the same shift) and stay reusable when it moves.
-        origin = camera.position
-        self._origin = origin if np.all(np.isfinite(origin)) else np.zeros(3)
-        draws = draw_list(snapshot, self.batches, stats, self._origin, camera, settings, (width, height))
+        origin = camera.position if np.all(np.isfinite(camera.position)) else np.zeros(3)
+        draws = draw_list(snapshot, self.batches, stats, origin, camera, settings, size)
         stats.messages.extend(getattr(snapshot, "messages", ()))
         self.textures.forget(getattr(snapshot, "images_changed", ()))
         world = with_sh_light(snapshot.world, self.textures, self.shaders)
         if world is not snapshot.world:  # an Environment Texture's light, projected on the GPU
             snapshot = dataclasses.replace(snapshot, world=world, world_color=world.mean)
-        start, stop = samples
-        accumulate = sample_count > 1
-        # The world's light with visibility (world/directions.py): a multi-sample frame adds
-        # ``world_samples`` directions of it per sample, each a sun with its own map.
-        sampled_world = needs_directions(snapshot.world, settings)
-        # Light portals: the directions gather where the world's light enters what the camera
-        # sees, and carry all of its light (no SH light on the surfaces of those samples). A
-        # one-sample frame then takes its directions too: the SH light of a room's sky, even
-        # occluded on screen, is nothing like the light through its windows.
-        cones = []
-        if sampled_world and getattr(snapshot, "portals", ()):
-            seen = [d for d in draws if d.instance.camera]
-            if seen:
-                box = corners_of(seen).reshape(-1, 3)
-                cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
-        directions = int(settings.world_samples) if sampled_world and (accumulate or cones) else 0
-        if directions and not cones:
-            # The world's light costs what it adds: directions in proportion to its share of
-            # the light reaching what the camera sees (world.directions.light_share).
-            seen = [d for d in draws if d.instance.camera]
-            if seen:
-                box = corners_of(seen).reshape(-1, 3)
-                share = light_share(snapshot.world, snapshot.lights, 0.5 * (box.min(axis=0) + box.max(axis=0)))
-                directions = directions_per_sample(share, directions)
-        debug = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
-        self._world_sampled = directions > 0
-        self._world_sh = not cones
-        # Without portals the directions shadow the SH light as a ratio of their sums over the
-        # frame's samples (never negative; lit.frag.glsl WORLD_RATIO); with portals they carry
-        # the whole light, f cos V L / p, never negative either.
-        self._world_ratio = directions > 0 and not cones
+        directions, cones = self._world_directions(snapshot, draws, settings, accumulate)
         room = MAX_LIGHTS - directions
         lights = select_lights(snapshot.lights, camera.position, room)
         if len(lights) < len(snapshot.lights):
             stats.messages.append(
                 f"Penumbra: {len(snapshot.lights)} lights; only the {room} that contribute most to the view are lit"
             )
-        # The world's ambient occlusion (``sampling.world_ao_sample``): which samples, how far;
-        # none where light portals send the world's directions into every sample.
-        ao_world = snapshot.world if snapshot.world is not None else snapshot.world_color
-        ao_distance = None
+        return FramePlan(
+            snapshot=snapshot,
+            camera=camera,
+            settings=settings,
+            size=size,
+            origin=origin,
+            draws=draws,
+            lights=lights,
+            aux=aux,
+            emission=emission,
+            sample_count=sample_count,
+            debug=DEBUG_VIEW[getattr(settings, "debug_view", "NONE")],
+            directions=directions,
+            cones=cones,
+        )
 
-        def world_ao(s):
-            nonlocal ao_distance
-            if cones or not sampling.world_ao_sample(s, accumulate, settings, ao_world, debug.id):
-                return None
-            if ao_distance is None:
-                ao_distance = sampling.world_ao_distance(settings, corners_of(draws)) if draws else 0.0
-            return (ao_distance, sampling.ao_jitter(s)) if ao_distance > 0.0 else None
+    @staticmethod
+    def _world_directions(snapshot, draws, settings, accumulate):
+        """How many directions of the world's light each sample of the frame draws with maps
+        (``world/directions.py``), and the cones of its light portals that gather them."""
+        # The world's light with visibility: a multi-sample frame adds ``world_samples``
+        # directions of it per sample, each a sun with its own map.
+        sampled_world = needs_directions(snapshot.world, settings)
+        # Light portals: the directions gather where the world's light enters what the camera
+        # sees, and carry all of its light (no SH light on the surfaces of those samples). A
+        # one-sample frame then takes its directions too: the SH light of a room's sky, even
+        # occluded on screen, is nothing like the light through its windows.
+        seen = [d for d in draws if d.instance.camera]
+        box = corners_of(seen).reshape(-1, 3) if seen else None
+        cones = []
+        if sampled_world and getattr(snapshot, "portals", ()) and seen:
+            cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
+        directions = int(settings.world_samples) if sampled_world and (accumulate or cones) else 0
+        if directions and not cones and seen:
+            # The world's light costs what it adds: directions in proportion to its share of
+            # the light reaching what the camera sees (world.directions.light_share).
+            share = light_share(snapshot.world, snapshot.lights, 0.5 * (box.min(axis=0) + box.max(axis=0)))
+            directions = directions_per_sample(share, directions)
+        return directions, cones
 
+    def _plan_samples(self, frame, start, adaptive, deadline, navigating, stats):
+        """The rest of the plan stage: what may end the frame early, where its directions
+        start, which lights move between its samples and the sizes of their maps (the frame's
+        first plan; a later call of the same frame keeps the first call's), and the screen
+        rectangles each light can reach."""
+        film, settings, lights = self.film, frame.settings, frame.lights
+        width, height = frame.size
+        accumulate = frame.accumulate
         # A sample with ambient occlusion (a frame's first) takes no directions of the world:
         # the directions' sequence starts at the next one.
-        first_directions = 1 if directions and accumulate and world_ao(0) is not None else 0
+        if frame.directions and accumulate and frame.world_ao(0) is not None:
+            frame.first_directions = 1
         # A lit debug view's values are not colour: no noise estimate of theirs ends a frame.
-        adaptive = adaptive if accumulate and not debug.lit else None
-        noise = adaptive is not None and adaptive.threshold > 0.0
-        settle = adaptive is not None and adaptive.settle > 0.0
+        frame.adaptive = adaptive if accumulate and not frame.debug.lit else None
+        frame.noise = frame.adaptive is not None and frame.adaptive.threshold > 0.0
+        frame.settle = frame.adaptive is not None and frame.adaptive.settle > 0.0
         if not accumulate:
             film.converged = 0  # a single sample shades every pixel, whatever an earlier frame left
             # While the view moves, maps keep the sizes planned NAVIGATION_REPLAN frames ago.
@@ -229,178 +342,184 @@ class Renderer:
                 self._navigation = (nav_key, last[1], last[2] + 1)
             else:
                 self._navigation = (nav_key, None, 1) if navigating else None
-        if accumulate:
+        else:
             # The NOISE view shows the estimate even where no threshold uses it.
             film.begin(
-                aux,
-                emission,
+                frame.aux,
+                frame.emission,
                 fresh=start == 0,
-                adaptive=noise or debug.id == "NOISE",
-                settle=settle,
-                world_ratio=self._world_ratio,
+                adaptive=frame.noise or frame.debug.id == "NOISE",
+                settle=frame.settle,
+                world_ratio=frame.world_ratio,
             )
-        plan = drawn = None
-        moving = set()
-        # With map jitter every shadowed light changes from sample to sample (its maps' texel
-        # grid), so lights with an extent are sampled on it however small their penumbra.
-        jitter = accumulate and bool(settings.shadow_map_jitter)
-        if accumulate:
+            # With map jitter every shadowed light changes from sample to sample (its maps'
+            # texel grid), so lights with an extent are sampled on it however small their
+            # penumbra.
+            frame.jitter = bool(settings.shadow_map_jitter)
             # The frame's centred plan decides which lights move and the sizes of their maps;
             # a later call of the same frame (the viewport's next refinement: nothing changed,
-            # or the frame would start afresh) keeps what the first call decided.
-            frame_key = (sample_count, jitter, tuple(lt.use_shadow for lt in lights))
+            # or the frame would start afresh) keeps what the first call decided (a cache keyed
+            # by what decides it).
+            frame_key = (frame.sample_count, frame.jitter, tuple(lt.use_shadow for lt in lights))
             if start > 0 and self._frame_plan is not None and self._frame_plan[0] == frame_key:
-                moving, sizes = self._frame_plan[1:]
+                frame.moving, sizes = self._frame_plan[1:]
                 self.shadow_pass.use_sizes(sizes)
             else:
-                first = self.shadow_pass.first_plan(draws, lights, camera, settings, film.size, accumulate)
+                first = self.shadow_pass.first_plan(frame.draws, lights, frame.camera, settings, film.size, True)
                 self.shadow_pass.keep_sizes(first, settings, lights)
-                moving = sampling.sampled_lights(lights, first, every=jitter)
-                if jitter:
-                    moving |= {i for i in first.lights if i < len(lights)}
-                self._frame_plan = (frame_key, moving, self.shadow_pass.sizes)
-        stats.lights_sampled = len(moving)
+                frame.moving = sampling.sampled_lights(lights, first, every=frame.jitter)
+                if frame.jitter:
+                    frame.moving |= {i for i in first.lights if i < len(lights)}
+                self._frame_plan = (frame_key, frame.moving, self.shadow_pass.sizes)
+        stats.lights_sampled = len(frame.moving)
         # Which part of the screen each light can reach: once a frame, padded by how far its
         # samples move it and by the camera's pixel offsets (light bins, lights out of view).
         reach = max(float(settings.filter_size), 0.0) if accumulate else 0.0
-        self._frame_rects = frame_light_rects(lights, draws, camera, width, height, reach)
-        if adaptive is not None and adaptive.time_limit > 0.0 and deadline is None:
-            deadline = sampling.clock() + adaptive.time_limit
-        pixels = width * height
-        clock.end()
-        for s in range(start, stop):
-            sample_start = clock.cpu_seconds
-            if settle and s == 1:
-                # Before the second sample, the pilot (settle.py): the centred pixel with every
-                # light at its centre, whose maps the settle test reads; settled pixels take
-                # its value in place of the first sample's and take no more samples.
-                centred = [
-                    dataclasses.replace(lt, sampled=True, jittered=jitter) if i in moving else lt
-                    for i, lt in enumerate(lights)
-                ]
-                pilot = SampleSpec(pilot=True, ao=world_ao(0))
-                centre = self._sample(draws, centred, camera, camera, snapshot, settings, aux, emission, stats, pilot)
-                with clock.stage("settle"):
-                    # The settle test's variant of the lit pass over the pilot's surfaces,
-                    # cameras, maps and lights, then the film's settle pass (settle.py).
-                    test = SampleSpec(sample_count=sample_count)
-                    target = film.settle_framebuffer()
-                    self._lit(draws, centre, snapshot, settings, False, False, FrameStats(), test, target)
-                    stats.pixels_settled = settle_pixels(film, settings, adaptive, sample_count, aux, emission)
-            if accumulate and film.converged >= pixels:
-                stats.stopped = "converged"  # every pixel settled, or a later call of a converged frame
-                break
-            clock.begin("sample set-up")
+        frame.rects = frame_light_rects(lights, frame.draws, frame.camera, width, height, reach)
+        if frame.adaptive is not None and frame.adaptive.time_limit > 0.0 and deadline is None:
+            deadline = sampling.clock() + frame.adaptive.time_limit
+        frame.deadline = deadline
+
+    def _settle(self, frame, stats):
+        """The settle stage, before a frame's second sample (settle.py): the pilot (the centred
+        pixel with every light at its centre, whose maps the settle test reads), the settle
+        test's variant of the lit pass over its surfaces, then the film's settle pass. Settled
+        pixels take the pilot's value in place of the first sample's and take no more samples."""
+        centred = [
+            dataclasses.replace(lt, sampled=True, jittered=frame.jitter) if i in frame.moving else lt
+            for i, lt in enumerate(frame.lights)
+        ]
+        pilot = SampleSpec(pilot=True, ao=frame.world_ao(0))
+        centre = self._sample(frame, centred, frame.camera, stats, pilot)
+        with self._clock.stage("settle"):
+            test = SampleSpec(sample_count=frame.sample_count)
+            target = self.film.settle_framebuffer()
+            self._lit(frame, centre, FrameStats(), test, target)
+            stats.pixels_settled = settle_pixels(
+                self.film, frame.settings, frame.adaptive, frame.sample_count, frame.aux, frame.emission
+            )
+
+    def _sample_at(self, frame, s, stats):
+        """Sample ``s`` of the frame: its pixel offset, its lights (moving ones at their point
+        for ``s``, the world's directions), the sample itself (``_sample``), then its weight
+        added to the film and, every few samples, the noise check (``stats.stopped``)."""
+        film, settings, camera = self.film, frame.settings, frame.camera
+        width, height = frame.size
+        accumulate, count = frame.accumulate, frame.sample_count
+        sample_start = self._clock.cpu_seconds
+        with self._clock.stage("sample set-up"):
             dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
             view_camera = camera
             if dx or dy:
                 jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
                 view_camera = dataclasses.replace(camera, projection=jittered)
-            sample_lights = [
-                sampling.light_at_sample(lt, i, s, sample_count, jitter, progressive=noise) if i in moving else lt
-                for i, lt in enumerate(lights)
+            lights = [
+                sampling.light_at_sample(lt, i, s, count, frame.jitter, progressive=frame.noise)
+                if i in frame.moving
+                else lt
+                for i, lt in enumerate(frame.lights)
             ]
-            if directions and s >= first_directions:
-                index = (s - first_directions) * directions
-                sample_lights += world_lights(snapshot.world, index, directions, cones=cones)
-                stats.world_directions += directions
-            clock.end()
-            spec = SampleSpec(
-                alpha_offset=(s + 0.5) / sample_count if accumulate else 0.5,
-                sample_count=sample_count if accumulate else 1,
-                ao=world_ao(s),
-                index=s,
-            )
-            passes = (snapshot, settings, aux, emission, stats)
-            drawn = self._sample(draws, sample_lights, camera, view_camera, *passes, spec)
-            plan = drawn.plan
-            clock.begin("accumulate")
+            if frame.directions and s >= frame.first_directions:
+                index = (s - frame.first_directions) * frame.directions
+                lights += world_lights(frame.snapshot.world, index, frame.directions, cones=frame.cones)
+                stats.world_directions += frame.directions
+        spec = SampleSpec(
+            alpha_offset=(s + 0.5) / count if accumulate else 0.5,
+            sample_count=count if accumulate else 1,
+            ao=frame.world_ao(s),
+            index=s,
+        )
+        drawn = self._sample(frame, lights, view_camera, stats, spec)
+        with self._clock.stage("accumulate"):
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
-                film.accumulate(weight, aux, emission, s)
-            if aux and accumulate and s == 0:  # the centred sample's depth and normal
+                film.accumulate(weight, frame.aux, frame.emission, s)
+            if frame.aux and accumulate and s == 0:  # the centred sample's depth and normal
                 film.keep_centre()
             stats.samples += 1
             # (No check after a frame's last sample: it ends there anyway.)
-            last = s + 1 == sample_count
-            if noise and not last and adaptive.checks_at(s + 1) and film.check(adaptive.threshold) >= pixels:
-                stats.stopped = "converged"
-            clock.end()
-            stats.sample_cpu_seconds.append(clock.cpu_seconds - sample_start)
-            if deadline is not None and accumulate and not stats.stopped:
-                film.finish()  # the sample's GPU work done, so the clock counts it
-                if sampling.clock() >= deadline:
-                    stats.stopped = "time limit"
-            if on_sample is not None and on_sample(s + 1) is False:
-                stats.cancelled = True
-                break
-            if stats.stopped:
-                break
-        self.last_sample = drawn
-        clock.begin("resolve")
-        stats.pixels_converged = film.converged if accumulate else 0
-        if accumulate and stats.samples:
-            film.resolve(aux, emission)
-        self.batches.keep({(key, geo.serial) for key, geo in snapshot.geometry.items()})
+            adaptive = frame.adaptive
+            last = s + 1 == count
+            if frame.noise and not last and adaptive.checks_at(s + 1):
+                if film.check(adaptive.threshold) >= width * height:
+                    stats.stopped = "converged"
+        stats.sample_cpu_seconds.append(self._clock.cpu_seconds - sample_start)
+        return drawn
+
+    def _resolve(self, frame, drawn, stats):
+        """The resolve stage: the film's accumulation divided by its weights; the batches the
+        frame did not use let go; a navigation frame that planned afresh keeps its map sizes."""
+        film = self.film
+        stats.pixels_converged = film.converged if frame.accumulate else 0
+        if frame.accumulate and stats.samples:
+            film.resolve(frame.aux, frame.emission)
+        self.batches.keep({(key, geo.serial) for key, geo in frame.snapshot.geometry.items()})
         nav = self._navigation
+        plan = drawn.plan if drawn is not None else None
         if nav is not None and nav[1] is None and plan is not None:  # a navigation frame that planned afresh
-            self._navigation = (nav[0], frame_sizes(plan, max(1, int(settings.shadow_map_size))), nav[2])
-        clock.end()
-        clock.begin("post")
+            sizes = frame_sizes(plan, max(1, int(frame.settings.shadow_map_size)))
+            self._navigation = (nav[0], sizes, nav[2])
+
+    def _post(self, frame, drawn, stats):
+        """The post stage: the post stack on the resolved image, or a debug view instead of
+        both; the frame's memory in ``stats``. Returns (colour texture, debug image or None)."""
+        film, settings = self.film, frame.settings
         debug_image = None
-        if debug.id != "NONE":  # the view instead of the image (and instead of the post stack)
-            debug_image = self._debug_view(debug.id, accumulate, settings, drawn, stats.ao_prepasses > 0)
+        if frame.debug.id != "NONE":  # the view instead of the image (and instead of the post stack)
+            occluded = stats.ao_prepasses > 0
+            debug_image = self._debug_view(frame.debug.id, frame.accumulate, settings, drawn, occluded)
             color = debug_view.upload(debug_image, settings.pixel_scale)
             stats.debug_legend = debug_image.legend
         else:
             color = self._post_pass(settings, stats)
+        plan = drawn.plan if drawn is not None else None
         stats.shadow_bytes = self.shadows.memory_bytes if plan is not None and plan.tiles else 0
         stats.texture_bytes = (
-            film.target_bytes(aux, accumulate)
+            film.target_bytes(frame.aux, frame.accumulate)
             + stats.shadow_bytes
             + film.post_ctx.memory_bytes
             + self.textures.bytes
             + (self.world_ao.memory_bytes if stats.ao_prepasses else 0)
         )
-        clock.end()
-        stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
-        stats.cpu_seconds, stats.gpu_seconds = clock.cpu, clock.gpu
-        stats.upload_bytes = self._uploaded() - uploaded_before
-        stats.shaders_compiled = self.shaders.compiled - compiled_before
-        stats.compile_seconds = self.shaders.compile_seconds - seconds_before
-        if not aux:
+        return color, debug_image
+
+    def _output(self, frame, color, debug_image, stats):
+        """The frame's ``FrameOutput``: its image and, with ``aux``, its passes."""
+        film = self.film
+        width, height = frame.size
+        if not frame.aux:
             out = FrameOutput(color, None, None, stats, width, height, lit=film.color)
             out.debug = debug_image
             return out
         out = FrameOutput(color, film.depth, film.shadow, stats, width, height, lit=film.color, normal=film.normal)
         out.debug = debug_image
-        out.emission = film.emission if emission else None
-        if accumulate and film.centre is not None:
+        out.emission = film.emission if frame.emission else None
+        if frame.accumulate and film.centre is not None:
             out.depth_data, out.normal_data = film.centre
         return out
 
-    def _sample(self, draws, lights, camera, view_camera, snapshot, settings, aux, emission, stats, spec):
-        """One sample (``spec``, a ``SampleSpec``): shadow maps (planned from the unjittered
-        ``camera``, so a light that does not move between samples keeps its map), then the lit
-        pass seen through ``view_camera``. With ``spec.ao`` the camera depth prepass of the
-        world's ambient occlusion is drawn first through the lit pass's raster camera
-        (``world/occlusion.py``). Returns what it drew (``SampleResult``)."""
-        film = self.film
+    def _sample(self, frame, lights, view_camera, stats, spec):
+        """One sample (``spec``, a ``SampleSpec``) of ``frame`` with ``lights``: shadow maps
+        (planned from the unjittered camera, so a light that does not move between samples
+        keeps its map), then the lit pass seen through ``view_camera``. With ``spec.ao`` the
+        camera depth prepass of the world's ambient occlusion is drawn first through the lit
+        pass's raster camera (``world/occlusion.py``). Returns what it drew (``SampleResult``)."""
+        film, draws, camera = self.film, frame.draws, frame.camera
         width, height = film.size
-        lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats, self._frame_rects)
+        lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats, frame.rects)
         self._clock.begin("shadow pass")
         plan = self.shadow_pass.draw(
             draws,
             lights,
             camera,
-            settings,
+            frame.settings,
             film.size,
             stats,
             self.shaders,
             self.materials,
             self.textures,
             self.batches,
-            self._origin,
+            frame.origin,
             spec.alpha_offset,
         )
         self._clock.end()
@@ -419,7 +538,7 @@ class Renderer:
                     draws,
                     raster_camera,
                     film.size,
-                    self._origin,
+                    frame.origin,
                     self.shaders,
                     self.materials,
                     self.textures,
@@ -427,18 +546,19 @@ class Renderer:
                     spec.alpha_offset,
                 )
         with self._clock.stage("lit pass"):
-            result.data = self._lit(draws, result, snapshot, settings, aux, emission, stats, spec)
+            result.data = self._lit(frame, result, stats, spec)
         stats.binned = result.data.bins is not None
         return result
 
-    def _lit(self, draws, sample, snapshot, settings, aux, emission, stats, spec, target=None):
+    def _lit(self, frame, sample, stats, spec, target=None):
         """The lit pass of ``sample`` (a ``SampleResult``: its lights, the maps of its plan, its
         cameras and light rectangles), for sample ``spec`` (``SampleSpec``; its ``ao`` over the
         prepass just drawn); ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
         variant drawn into it, ``settle.py``; never occluded). Returns the frame data it drew
         with."""
         ao = spec.ao if target is None else None
-        film = self.film
+        film, snapshot, settings = self.film, frame.snapshot, frame.settings
+        aux = frame.aux and target is None
         lights, plan = sample.lights, sample.plan
         raster_camera, view_camera, rects = sample.cameras
         atlas = self.shadows if plan is not None and plan.tiles else None
@@ -451,29 +571,29 @@ class Renderer:
             tile_size=atlas.size if atlas else 1,
             atlas_columns=atlas.columns if atlas else 1,
             depth_format=atlas.depth_format if atlas else "FLOAT32",
-            aux_outputs=aux and target is None,
+            aux_outputs=aux,
             rects=rects,
             size=film.size,
             alpha_offset=spec.alpha_offset,
-            origin=self._origin,
+            origin=frame.origin,
             sample_count=spec.sample_count,
             settle=target is not None,
             pilot=spec.pilot,
-            world_sampled=self._world_sampled,
-            world_sh=self._world_sh or not any(lt.world for lt in lights),
+            world_sampled=frame.world_sampled,
+            world_sh=frame.world_sh or not any(lt.world for lt in lights),
             world_ao=ao,
             sample_index=spec.index,
             rsm=atlas is not None and atlas.rsm,
-            world_ratio=self._world_ratio,
+            world_ratio=frame.world_ratio,
         )
-        seen = [d for d in draws if d.instance.camera]
+        seen = [d for d in frame.draws if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
         world = (snapshot.world, snapshot.world_color)
         ao_depth = self.world_ao.texture if ao is not None else None
         if target is not None:
-            self.lit_pass.draw_settle_test(film, seen, view_camera, data, atlas, stats, self._origin, masks, target)
+            self.lit_pass.draw_settle_test(film, seen, view_camera, data, atlas, stats, frame.origin, masks, target)
         else:
-            passes = (settings, aux, emission, stats, self._origin, masks)
+            passes = (settings, aux, frame.emission, stats, frame.origin, masks)
             self.lit_pass.draw(film, seen, view_camera, data, atlas, world, *passes, ao_depth=ao_depth)
         return data
 
