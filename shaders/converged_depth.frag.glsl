@@ -1,5 +1,5 @@
 /* Before a sample's lit pass: the nearest depth (0) where the pixel has converged, so every
- * surface fails the depth test there and is not shaded (programs.CONVERGED_DEPTH); elsewhere
+ * surface fails the depth test there and is not shaded (film_programs.CONVERGED_DEPTH); elsewhere
  * nothing is written. Drawn with colour writes masked off. */
 void main()
 {

@@ -1,4 +1,4 @@
-/* Adaptive sampling's convergence check (programs.CONVERGENCE), Cycles' estimate: the mean of
+/* Adaptive sampling's convergence check (film_programs.CONVERGENCE), Cycles' estimate: the mean of
  * all samples I against the mean A of every other sample (accumulated twice over), per pixel
  *   error = (|I.r - A.r| + |I.g - A.g| + |I.b - A.b| + |I.a - A.a|) / (0.0001 + sqrt(I.r + I.g + I.b))
  * (Cycles leaves alpha out; here a transparent film's edges count too). A pixel converges when

@@ -1,6 +1,6 @@
 /* out = scale * src where the pixel has not converged (adaptive sampling): a sample added to
  * the accumulation (the blend state adds), to the every-other-sample accumulation the error
- * estimate compares with, and to each pixel's own weight (programs.MASKED_COPY). A converged
+ * estimate compares with, and to each pixel's own weight (film_programs.MASKED_COPY). A converged
  * pixel keeps what it has. */
 void main()
 {

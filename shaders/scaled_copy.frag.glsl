@@ -1,6 +1,6 @@
 /* out = scale * src at (pixel - origin): a shadow tile copied into the atlas (the viewport is
  * the tile's place there), a sample added to the accumulation (the blend state adds), or the
- * accumulation resolved to its average (programs.SCALED_COPY). */
+ * accumulation resolved to its average (film_programs.SCALED_COPY). */
 void main()
 {
   ivec2 p = ivec2(gl_FragCoord.xy) - origin;

@@ -1,5 +1,5 @@
 /* The accumulation divided by each pixel's own weight: once adaptive sampling stopped some
- * pixels, pixels hold different numbers of samples (programs.WEIGHTED_RESOLVE). */
+ * pixels, pixels hold different numbers of samples (film_programs.WEIGHTED_RESOLVE). */
 void main()
 {
   ivec2 p = ivec2(gl_FragCoord.xy);

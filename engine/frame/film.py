@@ -9,7 +9,7 @@ import numpy as np
 
 from ..gpu_pool import new_texture
 from ..post.base import PostContext
-from .programs import (
+from .film_programs import (
     CONVERGED_DEPTH,
     MASKED_COPY,
     MASKED_COPY_SHADOW_WEIGHT,

@@ -6,13 +6,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...shaders.loader import set_uniforms
+from ...shaders.loader import Program, set_uniforms
 from ..gpu_pool import UniformBlocks
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
 from .programs import (
     AO_SAMPLER,
-    BACKGROUND,
     JITTER_SIZE,
     RSM_FLUX_SAMPLER,
     RSM_NORMAL_SAMPLER,
@@ -25,6 +24,24 @@ from .programs import (
     lit_program,
     terminator_uniforms,
     with_entry,
+)
+
+# The world's Environment Texture behind everything (materials.World.image).
+BACKGROUND = Program(
+    name="background",
+    vertex="fullscreen.vert.glsl",
+    fragment="background.frag.glsl",
+    libs=("lib/common.glsl", "lib/material.glsl"),
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(
+        ("MAT4", "inverse_view_proj"),
+        ("VEC2", "viewport_origin"),
+        ("VEC2", "viewport_size"),
+        ("FLOAT", "strength"),
+        ("FLOAT", "env_premultiplied"),  # 1: Blender stores the image premultiplied
+    ),
+    samplers=(("FLOAT_2D", "env"),),
+    outputs=(("VEC4", "out_color"),),
 )
 
 
@@ -164,7 +181,7 @@ class LitPass:
         return opaque, blended, _Parts(outside, terminators)
 
     def _background(self, film, world, camera, origin, depth_test="NONE"):
-        """The world's Environment Texture behind the scene (``programs.BACKGROUND``)."""
+        """The world's Environment Texture behind the scene (``BACKGROUND``)."""
         from mathutils import Matrix
 
         width, height = film.size

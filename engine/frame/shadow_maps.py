@@ -12,15 +12,11 @@ from ...shaders.loader import set_uniforms
 from ..enums import DEPTH_FORMAT
 from ..gpu_pool import UniformBlocks, new_texture
 from ..shadows.planning import pack_tiles
-from .programs import (
+from .film_programs import SCALED_COPY
+from .programs import RSM_FORMAT, RSM_TEXEL_BYTES, TILE_STRUCT, depth_defines, packed_tiles
+from .shadow_programs import (
     INSTANCE_TABLE_ROWS,
-    RSM_FORMAT,
-    RSM_TEXEL_BYTES,
-    SCALED_COPY,
-    TILE_STRUCT,
-    depth_defines,
     instanced_shadow_program,
-    packed_tiles,
     shadow_cutout_program,
     shadow_hair_program,
     shadow_program,
@@ -30,7 +26,7 @@ from .programs import (
 
 @dataclass
 class TreeCutout:
-    """A caster part whose alpha a compiled node tree gives (``programs.shadow_tree_program``):
+    """A caster part whose alpha a compiled node tree gives (``shadow_programs.shadow_tree_program``):
     the tree, its node_constants block, its images' textures and per-draw push constants."""
 
     tree: object
@@ -130,7 +126,7 @@ class ShadowAtlas:
     With ``rsm`` (Light Paths > Diffuse Bounces 1) the atlas is also a set of reflective
     shadow maps (Dachsbacher and Stamminger 2005): two RGBA16F targets of its size hold per
     texel the diffuse albedo and the light-facing world normal of the surface the map sees
-    there (``programs.with_rsm_output``), 16 bytes a texel more, drawn in the same pass as the
+    there (``shadow_programs.with_rsm_output``), 16 bytes a texel more, drawn in the same pass as the
     depth (a FLOAT32 atlas's framebuffer gets them as colour attachments; other formats draw
     them in the scratch target and copy them like the depth). Without it nothing changes."""
 

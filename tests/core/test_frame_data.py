@@ -14,7 +14,7 @@ from devkit.session import ROOT, load_penumbra
 load_penumbra()
 from penumbra.engine import settings  # noqa: E402
 from penumbra.engine.enums import LIGHT_TYPE, SHADOW_MODE  # noqa: E402
-from penumbra.engine.frame import programs  # noqa: E402
+from penumbra.engine.frame import programs, shadow_programs  # noqa: E402
 from penumbra.engine.frame.frame_data import build_frame_data  # noqa: E402
 from penumbra.engine.scene.extract import Camera, Light  # noqa: E402
 from penumbra.engine.shadows import kernels, lightspace  # noqa: E402
@@ -294,7 +294,7 @@ def test_cropped_plans_stay_finite_at_degenerate_and_extreme_inputs(case):
 def test_every_uniform_block_fits_what_any_gl_allows():
     """GL guarantees 16 KiB per uniform block (GL_MAX_UNIFORM_BLOCK_SIZE): the lights table and
     the shadow-tile table, at their maximum counts, stay within it."""
-    for program in (programs.LIT, programs.SHADOW_DEPTH):
+    for program in (programs.LIT, shadow_programs.SHADOW_DEPTH):
         for struct, name, count in program.uniform_blocks:
             assert struct.stride * max(count, 1) <= 16384, (program.name, name)
     assert programs.MAX_SHADOW_TILES * programs.TILE_STRUCT.stride <= 16384

@@ -11,7 +11,7 @@ Mode › Dithered, its alpha from the material, an alpha texture or a compiled n
 the lit pass's hash and alpha offset, so a dithered surface covers the same pixels in both),
 with the lit pass's back-face culling, and hair strips (widened toward the camera as the lit
 pass widens them); alpha-blended parts are left out, as the lit pass keeps them out of its
-depth. The programs are the shadow depth pass's (``programs.CAMERA_DEPTH``): the camera is its
+depth. The programs are the shadow depth pass's (``shadow_programs.CAMERA_DEPTH``): the camera is its
 "tile", and it writes the view depth itself (float32: full precision at any distance) instead
 of a map's normalised depth, clipping at the near plane as the lit pass does.
 
@@ -23,17 +23,10 @@ import numpy as np
 
 from ...gpu_pool import new_texture
 from ...shadows import lightspace
-from ..programs import (
-    TILE_STRUCT,
-    depth_defines,
-    image_premultiplied_bits,
-    shadow_cutout_program,
-    shadow_hair_program,
-    shadow_program,
-    shadow_tree_program,
-)
+from ..programs import TILE_STRUCT, depth_defines, image_premultiplied_bits
 from ..shadow_maps import draw_cutout
 from ..shadow_pass import tree_cutout
+from ..shadow_programs import shadow_cutout_program, shadow_hair_program, shadow_program, shadow_tree_program
 
 
 def camera_tile(camera, size, origin):

@@ -10,9 +10,21 @@ pixels are never read into Python, and an F12 render of a large HDRI pays a pass
 
 import dataclasses
 
+from ....shaders.loader import Program
 from ...scene.materials import equirect_sh
 from ...scene.textures import world_background
-from ..programs import WORLD_REDUCE
+
+# The world's Environment Texture box-filtered to a small image, read back for its SH light
+# (``world/sh_light.py``).
+WORLD_REDUCE = Program(
+    name="world_reduce",
+    vertex="fullscreen.vert.glsl",
+    fragment="world_reduce.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("VEC2", "target_size"), ("FLOAT", "env_premultiplied")),
+    samplers=(("FLOAT_2D", "env"),),
+    outputs=(("VEC4", "out_color"),),
+)
 
 
 def with_sh_light(world, textures, shaders):

@@ -1,0 +1,189 @@
+"""The film's programs (``film.Film``): a sample added to the accumulation and the
+accumulation resolved (by the total weight, or each pixel's with adaptive sampling), the
+convergence check, the world ratio's accumulations and resolve, settling, and the nearest
+depth written where a pixel converged."""
+
+from dataclasses import replace
+
+from ...shaders.loader import Program
+from .programs import WORLD_RATIO_OUTPUTS
+
+# out = scale * src at (pixel - origin): a shadow tile from the scratch target into its place in
+# the atlas (scale 1, origin the tile's corner; FLOAT16, RGBA8), a sample added to the
+# accumulation (scale its weight, additive blending) and the accumulation resolved (scale
+# 1 / total weight). The _SHADOW variant carries the Shadow pass along in a second target.
+SCALED_COPY = Program(
+    name="scaled_copy",
+    vertex="fullscreen.vert.glsl",
+    fragment="scaled_copy.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("IVEC2", "origin"), ("FLOAT", "scale")),
+    samplers=(("FLOAT_2D", "src_color"),),
+    outputs=(("VEC4", "out_color"),),
+    defines=(("WITH_SHADOW", False),),
+)
+SCALED_COPY_SHADOW = replace(
+    SCALED_COPY,
+    name="scaled_copy_shadow",
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "src_shadow")),
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
+    defines=(("WITH_SHADOW", True), ("CLAMP_SHADOW", False)),
+)
+# The accumulation resolved: the shadow's weighted mean of visibilities clamped to [0, 1]
+# (rounding of the sums and of 1 / total weight may carry it past 1).
+SCALED_RESOLVE_SHADOW = replace(
+    SCALED_COPY_SHADOW, name="scaled_resolve_shadow", defines=(("WITH_SHADOW", True), ("CLAMP_SHADOW", True))
+)
+
+
+# Adaptive sampling (``film.Film``): a sample added only where the pixel has not converged
+# (``converged`` > 0.5: nothing written), with the pixel's own weight in a further target;
+# the accumulation resolved by each pixel's weight; the convergence check; and the nearest
+# depth written where a pixel converged, so the lit pass does not shade it.
+MASKED_COPY = Program(
+    name="masked_copy",
+    vertex="fullscreen.vert.glsl",
+    fragment="masked_copy.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "scale"),),
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "converged")),
+    outputs=(("VEC4", "out_color"),),
+    defines=(("WITH_SHADOW", False), ("WITH_WEIGHT", False)),
+)
+MASKED_COPY_WEIGHT = replace(
+    MASKED_COPY,
+    name="masked_copy_weight",
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_weight")),
+    defines=(("WITH_SHADOW", False), ("WITH_WEIGHT", True)),
+)
+MASKED_COPY_SHADOW_WEIGHT = replace(
+    MASKED_COPY,
+    name="masked_copy_shadow_weight",
+    samplers=MASKED_COPY.samplers + (("FLOAT_2D", "src_shadow"),),
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow"), ("VEC4", "out_weight")),
+    defines=(("WITH_SHADOW", True), ("WITH_WEIGHT", True)),
+)
+WEIGHTED_RESOLVE = Program(
+    name="weighted_resolve",
+    vertex="fullscreen.vert.glsl",
+    fragment="weighted_resolve.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "weight")),
+    outputs=(("VEC4", "out_color"),),
+    defines=(("WITH_SHADOW", False),),
+)
+WEIGHTED_RESOLVE_SHADOW = replace(
+    WEIGHTED_RESOLVE,
+    name="weighted_resolve_shadow",
+    samplers=WEIGHTED_RESOLVE.samplers + (("FLOAT_2D", "src_shadow"),),
+    outputs=(("VEC4", "out_color"), ("VEC4", "out_shadow")),
+    defines=(("WITH_SHADOW", True),),
+)
+CONVERGENCE = Program(
+    name="convergence",
+    vertex="fullscreen.vert.glsl",
+    fragment="convergence.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    # per_pixel > 0.5: pixels hold their own weights (``weight``), else all ``weight_sum``.
+    push_constants=(("FLOAT", "threshold"), ("FLOAT", "weight_sum"), ("FLOAT", "per_pixel")),
+    samplers=(
+        ("FLOAT_2D", "accum"),
+        ("FLOAT_2D", "half_accum"),
+        ("FLOAT_2D", "converged"),
+        ("FLOAT_2D", "weight"),
+    ),
+    outputs=(("VEC4", "out_color"),),
+    libs=("lib/world_ratio.glsl",),
+)
+CONVERGENCE = replace(CONVERGENCE, defines=(("ERROR_OUTPUT", False), ("WORLD_RATIO", False)))
+# The NOISE debug view: each pixel's error estimate as the check reads it (``Film.error_array``).
+CONVERGENCE_ERROR = replace(
+    CONVERGENCE, name="convergence_error", defines=(("ERROR_OUTPUT", True), ("WORLD_RATIO", False))
+)
+# The world's light as a ratio (``Film.world_targets``): the accumulations of its SH light by
+# lobe and of its sums, and the every-other-sample accumulation of the sums.
+_WORLD_RATIO_SAMPLERS = (("FLOAT_2D", "world_diffuse"), ("FLOAT_2D", "world_specular"), ("FLOAT_2D", "world_sums"))
+
+
+def convergence_program(error_output=False, world_ratio=False):
+    """The convergence check (or, ``error_output``, its estimate for the NOISE view); with
+    ``world_ratio`` both means it compares take the world's light through its ratio."""
+    base = CONVERGENCE_ERROR if error_output else CONVERGENCE
+    if not world_ratio:
+        return base
+    return replace(
+        base,
+        name=f"{base.name}_ratio",
+        samplers=base.samplers + _WORLD_RATIO_SAMPLERS + (("FLOAT_2D", "half_world_sums"),),
+        defines=(("ERROR_OUTPUT", bool(error_output)), ("WORLD_RATIO", True)),
+    )
+
+
+# A sample's world ratio targets added to their accumulations in one pass, where not converged
+# (WITH_MASK, ``converged`` then bound).
+WORLD_RATIO_COPY = Program(
+    name="world_ratio_copy",
+    vertex="fullscreen.vert.glsl",
+    fragment="world_ratio_copy.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "scale"),),
+    samplers=_WORLD_RATIO_SAMPLERS + (("FLOAT_2D", "converged"),),
+    outputs=WORLD_RATIO_OUTPUTS,
+    defines=(("WITH_MASK", False),),
+)
+WORLD_RATIO_COPY_MASKED = replace(WORLD_RATIO_COPY, name="world_ratio_copy_masked", defines=(("WITH_MASK", True),))
+
+# The resolve of a frame with the world's light as a ratio: colour - U_d (1 - S_d) - U_s (1 - S_s)
+# from the accumulations, over the total weight (``scale``) or each pixel's (per_pixel > 0.5).
+WORLD_RATIO_RESOLVE = Program(
+    name="world_ratio_resolve",
+    vertex="fullscreen.vert.glsl",
+    fragment="world_ratio.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "scale"), ("FLOAT", "per_pixel")),
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "weight")) + _WORLD_RATIO_SAMPLERS,
+    outputs=(("VEC4", "out_color"),),
+    libs=("lib/world_ratio.glsl",),
+)
+# Settling (``engine/frame/settle.py``): the settle test's flags and the image so far give the
+# pixels no later sample can change; they join the converged mask.
+SETTLE = Program(
+    name="settle",
+    vertex="fullscreen.vert.glsl",
+    fragment="settle.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(
+        ("FLOAT", "threshold"),
+        ("FLOAT", "weight_sum"),
+        ("VEC2", "mean_shift"),
+        ("VEC3", "moment_shift"),
+        ("FLOAT", "flag_reach"),
+    ),
+    samplers=(("FLOAT_2D", "accum"), ("FLOAT_2D", "flags"), ("FLOAT_2D", "converged")),
+    outputs=(("VEC4", "out_color"),),
+    defines=(("WITH_SHADOW", False),),
+)
+SETTLE_SHADOW = replace(
+    SETTLE,
+    name="settle_shadow",
+    samplers=SETTLE.samplers + (("FLOAT_2D", "accum_shadow"),),
+    defines=(("WITH_SHADOW", True),),
+)
+SETTLED_COPY = Program(
+    name="settled_copy",
+    vertex="fullscreen.vert.glsl",
+    fragment="settled_copy.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    push_constants=(("FLOAT", "scale"),),
+    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "converged")),
+    outputs=(("VEC4", "out_color"),),
+)
+CONVERGED_DEPTH = Program(
+    name="converged_depth",
+    vertex="fullscreen.vert.glsl",
+    fragment="converged_depth.frag.glsl",
+    vertex_in=(("VEC2", "pos"),),
+    samplers=(("FLOAT_2D", "converged"),),
+    outputs=(("VEC4", "out_color"),),
+    depth_write="ANY",
+)
