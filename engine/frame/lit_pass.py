@@ -236,7 +236,14 @@ class LitPass:
         return self._jitter_tex[1]
 
     def _bins_texture(self, bins):
-        """The light-bin masks as an RGBA32F texture (a 1x1 zero texture when not binned)."""
+        """The light-bin masks as an RGBA32F texture (a 1x1 zero texture when not binned).
+
+        Each channel holds a word of 16 lights as the integer it is (below 2^24, so exact in
+        float32, and texelFetch returns a 32-bit float texel unfiltered, exactly as stored on
+        any conformant GPU); the shader converts it to uint. An RGBA32UI texture read through
+        an unsigned sampler would say so in its type, but Blender's ``gpu.types.GPUTexture``
+        takes only FLOAT buffers ("Only Buffer of format `FLOAT` is currently supported",
+        4.5 and 5.2), and a float upload into an integer texture is not defined."""
         import gpu
 
         if bins is None:

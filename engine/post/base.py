@@ -1,5 +1,6 @@
 """The post stack's shared machinery: the effect interface, render targets, the stack."""
 
+import hashlib
 from collections import namedtuple
 from dataclasses import dataclass, field
 from types import SimpleNamespace
@@ -179,27 +180,74 @@ def bilinear_up(small, h, w):
 def table_texture(rgb):
     """An RGBA32F texture of a built-in table: ``rgb`` is (height, width, 3), or (width, 3) for
     one row; alpha is 1."""
-    import gpu
-
     rgb = np.asarray(rgb, np.float32)
     if rgb.ndim == 2:
         rgb = rgb[None]
     h, w = rgb.shape[:2]
-    rgba = np.concatenate([rgb, np.ones((h, w, 1), np.float32)], axis=-1)
-    buf = gpu.types.Buffer("FLOAT", rgba.size, rgba.ravel().tolist())
-    return gpu.types.GPUTexture((w, h), format="RGBA32F", data=buf)
+    return rgba_texture(np.concatenate([rgb, np.ones((h, w, 1), np.float32)], axis=-1))
+
+
+# A user's lookup image (COLORIZER's LUT, LENS_FLARE's dirt) of at most this many texels is
+# drawn from a float table of its pixels; a larger one from Blender's own texture of it.
+IMAGE_TABLE_TEXELS = 1 << 20
+
+
+def srgb_to_linear(c):
+    """The sRGB transfer function decoded (IEC 61966-2-1), as Blender's sRGB textures decode."""
+    c = np.asarray(c, np.float32)
+    return np.where(c <= 0.04045, c / 12.92, ((np.maximum(c, 0.04045) + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+def image_pixels(image):
+    """``image``'s pixels as Blender's GPU texture of it holds them: (height, width, 4) float32,
+    row 0 at the bottom. Float images as stored (scene linear), byte images in sRGB decoded,
+    Non-Color and linear byte images as they are. None where numpy cannot give that (another
+    colour space, no pixels, more than IMAGE_TABLE_TEXELS texels)."""
+    w, h = image.size
+    if not image.has_data or w * h == 0 or w * h > IMAGE_TABLE_TEXELS:
+        return None
+    space = image.colorspace_settings
+    linear = space.is_data or space.name.startswith("Linear Rec.709") or space.name in ("Non-Color", "Raw")
+    decode = not image.is_float and space.name == "sRGB"
+    if not (linear or decode):
+        return None
+    pixels = np.empty(w * h * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    pixels = pixels.reshape(h, w, 4)
+    if decode:
+        pixels[..., :3] = srgb_to_linear(pixels[..., :3])
+    return pixels
 
 
 def image_or_table(image, cache, table):
-    """The texture of a user's Image, or of the built-in ``table`` (created once and kept in
-    ``cache``, a one-item list owned by the effect instance) when there is no image."""
+    """The texture of a user's Image, or of the built-in ``table`` when there is none; ``cache``
+    is a dict owned by the effect instance. A user's image becomes Penumbra's own RGBA32F table
+    of its pixels (``image_pixels``), uploaded again only when they change: the lookup reads
+    the same values on every GPU, whatever format and filtering Blender's own texture of the
+    image takes there. An image numpy cannot convert is drawn from Blender's texture."""
     import gpu
 
-    if image is not None:
+    if image is None:
+        if "table" not in cache:
+            cache["table"] = table_texture(table)
+        return cache["table"]
+    pixels = image_pixels(image)
+    if pixels is None:
         return gpu.texture.from_image(image)
-    if not cache:
-        cache.append(table_texture(table))
-    return cache[0]
+    key = (image.name, pixels.shape, hashlib.blake2b(pixels.tobytes(), digest_size=16).digest())
+    if cache.get("image", (None,))[0] != key:
+        cache["image"] = (key, rgba_texture(pixels))
+    return cache["image"][1]
+
+
+def rgba_texture(rgba):
+    """An RGBA32F texture of (height, width, 4) float32 ``rgba``, row 0 at the bottom."""
+    import gpu
+
+    rgba = np.ascontiguousarray(rgba, np.float32)
+    h, w = rgba.shape[:2]
+    buf = gpu.types.Buffer("FLOAT", rgba.size, rgba.ravel())
+    return gpu.types.GPUTexture((w, h), format="RGBA32F", data=buf)
 
 
 @dataclass

@@ -12,6 +12,8 @@ The lookup table is an image of W x H texels (row 0 = y 0, the bottom row of a B
 read with bilinear filtering between texel centres: ``x`` maps to the texel coordinate
 ``x * (W - 1)`` (texture coordinate ``u = (x * (W - 1) + 0.5) / W``), ``y`` likewise, so x = 0 is
 the centre of the first column and x = 1 the centre of the last. Only the LUT's RGB is used.
+The image is read as Penumbra's own float table of its pixels (``base.image_or_table``), so a
+LUT reads the same on every GPU.
 Without an image the built-in ``DEFAULT_LUT`` is used. The result is
 ``mix(c.rgb, lut.rgb, strength)``; alpha is kept.
 """
@@ -106,7 +108,7 @@ class Colorizer(PostEffect):
 
     def __init__(self):
         self._blur = Blur()
-        self._default_lut = []
+        self._default_lut = {}
 
     def is_identity(self, params):
         return params.strength <= 0.0

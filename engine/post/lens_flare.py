@@ -152,7 +152,7 @@ class LensFlare(PostEffect):
     )
 
     def __init__(self):
-        self._ramp = []
+        self._ramp = {}
 
     def is_identity(self, params):
         no_flare = params.ghosts <= 0 and params.halo_width <= 0.0

@@ -81,3 +81,35 @@ def test_colorizer_defaults_change_an_hdr_image_and_stay_finite(penumbra, gpu_ca
     out, stats = run_layers(gpu_call, img, [layer("COLORIZER")])
     assert np.all(np.isfinite(out)) and stats.post_passes >= 1
     assert np.abs(out - img).max() > 0.05
+
+
+@pytest.mark.parametrize("space", ["sRGB", "Non-Color"])
+def test_a_byte_lut_is_read_as_blenders_own_texture_holds_it(penumbra, gpu_call, space):
+    """A user's LUT is drawn from Penumbra's own float table of its pixels (the same values on
+    every GPU). For an 8-bit image the table is what Blender's own texture of it gives a
+    shader: that texture holds the image's bytes, as SRGB8_A8 (which a sampler decodes with the
+    sRGB transfer function, IEC 61966-2-1) for sRGB, as RGBA8 (bytes / 255) for Non-Color."""
+    import bpy
+
+    from penumbra.engine.post.base import image_pixels, srgb_to_linear
+
+    rng = np.random.default_rng(5)
+    image = bpy.data.images.new(f"Byte LUT {space}", 16, 3, float_buffer=False)
+    image.colorspace_settings.name = space
+    image.pixels.foreach_set(rng.uniform(0, 1, 16 * 3 * 4).astype(np.float32))
+    table = image_pixels(image)
+    assert table is not None and table.shape == (3, 16, 4)
+
+    def blenders(_engine, _depsgraph):
+        import gpu
+
+        texture = gpu.texture.from_image(image)
+        return texture.format, np.asarray(texture.read().to_list(), np.float32).reshape(3, 16, 4)
+
+    fmt, held = gpu_call(blenders)
+    stored = held[..., :3] / 255.0
+    assert fmt == ("SRGB8_A8" if space == "sRGB" else "RGBA8")
+    expected = srgb_to_linear(stored) if space == "sRGB" else stored
+    np.testing.assert_allclose(table[..., :3], expected, atol=1e-6)
+    if space == "sRGB":
+        assert np.abs(table[..., :3] - stored).max() > 0.05  # decoded, not the bytes
