@@ -27,7 +27,14 @@ from .programs import MAX_LIGHTS
 from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
-from .world.directions import directions_per_sample, light_share, needs_directions, portal_cones, world_lights
+from .world.directions import (
+    directions_per_sample,
+    light_share,
+    needs_directions,
+    portal_cones,
+    world_lights,
+    world_negligible,
+)
 from .world.occlusion import WorldAO
 from .world.sh_light import with_sh_light
 
@@ -84,6 +91,7 @@ class FramePlan:
     debug: object  # the DEBUG_VIEW entry
     directions: int = 0
     cones: list = dataclasses.field(default_factory=list)
+    world_negligible: bool = False  # the world's light is under the frame's noise (``world_negligible``)
     first_directions: int = 0  # the first sample that takes directions (after one with AO)
     adaptive: object = None
     noise: bool = False
@@ -122,6 +130,8 @@ class FramePlan:
         snapshot = self.snapshot
         world = snapshot.world if snapshot.world is not None else snapshot.world_color
         if self.cones or not sampling.world_ao_sample(s, self.accumulate, self.settings, world, self.debug.id):
+            return None
+        if self.world_negligible and self.debug.id != "WORLD_AO":  # occluding it could change no pixel
             return None
         if self._ao_distance is None:
             self._ao_distance = sampling.world_ao_distance(self.settings, corners_of(self.draws)) if self.draws else 0.0
@@ -215,7 +225,9 @@ class Renderer:
         counters = (self._uploaded(), self.shaders.compiled, self.shaders.compile_seconds)
         self._clock = self.film.clock = clock
         with clock.stage("prepare"):
-            frame = self._plan(snapshot, camera, settings, (width, height), aux, emission, samples, sample_count, stats)
+            frame = self._plan(
+                snapshot, camera, settings, (width, height), aux, emission, sample_count, adaptive, stats
+            )
             self._plan_samples(frame, samples[0], adaptive, deadline, navigating, stats)
         drawn = None
         pixels = width * height
@@ -247,10 +259,11 @@ class Renderer:
         stats.compile_seconds = self.shaders.compile_seconds - counters[2]
         return self._output(frame, color, debug_image, stats)
 
-    def _plan(self, snapshot, camera, settings, size, aux, emission, samples, sample_count, stats):
+    def _plan(self, snapshot, camera, settings, size, aux, emission, sample_count, adaptive, stats):
         """The plan stage: what the frame draws (the draw list, relative to the frame origin),
-        the world's light (its SH light, directions per sample, light portals), the lights it
-        lights with and the film it draws into. Returns the ``FramePlan`` the later stages read."""
+        the world's light (its SH light, directions per sample, light portals; none of them,
+        nor ambient occlusion, where its light is under the frame's Noise Threshold), the lights
+        it lights with and the film it draws into. Returns the ``FramePlan`` the later stages read."""
         width, height = size
         accumulate = sample_count > 1
         # A multi-sample frame's pixel offsets reach Filter Size pixels beyond the image: its
@@ -269,7 +282,9 @@ class Renderer:
         world = with_sh_light(snapshot.world, self.textures, self.shaders)
         if world is not snapshot.world:  # an Environment Texture's light, projected on the GPU
             snapshot = dataclasses.replace(snapshot, world=world, world_color=world.mean)
-        directions, cones = self._world_directions(snapshot, draws, settings, accumulate)
+        threshold = adaptive.threshold if adaptive is not None and accumulate else 0.0
+        negligible = world_negligible(snapshot.world if snapshot.world is not None else snapshot.world_color, threshold)
+        directions, cones = (0, []) if negligible else self._world_directions(snapshot, draws, settings, accumulate)
         room = MAX_LIGHTS - directions
         lights = select_lights(snapshot.lights, camera.position, room)
         if len(lights) < len(snapshot.lights):
@@ -290,6 +305,7 @@ class Renderer:
             debug=DEBUG_VIEW[getattr(settings, "debug_view", "NONE")],
             directions=directions,
             cones=cones,
+            world_negligible=negligible,
         )
 
     @staticmethod

@@ -174,3 +174,26 @@ def test_directions_follow_the_worlds_share_at_its_extremes():
     assert [ws.directions_per_sample(s, 4) for s in (1.0, 0.5, 0.25, 0.1, 1e-9, 0.0)] == [4, 4, 2, 1, 1, 1]
     assert ws.directions_per_sample(0.7, 0) == 0
     assert ws.directions_per_sample(0.3, 16) == 10
+
+
+def test_a_world_under_the_noise_threshold_is_negligible():
+    """``world_negligible``: a world whose whole light is under the noise a frame accepts
+    (sqrt of its radiance below the Noise Threshold, Cycles' error units for a pixel it alone
+    lights) takes no directions and no occlusion; one above it does, however bright the lamps
+    (they do not enter the rule). Constant colours, NaN and infinite worlds are read safely."""
+    for radiance, threshold, negligible in (
+        (0.0, 0.01, True),
+        (0.5e-4, 0.01, True),  # sqrt 0.007 < 0.01
+        (2e-4, 0.01, False),  # sqrt 0.014
+        (0.05, 0.01, False),  # the demo's dim world
+        (0.5e-6, 0.0, True),  # without adaptive sampling: NEGLIGIBLE_ERROR (0.001)
+        (2e-6, 0.0, False),
+    ):
+        world = World.constant((radiance, radiance, radiance))
+        assert ws.world_negligible(world, threshold) is negligible, (radiance, threshold)
+        assert ws.world_negligible((radiance, radiance, radiance), threshold) is negligible, (radiance, threshold)
+    assert ws.world_negligible(None)
+    # Non-finite SH light is read as ``light_share`` reads it (no light to shadow), never NaN.
+    assert ws.world_negligible(World.constant((np.inf, 0.0, 0.0)), 0.01)
+    assert ws.world_negligible(World.constant((np.nan, np.nan, np.nan)), 0.01)
+    assert not ws.world_negligible(World.constant((np.inf, 1.0, 1.0)), 0.01)

@@ -96,3 +96,40 @@ def test_sixteen_samples_issue_at_most_sixteen_times_one_samples_calls(penumbra,
     one = _frame_stats(gpu_call, scene, samples=1)[0]
     sixteen = _frame_stats(gpu_call, scene, samples=16)[0]
     assert sixteen.draws <= 16 * one.draws, (one.draws, sixteen.draws)
+
+
+def test_a_world_under_the_noise_threshold_takes_no_directions_nor_occlusion(penumbra, gpu_call):
+    """A world whose whole light is under the frame's Noise Threshold (``world_negligible``:
+    radiance 2e-5, sqrt 0.0045 < 0.01) costs no shadow map and no ambient occlusion prepass,
+    and still lights every surface (unshadowed); one twenty times brighter pays for both, and
+    so does the dim one in a frame without adaptive sampling (its threshold then 0.001)."""
+    from penumbra.engine.frame.sampling import Adaptive
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    counts = {}
+    for radiance, threshold in ((2e-5, 0.01), (4e-4, 0.01), (2e-5, 0.0), (0.0, 0.01)):
+        scene = _scene(sun=True)
+        ws.uniform_sky(scene, (1.0, 1.0, 1.0), radiance)
+        scene.penumbra.world_samples = 4
+        scene.penumbra.world_ao = True
+
+        def job(engine, depsgraph, scene=scene, threshold=threshold):
+            cam = camera_from_scene(depsgraph, scene, WIDTH, HEIGHT)
+            adaptive = Adaptive(threshold=threshold, min_samples=64) if threshold else None
+            out = engine.render_frame(depsgraph, cam, WIDTH, HEIGHT, samples=(0, 4), sample_count=4, aux=False,
+                                      adaptive=adaptive)  # fmt: skip
+            return out.stats.world_directions, out.stats.ao_prepasses, out.color_array().copy()
+
+        counts[(radiance, threshold)] = job_result = gpu_call(job)
+        assert np.all(np.isfinite(job_result[2]))
+    directions, prepasses, image = counts[(2e-5, 0.01)]
+    assert (directions, prepasses) == (0, 0), counts
+    bright = counts[(4e-4, 0.01)]
+    assert bright[0] > 0 and bright[1] > 0, bright[:2]
+    unthresholded = counts[(2e-5, 0.0)]
+    assert unthresholded[0] > 0 and unthresholded[1] > 0, unthresholded[:2]
+    # The negligible world still lights every surface, unshadowed: over the same frame with a
+    # black world it adds about its radiance times the surfaces' albedo, nowhere more than it
+    # (diffuse and specular each at most 2e-5).
+    added = image[..., :3] - counts[(0.0, 0.01)][2][..., :3]
+    assert added.min() > 0.2 * 2e-5 and added.max() <= 4e-5, (added.min(), added.max())

@@ -51,15 +51,44 @@ _SCRAMBLE = (0x6C8E9CF5, 0x2545F491)  # digital shifts of the two coordinates
 FULL_SHARE = 0.5
 
 
+# Without adaptive sampling, the Noise Threshold a world's light is negligible by
+# (``world_negligible``): a tenth of Cycles' default.
+NEGLIGIBLE_ERROR = 0.001
+
+
+def world_negligible(world, threshold=0.0):
+    """Whether the light of ``world`` (a ``materials.World`` with its SH light, or a
+    constant colour) is wholly under the noise a frame accepts, so shadowing it could move
+    no pixel by as much: it then takes no directions and no ambient occlusion, and lights
+    every surface unshadowed. In Cycles' error units (a difference over the square root of
+    the pixel's value) a pixel lit by the world alone, occluded or not, differs by sqrt(U),
+    U the world's radiance off a white surface facing its brightest axis (the SH irradiance
+    over pi, luminance): negligible where sqrt(U) < ``threshold`` (the frame's Noise
+    Threshold; NEGLIGIBLE_ERROR when 0). A black world is; any brighter one, however bright
+    its lamps, may not be (a pixel in their shadow sees the world's light alone)."""
+    threshold = threshold if threshold > 0.0 else NEGLIGIBLE_ERROR
+    if getattr(world, "sh", None) is not None:
+        radiance = _world_irradiance(world) / math.pi
+    else:  # a constant colour (no World datablock), or an image's light not yet known: its mean
+        colour = world.mean if hasattr(world, "sh") else (world if world is not None else (0.0, 0.0, 0.0))
+        radiance = float(np.nan_to_num(np.asarray(colour, np.float64)[:3], posinf=1e30) @ _LUMINANCE)
+    return math.sqrt(max(radiance, 0.0)) < threshold
+
+
+def _world_irradiance(world):
+    """The world's SH irradiance on its brightest of the six axes, in luminance."""
+    axes = np.array([[0, 0, 1], [0, 0, -1], [1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0]], np.float64)
+    sh = np.nan_to_num(np.asarray(world.sh, np.float64), posinf=0.0, neginf=0.0)
+    return math.pi * float(np.max(np.maximum(sh_basis(axes) @ sh, 0.0) @ _LUMINANCE))
+
+
 def light_share(world, lights, centre):
     """The world's share of the light reaching a surface at ``centre`` (the middle of what the
     camera sees) that faces each source: its irradiance from the SH light's brightest axis
     (pi x radiance, luminance) against each lamp's unshadowed irradiance there (Blender's
     conventions, lights.glsl: a sun's strength, P / (4 pi (d^2 + r^2)) for points and spots,
     cones ignored, P / (pi d^2) for areas). 1 without lamps; 0 for a black world."""
-    axes = np.array([[0, 0, 1], [0, 0, -1], [1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0]], np.float64)
-    sh = np.nan_to_num(np.asarray(world.sh, np.float64), posinf=0.0, neginf=0.0)
-    world_e = math.pi * float(np.max(np.maximum(sh_basis(axes) @ sh, 0.0) @ _LUMINANCE))
+    world_e = _world_irradiance(world)
     lamps = 0.0
     centre = np.asarray(centre, np.float64)
     for light in lights:
