@@ -1,5 +1,6 @@
 """The RenderEngine subclass: thin glue from Blender's callbacks to the Renderer."""
 
+import dataclasses
 import sys
 import traceback
 
@@ -18,7 +19,7 @@ from .frame.output import (
     viewport_window,
 )
 from .frame.sampling import adaptive_settings
-from .scene.extract import SceneCache, camera_from_scene, camera_from_view
+from .scene.extract import SceneCache, camera_from_scene, camera_from_view, camera_lens, matrix_np
 
 ENDLESS_SAMPLES = 64  # how finely soft lights are split when the viewport refines without end
 
@@ -107,7 +108,7 @@ class PenumbraEngineCore:
         self.last_stats = out.stats
         return out
 
-    def viewport_frame(self, depsgraph, view_matrix, window_matrix, width, height):
+    def viewport_frame(self, depsgraph, view_matrix, window_matrix, width, height, lens=None):
         """The frame a viewport redraw shows, one sample at a time:
         * the view moved since the last frame: one sample at ``navigation_scale`` of the
           region's resolution (post sizes scaled alike);
@@ -119,7 +120,7 @@ class PenumbraEngineCore:
         Sample k of the viewport is sample k of a final render, so N redraws show what a final
         render of N samples shows. Returns (FrameOutput, whether it rendered); ``refining()``
         says whether another redraw would render more."""
-        key = (width, height, tuple(map(tuple, view_matrix)), tuple(map(tuple, window_matrix)))
+        key = (width, height, tuple(map(tuple, view_matrix)), tuple(map(tuple, window_matrix)), lens)
         settings = depsgraph.scene.penumbra
         target = int(settings.viewport_samples)
         count = target if target > 0 else ENDLESS_SAMPLES
@@ -135,13 +136,13 @@ class PenumbraEngineCore:
             done = shown[2]
             if not self._wants_sample(done, target) or self._stopped:
                 return shown[1], False
-            camera = camera_from_view(view_matrix, window_matrix)
+            camera = dataclasses.replace(camera_from_view(view_matrix, window_matrix), lens=lens)
             out = self._viewport_sample(depsgraph, camera, width, height, done, count, adaptive)
             self._shown = (key, out, done + out.stats.samples, target)
             return out, True
         scale = float(settings.navigation_scale)
         moving = shown is not None and shown[0][:2] == (width, height) and shown[0] != key and scale < 1.0
-        camera = camera_from_view(view_matrix, window_matrix)
+        camera = dataclasses.replace(camera_from_view(view_matrix, window_matrix), lens=lens)
         self._shown = None
         self._stopped = ""
         if moving:
@@ -418,7 +419,14 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         rv3d = context.region_data
         width, height = region.width, region.height
         try:
-            out, _rendered = self.viewport_frame(depsgraph, rv3d.view_matrix, rv3d.window_matrix, width, height)
+            # Camera view: the scene camera's depth of field, refined as samples arrive.
+            lens = None
+            scene = depsgraph.scene
+            if rv3d.view_perspective == "CAMERA" and scene.camera is not None:
+                lens = camera_lens(scene.camera.evaluated_get(depsgraph), matrix_np(rv3d.view_matrix))
+            out, _rendered = self.viewport_frame(
+                depsgraph, rv3d.view_matrix, rv3d.window_matrix, width, height, lens=lens
+            )
         except Exception as exc:
             message = f"Penumbra: viewport draw failed: {exc}"
             if message != self._reported:  # once per distinct error, not every redraw

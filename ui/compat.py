@@ -38,6 +38,8 @@ INCLUDE = {
     # EEVEE only).
     "OBJECT_PT_shadow_terminator",
     "WORLD_PT_viewport_display",
+    "DATA_PT_camera_dof",  # depth of field by lens sampling (engine/frame/lens.py)
+    "DATA_PT_camera_dof_aperture",  # f-stop, blades, rotation, ratio
 }
 
 

@@ -13,6 +13,7 @@ import numpy as np
 from ..enums import DEBUG_VIEW, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
 from ..shadows import kernels, light_bins, lightspace
 from ..shadows.kernels import RING
+from .lens import coc_row
 from .programs import (
     FRAME_STRUCT,
     LIGHT_STRUCT,
@@ -142,6 +143,7 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "ao_distance": 0.0,
         "ao_jitter": (0.0, 0.0),
         "sample_index": 0,
+        "lens_coc": (0.0, 0.0, 0.0, 0.0),
     }
 
 
@@ -249,6 +251,8 @@ def build_frame_data(
     if world_ao is not None:
         frame.update(ao_row(camera.projection, size, *world_ao))
     frame["sample_index"] = int(sample_index)
+    if settle:  # where the lens blurs, a pixel keeps sampling (lib/lit_settle.glsl)
+        frame["lens_coc"] = coc_row(camera, *size)
     # One diffuse bounce from the maps' reflective targets: only where some light has a map.
     indirect = indirect_samples(settings) if rsm and shadowed > 0 else 0
     frame["shadowed_count"] = shadowed

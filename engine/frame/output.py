@@ -90,7 +90,6 @@ def render_views(render):
 # what the user is told[, the value that is not rendered: True unless given]). Checked on every
 # final render; each one in use is named once in the render report.
 _UNSUPPORTED = (
-    ("camera", "dof.use_dof", "camera depth of field is not rendered"),
     ("camera", "type", "panoramic cameras are not rendered (drawn as a perspective camera)", "PANO"),
     ("render", "use_motion_blur", "motion blur is not rendered"),
     ("render", "use_freestyle", "Freestyle lines are not rendered"),

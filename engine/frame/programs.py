@@ -135,6 +135,9 @@ FRAME_STRUCT = Struct(
         ("FLOAT", "ao_distance"),
         ("VEC2", "ao_jitter"),
         ("INT", "sample_index"),  # this sample's index in its frame (the bounce's sequence, INDIRECT_RSM)
+        # The settle test's depth of field (``lens.coc_row``): x the aperture's radius times the
+        # pixels per unit, y 1 / focus, z 1 with a lens (0: a pinhole).
+        ("VEC4", "lens_coc"),
     ),
 )
 

@@ -21,9 +21,11 @@ from .batches import Batches
 from .draw_list import corners_of, draw_list, frame_light_rects, light_masks, lights_in_view
 from .film import Film, FrameOutput
 from .frame_data import build_frame_data, select_lights
+from .lens import lens_camera, lens_offset, lens_reach
 from .lit_pass import LitPass
 from .material_blocks import MaterialBlocks
 from .programs import MAX_LIGHTS
+from .settle import flag_reach
 from .settle import settle as settle_pixels
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
@@ -100,6 +102,8 @@ class FramePlan:
     jitter: bool = False
     moving: set = dataclasses.field(default_factory=set)
     rects: object = None
+    reach: float = 0.0  # pixels the samples look beyond the image (pixel filter, lens)
+    lens_reach: float = 0.0  # of which the lens's: its widest circle of confusion's radius
     _ao_distance: float | None = None
 
     @property
@@ -266,9 +270,6 @@ class Renderer:
         it lights with and the film it draws into. Returns the ``FramePlan`` the later stages read."""
         width, height = size
         accumulate = sample_count > 1
-        # A multi-sample frame's pixel offsets reach Filter Size pixels beyond the image: its
-        # maps are planned for what those samples see too.
-        self.shadow_pass.begin_frame(max(float(settings.filter_size), 0.0) if accumulate else 0.0)
         emission = bool(emission and aux)
         self.film.ensure(width, height, aux, emission)
         # The frame origin: the GPU gets every position relative to the camera (model matrices,
@@ -277,6 +278,11 @@ class Renderer:
         # on it (each is drawn and read through the same shift) and stay reusable when it moves.
         origin = camera.position if np.all(np.isfinite(camera.position)) else np.zeros(3)
         draws = draw_list(snapshot, self.batches, stats, origin, camera, settings, size)
+        # A multi-sample frame's pixel offsets reach Filter Size pixels beyond the image, and
+        # its points of the lens (depth of field) as far as its widest circle of confusion: its
+        # maps and light bins are planned for what those samples see too.
+        reach, lens = self._sample_reach(camera, draws, settings, size, accumulate, stats)
+        self.shadow_pass.begin_frame(reach)
         stats.messages.extend(getattr(snapshot, "messages", ()))
         self.textures.forget(getattr(snapshot, "images_changed", ()))
         world = with_sh_light(snapshot.world, self.textures, self.shaders)
@@ -306,7 +312,28 @@ class Renderer:
             directions=directions,
             cones=cones,
             world_negligible=negligible,
+            reach=reach,
+            lens_reach=lens,
         )
+
+    @staticmethod
+    def _sample_reach(camera, draws, settings, size, accumulate, stats):
+        """Pixels beyond the image the frame's samples look: the pixel filter's reach and the
+        lens's (``lens.lens_reach`` over the depths of what is drawn), in a multi-sample frame;
+        0 for one sample, which looks through the pixel's and the lens's centres (said so in
+        the report where the camera has depth of field). Returns (the whole reach, the lens's)."""
+        if not accumulate:
+            if camera.lens is not None:
+                stats.messages.append(
+                    "Penumbra: depth of field needs 2 or more samples: one sample is drawn through the lens's centre"
+                )
+            return 0.0, 0.0
+        lens = 0.0
+        if camera.lens is not None and draws:
+            depths = lightspace.box_depth_range(camera.projection, camera.view, corners_of(draws), camera.is_ortho)
+            lens = lens_reach(camera, depths, *size) if depths is not None else 0.0
+        stats.lens_reach = lens
+        return max(float(settings.filter_size), 0.0) + lens, lens
 
     @staticmethod
     def _world_directions(snapshot, draws, settings, accumulate):
@@ -347,7 +374,12 @@ class Renderer:
         # A lit debug view's values are not colour: no noise estimate of theirs ends a frame.
         frame.adaptive = adaptive if accumulate and not frame.debug.lit else None
         frame.noise = frame.adaptive is not None and frame.adaptive.threshold > 0.0
-        frame.settle = frame.adaptive is not None and frame.adaptive.settle > 0.0
+        # With depth of field, only where no blur reaches past the settle test's neighbourhood.
+        frame.settle = (
+            frame.adaptive is not None
+            and frame.adaptive.settle > 0.0
+            and flag_reach(settings.filter_size, frame.lens_reach) is not None
+        )
         if not accumulate:
             film.converged = 0  # a single sample shades every pixel, whatever an earlier frame left
             # While the view moves, maps keep the sizes planned NAVIGATION_REPLAN frames ago.
@@ -390,8 +422,7 @@ class Renderer:
         stats.lights_sampled = len(frame.moving)
         # Which part of the screen each light can reach: once a frame, padded by how far its
         # samples move it and by the camera's pixel offsets (light bins, lights out of view).
-        reach = max(float(settings.filter_size), 0.0) if accumulate else 0.0
-        frame.rects = frame_light_rects(lights, frame.draws, frame.camera, width, height, reach)
+        frame.rects = frame_light_rects(lights, frame.draws, frame.camera, width, height, frame.reach)
         if frame.adaptive is not None and frame.adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + frame.adaptive.time_limit
         frame.deadline = deadline
@@ -412,7 +443,13 @@ class Renderer:
             target = self.film.settle_framebuffer()
             self._lit(frame, centre, FrameStats(), test, target)
             stats.pixels_settled = settle_pixels(
-                self.film, frame.settings, frame.adaptive, frame.sample_count, frame.aux, frame.emission
+                self.film,
+                frame.settings,
+                frame.adaptive,
+                frame.sample_count,
+                frame.aux,
+                frame.emission,
+                frame.lens_reach,
             )
 
     def _sample_at(self, frame, s, stats):
@@ -425,10 +462,11 @@ class Renderer:
         sample_start = self._clock.cpu_seconds
         with self._clock.stage("sample set-up"):
             dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
-            view_camera = camera
+            # Depth of field: the sample looks from its point of the lens (lens.py).
+            view_camera = lens_camera(camera, lens_offset(s, camera.lens)) if accumulate and camera.lens else camera
             if dx or dy:
-                jittered = sampling.jittered_projection(camera.projection, dx, dy, width, height)
-                view_camera = dataclasses.replace(camera, projection=jittered)
+                jittered = sampling.jittered_projection(view_camera.projection, dx, dy, width, height)
+                view_camera = dataclasses.replace(view_camera, projection=jittered)
             lights = [
                 sampling.light_at_sample(lt, i, s, count, frame.jitter, progressive=frame.noise)
                 if i in frame.moving

@@ -43,10 +43,16 @@ ENDLESS_MOMENTS = 1024  # the samples a frame without end is taken to have (its 
 MAX_FLAG_REACH = 4  # pixels: a wider filter keeps the 9x9 test (its weight beyond is tiny)
 
 
-def flag_reach(filter_size):
+def flag_reach(filter_size, lens=0.0):
     """How many pixels around a pixel the light test must hold: the nearest pixel centres
-    the pixel filter reaches (Filter Size pixels each way; at least the 3x3 neighbourhood)."""
-    return min(max(1, math.ceil(float(filter_size) - 1e-6)), MAX_FLAG_REACH)
+    the pixel filter reaches (Filter Size pixels each way; at least the 3x3 neighbourhood),
+    and with depth of field as far as the widest circle of confusion's radius (``lens``, in
+    pixels: a blurred surface reaches that far). None where that is beyond MAX_FLAG_REACH
+    with depth of field: the frame does not settle (a wider neighbourhood is not tested)."""
+    reach = max(1, math.ceil(float(filter_size) + float(lens) - 1e-6))
+    if lens > 0.0 and reach > MAX_FLAG_REACH:
+        return None
+    return min(reach, MAX_FLAG_REACH)
 
 
 @functools.lru_cache(maxsize=16)
@@ -69,18 +75,19 @@ def settle_shifts(kept, count, filter_size):
     return tuple(mean_k - mean_n), tuple(second_k - second_n)
 
 
-def settle(film, settings, adaptive, sample_count, aux=False, emission=False):
+def settle(film, settings, adaptive, sample_count, aux=False, emission=False, lens=0.0):
     """Settle the pixels of ``film`` no later sample can change by ``adaptive.settle``, once
     the settle test's variant of the lit pass has drawn its flags over the pilot's surfaces,
     maps and lights into ``film.settle_framebuffer()`` (``Renderer.render``): the film's settle
     pass. ``aux``: the frame has the Shadow pass, which must not change either; ``emission``:
-    and the Emission pass. Returns the number of pixels settled."""
+    and the Emission pass; ``lens``: the widest circle of confusion's radius in pixels (depth
+    of field; ``flag_reach``). Returns the number of pixels settled."""
     before = film.converged
     film.settle(
         adaptive.settle,
         settle_shifts(1, sample_count, settings.filter_size),
         aux,
         emission,
-        flag_reach(settings.filter_size),
+        flag_reach(settings.filter_size, lens),
     )
     return film.converged - before

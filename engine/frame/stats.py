@@ -96,6 +96,7 @@ class FrameStats:
     samples: int = 0  # samples rendered by this call
     lights_sampled: int = 0  # lights that moved between samples (the others kept one map)
     world_directions: int = 0  # directions of the world's light drawn with shadow maps (world/directions.py)
+    lens_reach: float = 0.0  # depth of field: the widest circle of confusion's radius, pixels (frame/lens.py)
     cancelled: bool = False  # on_sample asked to stop before the last sample
     stopped: str = ""  # why the frame ended before its last sample: "converged" or "time limit"
     pixels_converged: int = 0  # pixels adaptive sampling stopped (Noise Threshold)

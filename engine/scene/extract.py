@@ -235,11 +235,28 @@ class Light:
         return d / n if n > 0 and np.isfinite(n) else np.array([0.0, 0.0, -1.0])
 
 
+@dataclass(frozen=True)
+class Lens:
+    """A camera's thin lens, Camera > Depth of Field as Cycles reads it: ``radius`` of the
+    aperture in world units (focal length / (2 f-stop), the focal length in mm read as
+    millimetres of a metre; 1 / (2 f-stop) for an orthographic camera), ``focus`` the distance
+    along the view axis that stays sharp (Focus Distance, or the Focus Object's distance along
+    it), ``blades`` (0: a disc; else a regular polygon of that many corners, at least 3) and
+    their ``rotation``, and ``ratio``: the aperture's x is divided by it (anamorphic bokeh)."""
+
+    radius: float
+    focus: float
+    blades: int = 0
+    rotation: float = 0.0
+    ratio: float = 1.0
+
+
 @dataclass
 class Camera:
     view: np.ndarray  # world -> view
     projection: np.ndarray
     is_ortho: bool = False
+    lens: Lens | None = None  # depth of field (``frame/lens.py``); None: a pinhole
 
     @property
     def position(self):
@@ -296,7 +313,39 @@ def camera_from_scene(depsgraph, scene, width, height, matrix_world=None, shift_
     if any(abs(world.col[i].xyz.length - 1.0) > 1e-6 for i in range(3)):  # unscaled: as it is, to the bit
         world = world.normalized()
     view = matrix_np(world.inverted_safe())
-    return Camera(view=view, projection=proj, is_ortho=ortho)
+    return Camera(view=view, projection=proj, is_ortho=ortho, lens=camera_lens(cam_ob, view))
+
+
+# The nearest focus a lens takes (world units): a Focus Distance of 0 would put every depth
+# infinitely out of focus.
+MIN_FOCUS = 1e-6
+
+
+def camera_lens(cam_ob, view):
+    """The thin lens (``Lens``) of camera object ``cam_ob`` (evaluated) whose world -> view
+    matrix is ``view``, or None: Depth of Field off, or a panoramic camera (not rendered)."""
+    data = cam_ob.data
+    dof = data.dof
+    if not dof.use_dof or data.type == "PANO":
+        return None
+    fstop = max(float(dof.aperture_fstop), 1e-5)
+    radius = 1.0 / (2.0 * fstop) if data.type == "ORTHO" else float(data.lens) * 1e-3 / (2.0 * fstop)
+    focus = float(dof.focus_distance)
+    target = dof.focus_object
+    if target is not None:
+        point = np.array(target.matrix_world.translation, np.float64)
+        bone = target.pose.bones.get(dof.focus_subtarget) if target.pose and dof.focus_subtarget else None
+        if bone is not None:
+            point = np.array((target.matrix_world @ bone.matrix).translation, np.float64)
+        focus = abs(float((view[:3, :3] @ point + view[:3, 3])[2]))  # its distance along the view axis
+    blades = int(dof.aperture_blades)
+    return Lens(
+        radius=radius,
+        focus=max(focus, MIN_FOCUS) if np.isfinite(focus) else 1e30,
+        blades=blades if blades >= 3 else 0,
+        rotation=float(dof.aperture_rotation),
+        ratio=max(float(dof.aperture_ratio), 1e-6),
+    )
 
 
 def exact_depth_rows(proj, near, far, ortho):

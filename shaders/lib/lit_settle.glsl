@@ -121,6 +121,13 @@ vec4 settle_flags(vec3 world_term, float coverage)
 #  if ALPHA_MODE == 1 || ALPHA_MODE == 2
   settled = settled && coverage >= 1.0;
 #  endif
+  /* Depth of field (engine/frame/lens.py): where the circle of confusion is wider than half a
+   * pixel, every point of the lens sees this surface elsewhere. */
+  if (frame.lens_coc.z != 0.0) {
+    float z = max(v_view_depth, 1e-30);
+    float spread = (frame.is_ortho != 0) ? abs(z * frame.lens_coc.y - 1.0) : abs(frame.lens_coc.y - 1.0 / z);
+    settled = settled && 2.0 * frame.lens_coc.x * spread <= 0.5;
+  }
   return vec4(settled ? 1.0 : 0.0, settle_spread, 0.0, 1.0);
 }
 #endif

@@ -16,10 +16,10 @@ SHOWN = [
     "OBJECT_PT_shading",  # holds Light Linking and Shadow Linking
     "OBJECT_PT_shadow_terminator",  # Geometry, Shading and (drawn by compat) Normal Offset
     "PHYSICS_PT_add", "PARTICLE_PT_context_particles", "PENUMBRA_PT_film", "PENUMBRA_PT_passes",
+    "DATA_PT_camera_dof", "DATA_PT_camera_dof_aperture",  # depth of field by lens sampling
 ]  # fmt: skip
 HIDDEN = [
     "DATA_PT_light",  # would repeat the light type switch
-    "DATA_PT_camera_dof",  # depth of field is not rendered
     "RENDER_PT_freestyle", "DATA_PT_lightprobe", "RENDER_PT_eevee_motion_blur", "VIEWLAYER_PT_layer_passes",
 ]  # fmt: skip
 
