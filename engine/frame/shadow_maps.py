@@ -136,6 +136,7 @@ class ShadowAtlas:
         self.columns = 1
         self.depth_format = "FLOAT32"
         self.rsm = False  # the atlas has the reflective targets
+        self.rsm_refused = ""  # why the GPU refused them in the last ``ensure`` ("": it did not)
         self.flux = None  # (rsm) albedo of the surface each texel sees, RGBA16F
         self.normal = None  # (rsm) its world normal, turned towards the light, RGBA16F
         self._rsm_framebuffers = ()  # (rsm, not FLOAT32) the targets the scratch is copied into
@@ -157,6 +158,21 @@ class ShadowAtlas:
         return columns, rows
 
     def ensure(self, size, count, depth_format, rsm=False):
+        """Make the atlas hold ``count`` maps of ``size`` texels stored as ``depth_format``,
+        with the reflective targets when ``rsm``. Where the GPU refuses the reflective targets
+        (an allocation that fails), the atlas is made without them and ``rsm_refused`` says
+        why: the frame renders without the bounce rather than failing."""
+        self.rsm_refused = ""
+        try:
+            self._allocate(size, count, depth_format, rsm)
+        except Exception as exc:  # gpu.types.GPUTexture raises when the driver refuses
+            self.free()
+            if not rsm:
+                raise
+            self._allocate(size, count, depth_format, False)
+            self.rsm_refused = str(exc) or type(exc).__name__
+
+    def _allocate(self, size, count, depth_format, rsm):
         import gpu
 
         count = max(1, count)

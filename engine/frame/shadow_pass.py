@@ -14,7 +14,7 @@ from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, frame_til
 from . import sampling
 from .draw_list import corners_of
 from .frame_data import indirect_samples
-from .programs import image_premultiplied_bits
+from .programs import RSM_TEXEL_BYTES, image_premultiplied_bits
 from .shadow_maps import Caster, ShadowAtlas, TreeCutout
 
 UNSET = object()  # ``ShadowPass.depth_range`` before this frame's first plan
@@ -149,6 +149,17 @@ class ShadowPass:
             map_size = clamped
             self._sizes = self._derived = None  # planned afresh at the clamped size
             plan = self.plan(draws, lights, camera, settings, size, map_size)
+        rsm = indirect_samples(settings) > 0
+        if rsm:  # the bounce's reflective targets, budgeted before they are allocated
+            fitted = reflective_map_size(len(plan.tiles), max(t.size for t in plan.tiles))
+            if fitted is not None:
+                stats.messages.append(
+                    f"Penumbra: shadow map size {map_size} reduced to {fitted} for the bounce's reflective maps: "
+                    f"{len(plan.tiles)} maps would take more than {RSM_BUDGET_BYTES >> 20} MB"
+                )
+                map_size = fitted
+                self._sizes = self._derived = None
+                plan = self.plan(draws, lights, camera, settings, size, map_size)
         if plan.unshadowed:
             stats.messages.append(
                 f"Penumbra: {plan.unshadowed} light(s) left unshadowed: more than {MAX_SHADOW_TILES} shadow maps"
@@ -169,8 +180,12 @@ class ShadowPass:
                         tile.casters = np.array(
                             [c for c in tile.casters if blockers.links(draws[c].instance.names)], dtype=np.int64
                         )
-        rsm = indirect_samples(settings) > 0
         self.atlas.place(plan, settings.shadow_depth_format, rsm)
+        if self.atlas.rsm_refused:
+            stats.messages.append(
+                f"Penumbra: this GPU refused the bounce's reflective maps ({self.atlas.rsm_refused}): "
+                "rendered without the bounce"
+            )
         if self._casters[0] is not draws or self._casters[2] != rsm:  # the frame's, not the sample's
             self._casters = (draws, [caster(d, materials, textures, rsm) for d in draws], rsm)
         casters = self._casters[1]
@@ -306,6 +321,22 @@ def _view_corners(camera):
     except np.linalg.LinAlgError:
         return None
     return c if np.all(np.isfinite(c)) else None
+
+
+# The reflective targets of the bounce (two RGBA16F textures the atlas's size) take at most
+# this many bytes: a frame whose maps would need more draws every map smaller (they share the
+# depth pass's framebuffer, so the atlas's size is theirs), and says so.
+RSM_BUDGET_BYTES = 1 << 30
+
+
+def reflective_map_size(count, largest):
+    """The largest map size at which ``count`` maps' reflective targets fit RSM_BUDGET_BYTES,
+    or None when maps of ``largest`` texels already do (``ShadowAtlas.grid`` places them)."""
+    columns, rows = ShadowAtlas.grid(max(1, count))
+    per_texel = RSM_TEXEL_BYTES * columns * rows
+    if largest * largest * per_texel <= RSM_BUDGET_BYTES:
+        return None
+    return max(1, int(math.isqrt(RSM_BUDGET_BYTES // per_texel)))
 
 
 def _gpu_texture_limit():

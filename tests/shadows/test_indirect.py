@@ -214,3 +214,51 @@ def test_bounce_with_colour_depth_formats(bounce, depth_format):
     ratio = img[mask].mean() / wall_reference(points).mean()
     print(f"{depth_format}: ratio to the numpy reference {ratio:.4f}")
     assert abs(ratio - 1.0) < 0.05
+
+
+def test_reflective_maps_are_budgeted_and_a_refusal_never_fails_the_render(bounce, gpu_call, monkeypatch):
+    """The bounce's reflective targets are budgeted before they are allocated: a frame whose
+    maps would take more than the budget draws them smaller and says so once, still with the
+    bounce (a budget of 1 MB here: the sun's one map of 512 texels reduced to 256, 16 bytes a
+    texel); where the GPU refuses
+    the targets anyway (an allocation that raises), the frame renders without the bounce,
+    the same as Diffuse Bounces 0, with a message, instead of failing."""
+    from penumbra.engine.frame import shadow_maps, shadow_pass
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    assert shadow_pass.reflective_map_size(26, 2730) == math.isqrt((1 << 30) // (16 * 30))  # 6 x 5 slots
+    assert shadow_pass.reflective_map_size(4, 1024) is None
+
+    def frame(scene):
+        def job(engine, depsgraph):
+            out = engine.render_frame(depsgraph, camera_from_scene(depsgraph, scene, W, H), W, H)
+            atlas = engine.renderer.shadows
+            return out.color_array().copy(), list(out.stats.messages), atlas.flux is not None, atlas.size
+
+        return gpu_call(job)
+
+    scene = bounce()
+    plain, _messages, _targets, _size = frame(scene)
+    scene.penumbra.indirect_bounces = 1
+    full, _messages, targets, size = frame(scene)
+    assert targets and size == 512
+    monkeypatch.setattr(shadow_pass, "RSM_BUDGET_BYTES", 1 << 20)
+    small, messages, targets, size = frame(scene)
+    assert targets and size == math.isqrt((1 << 20) // 16) == 256, size
+    assert sum("reduced to" in m and "reflective maps" in m for m in messages) == 1, messages
+    mask, _points = wall_pixels(scene)
+    assert float(small[mask][:, :3].mean()) == pytest.approx(float(full[mask][:, :3].mean()), rel=0.1)
+    monkeypatch.setattr(shadow_pass, "RSM_BUDGET_BYTES", 1 << 30)
+
+    real = shadow_maps.new_texture
+
+    def refuse(pool, size, fmt):
+        if fmt == shadow_maps.RSM_FORMAT:
+            raise RuntimeError("GPUTexture.__new__(...) failed with 'unknown error'")
+        return real(pool, size, fmt)
+
+    monkeypatch.setattr(shadow_maps, "new_texture", refuse)
+    refused, messages, targets, _size = frame(scene)
+    assert not targets
+    assert sum("refused the bounce's reflective maps" in m for m in messages) == 1, messages
+    np.testing.assert_allclose(refused, plain, atol=1e-6)
