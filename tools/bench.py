@@ -1,5 +1,7 @@
 """Benchmarks, one command each (modules in tools/benchmarks/):
 
+    camera    depth of field: error against time vs Cycles (same lens, 1024 spp) and EEVEE
+              -> <out>/camera.csv, camera.png
     assets    glTF assets (devkit/gltf/) imported with Blender's importer: error against Cycles and
               time, Penumbra against EEVEE -> <out>/assets.csv, assets.png
     frame     render time of Penumbra, EEVEE, Workbench and Cycles on the demo scene
@@ -31,10 +33,11 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import assets, frame, perf, post, samples, shadows, soak, terminator, world
+from tools.benchmarks import assets, camera, frame, perf, post, samples, shadows, soak, terminator, world
 
 COMMANDS = {
     "assets": assets,
+    "camera": camera,
     "frame": frame,
     "perf": perf,
     "post": post,
