@@ -1,6 +1,7 @@
 """The RenderEngine subclass: thin glue from Blender's callbacks to the Renderer."""
 
 import dataclasses
+import math
 import sys
 import traceback
 
@@ -19,7 +20,7 @@ from .frame.output import (
     viewport_window,
 )
 from .frame.sampling import adaptive_settings
-from .scene.extract import SceneCache, camera_from_scene, camera_from_view, camera_lens, matrix_np
+from .scene.extract import SceneCache, camera_from_scene, camera_from_view, camera_lens, matrix_np, motion_matrices
 
 ENDLESS_SAMPLES = 64  # how finely soft lights are split when the viewport refines without end
 
@@ -71,6 +72,7 @@ class PenumbraEngineCore:
         adaptive=None,
         deadline=None,
         navigating=False,
+        motion=None,
     ):
         """Extract, then render samples ``samples`` of a frame of ``sample_count`` samples
         (``Renderer.render``); returns the renderer's FrameOutput. ``pixel_scale`` scales the
@@ -104,6 +106,7 @@ class PenumbraEngineCore:
             adaptive=adaptive,
             deadline=deadline,
             navigating=navigating,
+            motion=motion,
         )
         self.last_stats = out.stats
         return out
@@ -237,6 +240,50 @@ class PenumbraEngineCore:
         )
         return viewport_window(width, height, space.use_render_border, border)
 
+    def read_motion(self, depsgraph):
+        """What moves during this frame's shutter (Render > Motion Blur: its Position, Shutter
+        and Shutter Curve), read at the shutter's start, centre and end (``frame_set``, then
+        the frame set back): (``motion.Motion``, or None where nothing moves or motion blur is
+        off; report messages). Deforming meshes move with their object, at the frame's shape."""
+        from .frame.motion import CURVE_POINTS, Motion, moving_only
+
+        scene = depsgraph.scene
+        r = scene.render
+        shutter = float(r.motion_blur_shutter)
+        if not r.use_motion_blur or not (math.isfinite(shutter) and shutter > 0.0):
+            return None, []
+        start = {"START": 0.0, "CENTER": -0.5, "END": -1.0}.get(r.motion_blur_position, -0.5) * shutter
+        frame, subframe = scene.frame_current, float(scene.frame_subframe)
+        times = (0.0, 0.5, 1.0)
+        steps, cameras = [], []
+        try:
+            for t in times:
+                at = frame + subframe + start + t * shutter
+                whole = math.floor(at)
+                self.frame_set(int(whole), at - whole)
+                steps.append(motion_matrices(depsgraph))
+                cameras.append(_camera_view(scene.camera.evaluated_get(depsgraph)))
+        finally:
+            self.frame_set(frame, subframe)
+        reference = _camera_view(scene.camera.evaluated_get(depsgraph))
+        common = set(steps[0]).intersection(*steps[1:])
+        moving = moving_only({k: [m[k] for m in steps] for k in common})
+        camera = cameras if any(not np.array_equal(cameras[0], c) for c in cameras[1:]) else None
+        curve = _shutter_curve(r.motion_blur_shutter_curve, CURVE_POINTS)
+        motion = Motion(times=times, instances=moving, lights=moving, camera=camera, camera_ref=reference, curve=curve)
+        messages = []
+        deforming = sorted(
+            {
+                ob.name
+                for ob in scene.objects
+                if ob.type in ("MESH", "CURVES") and ob.visible_get() and _deforms(ob, scene)
+            }
+        )
+        if deforming:
+            names = ", ".join(f"'{n}'" for n in deforming[:3]) + (" ..." if len(deforming) > 3 else "")
+            messages.append(f"Penumbra: deformation motion blur is not rendered: {names} keep the frame's shape")
+        return (motion if motion.moves else None), messages
+
 
 class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
     bl_idname = "PENUMBRA"
@@ -291,6 +338,13 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         for message in unsupported_in_use(scene.camera.data, r, depsgraph.view_layer):
             self.report({"WARNING"}, message)
         try:
+            motion, messages = self.read_motion(depsgraph)
+        except Exception as exc:  # a render must end with a message, never a crash
+            traceback.print_exc(file=sys.stderr)
+            motion, messages = None, [f"Penumbra: motion blur could not be read ({exc}): rendered without it"]
+        for message in messages:
+            self.report({"WARNING"}, message)
+        try:
             limit = _gpu_texture_limit()
             if max(width, height) > limit:
                 self.report(
@@ -343,6 +397,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     on_sample=on_sample,
                     emission=vl.use_pass_emit,
                     adaptive=adaptive,
+                    motion=motion,
                 )
                 if out.stats.cancelled:
                     return  # cancelled: no result is written for this view
@@ -445,6 +500,32 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.draw_display(depsgraph.scene, out.color, width, height, window)
         if self.refining():
             self.tag_redraw()  # the next redraw refines: full resolution, or one more sample
+
+
+def _camera_view(cam_ob):
+    """A camera object's world -> view matrix, its scale ignored (as ``camera_from_scene``)."""
+    world = cam_ob.matrix_world
+    if any(abs(world.col[i].xyz.length - 1.0) > 1e-6 for i in range(3)):
+        world = world.normalized()
+    return matrix_np(world.inverted_safe())
+
+
+def _shutter_curve(mapping, points):
+    """Render > Motion Blur > Shutter Curve at ``points`` even fractions of the shutter, or
+    None where it is flat (every time weighs the same)."""
+    try:
+        mapping.initialize()
+        values = tuple(float(mapping.evaluate(mapping.curves[0], k / (points - 1))) for k in range(points))
+    except (AttributeError, IndexError, RuntimeError, TypeError):
+        return None
+    return None if max(values) - min(values) < 1e-6 else values
+
+
+def _deforms(ob, scene):
+    try:
+        return bool(ob.is_deform_modified(scene, "RENDER"))
+    except (AttributeError, TypeError, RuntimeError):
+        return False
 
 
 def _gpu_texture_limit():

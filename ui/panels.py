@@ -173,6 +173,39 @@ class PENUMBRA_PT_film(PenumbraPanel, bpy.types.Panel):
         layout.prop(context.scene.render, "film_transparent")
 
 
+class PENUMBRA_PT_motion_blur(PenumbraPanel, bpy.types.Panel):
+    """Render > Motion Blur, Blender's own settings as Penumbra reads them
+    (``engine/frame/motion.py``): Position, Shutter and the Shutter Curve below."""
+
+    bl_label = "Motion Blur"
+    bl_context = "render"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.render, "use_motion_blur", text="")
+
+    def draw(self, context):
+        layout = self.split_layout()
+        rd = context.scene.render
+        layout.active = rd.use_motion_blur
+        col = layout.column()
+        col.prop(rd, "motion_blur_position", text="Position")
+        col.prop(rd, "motion_blur_shutter")
+
+
+class PENUMBRA_PT_motion_blur_curve(PenumbraPanel, bpy.types.Panel):
+    bl_label = "Shutter Curve"
+    bl_context = "render"
+    bl_parent_id = "PENUMBRA_PT_motion_blur"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        rd = context.scene.render
+        layout.active = rd.use_motion_blur
+        layout.template_curve_mapping(rd, "motion_blur_shutter_curve")
+
+
 class PENUMBRA_PT_passes(PenumbraPanel, bpy.types.Panel):
     """The passes Penumbra writes (Combined always)."""
 
@@ -301,6 +334,8 @@ classes = (
     PENUMBRA_PT_sampling_viewport,
     PENUMBRA_PT_sampling_render,
     PENUMBRA_PT_film,
+    PENUMBRA_PT_motion_blur,
+    PENUMBRA_PT_motion_blur_curve,
     PENUMBRA_PT_passes,
     PENUMBRA_PT_shadows,
     PENUMBRA_PT_light,

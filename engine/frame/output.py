@@ -91,7 +91,6 @@ def render_views(render):
 # final render; each one in use is named once in the render report.
 _UNSUPPORTED = (
     ("camera", "type", "panoramic cameras are not rendered (drawn as a perspective camera)", "PANO"),
-    ("render", "use_motion_blur", "motion blur is not rendered"),
     ("render", "use_freestyle", "Freestyle lines are not rendered"),
 )
 

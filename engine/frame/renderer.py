@@ -17,6 +17,7 @@ from ..scene.textures import TextureCache
 from ..shadows import lightspace
 from ..shadows.planning import frame_sizes
 from . import debug_view, sampling
+from . import motion as motion_mod
 from .batches import Batches
 from .draw_list import corners_of, draw_list, frame_light_rects, light_masks, lights_in_view
 from .film import Film, FrameOutput
@@ -65,6 +66,7 @@ class SampleResult:
     plan: object
     cameras: tuple
     data: object = None
+    draws: list = None  # its draw list (a motion-blurred sample's own; None: the frame's)
 
 
 @dataclasses.dataclass
@@ -103,6 +105,7 @@ class FramePlan:
     moving: set = dataclasses.field(default_factory=set)
     rects: object = None
     reach: float = 0.0  # pixels the samples look beyond the image (pixel filter, lens)
+    motion: object = None  # ``motion.Motion``: each sample at its own time in the shutter
     lens_reach: float = 0.0  # of which the lens's: its widest circle of confusion's radius
     _ao_distance: float | None = None
 
@@ -200,6 +203,7 @@ class Renderer:
         adaptive=None,
         deadline=None,
         navigating=False,
+        motion=None,
     ):
         """Samples ``samples[0] .. samples[1] - 1`` of a frame of ``sample_count`` samples
         (``frame/sampling.py``), added to the samples this renderer already accumulated for
@@ -217,7 +221,9 @@ class Renderer:
         when there is no time limit: a frame stays a function of the scene and its settings.
         ``navigating``: a one-sample frame while the view moves; its lights' maps keep the
         sizes a navigation frame planned at most NAVIGATION_REPLAN frames before (one fit per
-        map, not two), and the frame after the view stops plans afresh.
+        map, not two), and the frame after the view stops plans afresh. ``motion``
+        (``motion.Motion``): what moves during the shutter; each sample of a multi-sample
+        frame is drawn at its own time in it (motion blur).
 
         The frame's stages, in order: plan (``_plan``: what the frame draws, its lights and
         the world's, which lights move and their maps' sizes), then per sample the settle test
@@ -232,6 +238,7 @@ class Renderer:
             frame = self._plan(
                 snapshot, camera, settings, (width, height), aux, emission, sample_count, adaptive, stats
             )
+            frame.motion = self._motion(motion, frame.accumulate, stats)
             self._plan_samples(frame, samples[0], adaptive, deadline, navigating, stats)
         drawn = None
         pixels = width * height
@@ -336,6 +343,19 @@ class Renderer:
         return max(float(settings.filter_size), 0.0) + lens, lens
 
     @staticmethod
+    def _motion(motion, accumulate, stats):
+        """The frame's ``Motion`` where something moves and the frame has samples to spread
+        over the shutter; a one-sample frame is drawn at the frame's time, and says so."""
+        if motion is None or not motion.moves:
+            return None
+        if not accumulate:
+            stats.messages.append(
+                "Penumbra: motion blur needs 2 or more samples: one sample is drawn at the frame's time"
+            )
+            return None
+        return motion
+
+    @staticmethod
     def _world_directions(snapshot, draws, settings, accumulate):
         """How many directions of the world's light each sample of the frame draws with maps
         (``world/directions.py``), and the cones of its light portals that gather them."""
@@ -376,7 +396,8 @@ class Renderer:
         frame.noise = frame.adaptive is not None and frame.adaptive.threshold > 0.0
         # With depth of field, only where no blur reaches past the settle test's neighbourhood.
         frame.settle = (
-            frame.adaptive is not None
+            frame.motion is None  # a moving surface's pixels change with the sample's time
+            and frame.adaptive is not None
             and frame.adaptive.settle > 0.0
             and flag_reach(settings.filter_size, frame.lens_reach) is not None
         )
@@ -409,20 +430,25 @@ class Renderer:
             # or the frame would start afresh) keeps what the first call decided (a cache keyed
             # by what decides it).
             frame_key = (frame.sample_count, frame.jitter, tuple(lt.use_shadow for lt in lights))
-            if start > 0 and self._frame_plan is not None and self._frame_plan[0] == frame_key:
+            # With motion blur every sample plans its maps from its own scene (``_sample_at``):
+            # the frame's centred plan says only which lights move.
+            cached = self._frame_plan is not None and self._frame_plan[0] == frame_key
+            if start > 0 and cached and frame.motion is None:
                 frame.moving, sizes = self._frame_plan[1:]
                 self.shadow_pass.use_sizes(sizes)
             else:
                 first = self.shadow_pass.first_plan(frame.draws, lights, frame.camera, settings, film.size, True)
-                self.shadow_pass.keep_sizes(first, settings, lights)
                 frame.moving = sampling.sampled_lights(lights, first, every=frame.jitter)
                 if frame.jitter:
                     frame.moving |= {i for i in first.lights if i < len(lights)}
-                self._frame_plan = (frame_key, frame.moving, self.shadow_pass.sizes)
+                if frame.motion is None:
+                    self.shadow_pass.keep_sizes(first, settings, lights)
+                    self._frame_plan = (frame_key, frame.moving, self.shadow_pass.sizes)
         stats.lights_sampled = len(frame.moving)
         # Which part of the screen each light can reach: once a frame, padded by how far its
         # samples move it and by the camera's pixel offsets (light bins, lights out of view).
-        frame.rects = frame_light_rects(lights, frame.draws, frame.camera, width, height, frame.reach)
+        if frame.motion is None:  # with motion blur each sample's own (``lights_in_view``)
+            frame.rects = frame_light_rects(lights, frame.draws, frame.camera, width, height, frame.reach)
         if frame.adaptive is not None and frame.adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + frame.adaptive.time_limit
         frame.deadline = deadline
@@ -460,7 +486,17 @@ class Renderer:
         width, height = frame.size
         accumulate, count = frame.accumulate, frame.sample_count
         sample_start = self._clock.cpu_seconds
+        draws, frame_lights = frame.draws, frame.lights
         with self._clock.stage("sample set-up"):
+            if frame.motion is not None:
+                # Motion blur: the sample's time in the shutter moves objects, lights and camera.
+                u = motion_mod.sample_time(s, count, frame.motion.curve)
+                moved = motion_mod.instances_at(frame.snapshot.instances, frame.motion, u)
+                snapshot = dataclasses.replace(frame.snapshot, instances=moved)
+                draws = draw_list(snapshot, self.batches, stats, frame.origin, camera, settings, frame.size)
+                frame_lights = motion_mod.lights_at(frame.lights, frame.motion, u)
+                camera = motion_mod.camera_at(camera, frame.motion, u)
+                self.shadow_pass.begin_frame(frame.reach)  # this sample's maps from its own scene
             dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
             # Depth of field: the sample looks from its point of the lens (lens.py).
             view_camera = lens_camera(camera, lens_offset(s, camera.lens)) if accumulate and camera.lens else camera
@@ -471,7 +507,7 @@ class Renderer:
                 sampling.light_at_sample(lt, i, s, count, frame.jitter, progressive=frame.noise)
                 if i in frame.moving
                 else lt
-                for i, lt in enumerate(frame.lights)
+                for i, lt in enumerate(frame_lights)
             ]
             if frame.directions and s >= frame.first_directions:
                 index = (s - frame.first_directions) * frame.directions
@@ -483,7 +519,7 @@ class Renderer:
             ao=frame.world_ao(s),
             index=s,
         )
-        drawn = self._sample(frame, lights, view_camera, stats, spec)
+        drawn = self._sample(frame, lights, view_camera, stats, spec, draws, camera)
         with self._clock.stage("accumulate"):
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
@@ -552,13 +588,16 @@ class Renderer:
             out.depth_data, out.normal_data = film.centre
         return out
 
-    def _sample(self, frame, lights, view_camera, stats, spec):
+    def _sample(self, frame, lights, view_camera, stats, spec, draws=None, camera=None):
         """One sample (``spec``, a ``SampleSpec``) of ``frame`` with ``lights``: shadow maps
-        (planned from the unjittered camera, so a light that does not move between samples
-        keeps its map), then the lit pass seen through ``view_camera``. With ``spec.ao`` the
-        camera depth prepass of the world's ambient occlusion is drawn first through the lit
+        (planned from the unjittered ``camera``, the frame's unless given, so a light that does
+        not move between samples keeps its map), then the lit pass seen through ``view_camera``,
+        of ``draws`` (the frame's unless given: a motion-blurred sample's own). With ``spec.ao``
+        the camera depth prepass of the world's ambient occlusion is drawn first through the lit
         pass's raster camera (``world/occlusion.py``). Returns what it drew (``SampleResult``)."""
-        film, draws, camera = self.film, frame.draws, frame.camera
+        film = self.film
+        draws = frame.draws if draws is None else draws
+        camera = frame.camera if camera is None else camera
         width, height = film.size
         lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats, frame.rects)
         self._clock.begin("shadow pass")
@@ -585,7 +624,7 @@ class Renderer:
         raster_camera = (
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
         )
-        result = SampleResult(lights, plan, (raster_camera, view_camera, rects))
+        result = SampleResult(lights, plan, (raster_camera, view_camera, rects), draws=draws)
         if spec.ao is not None:
             with self._clock.stage("world ao"):
                 self.world_ao.draw(
@@ -640,7 +679,7 @@ class Renderer:
             rsm=atlas is not None and atlas.rsm,
             world_ratio=frame.world_ratio,
         )
-        seen = [d for d in frame.draws if d.instance.camera]
+        seen = [d for d in (sample.draws if sample.draws is not None else frame.draws) if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
         world = (snapshot.world, snapshot.world_color)
         ao_depth = self.world_ao.texture if ao is not None else None

@@ -89,6 +89,7 @@ class MeshInstance:
     color: tuple = (1.0, 1.0, 1.0, 1.0)  # Object > Viewport Display > Color (the Object Info node's)
     random: float = 0.0  # the Object Info node's Random: Blender's per-object (or per-instance) hash
     hair: str | None = None  # hair strips (``Geometry.strands``): Render > Curves > Shape (STRAND, STRIP)
+    motion_key: tuple = ()  # which instance it is at another time of the shutter (``motion_key``)
 
 
 @dataclass(frozen=True)
@@ -193,6 +194,7 @@ class Light:
     receivers: LinkSet | None = None  # light linking: what it lights (None: everything)
     blockers: LinkSet | None = None  # shadow linking: what casts its shadow (None: everything)
     name: str = ""  # the light object's name (what the SHADOW_MAPS debug view labels its maps with)
+    motion_key: tuple = ()  # which light it is at another time of the shutter (``motion_key``)
     # A direction of the world's light (``frame/world/directions.py``): a sun whose ``color`` is
     # the world's radiance from it over its probability.
     world: bool = False
@@ -804,6 +806,7 @@ class SceneCache:
                 light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
                 if light is not None:
                     light.name = ob.name
+                    light.motion_key = motion_key(inst)
                     linking = getattr(ob, "light_linking", None)
                     if linking is not None:
                         light.receivers = linked(linking.receiver_collection)
@@ -853,6 +856,7 @@ class SceneCache:
                         if inst.is_instance and inst.parent is not None
                         else (orig.name_full,),
                         hair=strip,
+                        motion_key=motion_key(inst),
                     )
                 )
 
@@ -935,6 +939,23 @@ def is_portal(data):
     """Whether light ``data`` is a Cycles light portal (an area light that only tells where the
     world's light enters: it emits nothing)."""
     return data.type == "AREA" and bool(getattr(getattr(data, "cycles", None), "is_portal", False))
+
+
+def motion_key(inst):
+    """An instance of ``depsgraph.object_instances`` as the same one at another time of the
+    frame: its object, its instancer and its persistent id within it."""
+    ob = inst.object
+    orig = ob.original if ob.original is not None else ob
+    if inst.is_instance and inst.parent is not None:
+        parent = inst.parent.original if inst.parent.original is not None else inst.parent
+        return (orig.name_full, parent.name_full, tuple(inst.persistent_id))
+    return (orig.name_full,)
+
+
+def motion_matrices(depsgraph):
+    """{``motion_key``: world matrix} of every object instance at the depsgraph's time (what
+    ``render_engine.read_motion`` reads at each step of the shutter)."""
+    return {motion_key(inst): matrix_np(inst.matrix_world) for inst in depsgraph.object_instances}
 
 
 def light_from_blender(data, matrix):

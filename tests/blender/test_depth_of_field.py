@@ -30,7 +30,7 @@ def _scene(depth, focus, fstop=0.2, dof=True, samples=SAMPLES, blades=0):
     cam.data.dof.focus_distance = focus
     cam.data.dof.aperture_fstop = fstop
     cam.data.dof.aperture_blades = blades
-    scene.render.filter_size = 0.0
+    scene.penumbra.filter_size = 0.0
     scene.penumbra.render_samples = samples
     scene.penumbra.use_adaptive_sampling = False
     return scene
@@ -174,8 +174,8 @@ def test_defocused_pixels_keep_sampling_in_focus_ones_may_settle(penumbra, gpu_c
     assert defocused.sum() > 0.02 * mask.size
     assert not (mask & defocused).any(), int((mask & defocused).sum())
     if fstop == 0.35:  # the case that settles: its blur stays within the tested neighbourhood
-        assert flag_reach(scene.render.filter_size, reach) is not None, reach
-    if flag_reach(scene.render.filter_size, reach) is None:
+        assert flag_reach(scene.penumbra.filter_size, reach) is not None, reach
+    if flag_reach(scene.penumbra.filter_size, reach) is None:
         assert settled == 0 and not mask.any()
     else:
         assert settled > 0.02 * mask.size and mask.sum() == settled

@@ -17,6 +17,7 @@ SHOWN = [
     "OBJECT_PT_shadow_terminator",  # Geometry, Shading and (drawn by compat) Normal Offset
     "PHYSICS_PT_add", "PARTICLE_PT_context_particles", "PENUMBRA_PT_film", "PENUMBRA_PT_passes",
     "DATA_PT_camera_dof", "DATA_PT_camera_dof_aperture",  # depth of field by lens sampling
+    "PENUMBRA_PT_motion_blur", "PENUMBRA_PT_motion_blur_curve",  # Blender's motion blur settings
 ]  # fmt: skip
 HIDDEN = [
     "DATA_PT_light",  # would repeat the light type switch

@@ -57,14 +57,14 @@ def build(width, height):
     cam.dof.use_dof = True
     cam.dof.focus_object = scene.objects["Ball"]
     cam.dof.aperture_fstop = FSTOP
-    scene.render.filter_size = 1.5
+    scene.render.filter_size = scene.penumbra.filter_size = 1.5  # EEVEE's and Penumbra's
     return scene
 
 
 def _cycles(scene, spp):
     configure(scene, "CYCLES", samples=spp)
     scene.cycles.pixel_filter_type = "BLACKMAN_HARRIS"
-    scene.cycles.filter_width = scene.render.filter_size  # Cycles widens Blackman-Harris 2x itself: the same window
+    scene.cycles.filter_width = scene.penumbra.filter_size  # Cycles widens Blackman-Harris 2x itself: the same window
 
 
 def display(image):
