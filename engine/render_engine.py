@@ -242,9 +242,10 @@ class PenumbraEngineCore:
 
     def read_motion(self, depsgraph):
         """What moves during this frame's shutter (Render > Motion Blur: its Position, Shutter
-        and Shutter Curve), read at the shutter's start, centre and end (``frame_set``, then
-        the frame set back): (``motion.Motion``, or None where nothing moves or motion blur is
-        off; report messages). Deforming meshes move with their object, at the frame's shape."""
+        and Shutter Curve), read at the shutter's steps (``motion_steps``; ``frame_set`` to
+        each, then the frame set back): (``motion.Motion``, or None where nothing moves or
+        motion blur is off; report messages). An object with Cycles' Object > Motion Blur off
+        does not blur; deforming meshes move with their object, at the frame's shape."""
         from .frame.motion import CURVE_POINTS, Motion, moving_only
 
         scene = depsgraph.scene
@@ -254,7 +255,8 @@ class PenumbraEngineCore:
             return None, []
         start = {"START": 0.0, "CENTER": -0.5, "END": -1.0}.get(r.motion_blur_position, -0.5) * shutter
         frame, subframe = scene.frame_current, float(scene.frame_subframe)
-        times = (0.0, 0.5, 1.0)
+        count = motion_steps(scene.objects)
+        times = tuple(k / (count - 1) for k in range(count))
         steps, cameras = [], []
         try:
             for t in times:
@@ -266,23 +268,54 @@ class PenumbraEngineCore:
         finally:
             self.frame_set(frame, subframe)
         reference = _camera_view(scene.camera.evaluated_get(depsgraph))
-        common = set(steps[0]).intersection(*steps[1:])
+        still = {ob.name_full for ob in scene.objects if not _blurs(ob)}
+        common = {k for k in set(steps[0]).intersection(*steps[1:]) if k[0] not in still}
         moving = moving_only({k: [m[k] for m in steps] for k in common})
-        camera = cameras if any(not np.array_equal(cameras[0], c) for c in cameras[1:]) else None
+        moves = any(not np.array_equal(cameras[0], c) for c in cameras[1:]) and _blurs(scene.camera)
         curve = _shutter_curve(r.motion_blur_shutter_curve, CURVE_POINTS)
+        camera = cameras if moves else None
         motion = Motion(times=times, instances=moving, lights=moving, camera=camera, camera_ref=reference, curve=curve)
         messages = []
         deforming = sorted(
             {
                 ob.name
                 for ob in scene.objects
-                if ob.type in ("MESH", "CURVES") and ob.visible_get() and _deforms(ob, scene)
+                if ob.type in ("MESH", "CURVES")
+                and ob.visible_get()
+                and _blurs(ob, deform=True)
+                and _deforms(ob, scene)
             }
         )
         if deforming:
             names = ", ".join(f"'{n}'" for n in deforming[:3]) + (" ..." if len(deforming) > 3 else "")
             messages.append(f"Penumbra: deformation motion blur is not rendered: {names} keep the frame's shape")
         return (motion if motion.moves else None), messages
+
+
+# Cycles' most steps of an object's motion (Object::MAX_MOTION_STEPS).
+MAX_MOTION_STEPS = 129
+
+
+def motion_steps(objects):
+    """How many times in the shutter transforms are read: Cycles' Object > Motion Blur >
+    Steps n gives 2^n + 1 (3 at its default 1), the most of any object that blurs, at most
+    MAX_MOTION_STEPS (so objects with fewer steps still have theirs among them)."""
+    most = 1
+    for ob in objects:
+        settings = getattr(ob, "cycles", None)
+        if settings is not None and _blurs(ob):
+            most = max(most, int(getattr(settings, "motion_steps", 1)))
+    return min((2 << (min(most, 64) - 1)) + 1, MAX_MOTION_STEPS)
+
+
+def _blurs(ob, deform=False):
+    """Cycles' Object > Motion Blur (and its Deformation, ``deform``): on unless switched off."""
+    settings = getattr(ob, "cycles", None)
+    if settings is None:
+        return True
+    return bool(getattr(settings, "use_motion_blur", True)) and (
+        not deform or bool(getattr(settings, "use_deform_motion", True))
+    )
 
 
 class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):

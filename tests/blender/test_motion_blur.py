@@ -151,3 +151,26 @@ def test_the_shutters_steps_are_read_once_and_deformation_is_named(penumbra, gpu
     assert len(messages) == 1 and "'Wobbly'" in messages[0] and "deformation motion blur" in messages[0]
     scene.render.use_motion_blur = False
     assert gpu_call(job)[0] is None
+
+
+@pytest.mark.parametrize("steps", [1, 2, 64])
+def test_motion_steps_are_cycles_and_an_object_can_opt_out(penumbra, gpu_call, steps):
+    """Cycles' Object > Motion Blur > Steps n reads 2^n + 1 times (3, 5, and at 64 Cycles'
+    most, 129), evenly over the shutter; an object with its Motion Blur off does not blur."""
+    from penumbra.engine.render_engine import MAX_MOTION_STEPS
+
+    scene = _scene()
+    ball = scene.objects["Ball"]
+    ball.cycles.motion_steps = steps
+
+    def job(engine, depsgraph):
+        return engine.read_motion(depsgraph)[0]
+
+    motion = gpu_call(job)
+    count = min(2**steps + 1, MAX_MOTION_STEPS)
+    assert len(motion.times) == count and motion.times[0] == 0.0 and motion.times[-1] == 1.0
+    xs = [m[0, 3] for m in motion.instances[("Ball",)]]
+    np.testing.assert_allclose(xs, np.linspace(-0.25, 0.25, count), atol=1e-6)
+    if steps == 1:
+        ball.cycles.use_motion_blur = False
+        assert gpu_call(job) is None
