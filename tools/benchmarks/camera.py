@@ -1,20 +1,23 @@
-"""Depth of field by lens sampling: what each sample buys in error, and what it costs.
+"""The camera's lens and shutter by sampling: what each sample buys in error, and its cost.
 
-The demo scene without its post layers, its camera focused on the ball at f/0.1 (the ground
-before it and the slab and pillar behind it well out of focus), rendered by Penumbra at
-``--samples`` (4, 16, 64, 256), Cycles at 16 ... 256 spp and EEVEE at its defaults (16
-samples, its depth of field a post-process), all with the same lens and the same pixel filter
-(Blackman-Harris, Filter Size 1.5: Cycles' Pixel Filter Width 1.5), against Cycles at ``--reference`` spp
-(1024; direct light: max_bounces 0, cached per clone under out/reference_cache). For each: the
-median time of ``--runs`` F12 renders after a warm-up and the image's MAE in display space
-(Standard view, sRGB-encoded, clipped to [0, 1]).
+Three scenes from the demo scene without its post layers: ``defocus`` (its camera focused on
+the ball at f/0.1: the ground before it and the slab and pillar behind it well out of focus),
+``moving`` (the ball crossing the view at 3 units a frame, a shutter of half a frame) and
+``spinning`` (the crate turning half a turn a frame), rendered by Penumbra at ``--samples``
+(4, 16, 64, 256), Cycles at 16 ... 256 spp and EEVEE at its defaults (16 samples; its depth
+of field a post-process, its motion blur one step), all with the same lens, shutter and pixel
+filter (Blackman-Harris, Filter Size 1.5: Cycles' Pixel Filter Width 1.5), against Cycles at
+``--reference`` spp (1024; direct light: max_bounces 0, cached per clone under
+out/reference_cache). For each: the median time of ``--runs`` F12 renders after a warm-up and
+the image's MAE in display space (Standard view, sRGB-encoded, clipped to [0, 1]).
 
-Writes ``<out>/camera.csv`` and ``<out>/camera.png`` (error against time, and the reference
-beside Penumbra's 16 and 64 samples); a Markdown table to stdout. ``--quick``: 160x90,
-reference 256 spp.
+Writes ``<out>/camera.csv`` and ``<out>/camera.png`` (error against time per scene, and each
+scene's reference beside Penumbra's 64 samples); a Markdown table to stdout. ``--quick``:
+160x90, reference 256 spp, one run.
 """
 
 import hashlib
+import math
 import sys
 import time
 from pathlib import Path
@@ -30,7 +33,7 @@ HELP = "depth of field: error against time vs Cycles (same lens) and EEVEE -> <o
 
 CACHE = Path("out") / "reference_cache"
 FSTOP = 0.1
-CSV_FIELDS = ["engine", "samples", "time_s", "mae"]
+CSV_FIELDS = ["scene", "engine", "samples", "time_s", "mae"]
 
 
 def add_arguments(parser):
@@ -42,23 +45,57 @@ def add_arguments(parser):
     parser.add_argument("--samples", default="4,16,64,256", help="Penumbra's render samples (comma-separated)")
     parser.add_argument("--cycles-spp", default="16,64,128,256", help="Cycles' samples to time (comma-separated)")
     parser.add_argument("--reference", type=int, default=1024, help="Cycles' reference spp (default 1024)")
+    parser.add_argument("--scenes", default="defocus,moving,spinning", help="comma-separated: " + ", ".join(SCENES))
 
 
 def log(message):
     print(f"bench camera: {message}", file=sys.stderr, flush=True)
 
 
-def build(width, height):
-    """The demo scene without post layers, focused on the ball at f/0.1."""
+def _demo(width, height):
     scene = scenes.demo_scene(width, height)
     scene.penumbra.layers.clear()
     scene.view_settings.view_transform = "Standard"
+    scene.render.filter_size = scene.penumbra.filter_size = 1.5  # EEVEE's and Penumbra's
+    return scene
+
+
+def defocus(width, height):
+    """The demo scene focused on the ball at f/0.1."""
+    scene = _demo(width, height)
     cam = scene.camera.data
     cam.dof.use_dof = True
     cam.dof.focus_object = scene.objects["Ball"]
     cam.dof.aperture_fstop = FSTOP
-    scene.render.filter_size = scene.penumbra.filter_size = 1.5  # EEVEE's and Penumbra's
     return scene
+
+
+def _animated(scene, ob, path, index, values):
+    for frame, value in zip((1, 3), values, strict=True):
+        getattr(ob, path)[index] = value
+        ob.keyframe_insert(path, index=index, frame=frame)
+    scene.frame_set(2)
+    scene.render.use_motion_blur = True
+    scene.render.motion_blur_shutter = 0.5
+    scene.render.motion_blur_position = "CENTER"
+    return scene
+
+
+def moving(width, height):
+    """The ball crossing the view at 3 units a frame (1.5 within the shutter)."""
+    scene = _demo(width, height)
+    ball = scene.objects["Ball"]
+    x = ball.location.x
+    return _animated(scene, ball, "location", 0, (x - 3.0, x + 3.0))
+
+
+def spinning(width, height):
+    """The crate turning half a turn a frame about its vertical axis."""
+    scene = _demo(width, height)
+    return _animated(scene, scene.objects["Crate"], "rotation_euler", 2, (0.0, 2.0 * math.pi))
+
+
+SCENES = {"defocus": defocus, "moving": moving, "spinning": spinning}
 
 
 def _cycles(scene, spp):
@@ -73,9 +110,12 @@ def display(image):
     return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
 
 
-def reference(scene, spp):
-    """Cycles' image at ``spp`` (display values), cached by Blender version, size and spp."""
-    key = f"camera-{bpy.app.version_string}-{scene.render.resolution_x}x{scene.render.resolution_y}-{spp}-{FSTOP}"
+def reference(name, scene, spp):
+    """Cycles' image of scene ``name`` at ``spp`` (display values), cached by Blender version,
+    scene, size and spp (and this file's content)."""
+    own = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:10]
+    size = f"{scene.render.resolution_x}x{scene.render.resolution_y}"
+    key = f"camera-{own}-{bpy.app.version_string}-{name}-{size}-{spp}"
     path = CACHE / f"{hashlib.sha256(key.encode()).hexdigest()[:16]}.npy"
     if path.exists():
         return np.load(path)
@@ -91,37 +131,63 @@ def measure(scene, runs, ref):
     return timing.render(runs, warmup=0).median, float(np.abs(image - ref).mean()), image
 
 
-def plot(rows, shown, ref, path, title):
+def plot(rows, shown, path, title):
+    """Error against time per scene (top), each scene's reference and Penumbra's 64 samples."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(12, 7))
-    ax = fig.add_subplot(2, 1, 1)
+    names = list(shown)
+    fig, axes = plt.subplots(3, len(names), figsize=(4.5 * len(names), 10), squeeze=False)
     styles = {"Penumbra": ("tab:blue", "-o"), "Cycles": ("tab:red", "-P"), "EEVEE": ("tab:purple", "*")}
-    for engine, (colour, style) in styles.items():
-        pts = sorted((r for r in rows if r["engine"] == engine), key=lambda r: r["samples"])
-        ax.plot([r["time_s"] for r in pts], [r["mae"] for r in pts], style, color=colour, label=engine)
-        for r in pts:
-            ax.annotate(
-                str(r["samples"]), (r["time_s"], r["mae"]), fontsize=7, xytext=(3, 3), textcoords="offset points"
-            )
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("time per frame (s, median, log)")
-    ax.set_ylabel("display MAE vs the Cycles reference")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(title, fontsize=9)
-    for k, (label, image) in enumerate([("Cycles reference", ref), *shown]):
-        sub = fig.add_subplot(2, 3, 4 + k)
-        sub.imshow(image[::-1], interpolation="nearest")
-        sub.set_title(label, fontsize=8)
-        sub.axis("off")
+    for col, name in enumerate(names):
+        ax = axes[0, col]
+        for engine, (colour, style) in styles.items():
+            pts = sorted((r for r in rows if r["engine"] == engine and r["scene"] == name), key=lambda r: r["samples"])
+            ax.plot([r["time_s"] for r in pts], [r["mae"] for r in pts], style, color=colour, label=engine)
+            for r in pts:
+                where = (r["time_s"], r["mae"])
+                ax.annotate(str(r["samples"]), where, fontsize=7, xytext=(3, 3), textcoords="offset points")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("time per frame (s, median, log)")
+        ax.set_ylabel("display MAE vs the reference")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title(name, fontsize=9)
+        for row, (label, image) in enumerate(shown[name], start=1):
+            axes[row, col].imshow(image[::-1], interpolation="nearest")
+            axes[row, col].set_title(f"{name}: {label}", fontsize=8)
+            axes[row, col].axis("off")
+    fig.suptitle(title, fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+def sweep(name, width, height, spp, samples, cycles_spp, runs):
+    """Rows of scene ``name`` and its (reference, Penumbra 64) images."""
+    scene = SCENES[name](width, height)
+    log(f"{name}: Cycles reference {spp} spp at {width}x{height}")
+    ref = reference(name, scene, spp)
+    rows, best = [], None
+    for n in samples:
+        log(f"{name}: Penumbra {n}")
+        configure(scene, "PENUMBRA", render_samples=n)
+        seconds, mae, image = measure(scene, runs, ref)
+        rows.append({"scene": name, "engine": "Penumbra", "samples": n, "time_s": seconds, "mae": mae})
+        best = (f"Penumbra {n} samples", image) if n <= 64 or best is None else best
+    for n in cycles_spp:
+        log(f"{name}: Cycles {n}")
+        _cycles(scene, n)
+        seconds, mae, _image = measure(scene, runs, ref)
+        rows.append({"scene": name, "engine": "Cycles", "samples": n, "time_s": seconds, "mae": mae})
+    log(f"{name}: EEVEE")
+    configure(scene, "EEVEE", taa_render_samples=EEVEE_SAMPLES)
+    seconds, mae, _image = measure(scene, runs, ref)
+    rows.append({"scene": name, "engine": "EEVEE", "samples": EEVEE_SAMPLES, "time_s": seconds, "mae": mae})
+    return rows, [(f"Cycles {spp} spp", ref), best]
 
 
 def run(args):
@@ -130,39 +196,24 @@ def run(args):
     spp = 256 if args.quick else args.reference
     samples = [int(n) for n in args.samples.split(",") if n.strip()]
     cycles_spp = [int(n) for n in args.cycles_spp.split(",") if n.strip()]
+    names = [n.strip() for n in args.scenes.split(",") if n.strip()]
     args.out.mkdir(parents=True, exist_ok=True)
     session.load_penumbra().register()
     started = time.perf_counter()
-    rows, shown = [], []
+    rows, shown = [], {}
     with session.stdout_to_stderr():
-        scene = build(width, height)
-        log(f"Cycles reference {spp} spp at {width}x{height}")
-        ref = reference(scene, spp)
-        for n in samples:
-            log(f"Penumbra {n}")
-            configure(scene, "PENUMBRA", render_samples=n)
-            seconds, mae, image = measure(scene, runs, ref)
-            rows.append({"engine": "Penumbra", "samples": n, "time_s": seconds, "mae": mae})
-            if n in (16, 64):
-                shown.append((f"Penumbra {n} samples", image))
-        for n in cycles_spp:
-            log(f"Cycles {n}")
-            _cycles(scene, n)
-            seconds, mae, _image = measure(scene, runs, ref)
-            rows.append({"engine": "Cycles", "samples": n, "time_s": seconds, "mae": mae})
-        log("EEVEE")
-        configure(scene, "EEVEE", taa_render_samples=EEVEE_SAMPLES)
-        seconds, mae, _image = measure(scene, runs, ref)
-        rows.append({"engine": "EEVEE", "samples": EEVEE_SAMPLES, "time_s": seconds, "mae": mae})
+        for name in names:
+            scene_rows, shown[name] = sweep(name, width, height, spp, samples, cycles_spp, runs)
+            rows += scene_rows
     report.write_csv(args.out / "camera.csv", rows, CSV_FIELDS)
     title = (
-        f"Depth of field (demo scene, f/{FSTOP}, focused on the ball), {width}x{height}, against Cycles {spp} spp; "
-        f"Blender {bpy.app.version_string}"
+        f"Depth of field (f/{FSTOP}) and motion blur (a shutter of half a frame), {width}x{height}, against "
+        f"Cycles {spp} spp; Blender {bpy.app.version_string}"
     )
-    plot(rows, shown, ref, args.out / "camera.png", title)
-    cells = [[r["engine"], r["samples"], f"{r['time_s']:.3f}", f"{r['mae']:.4f}"] for r in rows]
+    plot(rows, shown, args.out / "camera.png", title)
+    cells = [[r["scene"], r["engine"], r["samples"], f"{r['time_s']:.3f}", f"{r['mae']:.4f}"] for r in rows]
     print(f"### {title}\n")
-    print(report.markdown_table(["Engine", "Samples", "Time (s)", "Display MAE"], cells))
+    print(report.markdown_table(["Scene", "Engine", "Samples", "Time (s)", "Display MAE"], cells))
     print(
         f"\nGPU: {session.gpu_renderer() or 'n/a'}; {runs} timed render(s) per configuration; "
         f"{(time.perf_counter() - started) / 60:.1f} min. Wrote camera.csv, camera.png."
