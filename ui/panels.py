@@ -107,6 +107,26 @@ class PENUMBRA_PT_world(_SettingsPanel, bpy.types.Panel):
     section = settings.WORLD
 
 
+class PENUMBRA_PT_world_sun(PenumbraPanel, bpy.types.Panel):
+    """World > Sun, EEVEE's settings as Penumbra reads them (``frame/world/sun.py``): an
+    Environment Texture's light above the threshold becomes a sun."""
+
+    bl_label = "Sun"
+    bl_context = "world"
+    bl_parent_id = "PENUMBRA_PT_world"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.world is not None
+
+    def draw(self, context):
+        layout = self.split_layout()
+        world = context.world
+        layout.prop(world, "sun_threshold", text="Threshold")
+        layout.prop(world, "sun_angle", text="Angle")
+        layout.prop(world, "use_sun_shadow", text="Shadow")
+
+
 class PENUMBRA_PT_viewport(_SettingsPanel, bpy.types.Panel):
     bl_label = "Viewport"
     section = settings.VIEWPORT
@@ -342,6 +362,7 @@ classes = (
     PENUMBRA_PT_lighting,
     PENUMBRA_PT_light_paths,
     PENUMBRA_PT_world,
+    PENUMBRA_PT_world_sun,
     PENUMBRA_PT_viewport,
     PENUMBRA_PT_simplify,
     PENUMBRA_PT_debug,

@@ -40,6 +40,7 @@ from .world.directions import (
 )
 from .world.occlusion import WorldAO
 from .world.sh_light import with_sh_light
+from .world.sun import with_sun
 
 
 @dataclasses.dataclass(frozen=True)
@@ -295,6 +296,11 @@ class Renderer:
         world = with_sh_light(snapshot.world, self.textures, self.shaders)
         if world is not snapshot.world:  # an Environment Texture's light, projected on the GPU
             snapshot = dataclasses.replace(snapshot, world=world, world_color=world.mean)
+        world, sun = with_sun(snapshot.world)  # World > Settings > Sun: its light above the threshold
+        if sun is not None:
+            snapshot = dataclasses.replace(
+                snapshot, world=world, world_color=world.mean, lights=[*snapshot.lights, sun]
+            )
         threshold = adaptive.threshold if adaptive is not None and accumulate else 0.0
         negligible = world_negligible(snapshot.world if snapshot.world is not None else snapshot.world_color, threshold)
         directions, cones = (0, []) if negligible else self._world_directions(snapshot, draws, settings, accumulate)

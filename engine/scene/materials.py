@@ -633,6 +633,24 @@ def summary(read):
 # --- world --------------------------------------------------------------------------------
 
 
+@dataclass(frozen=True)
+class WorldSun:
+    """World > Settings > Sun, as EEVEE reads it: the Environment Texture's radiance above
+    ``threshold`` becomes a sun of angle ``angle`` (radians), shadowed when ``shadow``, the
+    rest stays in the world's SH light (``frame/world/sun.py``). A threshold of 0 extracts none."""
+
+    threshold: float = 10.0
+    angle: float = 0.0092
+    shadow: bool = True
+
+    @classmethod
+    def of(cls, world):
+        threshold = float(getattr(world, "sun_threshold", 0.0))
+        if not (threshold > 0.0 and np.isfinite(threshold)):
+            return None
+        return cls(threshold, float(getattr(world, "sun_angle", 0.0092)), bool(getattr(world, "use_sun_shadow", True)))
+
+
 @dataclass
 class World:
     """Light from the world: ``sh`` are order-2 spherical-harmonic coefficients (9, 3) of its
@@ -649,6 +667,7 @@ class World:
     # The Environment Texture's Mapping rotation: world direction -> the image's direction (3, 3),
     # None for none.
     rotation: np.ndarray | None = None
+    sun: WorldSun | None = None  # World > Settings > Sun (EEVEE's): its light above a threshold
 
     @property
     def mean(self):
@@ -811,6 +830,7 @@ def _world_surface(scene):
             image=src.image.name_full,
             strength=strength,
             rotation=rotation,
+            sun=WorldSun.of(world),
         )
     if src.bl_idname == "ShaderNodeRGB":
         return World.constant(np.array(out.default_value[:3]) * strength, messages)

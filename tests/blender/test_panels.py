@@ -18,6 +18,7 @@ SHOWN = [
     "PHYSICS_PT_add", "PARTICLE_PT_context_particles", "PENUMBRA_PT_film", "PENUMBRA_PT_passes",
     "DATA_PT_camera_dof", "DATA_PT_camera_dof_aperture",  # depth of field by lens sampling
     "PENUMBRA_PT_motion_blur", "PENUMBRA_PT_motion_blur_curve",  # Blender's motion blur settings
+    "PENUMBRA_PT_world_sun",  # EEVEE's World > Sun: threshold, angle, shadow
 ]  # fmt: skip
 HIDDEN = [
     "DATA_PT_light",  # would repeat the light type switch

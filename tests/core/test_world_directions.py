@@ -197,3 +197,35 @@ def test_a_world_under_the_noise_threshold_is_negligible():
     assert ws.world_negligible(World.constant((np.inf, 0.0, 0.0)), 0.01)
     assert ws.world_negligible(World.constant((np.nan, np.nan, np.nan)), 0.01)
     assert not ws.world_negligible(World.constant((np.inf, 1.0, 1.0)), 0.01)
+
+
+def test_the_worlds_sun_takes_the_light_above_the_threshold():
+    """World > Sun (``world.sun.with_sun``): the image's radiance above the threshold becomes a
+    sun of that irradiance, shining from the extracted light's direction (the Mapping rotation
+    followed), the rest stays in the SH light and the directions' image, capped at the
+    threshold: the two add up to the image's whole light, and neither is below zero. No texel
+    above it, or a threshold of 0, extracts nothing."""
+    from penumbra.engine.frame.world import sun as world_sun
+    from penumbra.engine.scene.materials import WorldSun, equirect_sh
+
+    h, w = 32, 64
+    env = np.full((h, w, 3), 0.5)
+    env[20, 40] = (400.0, 300.0, 200.0)  # a sun, one texel
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # 90 degrees about z
+    for rotation in (None, turn):
+        world = World(sh=equirect_sh(env, rotation), background=None, env=env, rotation=rotation, sun=WorldSun(10.0))
+        out, light = world_sun.with_sun(world)
+        d, omega = world_sun._directions(h, w)
+        expected = (env[20, 40] - 10.0) * omega[20, 40]
+        np.testing.assert_allclose(light.color, expected, rtol=1e-12)
+        towards = d[20, 40] @ (rotation if rotation is not None else np.eye(3))
+        np.testing.assert_allclose(light.matrix[:3, 2], towards, atol=1e-12)  # -Z shines from it
+        assert light.type == "SUN" and light.use_shadow and light.angle == pytest.approx(0.0092)
+        assert out.env.max() <= 10.0 and out.env.min() >= 0.0
+        whole = (env * omega[..., None]).sum(axis=(0, 1))
+        np.testing.assert_allclose((out.env * omega[..., None]).sum(axis=(0, 1)) + light.color, whole, rtol=1e-12)
+        np.testing.assert_allclose(out.sh, equirect_sh(out.env, rotation), rtol=1e-12)
+    dim = World(sh=equirect_sh(env * 0.01), background=None, env=env * 0.01, sun=WorldSun(10.0))
+    assert world_sun.with_sun(dim) == (dim, None)
+    off = World(sh=equirect_sh(env), background=None, env=env, sun=None)
+    assert world_sun.with_sun(off) == (off, None)

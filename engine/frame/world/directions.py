@@ -262,7 +262,7 @@ def _in_cone(axis, cos_max, a, b):
     z = 1.0 - a * (1.0 - cos_max)
     r = math.sqrt(max(1.0 - z * z, 0.0))
     phi = 2.0 * math.pi * b
-    frame = _frame_towards(axis)
+    frame = frame_towards(axis)
     return frame @ np.array([r * math.cos(phi), r * math.sin(phi), z])
 
 
@@ -345,7 +345,7 @@ def world_lights(world, index, count, name="World", cones=()):
     lights = []
     for k in range(count):
         matrix = np.eye(4)
-        matrix[:3, :3] = _frame_towards(d[k])  # the sun shines along -Z: from d[k]
+        matrix[:3, :3] = frame_towards(d[k])  # the sun shines along -Z: from d[k]
         lights.append(
             Light(
                 type="SUN",
@@ -361,7 +361,7 @@ def world_lights(world, index, count, name="World", cones=()):
     return lights
 
 
-def _frame_towards(d):
+def frame_towards(d):
     """A rotation whose Z axis is ``d`` (a light's -Z is where it shines)."""
     z = d / max(np.linalg.norm(d), 1e-300)
     helper = np.array([1.0, 0.0, 0.0]) if abs(z[2]) > 0.9 else np.array([0.0, 0.0, 1.0])
