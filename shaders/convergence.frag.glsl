@@ -1,5 +1,6 @@
 /* Adaptive sampling's convergence check (film_programs.CONVERGENCE), Cycles' estimate: the mean of
- * all samples I against the mean A of every other sample (accumulated twice over), per pixel
+ * all samples I against the mean A of every other sample (times half_scale: the whole weight
+ * over the odd samples'), per pixel
  *   error = (|I.r - A.r| + |I.g - A.g| + |I.b - A.b| + |I.a - A.a|) / (0.0001 + sqrt(I.r + I.g + I.b))
  * (Cycles leaves alpha out; here a transparent film's edges count too). A pixel converges when
  * the error of every pixel of its 3x3 neighbourhood is below the threshold (Cycles dilates
@@ -15,13 +16,13 @@ float pixel_error(ivec2 q)
     return 0.0;
   }
   vec4 I = texelFetch(accum, q, 0) / n;
-  vec4 A = texelFetch(half_accum, q, 0) / n;
+  vec4 A = half_scale * texelFetch(half_accum, q, 0) / n;
 #if WORLD_RATIO
   /* The world's light through its ratio in both means (lib/world_ratio.glsl): the SH light
    * by lobe of all samples, the sums of all samples and of every other one. */
   vec3 u_d = texelFetch(world_diffuse, q, 0).rgb / n, u_s = texelFetch(world_specular, q, 0).rgb / n;
   I = world_ratio_apply(I, u_d, u_s, texelFetch(world_sums, q, 0));
-  A = world_ratio_apply(A, u_d, u_s, texelFetch(half_world_sums, q, 0));
+  A = world_ratio_apply(A, u_d, u_s, half_scale * texelFetch(half_world_sums, q, 0));
 #endif
   vec4 d = abs(I - A);
   return (d.r + d.g + d.b + d.a) / (0.0001 + sqrt(max(I.r + I.g + I.b, 0.0)));

@@ -8,11 +8,11 @@ void main()
   if (texelFetch(converged, p, 0).r > 0.5) {
     discard;
   }
-  out_color = scale * texelFetch(src_color, p, 0);
+  out_color = scale * film_source(src_color, p);
 #if WITH_SHADOW
-  out_shadow = vec4(scale * texelFetch(src_shadow, p, 0).r);
+  out_shadow = vec4(scale * film_source(src_shadow, p).r);
 #endif
 #if WITH_WEIGHT
-  out_weight = vec4(scale);
+  out_weight = vec4(scale, 1.0, 0.0, 0.0); /* its weight, and one sample more */
 #endif
 }

@@ -4,12 +4,12 @@
 void main()
 {
   ivec2 p = ivec2(gl_FragCoord.xy) - origin;
-  out_color = scale * texelFetch(src_color, p, 0);
+  out_color = scale * film_source(src_color, p);
 #if WITH_SHADOW
 #  if CLAMP_SHADOW
-  out_shadow = vec4(clamp(scale * texelFetch(src_shadow, p, 0).r, 0.0, 1.0));
+  out_shadow = vec4(clamp(scale * film_source(src_shadow, p).r, 0.0, 1.0));
 #  else
-  out_shadow = vec4(scale * texelFetch(src_shadow, p, 0).r);
+  out_shadow = vec4(scale * film_source(src_shadow, p).r);
 #  endif
 #endif
 }

@@ -9,7 +9,7 @@ void main()
     discard;
   }
 #endif
-  out_world_diffuse = scale * texelFetch(world_diffuse, p, 0);
-  out_world_specular = scale * texelFetch(world_specular, p, 0);
-  out_world_sums = scale * texelFetch(world_sums, p, 0);
+  out_world_diffuse = scale * film_source(world_diffuse, p);
+  out_world_specular = scale * film_source(world_specular, p);
+  out_world_sums = scale * film_source(world_sums, p);
 }

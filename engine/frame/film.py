@@ -26,6 +26,7 @@ from .film_programs import (
     WORLD_RATIO_COPY_MASKED,
     WORLD_RATIO_RESOLVE,
     convergence_program,
+    gathering,
 )
 from .sampling import THRESHOLD_SCALE
 from .stats import StageClock
@@ -70,6 +71,11 @@ class FrameOutput:
 
 
 _WORLD_NAMES = ("world_diffuse", "world_specular", "world_sums")  # the world ratio's targets, in order
+
+
+def _gathered(program, gather):
+    """(``program``, or its gathering variant when ``gather`` is given,)."""
+    return (gathering(program),) if gather else (program,)
 
 
 def _clear_zero(texture):
@@ -129,6 +135,8 @@ class Film:
         self._accum_color = self._accum_shadow = self._accum_fb = self._resolve_fb = None
         self._emission_targets = None  # (accumulation, its framebuffer, the resolve's framebuffer)
         self._weight_sum = 0.0
+        self._half_weight_sum = 0.0
+        self.gather_reach = 0  # the frame's (``begin``)
         self.sample_weights = []  # each accumulated sample's filter weight, in order
         self._fullscreen_batch = None
         # Adaptive sampling: the every-other-sample accumulation, the converged masks (read
@@ -273,7 +281,7 @@ class Film:
             if self.tracking:
                 per_pixel += 16
             if self._masks is not None:
-                per_pixel += 4 + 4 + (4 if self._weight is not None else 0)
+                per_pixel += 4 + 4 + (8 if self._weight is not None else 0)
             if self._settle is not None:
                 per_pixel += 16
             if self.world_ratio:
@@ -282,11 +290,14 @@ class Film:
 
     # --- samples --------------------------------------------------------------------------
 
-    def begin(self, aux, emission, fresh, adaptive=False, settle=False, world_ratio=False):
+    def begin(self, aux, emission, fresh, adaptive=False, settle=False, world_ratio=False, gather_reach=0):
         """Before a multi-sample frame's samples: the accumulation targets, cleared when the
         frame starts afresh (``fresh``); ``adaptive``: the frame estimates each pixel's error
         (from a fresh start on); ``settle``: pixels may settle (``settle``), so the converged
-        masks exist; ``world_ratio``: the frame's world light is a ratio (its targets too)."""
+        masks exist; ``world_ratio``: the frame's world light is a ratio (its targets too);
+        ``gather_reach``: the gathering film's reach in pixels (``sampling.gather_reach``; 0:
+        each pixel its own samples), which a converged pixel stays shaded for."""
+        self.gather_reach = int(gather_reach)
         self._ensure_accumulation(aux)
         self.world_ratio = bool(world_ratio)
         if fresh:
@@ -301,27 +312,33 @@ class Film:
             if emission:
                 self._emission_accumulation().clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
             self._weight_sum = 0.0
+            self._half_weight_sum = 0.0  # of the every-other-sample accumulation (the odd samples)
             self.sample_weights = []
 
-    def accumulate(self, weight, aux, emission, sample=0):
+    def accumulate(self, weight, aux, emission, sample=0, gather=None):
         """accumulation += weight * this sample (colour, shadow with ``aux``, and Emission),
         in the pixels that have not converged; ``sample``: its index (adaptive sampling adds
-        the odd ones to its second accumulation)."""
+        the odd ones to its second accumulation). ``gather`` (``sampling.gather_uniforms``):
+        each pixel takes the sample from the pixels within the filter's reach, by the window's
+        weights, which sum to ``weight`` (the gathering film)."""
         mask = self.mask
         if mask is None:
-            self._scaled_copy(self._accum_fb, (self.color, self.shadow), weight, aux, blend="ADDITIVE_PREMULT")
+            sources = (self.color, self.shadow)
+            self._scaled_copy(self._accum_fb, sources, weight, aux, blend="ADDITIVE_PREMULT", gather=gather)
         else:
             with_shadow = aux and self._accum_shadow is not None
             samplers = {"src_color": self.color, "converged": mask}
             if with_shadow:
                 samplers["src_shadow"] = self.shadow
-            program = MASKED_COPY_SHADOW_WEIGHT if with_shadow else MASKED_COPY_WEIGHT
-            self.fullscreen(program, self._masked_fb(with_shadow), samplers, {"scale": weight}, "ADDITIVE_PREMULT")
+            program = _gathered(MASKED_COPY_SHADOW_WEIGHT if with_shadow else MASKED_COPY_WEIGHT, gather)[0]
+            uniforms = {"scale": weight, **(gather or {})}
+            self.fullscreen(program, self._masked_fb(with_shadow), samplers, uniforms, "ADDITIVE_PREMULT")
         if emission:
             _accum, accum_fb, _resolve_fb = self._emission_targets
-            self._copy(accum_fb, self.emission, weight, mask)
+            self._copy(accum_fb, self.emission, weight, mask, gather)
         if self.tracking and sample % 2 == 1:
-            self._copy(self._half_fb, self.color, 2.0 * weight, mask)
+            self._copy(self._half_fb, self.color, weight, mask, gather)
+            self._half_weight_sum += weight
         if self._shaded_total_fb is not None:
             self.fullscreen(
                 SCALED_COPY, self._shaded_total_fb, {"src_color": self.shaded}, {"scale": 1.0}, "ADDITIVE_PREMULT"
@@ -332,20 +349,24 @@ class Film:
                 samplers["converged"] = mask
             else:
                 samplers["converged"] = self.world[2]  # bound, never read
-            program = WORLD_RATIO_COPY if mask is None else WORLD_RATIO_COPY_MASKED
-            self.fullscreen(program, self._world_accum_fb, samplers, {"scale": weight}, "ADDITIVE_PREMULT")
+            program = _gathered(WORLD_RATIO_COPY if mask is None else WORLD_RATIO_COPY_MASKED, gather)[0]
+            uniforms = {"scale": weight, **(gather or {})}
+            self.fullscreen(program, self._world_accum_fb, samplers, uniforms, "ADDITIVE_PREMULT")
             if self.tracking and sample % 2 == 1:
-                self._copy(self._world_half[1], self.world[2], 2.0 * weight, mask)
+                self._copy(self._world_half[1], self.world[2], weight, mask, gather)
         self._weight_sum += weight
         self.sample_weights.append(float(weight))
 
-    def _copy(self, framebuffer, source, scale, mask):
-        """framebuffer += scale * source, where not converged (``mask``, when some pixel is)."""
+    def _copy(self, framebuffer, source, scale, mask, gather=None):
+        """framebuffer += scale * source, where not converged (``mask``, when some pixel is);
+        ``gather``: the source gathered over the filter's reach."""
+        uniforms = {"scale": scale, **(gather or {})}
         if mask is None:
-            self.fullscreen(SCALED_COPY, framebuffer, {"src_color": source}, {"scale": scale}, "ADDITIVE_PREMULT")
+            program = _gathered(SCALED_COPY, gather)[0]
+            self.fullscreen(program, framebuffer, {"src_color": source}, uniforms, "ADDITIVE_PREMULT")
         else:
             samplers = {"src_color": source, "converged": mask}
-            self.fullscreen(MASKED_COPY, framebuffer, samplers, {"scale": scale}, "ADDITIVE_PREMULT")
+            self.fullscreen(_gathered(MASKED_COPY, gather)[0], framebuffer, samplers, uniforms, "ADDITIVE_PREMULT")
 
     def keep_centre(self):
         """Keep the centred sample's depth and normal (a multi-sample frame's Depth and Normal
@@ -521,10 +542,17 @@ class Film:
             "threshold": float(threshold) * THRESHOLD_SCALE,
             "weight_sum": float(self._weight_sum),
             "per_pixel": 1.0 if self._weight is not None else 0.0,
+            "half_scale": self._half_scale(),
         }
         samplers.update(self._convergence_world_samplers())
         self.fullscreen(convergence_program(False, self.world_ratio), self._mask_fbs[dst], samplers, uniforms)
         return self._take_mask(dst)
+
+    def _half_scale(self):
+        """What the every-other-sample accumulation is multiplied by to be a mean over the
+        same weight as the whole one: the total weight over the odd samples' (2 when the
+        samples weigh alike; a gathering film's samples do not)."""
+        return float(self._weight_sum / self._half_weight_sum) if self._half_weight_sum > 0.0 else 2.0
 
     def _convergence_world_samplers(self):
         """The world ratio's accumulations the convergence check reads (none without it)."""
@@ -541,8 +569,10 @@ class Film:
         count = int(np.count_nonzero(mask > 0.5))
         if count and self._weight is None:
             # From now on pixels hold different numbers of samples; so far each has them all.
-            self._weight = new_texture(self.pool, self.size, "R32F")
-            self._weight.clear(format="FLOAT", value=(float(self._weight_sum),))
+            # r: the pixel's weight; g: the samples it took (a gathering film's pixel may take
+            # less than a sample's whole weight, beside a converged one).
+            self._weight = new_texture(self.pool, self.size, "RG32F")
+            self._weight.clear(format="FLOAT", value=(float(self._weight_sum), float(len(self.sample_weights))))
             self._masked_fbs = {}
         self.converged = count
         return count
@@ -556,18 +586,14 @@ class Film:
         """Each pixel's weight (its samples' total), (height, width)."""
         if self._weight is None:
             return np.full(self.size[::-1], self._weight_sum, np.float32)
-        return texture_array(self._weight, 1)[..., 0]
+        return texture_array(self._weight, 2)[..., 0]
 
     def samples_array(self):
-        """Samples each pixel took, (height, width): its weight (the filter weights of the
-        samples it was shaded in, which are the first ones: a pixel stops when it converges)
-        against the running totals of the samples' weights."""
-        totals = np.cumsum(np.asarray(self.sample_weights, np.float64))
-        if totals.size == 0:
-            return np.zeros(self.size[::-1], np.float32)
-        weights = self.weights_array().astype(np.float64)
-        counts = np.searchsorted(totals, weights * (1.0 - 1e-5), side="left") + 1
-        return np.where(weights > 0.0, np.minimum(counts, totals.size), 0).astype(np.float32)
+        """Samples each pixel took, (height, width): every sample so far until a pixel
+        converged, then what it had (counted beside its weight)."""
+        if self._weight is None:
+            return np.full(self.size[::-1], len(self.sample_weights), np.float32)
+        return texture_array(self._weight, 2)[..., 1].copy()
 
     def error_array(self):
         """Each pixel's error estimate as adaptive sampling's check reads it (the largest of its
@@ -589,6 +615,7 @@ class Film:
             "threshold": float(THRESHOLD_SCALE),
             "weight_sum": float(self._weight_sum),
             "per_pixel": 1.0 if self._weight is not None else 0.0,
+            "half_scale": self._half_scale(),
         }
         samplers.update(self._convergence_world_samplers())
         self.fullscreen(convergence_program(True, self.world_ratio), framebuffer, samplers, uniforms)
@@ -613,7 +640,8 @@ class Film:
 
     def mask_depth(self, framebuffer):
         """Clear ``framebuffer``'s z-buffer and write the nearest depth where a pixel
-        converged, so the lit pass's surfaces fail the depth test there (no shading)."""
+        converged, so the lit pass's surfaces fail the depth test there (no shading); with a
+        gathering film, only where every pixel within its reach converged too."""
         import gpu
 
         width, height = self.size
@@ -627,6 +655,7 @@ class Film:
             gpu.state.color_mask_set(False, False, False, False)
             shader.bind()
             shader.uniform_sampler("converged", self.mask)
+            shader.uniform_int("reach", int(self.gather_reach))
             self._fullscreen_batch.draw(shader)
             gpu.state.color_mask_set(True, True, True, True)
             gpu.state.depth_mask_set(False)
@@ -663,15 +692,16 @@ class Film:
             )
         return self._emission_targets[0]
 
-    def _scaled_copy(self, framebuffer, sources, scale, aux, blend="NONE", resolve=False):
+    def _scaled_copy(self, framebuffer, sources, scale, aux, blend="NONE", resolve=False, gather=None):
         """framebuffer (<blend>)= scale * sources: colour, and shadow when ``aux`` and the
-        accumulation carries it (clamped to [0, 1] when ``resolve``: a mean visibility)."""
+        accumulation carries it (clamped to [0, 1] when ``resolve``: a mean visibility);
+        ``gather``: the sources gathered over the filter's reach (``sampling.gather_uniforms``)."""
         with_shadow = aux and self._accum_shadow is not None
         samplers = {"src_color": sources[0]}
         if with_shadow:
             samplers["src_shadow"] = sources[1]
         program = (SCALED_RESOLVE_SHADOW if resolve else SCALED_COPY_SHADOW) if with_shadow else SCALED_COPY
-        self.fullscreen(program, framebuffer, samplers, {"scale": scale}, blend)
+        self.fullscreen(*_gathered(program, gather), framebuffer, samplers, {"scale": scale, **(gather or {})}, blend)
 
     def _batch(self, shader):
         from gpu_extras.batch import batch_for_shader
@@ -699,8 +729,9 @@ class Film:
                 shader.uniform_sampler(name, tex)
             if any(pc[1] == "origin" for pc in program.push_constants):
                 shader.uniform_int("origin", (0, 0))
+            integer = {pc[1] for pc in program.push_constants if pc[0].startswith(("INT", "IVEC"))}
             for name, value in uniforms.items():
-                shader.uniform_float(name, value)
+                (shader.uniform_int if name in integer else shader.uniform_float)(name, value)
             self._fullscreen_batch.draw(shader)
             gpu.state.blend_set("NONE")
             gpu.state.depth_test_set("NONE")

@@ -16,6 +16,7 @@ SCALED_COPY = Program(
     name="scaled_copy",
     vertex="fullscreen.vert.glsl",
     fragment="scaled_copy.frag.glsl",
+    libs=("lib/film_gather.glsl",),
     vertex_in=(("VEC2", "pos"),),
     push_constants=(("IVEC2", "origin"), ("FLOAT", "scale")),
     samplers=(("FLOAT_2D", "src_color"),),
@@ -44,6 +45,7 @@ MASKED_COPY = Program(
     name="masked_copy",
     vertex="fullscreen.vert.glsl",
     fragment="masked_copy.frag.glsl",
+    libs=("lib/film_gather.glsl",),
     vertex_in=(("VEC2", "pos"),),
     push_constants=(("FLOAT", "scale"),),
     samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "converged")),
@@ -84,8 +86,14 @@ CONVERGENCE = Program(
     vertex="fullscreen.vert.glsl",
     fragment="convergence.frag.glsl",
     vertex_in=(("VEC2", "pos"),),
-    # per_pixel > 0.5: pixels hold their own weights (``weight``), else all ``weight_sum``.
-    push_constants=(("FLOAT", "threshold"), ("FLOAT", "weight_sum"), ("FLOAT", "per_pixel")),
+    # per_pixel > 0.5: pixels hold their own weights (``weight``), else all ``weight_sum``;
+    # half_scale: what the every-other-sample accumulation is multiplied by (``Film._half_scale``).
+    push_constants=(
+        ("FLOAT", "threshold"),
+        ("FLOAT", "weight_sum"),
+        ("FLOAT", "per_pixel"),
+        ("FLOAT", "half_scale"),
+    ),
     samplers=(
         ("FLOAT_2D", "accum"),
         ("FLOAT_2D", "half_accum"),
@@ -125,6 +133,7 @@ WORLD_RATIO_COPY = Program(
     name="world_ratio_copy",
     vertex="fullscreen.vert.glsl",
     fragment="world_ratio_copy.frag.glsl",
+    libs=("lib/film_gather.glsl",),
     vertex_in=(("VEC2", "pos"),),
     push_constants=(("FLOAT", "scale"),),
     samplers=_WORLD_RATIO_SAMPLERS + (("FLOAT_2D", "converged"),),
@@ -183,7 +192,24 @@ CONVERGED_DEPTH = Program(
     vertex="fullscreen.vert.glsl",
     fragment="converged_depth.frag.glsl",
     vertex_in=(("VEC2", "pos"),),
+    push_constants=(("INT", "reach"),),  # the gathering film's reach (0: none)
     samplers=(("FLOAT_2D", "converged"),),
     outputs=(("VEC4", "out_color"),),
     depth_write="ANY",
 )
+
+
+# The gathering film (``sampling.gathers``): a copy program whose source is gathered from the
+# sample pixels within the filter's reach (``lib/film_gather.glsl``), for adding a sample to
+# the accumulations; the sample's image shift, the window's width and reach as push constants.
+GATHER_PUSH = (("VEC2", "gather_shift"), ("FLOAT", "gather_width"), ("INT", "gather_reach"))
+
+
+def gathering(program):
+    """``program`` (SCALED_COPY, MASKED_COPY, WORLD_RATIO_COPY or a variant) gathering its source."""
+    return replace(
+        program,
+        name=f"{program.name}_gather",
+        push_constants=program.push_constants + GATHER_PUSH,
+        defines=program.defines + (("GATHER", True),),
+    )

@@ -426,6 +426,9 @@ class Renderer:
                 adaptive=frame.noise or frame.debug.id == "NOISE",
                 settle=frame.settle,
                 world_ratio=frame.world_ratio,
+                gather_reach=sampling.gather_reach(settings.filter_size)
+                if sampling.gathers(settings.filter_size)
+                else 0,
             )
             # With map jitter every shadowed light changes from sample to sample (its maps'
             # texel grid), so lights with an extent are sampled on it however small their
@@ -529,7 +532,8 @@ class Renderer:
         with self._clock.stage("accumulate"):
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
-                film.accumulate(weight, frame.aux, frame.emission, s)
+                gather = sampling.gather_uniforms(dx, dy, settings.filter_size)  # the gathering film
+                film.accumulate(weight, frame.aux, frame.emission, s, gather)
             if frame.aux and accumulate and s == 0:  # the centred sample's depth and normal
                 film.keep_centre()
             stats.samples += 1

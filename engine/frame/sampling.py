@@ -98,15 +98,89 @@ def _filter_inverse_cdf(u, filter_size):
     return float(np.interp(u, cdf, x))
 
 
+# The gathering film (``film.Film.accumulate`` with ``gather``, EEVEE's film): each sample is
+# jittered uniformly over its pixel and shaded once, and every film pixel gathers the samples
+# within the filter's reach, each weighted by the Blackman-Harris window at its distance
+# (separable, as the offsets of the importance-sampled film were drawn per axis); weights are
+# accumulated per pixel and divided at resolve. A film pixel reads sample pixels up to
+# ``gather_reach`` each way; a filter wider than GATHER_REACH_MAX of them keeps the film that
+# draws each sample's offset from the filter (importance sampling, one sample per pixel).
+GATHER_REACH_MAX = 4
+
+
+def gather_reach(filter_size):
+    """Sample pixels each way along an axis a film pixel gathers from: those whose shading
+    point (within half a pixel of their centre) can lie inside the filter's reach (Filter
+    Size pixels): |t| < Filter Size + 1/2."""
+    if not filter_size > 0.0:
+        return 0
+    return max(0, math.ceil(float(filter_size) + 0.5) - 1)
+
+
+def gathers(filter_size):
+    """Whether a multi-sample frame of this Filter Size gathers (``GATHER_REACH_MAX``)."""
+    return filter_size > 0.0 and gather_reach(filter_size) <= GATHER_REACH_MAX
+
+
+def film_reach(filter_size):
+    """How far, in pixels, a film pixel gathers samples (``gather_reach`` where the frame
+    gathers, else 0: each pixel its own)."""
+    return gather_reach(filter_size) if gathers(filter_size) else 0
+
+
+def axis_weights(shift, filter_size):
+    """The window's weight of each sample pixel t = -R .. R along one axis for a sample whose
+    image moved by ``shift`` pixels (the pixel t away sees the point t - shift away)."""
+    width = filter_width(filter_size)
+    reach = gather_reach(filter_size)
+    return [blackman_harris(t - shift, width) for t in range(-reach, reach + 1)]
+
+
 def pixel_offset(s, filter_size):
-    """(dx, dy, weight) of sample ``s``: its image offset in pixels, distributed as the film
-    filter (Halton points through the filter's inverse CDF, sample 0 at the centre), and its
-    weight (1: the distribution already carries the filter)."""
-    if s == 0 or filter_size <= 0.0:
+    """(dx, dy, weight) of sample ``s``: how far its image moves, in pixels, and its weight in
+    the film, sample 0 at the centre. A gathering film (``gathers``): uniform over the pixel
+    (the Halton (2, 3) point s, centred), the weight the window's total over the pixels it
+    reaches (what the film divides by). Otherwise distributed as the film filter (Halton
+    points through the filter's inverse CDF), weight 1 (the distribution carries the filter)."""
+    if filter_size <= 0.0:
+        return 0.0, 0.0, 1.0
+    if gathers(filter_size):
+        dx = math.fmod(radical_inverse(s, PIXEL_BASES[0]) + 0.5, 1.0) - 0.5
+        dy = math.fmod(radical_inverse(s, PIXEL_BASES[1]) + 0.5, 1.0) - 0.5
+        return dx, dy, sum(axis_weights(dx, filter_size)) * sum(axis_weights(dy, filter_size))
+    if s == 0:
         return 0.0, 0.0, 1.0
     dx = _filter_inverse_cdf(radical_inverse(s, PIXEL_BASES[0]), filter_size)
     dy = _filter_inverse_cdf(radical_inverse(s, PIXEL_BASES[1]), filter_size)
     return dx, dy, 1.0
+
+
+def sample_taps(s, filter_size):
+    """Where sample ``s`` is seen from a film pixel, and how much: (x, y, weight) of each
+    point, in pixels from the pixel's centre, the weights summing to the sample's (``pixel_offset``)."""
+    dx, dy, weight = pixel_offset(s, filter_size)
+    if not gathers(filter_size):
+        return [(-dx, -dy, weight)]
+    reach = gather_reach(filter_size)
+    wx, wy = axis_weights(dx, filter_size), axis_weights(dy, filter_size)
+    return [
+        (tx - dx, ty - dy, a * b)
+        for ty, b in zip(range(-reach, reach + 1), wy, strict=True)
+        for tx, a in zip(range(-reach, reach + 1), wx, strict=True)
+        if a * b > 0.0
+    ]
+
+
+def gather_uniforms(dx, dy, filter_size):
+    """The gather's push constants of a sample moved by (dx, dy) pixels (``lib/film_gather.glsl``),
+    or None when the frame does not gather."""
+    if not gathers(filter_size):
+        return None
+    return {
+        "gather_shift": (float(dx), float(dy)),
+        "gather_width": float(filter_width(filter_size)),
+        "gather_reach": int(gather_reach(filter_size)),
+    }
 
 
 def jittered_projection(projection, dx, dy, width, height):

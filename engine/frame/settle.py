@@ -65,12 +65,19 @@ def settle_shifts(kept, count, filter_size):
     asks again."""
 
     def moments(n):
-        offsets = np.array([sampling.pixel_offset(s, filter_size)[:2] for s in range(n)], np.float64)
-        dx, dy = offsets[:, 0], offsets[:, 1]
-        return np.array([dx.mean(), dy.mean()]), np.array([(dx * dx).mean(), (dy * dy).mean(), (dx * dy).mean()])
+        # Every point the samples are seen at from a pixel, by its weight (a gathering film's
+        # sample reaches the pixel from each of its neighbours, ``sampling.sample_taps``); as
+        # offsets of the image, the negative of where the point lies.
+        taps = np.array([t for s in range(n) for t in sampling.sample_taps(s, filter_size)], np.float64)
+        w = taps[:, 2] / taps[:, 2].sum()
+        dx, dy = -taps[:, 0], -taps[:, 1]
+        return np.array([w @ dx, w @ dy]), np.array([w @ (dx * dx), w @ (dy * dy), w @ (dx * dy)])
 
     total = int(count) if count > 0 else ENDLESS_MOMENTS
-    mean_k, second_k = moments(max(1, int(kept)))
+    if int(kept) <= 1:  # the pilot: a settled pixel takes its own value, ungathered
+        mean_k, second_k = np.zeros(2), np.zeros(3)
+    else:
+        mean_k, second_k = moments(int(kept))
     mean_n, second_n = moments(max(total, int(kept)))
     return tuple(mean_k - mean_n), tuple(second_k - second_n)
 

@@ -19,26 +19,38 @@ def _light(kind, **kw):
     return Light(type=kind, color=np.ones(3), matrix=m, radius=kw.pop("radius", 0.0), **kw)
 
 
-def test_first_sample_is_centred_and_offsets_fill_the_filter_width():
-    assert sampling.pixel_offset(0, 1.5) == (0.0, 0.0, 1.0)
-    offsets = np.array([sampling.pixel_offset(s, 1.0)[:2] for s in range(1, 1025)])
-    assert np.all(np.abs(offsets) < 1.0)  # within +-filter_size, as in Cycles and EEVEE
-    # Low discrepancy: every quarter of the square gets a quarter of the points, +-2.
-    quadrants = np.histogram2d(offsets[:, 0], offsets[:, 1], bins=2, range=[[-1, 1], [-1, 1]])[0]
+def test_first_sample_is_centred_and_offsets_fill_the_pixel():
+    """The gathering film: sample 0 at the pixel's centre, the others uniform over the pixel
+    (Halton (2, 3), centred), each weighing the window's total over the pixels it reaches; no
+    filter, no jitter; a filter wider than the gather reaches draws offsets from the filter."""
+    assert sampling.pixel_offset(0, 1.5)[:2] == (0.0, 0.0)
+    offsets = np.array([sampling.pixel_offset(s, 1.5)[:2] for s in range(1, 1025)])
+    assert np.all(offsets >= -0.5) and np.all(offsets < 0.5)
+    # Low discrepancy: every quarter of the pixel gets a quarter of the points, +-2.
+    quadrants = np.histogram2d(offsets[:, 0], offsets[:, 1], bins=2, range=[[-0.5, 0.5], [-0.5, 0.5]])[0]
     assert np.all(np.abs(quadrants - 256) <= 2)
-    # Distributed as the filter: the histogram of x follows the Blackman-Harris window.
-    counts, edges = np.histogram(offsets[:, 0], bins=8, range=(-1, 1))
-    centres = 0.5 * (edges[1:] + edges[:-1])
-    window = np.array([sampling.blackman_harris(c, sampling.filter_width(1.0)) for c in centres])
-    np.testing.assert_allclose(counts / counts.sum(), window / window.sum(), atol=0.01)
     assert all(sampling.pixel_offset(s, 0.0) == (0.0, 0.0, 1.0) for s in range(5))  # no filter: no jitter
+    wide = 2.0 * sampling.GATHER_REACH_MAX
+    assert not sampling.gathers(wide) and sampling.pixel_offset(3, wide)[2] == 1.0
 
 
-def test_the_filter_is_blackman_harris_and_samples_weigh_alike():
+def test_a_samples_taps_are_the_filter_at_their_distance():
+    """One sample's contribution to a film pixel is the Blackman-Harris window at the
+    distance between the pixel's centre and the point the sample pixel shaded, separable in
+    x and y (``sample_taps``), and the taps' weights sum to the sample's weight in the film."""
     assert sampling.blackman_harris(0.0, 1.5) == pytest.approx(1.0)
     assert sampling.blackman_harris(0.75, 1.5) == pytest.approx(0.0, abs=1e-4)
     assert sampling.blackman_harris(2.0, 1.5) == 0.0
-    assert all(sampling.pixel_offset(s, 1.5)[2] == 1.0 for s in range(8))
+    width = sampling.filter_width(1.5)
+    assert sampling.gather_reach(1.5) == 1 and sampling.gather_reach(0.3) == 0 and sampling.gather_reach(2.0) == 2
+    for s in range(12):
+        dx, dy, weight = sampling.pixel_offset(s, 1.5)
+        taps = sampling.sample_taps(s, 1.5)
+        assert sum(w for _x, _y, w in taps) == pytest.approx(weight)
+        for x, y, w in taps:
+            assert abs(x) < 1.5 + 1e-9 and abs(y) < 1.5 + 1e-9
+            assert w == pytest.approx(sampling.blackman_harris(x, width) * sampling.blackman_harris(y, width))
+            assert (x + dx) == pytest.approx(round(x + dx)) and (y + dy) == pytest.approx(round(y + dy))
 
 
 def test_jittered_projection_moves_the_image_by_whole_pixels_in_clip_space():
@@ -272,6 +284,7 @@ def test_filter_reach_at_its_extremes():
     assert [flag_reach(f) for f in (0.0, 0.5, 1.0, 1.5, 2.0, 10.0)] == [1, 1, 1, 2, 2, MAX_FLAG_REACH]
     offsets = np.array([sampling.pixel_offset(s, 10.0)[:2] for s in range(1, 257)])
     assert np.all(np.isfinite(offsets)) and np.all(np.abs(offsets) < 10.0)  # within the reach
+    assert all(np.isfinite(sampling.pixel_offset(s, 4.4)[2]) for s in range(8))  # the widest gather
 
 
 @pytest.mark.parametrize("ior", [0.0, -1.0, 1.0, 1.5, 1e6, math.inf, math.nan])

@@ -122,13 +122,15 @@ def _grating_visibility(y):
     return seen / len(dirs)
 
 
-def _pixel_offsets(n, filter_size):
-    """The world-space pixel offsets sample 0 .. n-1 look through: sample s shifts the image
-    by (dx, dy) pixels (``sampling.pixel_offset``), so a pixel centre sees the point (-dx,
-    -dy) pixels from its own."""
-    from penumbra.engine.frame.sampling import pixel_offset
+def _sample_taps(n, filter_size):
+    """Where samples 0 .. n-1 are seen from a pixel centre, and by what share: (x, y, weight)
+    in pixels (``sampling.sample_taps``: a gathering film takes each sample from the pixels
+    around, by the filter's weights), the weights summing to 1."""
+    from penumbra.engine.frame.sampling import sample_taps
 
-    return [tuple(-v for v in pixel_offset(s, filter_size)[:2]) for s in range(n)]
+    taps = [t for s in range(n) for t in sample_taps(s, filter_size)]
+    total = sum(w for _x, _y, w in taps)
+    return [(x, y, w / total) for x, y, w in taps]
 
 
 def _grating_expected(scene, n, grid=48):
@@ -144,7 +146,7 @@ def _grating_expected(scene, n, grid=48):
         offsets, weights = _filter_weights(scene.penumbra.filter_size, grid)
         taps = [(ox, oy, wx * wy) for ox, wx in zip(offsets, weights) for oy, wy in zip(offsets, weights)]
     else:
-        taps = [(ox, oy, 1.0 / n) for ox, oy in _pixel_offsets(n, scene.penumbra.filter_size)]
+        taps = _sample_taps(n, scene.penumbra.filter_size)
     out = np.zeros((h, w))
     for ox, oy, weight in taps:
         out += weight * np.interp(p[..., 1] + ox * right[1] + oy * up[1], ys, vis)
@@ -228,7 +230,7 @@ def _sphere_expected(scene, ball, samples, grid=24):
         offsets, weights = _filter_weights(scene.penumbra.filter_size, grid)
         taps = [(ox, oy, wx * wy) for ox, wx in zip(offsets, weights) for oy, wy in zip(offsets, weights)]
     else:
-        taps = [(ox, oy, 1.0 / samples) for ox, oy in _pixel_offsets(samples, scene.penumbra.filter_size)]
+        taps = _sample_taps(samples, scene.penumbra.filter_size)
     out, judged = np.zeros((h, w)), np.ones((h, w), bool)
     facing = normals @ forward
     for ox, oy, weight in taps:
