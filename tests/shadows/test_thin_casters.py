@@ -4,7 +4,8 @@ are as much the pixel filter's as the maps'. The short version of ``tools.bench 
 160x90 against Cycles through the same Blackman-Harris filter (``kit.matched_filter``).
 
 Measured on 5.2 (reference Cycles 256 spp, seed 1), mean |visibility error|: Cycles 16 spp
-0.0081, Penumbra 64 samples 0.0050, 16 samples 0.0100. The slats' shadows are about a pixel
+0.0081, Penumbra 64 samples 0.0032, 16 samples 0.0047 with the gathering film (0.0050 and
+0.0100 before it). The slats' shadows are about a pixel
 wide at this size, so almost no pixel is under half visible and the IoU says nothing here;
 the bench's IoU at 320x180 is in docs/benchmarks.md.
 """
@@ -41,8 +42,9 @@ def _measure(engine, samples):
 
 def test_thin_shadows_converge_past_cycles_16_spp(penumbra):
     """At 64 samples Penumbra's visibility error is within 1.5x of Cycles at 16 spp (measured:
-    0.62x), and the default 16 samples within 2x (1.23x). The filter is the same in both, so
-    what remains is the maps', the light's and the pixel filter's sampling."""
+    0.40x), and the default 16 samples within it (0.58x; 1.23x before the film gathered). The
+    filter is the same in both, so what remains is the maps', the light's and the pixel
+    filter's sampling."""
     ref = _reference()
     valid = np.isfinite(ref)
     assert valid.mean() > 0.5 and (ref[valid] < 0.9).mean() > 0.02  # there are thin shadows to judge
@@ -51,7 +53,7 @@ def test_thin_shadows_converge_past_cycles_16_spp(penumbra):
     at_16 = _measure("PENUMBRA", 16)
     scores = {"cycles16": cycles, "penumbra64": at_64, "penumbra16": at_16}
     assert at_64["mae"] <= 1.5 * cycles["mae"], scores
-    assert at_16["mae"] <= 2.0 * cycles["mae"], scores
+    assert at_16["mae"] <= cycles["mae"], scores
 
 
 def test_the_pixel_filter_is_blenders(penumbra):
