@@ -73,9 +73,9 @@ class FrameOutput:
 _WORLD_NAMES = ("world_diffuse", "world_specular", "world_sums")  # the world ratio's targets, in order
 
 
-def _gathered(program, gather):
-    """(``program``, or its gathering variant when ``gather`` is given,)."""
-    return (gathering(program),) if gather else (program,)
+def _gathered(program, gather, reach):
+    """(``program``, or, when ``gather`` is given, its variant gathering ``reach`` pixels each way,)."""
+    return (gathering(program, reach),) if gather else (program,)
 
 
 def _clear_zero(texture):
@@ -330,7 +330,9 @@ class Film:
             samplers = {"src_color": self.color, "converged": mask}
             if with_shadow:
                 samplers["src_shadow"] = self.shadow
-            program = _gathered(MASKED_COPY_SHADOW_WEIGHT if with_shadow else MASKED_COPY_WEIGHT, gather)[0]
+            program = _gathered(
+                MASKED_COPY_SHADOW_WEIGHT if with_shadow else MASKED_COPY_WEIGHT, gather, self.gather_reach
+            )[0]
             uniforms = {"scale": weight, **(gather or {})}
             self.fullscreen(program, self._masked_fb(with_shadow), samplers, uniforms, "ADDITIVE_PREMULT")
         if emission:
@@ -349,7 +351,9 @@ class Film:
                 samplers["converged"] = mask
             else:
                 samplers["converged"] = self.world[2]  # bound, never read
-            program = _gathered(WORLD_RATIO_COPY if mask is None else WORLD_RATIO_COPY_MASKED, gather)[0]
+            program = _gathered(
+                WORLD_RATIO_COPY if mask is None else WORLD_RATIO_COPY_MASKED, gather, self.gather_reach
+            )[0]
             uniforms = {"scale": weight, **(gather or {})}
             self.fullscreen(program, self._world_accum_fb, samplers, uniforms, "ADDITIVE_PREMULT")
             if self.tracking and sample % 2 == 1:
@@ -362,11 +366,17 @@ class Film:
         ``gather``: the source gathered over the filter's reach."""
         uniforms = {"scale": scale, **(gather or {})}
         if mask is None:
-            program = _gathered(SCALED_COPY, gather)[0]
+            program = _gathered(SCALED_COPY, gather, self.gather_reach)[0]
             self.fullscreen(program, framebuffer, {"src_color": source}, uniforms, "ADDITIVE_PREMULT")
         else:
             samplers = {"src_color": source, "converged": mask}
-            self.fullscreen(_gathered(MASKED_COPY, gather)[0], framebuffer, samplers, uniforms, "ADDITIVE_PREMULT")
+            self.fullscreen(
+                _gathered(MASKED_COPY, gather, self.gather_reach)[0],
+                framebuffer,
+                samplers,
+                uniforms,
+                "ADDITIVE_PREMULT",
+            )
 
     def keep_centre(self):
         """Keep the centred sample's depth and normal (a multi-sample frame's Depth and Normal
@@ -701,7 +711,13 @@ class Film:
         if with_shadow:
             samplers["src_shadow"] = sources[1]
         program = (SCALED_RESOLVE_SHADOW if resolve else SCALED_COPY_SHADOW) if with_shadow else SCALED_COPY
-        self.fullscreen(*_gathered(program, gather), framebuffer, samplers, {"scale": scale, **(gather or {})}, blend)
+        self.fullscreen(
+            *_gathered(program, gather, self.gather_reach),
+            framebuffer,
+            samplers,
+            {"scale": scale, **(gather or {})},
+            blend,
+        )
 
     def _batch(self, shader):
         from gpu_extras.batch import batch_for_shader

@@ -201,15 +201,17 @@ CONVERGED_DEPTH = Program(
 
 # The gathering film (``sampling.gathers``): a copy program whose source is gathered from the
 # sample pixels within the filter's reach (``lib/film_gather.glsl``), for adding a sample to
-# the accumulations; the sample's image shift, the window's width and reach as push constants.
-GATHER_PUSH = (("VEC2", "gather_shift"), ("FLOAT", "gather_width"), ("INT", "gather_reach"))
+# the accumulations; the window's weights along x and y (made in Python) as push constants,
+# its reach compiled in.
+GATHER_PUSH = (("MAT3", "gather_wx"), ("MAT3", "gather_wy"))
 
 
-def gathering(program):
-    """``program`` (SCALED_COPY, MASKED_COPY, WORLD_RATIO_COPY or a variant) gathering its source."""
+def gathering(program, reach):
+    """``program`` (SCALED_COPY, MASKED_COPY, WORLD_RATIO_COPY or a variant) gathering its source
+    from the sample pixels ``reach`` each way (``sampling.gather_reach``, compiled in)."""
     return replace(
         program,
-        name=f"{program.name}_gather",
+        name=f"{program.name}_gather{int(reach)}",
         push_constants=program.push_constants + GATHER_PUSH,
-        defines=program.defines + (("GATHER", True),),
+        defines=program.defines + (("GATHER", True), ("GATHER_REACH", int(reach))),
     )

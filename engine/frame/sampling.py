@@ -172,14 +172,19 @@ def sample_taps(s, filter_size):
 
 
 def gather_uniforms(dx, dy, filter_size):
-    """The gather's push constants of a sample moved by (dx, dy) pixels (``lib/film_gather.glsl``),
-    or None when the frame does not gather."""
+    """The gather's push constants of a sample moved by (dx, dy) pixels (``lib/film_gather.glsl``):
+    the window's weights of the sample pixels t = -R .. R along x and along y, each padded to
+    nine (a mat3's entries, column by column; the reach R is the program's, ``film.Film.gather_reach``);
+    None when the frame does not gather."""
     if not gathers(filter_size):
         return None
+
+    def nine(weights):
+        return tuple(float(w) for w in weights) + (0.0,) * (9 - len(weights))
+
     return {
-        "gather_shift": (float(dx), float(dy)),
-        "gather_width": float(filter_width(filter_size)),
-        "gather_reach": int(gather_reach(filter_size)),
+        "gather_wx": nine(axis_weights(dx, filter_size)),
+        "gather_wy": nine(axis_weights(dy, filter_size)),
     }
 
 

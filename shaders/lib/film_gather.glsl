@@ -18,14 +18,14 @@
 #endif
 
 #if GATHER
-float gather_window(float x)
+/* The window's weight of sample pixel t (-GATHER_REACH .. GATHER_REACH) along one axis: the
+ * Blackman-Harris window at the distance to the point it shaded, made in Python
+ * (sampling.gather_uniforms) and padded to a mat3's nine entries, column by column. The reach
+ * is compiled in, so the loops unroll and no tap branches. */
+float gather_weight(mat3 weights, int t)
 {
-  float t = x / gather_width + 0.5;
-  if (t <= 0.0 || t >= 1.0) {
-    return 0.0;
-  }
-  float a = 6.283185307179586 * t;
-  return 0.35875 - 0.48829 * cos(a) + 0.14128 * cos(2.0 * a) - 0.01168 * cos(3.0 * a);
+  int k = t + GATHER_REACH;
+  return weights[k / 3][k % 3];
 }
 
 vec4 film_source(sampler2D tex, ivec2 p)
@@ -33,21 +33,13 @@ vec4 film_source(sampler2D tex, ivec2 p)
   ivec2 last = textureSize(tex, 0) - 1;
   vec4 sum = vec4(0.0);
   float used = 0.0;
-  for (int j = -gather_reach; j <= gather_reach; j++) {
-    float wy = gather_window(float(j) - gather_shift.y);
-    if (wy <= 0.0) {
-      continue;
-    }
-    for (int i = -gather_reach; i <= gather_reach; i++) {
-      float w = wy * gather_window(float(i) - gather_shift.x);
-      if (w <= 0.0) {
-        continue;
-      }
+  for (int j = -GATHER_REACH; j <= GATHER_REACH; j++) {
+    float wy = gather_weight(gather_wy, j);
+    for (int i = -GATHER_REACH; i <= GATHER_REACH; i++) {
       vec4 c = texelFetch(tex, clamp(p + ivec2(i, j), ivec2(0), last), 0);
-      if (any(isnan(c)) || any(isinf(c))) {
-        continue;
-      }
-      sum += w * c;
+      bool finite = !(any(isnan(c)) || any(isinf(c)));
+      float w = finite ? wy * gather_weight(gather_wx, i) : 0.0;
+      sum += w * (finite ? c : vec4(0.0));
       used += w;
     }
   }
