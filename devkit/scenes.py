@@ -58,6 +58,16 @@ def material(name, color, roughness=0.5, specular=0.5, metallic=0.0):
     return mat
 
 
+def emissive(name="Glow", strength=1.0):
+    """A black Principled BSDF emitting white at ``strength``: it shows its own light alone."""
+    mat = material(name, (0.0, 0.0, 0.0), specular=0.0)
+    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Emission Color" if "Emission Color" in bsdf.inputs else "Emission"].default_value = (1, 1, 1, 1)
+    if "Emission Strength" in bsdf.inputs:
+        bsdf.inputs["Emission Strength"].default_value = strength
+    return mat
+
+
 def white(name="White", albedo=WHITE_ALBEDO):
     """A purely diffuse grey material: albedo / pi, no specular reflection."""
     return material(name, (albedo,) * 3, roughness=1.0, specular=0.0)

@@ -107,17 +107,12 @@ class PENUMBRA_PT_world(_SettingsPanel, bpy.types.Panel):
     section = settings.WORLD
 
 
-class PENUMBRA_PT_world_sun(PenumbraPanel, bpy.types.Panel):
+class PENUMBRA_PT_world_sun(PENUMBRA_PT_world):
     """World > Sun, EEVEE's settings as Penumbra reads them (``frame/world/sun.py``): an
     Environment Texture's light above the threshold becomes a sun."""
 
     bl_label = "Sun"
-    bl_context = "world"
     bl_parent_id = "PENUMBRA_PT_world"
-
-    @classmethod
-    def poll(cls, context):
-        return super().poll(context) and context.world is not None
 
     def draw(self, context):
         layout = self.split_layout()

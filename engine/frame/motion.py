@@ -152,26 +152,26 @@ def sample_time(s, count, curve=None):
     return _inverse_cdf(curve, (k + 0.5) / count) if curve is not None else (k + 0.5) / count
 
 
+def moved(items, steps_by_key, times, u):
+    """``items`` (``MeshInstance`` or ``Light``, each with a ``motion_key``) with the matrices
+    of those in ``steps_by_key`` (their matrices at ``times``) at shutter fraction ``u``."""
+    if not steps_by_key:
+        return items
+    out = []
+    for item in items:
+        steps = steps_by_key.get(item.motion_key)
+        out.append(item if steps is None else replace(item, matrix=interpolate(times, steps, u)))
+    return out
+
+
 def instances_at(instances, motion, u):
     """``instances`` (``MeshInstance``) with the moving ones' matrices at shutter fraction ``u``."""
-    if not motion.instances:
-        return instances
-    out = []
-    for inst in instances:
-        steps = motion.instances.get(inst.motion_key)
-        out.append(inst if steps is None else replace(inst, matrix=interpolate(motion.times, steps, u)))
-    return out
+    return moved(instances, motion.instances, motion.times, u)
 
 
 def lights_at(lights, motion, u):
     """``lights`` with the moving ones' matrices at shutter fraction ``u``."""
-    if not motion.lights:
-        return lights
-    out = []
-    for light in lights:
-        steps = motion.lights.get(light.motion_key)
-        out.append(light if steps is None else replace(light, matrix=interpolate(motion.times, steps, u)))
-    return out
+    return moved(lights, motion.lights, motion.times, u)
 
 
 def camera_at(camera, motion, u):

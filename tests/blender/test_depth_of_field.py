@@ -18,11 +18,7 @@ SAMPLES = 64
 
 def _scene(depth, focus, fstop=0.2, dof=True, samples=SAMPLES, blades=0):
     scene = scenes.empty_scene(W, H)
-    mat = scenes.material("Glow", (0.0, 0.0, 0.0), specular=0.0)
-    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
-    bsdf.inputs["Emission Color" if "Emission Color" in bsdf.inputs else "Emission"].default_value = (1, 1, 1, 1)
-    if "Emission Strength" in bsdf.inputs:
-        bsdf.inputs["Emission Strength"].default_value = 1.0
+    mat = scenes.emissive()
     scenes.uv_sphere(scene, "Point", center=(0.0, 0.0, -depth), radius=RHO, segments=64, rings=32, mat=mat)
     cam = scenes.camera(scene, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), lens=50.0, clip=(0.1, 100.0))
     cam.data.sensor_fit = "HORIZONTAL"

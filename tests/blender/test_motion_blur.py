@@ -21,11 +21,7 @@ def _scene(shutter=0.5, blur=True, samples=SAMPLES, interpolation="LINEAR", came
     """The sphere at x = -1 on frame 1 and x = +1 on frame 3 (or the camera moving the other
     way), rendered at frame 2."""
     scene = scenes.empty_scene(W, H)
-    mat = scenes.material("Glow", (0.0, 0.0, 0.0), specular=0.0)
-    bsdf = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
-    bsdf.inputs["Emission Color" if "Emission Color" in bsdf.inputs else "Emission"].default_value = (1, 1, 1, 1)
-    if "Emission Strength" in bsdf.inputs:
-        bsdf.inputs["Emission Strength"].default_value = 1.0
+    mat = scenes.emissive()
     ball = scenes.uv_sphere(scene, "Ball", center=(0.0, 0.0, -DEPTH), radius=RHO, segments=64, rings=32, mat=mat)
     cam = scenes.camera(scene, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), lens=50.0, clip=(0.1, 100.0))
     cam.data.sensor_fit = "HORIZONTAL"

@@ -27,7 +27,14 @@ HIDDEN = [
 
 
 def _panel(name):
-    return next((p for p in bpy.types.Panel.__subclasses__() if p.__name__ == name), None)
+    """The registered panel class ``name``, however deep among Panel's subclasses."""
+    pending = list(bpy.types.Panel.__subclasses__())
+    while pending:
+        panel = pending.pop()
+        if panel.__name__ == name:
+            return panel
+        pending.extend(panel.__subclasses__())
+    return None
 
 
 @pytest.mark.parametrize("name", SHOWN)
