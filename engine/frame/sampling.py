@@ -4,11 +4,13 @@ Plain numpy, no bpy and no gpu. A frame of N samples renders sample s = 0 .. N-1
 them with the film filter's weights:
 
 * **Pixels.** Sample s shifts the whole image by a sub-pixel offset: sample 0 by nothing (the
-  pixel centre), sample s > 0 by the Halton (2, 3) point s mapped through the inverse CDF of
-  the Blackman-Harris filter Blender calls ``filter_size`` pixels wide (``filter_width``:
-  it reaches ``filter_size`` pixels each way, as Cycles' Pixel Filter Width and EEVEE's Filter
-  Size do), so offsets are distributed as the filter and the plain average converges to the image
-  convolved with it.
+  pixel centre), sample s > 0 by the Halton (2, 3) point s, centred, uniform over the pixel,
+  and the film gathers it into every pixel within the reach of the Blackman-Harris filter
+  Blender calls ``filter_size`` (``filter_width``: it reaches ``filter_size`` pixels each way,
+  as Cycles' Pixel Filter Width and EEVEE's Filter Size do), weighted by the filter at each
+  distance (``sample_taps``), so the weighted average converges to the image convolved with
+  it. A filter wider than the gather reaches draws each offset from the filter instead
+  (through its inverse CDF: the plain average converges to the same image).
 * **Soft lights.** A light with size (sun ``angle``, point/spot ``shadow_soft_size``, area
   ``size``/``size_y`` and shape) shines from a different point of itself in each sample, in
   an order and rotation of its own so lights do not move in step: a sun from Vogel's spiral

@@ -57,9 +57,10 @@ def flag_reach(filter_size, lens=0.0):
 
 @functools.lru_cache(maxsize=16)
 def settle_shifts(kept, count, filter_size):
-    """How the pixel offsets of samples 0 .. ``kept`` - 1 differ from those of all ``count``
-    samples of the frame (0: without end): (mean dx, mean dy), (mean dx^2, mean dy^2,
-    mean dx dy), the kept ones' minus the whole frame's. A smooth image's kept average
+    """How the points samples 0 .. ``kept`` - 1 are seen at differ from those of all ``count``
+    samples of the frame (0: without end; ``kept`` 1: the pilot's own pixel), as image offsets
+    weighted as the film weighs them (``sampling.sample_taps``): (mean dx, mean dy), (mean
+    dx^2, mean dy^2, mean dx dy), the kept ones' minus the whole frame's. A smooth image's kept average
     differs from the frame's by gradient . mean + 1/2 Hessian : moments (``settle.frag.glsl``).
     Cached: a frame without end takes 1024 offsets (a few ms), and every viewport refinement
     asks again."""
