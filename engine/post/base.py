@@ -188,8 +188,9 @@ def table_texture(rgb):
 
 
 # A user's lookup image (COLORIZER's LUT, LENS_FLARE's dirt) of at most this many texels is
-# drawn from a float table of its pixels; a larger one from Blender's own texture of it.
-IMAGE_TABLE_TEXELS = 1 << 20
+# drawn from a float table of its pixels, read and hashed each frame (about a millisecond at
+# 512 x 512); a larger one from Blender's own texture of it.
+IMAGE_TABLE_TEXELS = 1 << 18
 
 
 def srgb_to_linear(c):

@@ -17,6 +17,7 @@ full image.
 """
 
 import dataclasses
+import hashlib
 import math
 
 import numpy as np
@@ -42,6 +43,12 @@ def _directions(h, w):
     return d, (2.0 * math.pi / w) * (math.pi / h) * np.broadcast_to(cl, (h, w))
 
 
+# The last few extractions by content (the image's light, the rotation, the Sun settings):
+# a frame whose world did not change takes its sun again instead of projecting anew (1-2 ms).
+_KEPT = {}
+_KEPT_MAX = 4
+
+
 def with_sun(world):
     """(``world`` with its SH light and ``env`` of what the sun leaves, the sun as an
     ``extract.Light`` or None): None where the world has no Sun threshold, no image light or
@@ -50,10 +57,28 @@ def with_sun(world):
     env = getattr(world, "env", None)
     if sun is None or env is None or world.sh is None:
         return world, None
+    rotation = None if world.rotation is None else np.asarray(world.rotation, np.float64).tobytes()
+    key = (hashlib.blake2b(np.ascontiguousarray(env).tobytes(), digest_size=16).digest(), rotation, sun)
+    kept = _KEPT.get(key)
+    if kept is None:
+        kept = _extract(world, sun, env)
+        if len(_KEPT) >= _KEPT_MAX:
+            _KEPT.pop(next(iter(_KEPT)))
+        _KEPT[key] = kept
+    if kept is None:
+        return world, None
+    sh, left, light = kept
+    out = dataclasses.replace(world, sh=sh, background=world_background(sh), env=left)
+    return out, dataclasses.replace(light, matrix=light.matrix.copy(), color=light.color.copy())
+
+
+def _extract(world, sun, env):
+    """(the rest's SH light, the rest, the sun) of ``env``, or None where no texel is above the
+    threshold."""
     rgb = np.nan_to_num(np.asarray(env, np.float64)[..., :3], posinf=0.0, neginf=0.0)
     excess = np.maximum(rgb - sun.threshold, 0.0)
     if not np.any(excess > 0.0):
-        return world, None
+        return None
     d, omega = _directions(*rgb.shape[:2])
     if world.rotation is not None:
         d = d @ np.asarray(world.rotation, np.float64)  # the image's direction -> the world's
@@ -62,11 +87,10 @@ def with_sun(world):
     axis = np.einsum("hw,hwc->c", weight, d)
     length = float(np.linalg.norm(axis))
     if not (length > 0.0 and math.isfinite(length)):
-        return world, None
+        return None
     irradiance = flux.sum(axis=(0, 1))
     left = np.minimum(rgb, sun.threshold)
     sh = equirect_sh(left, world.rotation)
-    out = dataclasses.replace(world, sh=sh, background=world_background(sh), env=left)
     matrix = np.eye(4)
     matrix[:3, :3] = frame_towards(axis / length)
     light = Light(
@@ -78,4 +102,4 @@ def with_sun(world):
         use_shadow=bool(sun.shadow),
         name="World Sun",
     )
-    return out, light
+    return sh, left, light
