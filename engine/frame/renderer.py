@@ -367,7 +367,8 @@ class Renderer:
         (``world/directions.py``), and the cones of its light portals that gather them."""
         # The world's light with visibility: a multi-sample frame adds ``world_samples``
         # directions of it per sample, each a sun with its own map.
-        sampled_world = needs_directions(snapshot.world, settings)
+        if not needs_directions(snapshot.world, settings):
+            return 0, []
         # Light portals: the directions gather where the world's light enters what the camera
         # sees, and carry all of its light (no SH light on the surfaces of those samples). A
         # one-sample frame then takes its directions too: the SH light of a room's sky, even
@@ -375,9 +376,9 @@ class Renderer:
         seen = [d for d in draws if d.instance.camera]
         box = corners_of(seen).reshape(-1, 3) if seen else None
         cones = []
-        if sampled_world and getattr(snapshot, "portals", ()) and seen:
+        if getattr(snapshot, "portals", ()) and seen:
             cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
-        directions = int(settings.world_samples) if sampled_world and (accumulate or cones) else 0
+        directions = int(settings.world_samples) if accumulate or cones else 0
         if directions and not cones and seen:
             # The world's light costs what it adds: directions in proportion to its share of
             # the light reaching what the camera sees (world.directions.light_share).
