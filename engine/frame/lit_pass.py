@@ -11,6 +11,7 @@ from ..gpu_pool import UniformBlocks
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
 from .programs import (
+    AO_HORIZONS_SAMPLER,
     AO_SAMPLER,
     JITTER_SIZE,
     RSM_FLUX_SAMPLER,
@@ -62,15 +63,16 @@ class LitPass:
         self.uploaded = 0  # bytes sent to the GPU since creation (uniform blocks, textures of data)
 
     def draw(
-        self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None, ao_depth=None
+        self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None, ao=None
     ):
         """The film's lit pass: every visible part of ``draws``, grouped by material variant:
         opaque and alpha-hashed parts nearest first, then alpha-blended parts farthest first,
         blended over them (their depth, normal and shadow stay those of what is behind; EEVEE
         too keeps blended surfaces out of its depth). ``atlas``: the shadow atlas, or None when
         no map was planned; ``world``: the snapshot's World (or None) and ``world_color``.
-        ``ao_depth``: the camera depth prepass (``world.occlusion.WorldAO.texture``) that a
-        ``WORLD_AO`` variant (``data.defines``) reads."""
+        ``ao``: the renderer's ``world.occlusion.WorldAO``, its camera depth prepass drawn, when
+        the variant occludes the world (``WORLD_AO`` in ``data.defines``): its horizons are
+        marched at half resolution first, and the lit pass reads both."""
         import gpu
 
         world_data, world_color = world
@@ -95,7 +97,11 @@ class LitPass:
         if world_data is not None and world_data.image is not None and not transparent:
             self._background(film, world_data, camera, origin, "LESS_EQUAL" if converged else "NONE")
         opaque, blended, parts = self._entries(draws, camera, atlas, stats, hashed_last=False)
-        submit = _Submission(self, film, camera, data, atlas, origin, masks, ao_depth, parts, stats)
+        if not data.defines.get("WORLD_AO"):
+            ao = None
+        elif ao is not None:
+            ao.march(self._ubo("frame", data.frame), self.shaders, stats)
+        submit = _Submission(self, film, camera, data, atlas, origin, masks, ao, parts, stats)
         submit.emission = emission and not emission_apart
         submit.counted = counted
         submit.ratio = ratio
@@ -300,9 +306,9 @@ class _Submission:
     ``emission``, ``counted`` and ``ratio``: what the film's targets take (the settle test's
     take none of them); ``rebind()`` before drawing into other targets."""
 
-    def __init__(self, lit, film, camera, data, atlas, origin, masks, ao_depth, parts, stats):
+    def __init__(self, lit, film, camera, data, atlas, origin, masks, ao, parts, stats):
         self.lit, self.data, self.atlas, self.origin = lit, data, atlas, origin
-        self.masks, self.ao_depth, self.parts, self.stats = masks, ao_depth, parts, stats
+        self.masks, self.ao, self.parts, self.stats = masks, ao, parts, stats
         self.shadow_tex = atlas.texture if atlas is not None else lit._shadow_dummy()
         self.emission = self.counted = self.ratio = False
         self.entry = lit_entry(data.defines)  # the colour, the settle test's flags or a debug view's
@@ -355,7 +361,8 @@ class _Submission:
         shader.uniform_sampler("jitter_tex", lit._jitter(data.disk_samples))
         shader.uniform_sampler("light_bins", lit._bins_texture(data.bins))
         if defines.get("WORLD_AO"):
-            shader.uniform_sampler(AO_SAMPLER, self.ao_depth)
+            shader.uniform_sampler(AO_SAMPLER, self.ao.texture)
+            shader.uniform_sampler(AO_HORIZONS_SAMPLER, self.ao.horizons)
         if self.rsm:
             shader.uniform_sampler(RSM_FLUX_SAMPLER, self.atlas.flux)
             shader.uniform_sampler(RSM_NORMAL_SAMPLER, self.atlas.normal)

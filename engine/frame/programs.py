@@ -30,6 +30,7 @@ max_filter_radius = lightspace.max_filter_radius
 
 SHADOW_SAMPLER = "shadow_atlas"
 AO_SAMPLER = "ao_depth"
+AO_HORIZONS_SAMPLER = "ao_horizons"
 
 LIGHT_STRUCT = Struct(
     "LightData",
@@ -247,12 +248,14 @@ LIT = Program(
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
     push_constants=(("MAT4", "model"), ("IVEC4", "light_mask"), ("INT", "solid")),
-    # ao_depth: with WORLD_AO, the camera depth prepass (``world.occlusion.WorldAO``), view depth per pixel.
+    # ao_depth: with WORLD_AO, the camera depth prepass (``world.occlusion.WorldAO``), view depth per
+    # pixel; ao_horizons: the horizons marched at half resolution over it (``lib/gtao.glsl``).
     samplers=(
         ("FLOAT_2D", SHADOW_SAMPLER),
         ("FLOAT_3D", "jitter_tex"),
         ("FLOAT_2D", "light_bins"),
         ("FLOAT_2D", AO_SAMPLER),
+        ("FLOAT_2D", AO_HORIZONS_SAMPLER),
     ),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
@@ -275,6 +278,7 @@ LIT = Program(
             "COUNT_SHADED": False,
             "INDIRECT_RSM": False,
             "RSM_SAMPLES": 1,
+            "GTAO_UPSAMPLE": True,
         }.items()
     ),
 )

@@ -693,12 +693,11 @@ class Renderer:
         seen = [d for d in (sample.draws if sample.draws is not None else frame.draws) if d.instance.camera]
         masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
         world = (snapshot.world, snapshot.world_color)
-        ao_depth = self.world_ao.texture if ao is not None else None
         if target is not None:
             self.lit_pass.draw_settle_test(film, seen, view_camera, data, atlas, stats, frame.origin, masks, target)
         else:
             passes = (settings, aux, frame.emission, stats, frame.origin, masks)
-            self.lit_pass.draw(film, seen, view_camera, data, atlas, world, *passes, ao_depth=ao_depth)
+            self.lit_pass.draw(film, seen, view_camera, data, atlas, world, *passes, ao=self.world_ao if ao else None)
         return data
 
     def _debug_view(self, view, accumulate, settings, last, occluded=False):

@@ -4,6 +4,9 @@
 #ifndef WORLD_AO
 #  define WORLD_AO 0
 #endif
+#ifndef GTAO_UPSAMPLE
+#  define GTAO_UPSAMPLE 0 /* 1: the lit pass, reading the half-resolution horizons */
+#endif
 
 #if WORLD_AO
 /* Screen-space ground-truth ambient occlusion of the world's light (Jimenez, Wu, Pesce and
@@ -34,6 +37,9 @@
 #  define GTAO_STEPS 6
 #  define GTAO_FALLOFF 0.25
 #  define GTAO_THICKNESS 0.15
+#  if GTAO_SLICES != 3
+#    error "the half-resolution target packs three slices"
+#  endif
 
 /* Interleaved gradient noise (Jimenez 2014, "Next Generation Post Processing in Call of Duty:
  * Advanced Warfare"): float arithmetic on the pixel's integer coordinates. */
@@ -96,34 +102,55 @@ struct GtaoHorizons {
   bool valid;
 };
 
-/* The horizons around view-space point ``P`` (the fragment's own) at pixel ``frag``. */
-GtaoHorizons gtao_horizons(vec3 P, vec2 frag)
+/* The frame of the horizons around view-space point ``P`` at pixel ``frag``: V and each
+ * slice's direction t (rotated per noise ``cell`` and per sample), and in ``pixels`` how far
+ * the occlusion reaches on screen (0: under a pixel, or a degenerate camera: unoccluded). The
+ * noise cell is the half-resolution texel whose representative ``frag`` is, so the noise keeps
+ * its pattern from cell to cell (interleaved gradient noise read every second pixel repeats in
+ * stripes). */
+GtaoHorizons gtao_frame(vec3 P, vec2 frag, vec2 cell, out float pixels)
 {
   GtaoHorizons g;
   g.valid = false;
   g.V = (frame.is_ortho != 0) ? vec3(0.0, 0.0, 1.0) : -P * inversesqrt(max(dot(P, P), 1e-37));
-  float radius = frame.ao_distance;
   vec2 size = frame.ao_viewport;
   vec2 scale = vec2(frame.ao_projection.x * size.x, frame.ao_projection.y * size.y); /* pixels per unit at w 1, x2 */
   float w = frame.ao_projection_w.z * P.z + frame.ao_projection_w.w;
-  float pixels = 0.5 * radius * min(abs(scale.x), abs(scale.y)) / max(abs(w), 1e-37);
+  pixels = 0.5 * frame.ao_distance * min(abs(scale.x), abs(scale.y)) / max(abs(w), 1e-37);
   pixels = min(pixels, length(size));
-  if (!(radius > 0.0) || !(pixels >= 1.0) || !(abs(scale.x) > 0.0) || !(abs(scale.y) > 0.0)) {
-    return g; /* nothing within a pixel, or a degenerate camera: unoccluded */
+  if (!(frame.ao_distance > 0.0) || !(pixels >= 1.0) || !(abs(scale.x) > 0.0) || !(abs(scale.y) > 0.0)) {
+    pixels = 0.0;
+    return g;
   }
-  g.valid = true;
-  float inv_radius = 1.0 / radius;
-  float noise = gtao_noise(frag);
-  float rotation = fract(noise + frame.ao_jitter.x);
-  float offset = fract(pixel_hash(frag) + frame.ao_jitter.y);
+  float rotation = fract(gtao_noise(cell) + frame.ao_jitter.x);
   for (int i = 0; i < GTAO_SLICES; i++) {
     float phi = M_PI * (float(i) + rotation) / float(GTAO_SLICES);
-    vec2 omega = vec2(cos(phi), sin(phi));
     /* The slice's direction at P's depth: the screen direction lifted to view space. */
-    vec3 d = vec3(omega.x / scale.x, omega.y / scale.y, 0.0);
+    vec3 d = vec3(cos(phi) / scale.x, sin(phi) / scale.y, 0.0);
     d -= g.V * dot(d, g.V);
     float dl = length(d);
     g.t[i] = (dl > 0.0) ? d / dl : vec3(1.0, 0.0, 0.0);
+    g.h[i] = vec2(-0.5 * M_PI, 0.5 * M_PI);
+  }
+  g.valid = true;
+  return g;
+}
+
+/* The horizons around view-space point ``P`` at pixel ``frag`` (noise ``cell``, gtao_frame). */
+GtaoHorizons gtao_horizons(vec3 P, vec2 frag, vec2 cell)
+{
+  float pixels;
+  GtaoHorizons g = gtao_frame(P, frag, cell, pixels);
+  if (!g.valid) {
+    return g; /* nothing within a pixel, or a degenerate camera: unoccluded */
+  }
+  float inv_radius = 1.0 / frame.ao_distance;
+  vec2 size = frame.ao_viewport;
+  float rotation = fract(gtao_noise(cell) + frame.ao_jitter.x);
+  float offset = fract(pixel_hash(cell) + frame.ao_jitter.y);
+  for (int i = 0; i < GTAO_SLICES; i++) {
+    float phi = M_PI * (float(i) + rotation) / float(GTAO_SLICES);
+    vec2 omega = vec2(cos(phi), sin(phi));
     vec2 horizon_cos = vec2(-1.0);
     for (int side = 0; side < 2; side++) {
       vec2 dir = (side == 0) ? -omega : omega;
@@ -155,6 +182,105 @@ GtaoHorizons gtao_horizons(vec3 P, vec2 frag)
   }
   return g;
 }
+
+/* Half resolution. The horizons do not depend on the normal, so they are marched once per 2x2
+ * pixels (shaders/ao_horizons.frag.glsl, engine/frame/world/occlusion.py), from one pixel of
+ * each block, its representative (gtao_representative), into an RGBA32F target: each slice's
+ * two angles packed in one float (11 bits each, exact in a float's 24-bit mantissa, rounded
+ * towards the open side, so a plane's own horizon never occludes it) and the representative's
+ * view depth (0: nothing drawn; horizons -1: unoccluded). A lit fragment takes the horizons of
+ * its own block's representative where that lies within GTAO_UPSAMPLE_REACH of the occlusion
+ * distance or GTAO_UPSAMPLE_PIXELS of the fragment's pixel size on its surface (a plane seen at
+ * a grazing angle has neighbours far apart); else (a silhouette, a thin object) those of the
+ * nearest in space of the four representatives around it (nearest-depth upsampling). It uses
+ * them in that representative's frame (V, slice directions) and integrates them for its own
+ * normals (a surface the prepass leaves out, alpha-blended, stays unoccluded: lit_world.glsl).
+ * No fragment marches its own: the march's code in the lit pass cost a software rasteriser a
+ * sixth of the pass even where it never ran. */
+#  define GTAO_QUANTA 2047.0
+#  define GTAO_UPSAMPLE_REACH 0.1
+#  define GTAO_UPSAMPLE_PIXELS 3.0
+
+/* The pixel that stands for half-resolution texel ``cell``: one of its block's four, picked by
+ * a hash of the cell (a fixed corner would shift every horizon half a pixel the same way:
+ * 0.01 less occlusion at the foot of a wall), inside the film. */
+vec2 gtao_representative(vec2 cell)
+{
+  int k = int(pixel_hash(cell + 31.0) * 4.0) & 3;
+  vec2 p = 2.0 * cell + vec2(float(k & 1), float(k >> 1));
+  return min(p, frame.ao_viewport - 1.0) + 0.5;
+}
+
+float gtao_pack(vec2 h)
+{
+  vec2 q = ceil(clamp(vec2(-h.x, h.y) * (1.0 / M_PI), 0.0, 1.0) * GTAO_QUANTA);
+  return q.x * 2048.0 + q.y;
+}
+
+vec2 gtao_unpack(float v)
+{
+  float qx = floor(v * (1.0 / 2048.0));
+  return vec2(-qx, v - qx * 2048.0) * (M_PI / GTAO_QUANTA);
+}
+
+#  if GTAO_UPSAMPLE
+/* Representative ``c`` of the half-resolution target, if its point lies nearer to ``P`` than
+ * ``best`` (then lowered to its distance). */
+bool gtao_nearer(ivec2 c, vec3 P, inout float best, inout vec4 rep, inout vec3 rep_P, inout vec2 rep_frag,
+                 inout ivec2 rep_cell)
+{
+  vec4 r = texelFetch(ao_horizons, c, 0);
+  if (!(r.w > 0.0)) {
+    return false;
+  }
+  vec2 f = gtao_representative(vec2(c));
+  vec3 S = gtao_view_position(f, r.w);
+  float d = distance(S, P);
+  if (!(d < best)) {
+    return false;
+  }
+  best = d;
+  rep = r;
+  rep_P = S;
+  rep_frag = f;
+  rep_cell = c;
+  return true;
+}
+
+GtaoHorizons gtao_horizons_upsampled(vec3 P, vec2 frag, float footprint)
+{
+  ivec2 last = textureSize(ao_horizons, 0) - 1;
+  float best = max(GTAO_UPSAMPLE_REACH * frame.ao_distance, GTAO_UPSAMPLE_PIXELS * footprint);
+  vec4 rep = vec4(0.0);
+  vec3 rep_P = P;
+  vec2 rep_frag = frag;
+  ivec2 rep_cell = ivec2(0);
+  /* The fragment's own block first (a plane's pixels take it, whatever the rounding of their
+   * distances to the others); else the nearest of the four representatives around it. */
+  if (!gtao_nearer(min(ivec2(floor(frag)) / 2, last), P, best, rep, rep_P, rep_frag, rep_cell)) {
+    best = 3.4e38;
+    ivec2 base = ivec2(floor((floor(frag) - 1.0) * 0.5));
+    for (int k = 0; k < 4; k++) {
+      gtao_nearer(clamp(base + ivec2(k & 1, k >> 1), ivec2(0), last), P, best, rep, rep_P, rep_frag, rep_cell);
+    }
+  }
+  if (!(rep.w > 0.0)) {
+    GtaoHorizons none;
+    none.valid = false;
+    return none; /* no surface of the prepass around (a blended surface over the world) */
+  }
+  float pixels;
+  GtaoHorizons g = gtao_frame(rep_P, rep_frag, vec2(rep_cell), pixels);
+  if (!(rep.x >= 0.0)) {
+    g.valid = false;
+    return g;
+  }
+  g.h[0] = gtao_unpack(rep.x);
+  g.h[1] = gtao_unpack(rep.y);
+  g.h[2] = gtao_unpack(rep.z);
+  return g;
+}
+#  endif
 
 /* One half of a slice's cosine-weighted arc from V to horizon angle h, for the normal
  * projected onto the slice at angle n from V (Jimenez et al. 2016, eq. 10). */

@@ -101,7 +101,17 @@ vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
 {
 #if WORLD_AO
   mat3 ao_rotation = mat3(frame.view);
-  GtaoHorizons ao_horizons = gtao_horizons((frame.view * vec4(s.P, 1.0)).xyz, gl_FragCoord.xy);
+  vec3 ao_P = (frame.view * vec4(s.P, 1.0)).xyz;
+  float ao_footprint = max(length(dFdx(ao_P)), length(dFdy(ao_P))); /* a pixel's size on the surface */
+  /* A fragment behind the prepass's surface at its pixel is hidden (the lit pass draws the
+   * same opaque surfaces) and its colour overwritten; one in front of it is a surface the
+   * prepass leaves out (alpha-blended) and stays unoccluded. Neither reads the horizons. */
+  float ao_front = texelFetch(ao_depth, ivec2(gl_FragCoord.xy), 0).r;
+  GtaoHorizons ao_horizons;
+  ao_horizons.valid = false;
+  if (!(ao_front > 0.0) || abs(-ao_P.z - ao_front) <= 0.01 * ao_front) {
+    ao_horizons = gtao_horizons_upsampled(ao_P, gl_FragCoord.xy, ao_footprint);
+  }
 #endif
   vec3 color = vec3(0.0);
   for (int k = 0; k < NODE_LOBES; k++) {

@@ -73,15 +73,17 @@ def frame(gpu_call, scene, width=W, height=H, samples=1, aux=True):
 NEAR_TOLERANCE = 0.06
 
 
-def test_floor_at_the_foot_of_a_wall_sees_half_the_world(penumbra):
+@pytest.mark.parametrize("size", [(W, H), (W - 1, H - 1)])
+def test_floor_at_the_foot_of_a_wall_sees_half_the_world(penumbra, size):
     """A point on a floor at the foot of an infinite wall sees half the cosine-weighted
     hemisphere: radiance albedo * world * 0.5. Floor points 3-12 cm from the wall, which the
     frame shows up to 2.7 m (a wall that high leaves them 0.5 + at most 0.022,
     ``visible_wall_visibility``). Screen-space error on top: 3 slices of 6 steps find the
     highest point of the wall only up to their last step inside the frame, which leaves the
     band's mean within NEAR_TOLERANCE of 1/2 (measured 0.537) and per pixel the noise of three
-    slice directions. Floor points beyond the distance (0.2 m) see the whole world, exactly."""
-    scene = wall_scene()
+    slice directions. Floor points beyond the distance (0.2 m) see the whole world, exactly.
+    At an odd size too: the half-resolution horizons' last column and row stand for one pixel."""
+    scene = wall_scene(size=size)
     color = render(scene)["Combined"][..., :3].mean(axis=-1)
     y = floor_points(scene)[..., 1]
     near = (y > -0.12) & (y < -0.03)
@@ -100,6 +102,23 @@ def test_floor_at_the_foot_of_a_wall_sees_half_the_world(penumbra):
     np.testing.assert_allclose(color[far] / full, 1.0, rtol=1e-4)
     near = (y > -0.1) & (y < -0.03)
     assert (color[near] / full).mean() < 0.9  # still within reach of the wall
+
+
+def test_horizons_are_marched_at_half_resolution(penumbra, gpu_call):
+    """The horizons are marched once per 2x2 pixels (``WorldAO.march``, odd sizes rounded up),
+    and the lit pass upsamples them: the wall scene's floor near the wall still gets its
+    occlusion, in every 2x2 block alike (no block left at 1 or stuck at its representative's)."""
+    scene = wall_scene(size=(W + 1, H + 1))
+    stats, color = frame(gpu_call, scene, W + 1, H + 1)
+    assert stats.ao_prepasses == 1 and stats.ao_texels == ((W + 2) // 2) * ((H + 2) // 2)
+    y = floor_points(scene)[..., 1]
+    v = color.mean(axis=-1) / (ALBEDO * WORLD[0])
+    near = (y > -0.12) & (y < -0.03)
+    for dy in (0, 1):
+        for dx in (0, 1):
+            sub = near[dy::2, dx::2]
+            assert sub.sum() > 40
+            assert abs(v[dy::2, dx::2][sub].mean() - 0.5) < NEAR_TOLERANCE, (dx, dy)
 
 
 def open_floor(ortho=False, size=(W, H)):
