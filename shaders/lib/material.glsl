@@ -18,10 +18,22 @@
 #define EXTENSION_MIRROR 3
 #define IMAGE_MAX_ANISOTROPY 8
 
+/* i modulo n (> 0) in [0, n), from remainders of non-negative operands only: GLSL leaves %
+ * undefined when an operand is negative (drivers differ), and an index left of the image or of
+ * an equirectangular seam is -1. */
+int wrap_repeat(int i, int n)
+{
+  if (i >= 0) {
+    return i % n;
+  }
+  int m = (-i) % n;
+  return (m == 0) ? 0 : n - m;
+}
+
 int wrap_mirror(int i, int n)
 {
   int period = 2 * n;
-  int m = ((i % period) + period) % period;
+  int m = wrap_repeat(i, period);
   return (m < n) ? m : period - 1 - m;
 }
 
@@ -29,7 +41,7 @@ int wrap_mirror(int i, int n)
 int wrap_index(int i, int n, int extension)
 {
   if (extension == EXTENSION_REPEAT) {
-    return ((i % n) + n) % n;
+    return wrap_repeat(i, n);
   }
   if (extension == EXTENSION_MIRROR) {
     return wrap_mirror(i, n);
@@ -46,10 +58,14 @@ vec4 texel_or_zero(sampler2D tex, int x, int y, int level)
 }
 
 /* Bilinear at mip ``level`` between its texel centres; ``uv`` in [0, 1] image units. The
- * four texels' indices are wrapped once per axis. */
+ * four texels' indices are wrapped once per axis. The level's size is the full size halved
+ * ``level`` times (OpenGL's rule for a mip chain), not textureSize at that level: with a level
+ * that differs between the pixels of one quad (a wide view's background, where the footprint
+ * crosses a whole level), llvmpipe answered every pixel with one pixel's size, and the others
+ * read out of their level: black or sky texels in the ground at 170 degrees. */
 vec4 image_bilinear(sampler2D tex, vec2 uv, int level, int extension)
 {
-  ivec2 size = max(textureSize(tex, level), ivec2(1));
+  ivec2 size = max(textureSize(tex, 0) >> level, ivec2(1));
   vec2 st = uv * vec2(size) - 0.5;
   ivec2 i = ivec2(floor(st));
   vec2 f = st - floor(st);
