@@ -19,6 +19,8 @@ glossy_spheres     five spheres of Principled roughness 0.15 to 0.5 (coloured, I
                    grey ground under a dim uniform sky (0.6, 0.7, 0.9) x 0.3 and a sun 40 deg
                    up: the world's light is a small share, its glossy reflections of the
                    ground are blocked (where an estimator that subtracts went negative)
+skylight_room      a closed 6 x 4 x 3 m room lit through a skylight and a doorway, a crate and
+                   a pillar inside; no light portal for Penumbra (Cycles gets two)
 window_room        a closed 4 x 5 x 2.8 m room of 0.2 m thick, overlapping boxes (no seam
                    lets light through) with one 1.6 x 1.4 m window in the +Y wall, a uniform
                    sky of strength 4 outside, a table and a sphere by the window; the camera
@@ -301,11 +303,52 @@ def window_room(scene):
     return scene
 
 
+def skylight_room(scene):
+    """A closed 6 x 4 x 3 m room (walls as ``window_room``'s: overlapping boxes WALL thick)
+    lit by a uniform sky of strength 4 through a 1.2 x 1.2 m skylight in the ceiling and a
+    0.9 x 2.0 m doorway in the west wall, with a crate under the skylight and a pillar; the
+    camera in a corner looking across. No light portal for Penumbra (it finds the openings
+    itself, ``engine/frame/world/probe.py``); Cycles gets portals over both openings, which
+    only speed up its convergence (``use_engine``)."""
+    uniform_sky(scene, (0.85, 0.9, 1.0), ROOM_SKY_STRENGTH)
+    X, Y, Z, t, o = 3.0, 2.0, 3.0, WALL, 0.05
+    walls = principled("Walls", (0.7, 0.72, 0.75), 0.8)
+    floor = principled("Floor", (0.45, 0.5, 0.4), 0.6)
+    _span_box(scene, "Floor", (-X - t, -Y - t, -t), (X + t, Y + t, 0.0), floor)
+    # The ceiling around the skylight: x in [0.4, 1.6], y in [-0.6, 0.6].
+    sx, sy = (0.4, 1.6), (-0.6, 0.6)
+    _span_box(scene, "CeilingW", (-X - t, -Y - t, Z), (sx[0], Y + t, Z + t), walls)
+    _span_box(scene, "CeilingE", (sx[1], -Y - t, Z), (X + t, Y + t, Z + t), walls)
+    _span_box(scene, "CeilingS", (sx[0] - o, -Y - t, Z), (sx[1] + o, sy[0], Z + t), walls)
+    _span_box(scene, "CeilingN", (sx[0] - o, sy[1], Z), (sx[1] + o, Y + t, Z + t), walls)
+    _span_box(scene, "WallE", (X, -Y - t, -t), (X + t, Y + t, Z + t), walls)
+    _span_box(scene, "WallS", (-X - t, -Y - t, -t), (X + t, -Y, Z + t), walls)
+    _span_box(scene, "WallN", (-X - t, Y, -t), (X + t, Y + t, Z + t), walls)
+    # The west wall around the doorway: y in [-1.2, -0.3], z in [0, 2].
+    dy, dz = (-1.2, -0.3), 2.0
+    _span_box(scene, "WallW_south", (-X - t, -Y - t, -t), (-X, dy[0], Z + t), walls)
+    _span_box(scene, "WallW_north", (-X - t, dy[1], -t), (-X, Y + t, Z + t), walls)
+    _span_box(scene, "WallW_above", (-X - t, dy[0] - o, dz), (-X, dy[1] + o, Z + t), walls)
+    stone = principled("Stone", (0.6, 0.55, 0.5), 0.7)
+    _span_box(scene, "Crate", (0.6, -0.9, 0.0), (1.4, -0.1, 0.8), stone)
+    cylinder(scene, "Pillar", (-0.8, 0.6, 0.7), 0.3, 1.4, principled("Pillar", (0.8, 0.8, 0.8), 0.5))
+    # Cycles' portals (location, rotation, size x, size y; each faces -Z into the room).
+    scene["world_portals"] = [
+        (sum(sx) / 2, sum(sy) / 2, Z, 0.0, 0.0, 0.0, sx[1] - sx[0], sy[1] - sy[0]),
+        (-X, sum(dy) / 2, dz / 2, 0.0, -math.pi / 2, 0.0, dz, dy[1] - dy[0]),
+    ]
+    cam = scenes.look_at(scene, (2.6, 1.6, 1.7), (-1.0, -0.6, 0.6), lens=16.0)
+    cam.data.clip_start = 0.05
+    cam.data.clip_end = 50.0
+    return scene
+
+
 SCENES = {
     "sky_outdoor": sky_outdoor,
     "sky_outdoor_hdri": sky_outdoor_hdri,
     "glossy_spheres": glossy_spheres,
     "window_room": window_room,
+    "skylight_room": skylight_room,
 }
 INDOOR = ("window_room",)  # scenes where the bounce matters (a Cycles reference with one bounce)
 
@@ -362,6 +405,31 @@ def _portal(scene, present):
         ob.data.cycles.is_portal = True
 
 
+def _portals(scene, present):
+    """Add (``present``) or remove Cycles' light portals over a room's openings
+    (``scene['world_portals']``: location, rotation, size x, size y each)."""
+    for ob in [ob for ob in scene.objects if ob.name.startswith(PORTAL + "_")]:
+        data = ob.data
+        bpy.data.objects.remove(ob)
+        bpy.data.lights.remove(data)
+    if not present or "world_portals" not in scene:
+        return
+    for k, row in enumerate(scene["world_portals"]):
+        x, y, z, rx, ry, rz, size_x, size_y = (float(v) for v in row)
+        ob = scenes.light(
+            scene,
+            f"{PORTAL}_{k}",
+            "AREA",
+            0.0,
+            location=(x, y, z),
+            rotation=(rx, ry, rz),
+            shape="RECTANGLE",
+            size=size_x,
+            size_y=size_y,
+        )
+        ob.data.cycles.is_portal = True
+
+
 def use_engine(scene, engine, **settings):
     """Set ``scene`` up for ``engine`` ('PENUMBRA', 'CYCLES' or 'EEVEE') with ``settings``:
 
@@ -374,6 +442,7 @@ def use_engine(scene, engine, **settings):
     Returns the names of the settings skipped."""
     key = engine.upper()
     _portal(scene, key in ("CYCLES", "PENUMBRA"))
+    _portals(scene, key == "CYCLES")
     if key == "CYCLES":
         engines.configure(scene, "CYCLES", **cycles_settings(**settings), **kit.matched_filter(scene))
         return []

@@ -39,6 +39,7 @@ from .world.directions import (
     world_negligible,
 )
 from .world.occlusion import WorldAO
+from .world.probe import WorldProbe, probe_due
 from .world.sh_light import with_sh_light
 from .world.sun import with_sun
 
@@ -173,6 +174,7 @@ class Renderer:
         self.shadow_pass = ShadowPass(pool)
         self.lit_pass = LitPass(self.shaders, self.materials, self.textures)
         self.world_ao = WorldAO(pool)  # the camera depth prepass of the world's ambient occlusion
+        self.world_probe = WorldProbe(pool)  # where the world's light gets into an interior
         self.post = post_stack()
         # What the last frame's last sample drew (``SampleResult``), for inspection: nothing
         # in a frame reads what an earlier call left here.
@@ -304,6 +306,13 @@ class Renderer:
         threshold = adaptive.threshold if adaptive is not None and accumulate else 0.0
         negligible = world_negligible(snapshot.world if snapshot.world is not None else snapshot.world_color, threshold)
         directions, cones = (0, []) if negligible else self._world_directions(snapshot, draws, settings, accumulate)
+        if not negligible and not cones and probe_due(snapshot, draws, settings):
+            # No light portal: an interior's openings found by the world's probe stand in for them.
+            cones = self.world_probe.cones(
+                draws, snapshot.world, origin, self.shaders, self.materials, self.textures, stats
+            )
+            if cones:
+                directions = int(settings.world_samples)
         room = MAX_LIGHTS - directions
         lights = select_lights(snapshot.lights, camera.position, room)
         if len(lights) < len(snapshot.lights):
@@ -758,3 +767,4 @@ class Renderer:
         self.film.release()
         self.shadows.free()
         self.world_ao.release()
+        self.world_probe.release()

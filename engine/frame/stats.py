@@ -112,6 +112,7 @@ class FrameStats:
     # draw calls; counted apart, not in ``passes`` and ``draws``.
     ao_prepasses: int = 0
     ao_draws: int = 0
+    probe_draws: int = 0  # draw calls of the world's probe (``world/probe.py``), counted apart
     ao_texels: int = 0  # texels whose horizons were marched (half resolution: a quarter of the film)
     upload_bytes: int = 0  # bytes sent to the GPU: uniform blocks, batches built, textures of data
     cpu_seconds: dict = field(default_factory=dict)  # stage -> render-thread CPU seconds (``StageClock.cpu``)

@@ -72,6 +72,25 @@ def test_world_shadows_are_what_brings_it_close(penumbra, name):
     assert off >= 2.0 * on and off - on >= 0.02, (name, on, off)
 
 
+def test_a_room_without_a_portal_finds_its_window(penumbra, monkeypatch):
+    """The room with its light portal removed, as most interiors users render come: the
+    world's probe (``world/probe.py``) finds the window from depth and the frame draws its
+    directions through it. At 64 samples within the room's target of Cycles (measured 0.018;
+    0.099 with the probe off, the directions drawn over the whole sphere)."""
+    from penumbra.engine.frame.world import probe
+
+    def room():
+        scene = ws.build("window_room", WIDTH, HEIGHT)
+        ws.use_engine(scene, "PENUMBRA", render_samples=SAMPLES, world_shadows=True)
+        ws._portal(scene, False)
+        return ws.mae(ws.render_display(scene), _reference("window_room"))
+
+    found = room()
+    monkeypatch.setattr(probe, "INTERIOR_SHARE", 0.0)  # no frame is an interior
+    blind = room()
+    assert found <= TARGETS["window_room"] and blind >= 2.0 * found, (found, blind)
+
+
 @pytest.mark.parametrize("name", ["sky_outdoor"])
 def test_one_sample_frame_is_close_to_the_converged_one(penumbra, name):
     """The sky-lit one-sample frame (the viewport while the view moves: ambient occlusion for

@@ -132,8 +132,13 @@ class WorldDistribution:
         self.sh = np.nan_to_num(np.asarray(sh, np.float64), posinf=0.0, neginf=0.0)
         # world direction -> the image's (an Environment Texture's Mapping), or None
         self.rotation = None if rotation is None else np.asarray(rotation, np.float64)
-        # (unit axis, cos of the half-angle) of each portal's cone (``portal_cones``).
-        self.cones = [(np.asarray(a, np.float64), float(c)) for a, c in cones if -1.0 <= c < 1.0]
+        # (unit axis, cos of the half-angle) of each portal's cone (``portal_cones``), or a
+        # ``guide``: a WorldDistribution of where the light gets in (``world/probe.py``).
+        self.cones = [
+            c if isinstance(c, WorldDistribution) else (np.asarray(c[0], np.float64), float(c[1]))
+            for c in cones
+            if isinstance(c, WorldDistribution) or -1.0 <= c[1] < 1.0
+        ]
         self.env = None
         if env is not None:
             env = np.nan_to_num(np.asarray(env, np.float64)[..., :3], posinf=0.0, neginf=0.0)
@@ -182,7 +187,11 @@ class WorldDistribution:
         if not self.cones:
             return base
         cones = np.zeros(len(d))
-        for axis, cos_max in self.cones:
+        for cone in self.cones:
+            if isinstance(cone, WorldDistribution):
+                cones += cone.image_pdf(d)
+                continue
+            axis, cos_max = cone
             inside = d @ axis >= cos_max
             cones += inside / (2.0 * math.pi * (1.0 - cos_max))
         return PORTAL_SHARE * cones / len(self.cones) + (1.0 - PORTAL_SHARE) * base
@@ -191,9 +200,12 @@ class WorldDistribution:
         uniform = np.full(len(d), 1.0 / (4.0 * math.pi))
         if self.env is None:
             return uniform
+        return UNIFORM_SHARE * uniform + (1.0 - UNIFORM_SHARE) * self.image_pdf(d)
+
+    def image_pdf(self, d):
+        """The density (per steradian) of ``_from_image``'s directions at ``d`` (n, 3)."""
         r, c = self._texel(d)
-        lum = self.p_texel[r, c] / self.band[r]
-        return UNIFORM_SHARE * uniform + (1.0 - UNIFORM_SHARE) * lum
+        return self.p_texel[r, c] / self.band[r]
 
     def _texel(self, d):
         h, w = self.env.shape[:2]
@@ -220,6 +232,9 @@ class WorldDistribution:
         for k in np.nonzero(in_cone)[0]:
             x = a[k] / PORTAL_SHARE * n
             i = min(int(x), n - 1)
+            if isinstance(self.cones[i], WorldDistribution):
+                out[k] = self.cones[i]._from_image(np.array([min(x - i, 1.0 - 1e-12)]), np.array([b[k]]))[0]
+                continue
             axis, cos_max = self.cones[i]
             out[k] = _in_cone(axis, cos_max, min(x - i, 1.0 - 1e-12), b[k])
         return out
@@ -264,6 +279,20 @@ def _in_cone(axis, cos_max, a, b):
     phi = 2.0 * math.pi * b
     frame = frame_towards(axis)
     return frame @ np.array([r * math.cos(phi), r * math.sin(phi), z])
+
+
+def guide(weights):
+    """A distribution of directions (a ``WorldDistribution`` whose image is ``weights``, an
+    (h, w) equirectangular grid in world directions, row 0 at the bottom, as the world's
+    images are read) that a frame's ``cones`` can hold in place of a cone: its directions are
+    drawn in proportion to each cell's weight (``world/probe.py``: where the world's light gets
+    into an interior). None where the weights hold nothing."""
+    weights = np.nan_to_num(np.asarray(weights, np.float64), posinf=0.0, neginf=0.0)
+    h, w = weights.shape
+    band = np.diff(np.sin((np.arange(h + 1) / h - 0.5) * math.pi)) * (2.0 * math.pi / w)
+    per_sr = np.clip(weights, 0.0, None) / band[:, None]  # the grid's weight per solid angle
+    dist = WorldDistribution(np.zeros((9, 3)), np.repeat(per_sr[..., None], 3, axis=-1) / _LUMINANCE.sum())
+    return dist if dist.env is not None else None
 
 
 def portal_cones(portals, lo, hi):
@@ -317,7 +346,9 @@ def distribution(world, cones=()):
     """The ``WorldDistribution`` of ``world`` (a ``materials.World`` whose SH is known) with
     the portals' ``cones``, remembered on the world object for those cones (a snapshot's
     world is rebuilt when the world changes)."""
-    key = tuple((tuple(np.round(a, 12)), round(c, 12)) for a, c in cones)
+    key = tuple(
+        id(c) if isinstance(c, WorldDistribution) else (tuple(np.round(c[0], 12)), round(c[1], 12)) for c in cones
+    )
     cached = getattr(world, "_distribution", None)
     if cached is None or cached[0] != key:
         cached = (
