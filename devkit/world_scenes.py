@@ -19,6 +19,7 @@ glossy_spheres     five spheres of Principled roughness 0.15 to 0.5 (coloured, I
                    grey ground under a dim uniform sky (0.6, 0.7, 0.9) x 0.3 and a sun 40 deg
                    up: the world's light is a small share, its glossy reflections of the
                    ground are blocked (where an estimator that subtracts went negative)
+window_room_bare   ``window_room`` with no portal for Penumbra (Cycles keeps its own)
 skylight_room      a closed 6 x 4 x 3 m room lit through a skylight and a doorway, a crate and
                    a pillar inside; no light portal for Penumbra (Cycles gets two)
 window_room        a closed 4 x 5 x 2.8 m room of 0.2 m thick, overlapping boxes (no seam
@@ -343,14 +344,26 @@ def skylight_room(scene):
     return scene
 
 
+def window_room_bare(scene):
+    """``window_room`` as most rooms come: no light portal for Penumbra (Cycles keeps one over
+    the window, which only speeds up its convergence)."""
+    window_room(scene)
+    x0, x1, z0, z1, y = (float(v) for v in scene["world_window"])
+    del scene["world_window"]
+    scene["world_portals"] = [((x0 + x1) / 2, y, (z0 + z1) / 2, -math.pi / 2, 0.0, 0.0, x1 - x0, z1 - z0)]
+    return scene
+
+
 SCENES = {
     "sky_outdoor": sky_outdoor,
     "sky_outdoor_hdri": sky_outdoor_hdri,
     "glossy_spheres": glossy_spheres,
     "window_room": window_room,
+    "window_room_bare": window_room_bare,
     "skylight_room": skylight_room,
 }
 INDOOR = ("window_room",)  # scenes where the bounce matters (a Cycles reference with one bounce)
+PORTALLED = ("window_room", "window_room_bare", "skylight_room")  # Cycles renders them through portals
 
 
 def build(name, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
@@ -437,12 +450,14 @@ def use_engine(scene, engine, **settings):
               have (WORLD_SETTINGS) is skipped, any other unknown name is an error
     CYCLES    ``bounces`` (0: direct light; 1: one diffuse bounce), ``samples``, ``seed``,
               through Penumbra's pixel filter, a portal over a room's window (Penumbra too)
+              and over ``world_portals`` (Cycles only); ``portals=False``: none (any engine)
     EEVEE     ``devkit.engines``' EEVEE (16 TAA samples), no light probe baked
 
     Returns the names of the settings skipped."""
     key = engine.upper()
-    _portal(scene, key in ("CYCLES", "PENUMBRA"))
-    _portals(scene, key == "CYCLES")
+    portals = settings.pop("portals", True)
+    _portal(scene, portals and key in ("CYCLES", "PENUMBRA"))
+    _portals(scene, portals and key == "CYCLES")
     if key == "CYCLES":
         engines.configure(scene, "CYCLES", **cycles_settings(**settings), **kit.matched_filter(scene))
         return []

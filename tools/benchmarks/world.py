@@ -12,6 +12,7 @@ On ``devkit.world_scenes`` (``sky_outdoor``: objects on a ground under a uniform
 - Cycles with max_bounces 0 (the world's direct light with visibility) at 1, 4, 16, 64 and
   128 spp; in the room also with one diffuse bounce. Same pixel filter as Penumbra
   (``reference_kit.matched_filter``), a light portal over the room's window.
+- In the rooms, Cycles again without its light portals (what a user without portals gets).
 - EEVEE once, as ``devkit.engines`` sets it up (16 TAA samples; no light probe baked).
 
 Error: the mean absolute difference of display-referred RGB (the 'Standard' view, 0..1, every
@@ -80,6 +81,7 @@ SHADOWS_OFF = "Penumbra, world shadows off"
 BOUNCE = "Penumbra, 1 bounce"
 CYCLES = "Cycles"
 CYCLES_BOUNCE = "Cycles, 1 bounce"
+CYCLES_BARE = "Cycles, no portal"
 EEVEE = f"EEVEE ({EEVEE_SAMPLES} TAA)"
 
 
@@ -100,6 +102,9 @@ def configs(plan, name):
             out.append((BOUNCE, "PENUMBRA", n, "bounce1", settings))
     for n in plan.cycles_spp:
         out.append((CYCLES, "CYCLES", n, "direct", {"samples": n, "bounces": 0}))
+    if name in ws.PORTALLED:  # what a user without portals gets from Cycles
+        for n in plan.cycles_spp:
+            out.append((CYCLES_BARE, "CYCLES", n, "direct", {"samples": n, "bounces": 0, "portals": False}))
     if name in ws.INDOOR:
         for n in plan.cycles_spp:
             out.append((CYCLES_BOUNCE, "CYCLES", n, "bounce1", {"samples": n, "bounces": 1}))
@@ -161,6 +166,7 @@ def plot(rows, path, plan):
         BOUNCE: ("tab:cyan", "-s"),
         CYCLES: ("tab:red", "-P"),
         CYCLES_BOUNCE: ("tab:orange", "--P"),
+        CYCLES_BARE: ("tab:red", ":x"),
     }
     fig, axes = plt.subplots(1, len(plan.scenes), figsize=(5.2 * len(plan.scenes), 4.6), squeeze=False)
     for ax, name in zip(axes[0], plan.scenes, strict=True):
