@@ -206,7 +206,8 @@ class WorldProbe:
             tuple(np.round(lo, 9)),
             tuple(np.round(hi, 9)),
             tuple((id(d.whole), tuple(np.round(np.asarray(d.model).ravel(), 9))) for d in seen),
-            id(world),
+            np.asarray(world.sh, np.float64).tobytes(),  # the world by content: a frame's is a new object
+            id(getattr(world, "env", None)),
         )
         if self._last is not None and self._last[0] == key:
             return self._last[1]
