@@ -309,10 +309,11 @@ class Renderer:
         if not negligible and not cones and probe_due(snapshot, draws, settings):
             # No light portal: an interior's openings found by the world's probe stand in for them.
             cones = self.world_probe.cones(
-                draws, snapshot.world, origin, self.shaders, self.materials, self.textures, stats
+                draws, snapshot.world, camera.position, origin, self.shaders, self.materials, self.textures, stats
             )
             if cones:
                 directions = int(settings.world_samples)
+                stats.world_guided = True
         room = MAX_LIGHTS - directions
         lights = select_lights(snapshot.lights, camera.position, room)
         if len(lights) < len(snapshot.lights):

@@ -113,6 +113,7 @@ class FrameStats:
     ao_prepasses: int = 0
     ao_draws: int = 0
     probe_draws: int = 0  # draw calls of the world's probe (``world/probe.py``), counted apart
+    world_guided: bool = False  # the probe found an interior: the world's directions come through its openings
     ao_texels: int = 0  # texels whose horizons were marched (half resolution: a quarter of the film)
     upload_bytes: int = 0  # bytes sent to the GPU: uniform blocks, batches built, textures of data
     cpu_seconds: dict = field(default_factory=dict)  # stage -> render-thread CPU seconds (``StageClock.cpu``)

@@ -235,7 +235,7 @@ def image_or_table(image, cache, table):
     pixels = image_pixels(image)
     if pixels is None:
         return gpu.texture.from_image(image)
-    key = (image.name, pixels.shape, hashlib.blake2b(pixels.tobytes(), digest_size=16).digest())
+    key = (image.name, pixels.shape, hashlib.sha256(np.ascontiguousarray(pixels).data).digest())
     if cache.get("image", (None,))[0] != key:
         cache["image"] = (key, rgba_texture(pixels))
     return cache["image"][1]

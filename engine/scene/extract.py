@@ -502,7 +502,7 @@ def _closed_cached(tris, co):
     a large closed mesh, while hashing the arrays costs a few percent of it."""
     import hashlib
 
-    digest = hashlib.blake2b(digest_size=16)
+    digest = hashlib.sha256()
     digest.update(np.ascontiguousarray(tris, np.int32).data)
     digest.update(np.ascontiguousarray(co, np.float32).data)
     key = digest.digest()

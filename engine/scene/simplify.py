@@ -50,7 +50,7 @@ def simplified(geo, level):
     the level would keep more than WORTH of the triangles or none at all."""
     digest = getattr(geo, "_simplify_digest", None)
     if digest is None:
-        h = hashlib.blake2b(digest_size=16)
+        h = hashlib.sha256()
         h.update(np.ascontiguousarray(geo.indices).data)
         h.update(np.ascontiguousarray(geo.positions).data)
         h.update(np.ascontiguousarray(geo.normals).data)

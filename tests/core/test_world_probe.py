@@ -46,7 +46,7 @@ SKYLIGHT = (2, 1.0, ((-0.6, 0.6), (-0.6, 0.6)))  # in the ceiling
 
 
 def guide_of(d, s, depth, opened):
-    return probe.opening_guide(d, s, depth, opened, np.zeros(3))
+    return probe.opening_guide([(d, s, depth, opened, np.zeros(3))])
 
 
 @pytest.mark.parametrize("openings", [(WINDOW,), (WINDOW, SKYLIGHT)])
@@ -75,13 +75,19 @@ def test_an_interiors_guide_draws_through_its_openings(openings):
 
 def test_outdoors_and_closed_rooms_get_no_guide():
     """A room open above (more than INTERIOR_SHARE of the world seen), a closed room (nothing
-    open) and a room seen from outside nothing (no wall) take no guide."""
+    open) and a room seen from outside nothing (no wall) take no guide; a camera in the open
+    takes none though the middle of its view lies in a room (a house seen from its garden),
+    and a camera in a room takes the rays of the middle's probe where that stands inside too."""
     d, s, depth, opened = cube()
     assert guide_of(d, s, depth, opened) is None  # closed
     roofless = opened | (d[:, 2] > 0.0)
     assert guide_of(d, s, np.where(roofless, 0.0, depth), roofless) is None
     everything = np.ones(len(d), bool)
     assert guide_of(d, s, np.zeros(len(d)), everything) is None
+    room = (d, s, *cube(openings=(WINDOW,))[2:], np.zeros(3))
+    garden = (d, s, np.where(roofless, 0.0, depth), roofless, np.array([0.0, 9.0, 0.0]))
+    assert probe.opening_guide([garden, room]) is None
+    assert probe.opening_guide([room, garden]) is not None
 
 
 def test_the_guide_keeps_a_frame_unbiased():

@@ -91,6 +91,53 @@ def test_a_room_without_a_portal_finds_its_window(penumbra, monkeypatch):
     assert found <= TARGETS["window_room"] and blind >= 2.0 * found, (found, blind)
 
 
+def _guided(gpu_call, scene, samples=4):
+    """(FrameStats of a ``samples``-sample frame of ``scene``, its light finite and >= 0)."""
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    w, h = scene.render.resolution_x, scene.render.resolution_y
+
+    def job(engine, depsgraph):
+        cam = camera_from_scene(depsgraph, scene, w, h)
+        out = engine.render_frame(depsgraph, cam, w, h, samples=(0, samples), sample_count=samples)
+        return out.stats, out.color_array().copy()
+
+    stats, color = gpu_call(job)
+    assert np.all(np.isfinite(color)) and color.min() >= 0.0
+    return stats
+
+
+def test_the_probe_tells_a_room_from_a_house_seen_outside(penumbra, gpu_call):
+    """The room without its portal, seen from inside, is an interior (its directions come
+    through the window); the same room on a ground seen from its garden is not (the middle of
+    what that camera sees lies inside the house: the probe looks from the camera); a room lit
+    by lamps is not probed; a closed box (no opening) takes no guide."""
+    scene = ws.build("window_room_bare", 64, 36)
+    ws.use_engine(scene, "PENUMBRA", render_samples=4)
+    inside = _guided(gpu_call, scene)
+    assert inside.world_guided and inside.probe_draws > 0
+
+    scenes.plane(scene, "Garden", size=80.0, z=-0.2, mat=scenes.white())
+    cam = scene.camera
+    cam.location = (1.5, 9.0, 2.0)
+    scenes.aim(cam, (0.0, 0.0, 1.2))
+    outside = _guided(gpu_call, scene)
+    assert outside.probe_draws > 0 and not outside.world_guided
+
+    closed = ws.build("window_room_bare", 64, 36)
+    ws.use_engine(closed, "PENUMBRA", render_samples=4)
+    for name in ("WallN_below", "WallN_above"):  # the window filled in
+        ob = closed.objects[name]
+        ob.scale.z = 30.0
+    assert not _guided(gpu_call, closed).world_guided
+
+    lamp = ws.build("window_room_bare", 64, 36)
+    ws.use_engine(lamp, "PENUMBRA", render_samples=4)
+    scenes.light(lamp, "Lamp", "POINT", 5000.0, location=(0.0, 0.0, 2.0))
+    lit = _guided(gpu_call, lamp)
+    assert lit.probe_draws == 0 and not lit.world_guided
+
+
 @pytest.mark.parametrize("name", ["sky_outdoor"])
 def test_one_sample_frame_is_close_to_the_converged_one(penumbra, name):
     """The sky-lit one-sample frame (the viewport while the view moves: ambient occlusion for

@@ -58,7 +58,7 @@ def with_sun(world):
     if sun is None or env is None or world.sh is None:
         return world, None
     rotation = None if world.rotation is None else np.asarray(world.rotation, np.float64).tobytes()
-    key = (hashlib.blake2b(np.ascontiguousarray(env).tobytes(), digest_size=16).digest(), rotation, sun)
+    key = (hashlib.sha256(np.ascontiguousarray(env).data).digest(), rotation, sun)
     kept = _KEPT.get(key)
     if kept is None:
         kept = _extract(world, sun, env)
