@@ -505,7 +505,8 @@ SCENE_PARAMS = (
         "indirect_samples",
         "INT",
         16,
-        "Points of each light's reflective shadow map gathered per pixel and sample",
+        "Points of each light's reflective shadow map gathered per pixel and sample; the world's directions "
+        "share them, as one light",
         min=1,
         max=256,
         label="Bounce Samples",

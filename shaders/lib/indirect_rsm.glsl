@@ -24,8 +24,10 @@
  * ignores the occlusion of the bounce (light bounces through walls to points the sender does
  * not see), as the paper does.
  *
- * Sampling: RSM_SAMPLES texels per light and sample, on a per-pixel rotation of a 3-D
- * additive recurrence (Roberts' R3 sequence) indexed by frame.sample_index * RSM_SAMPLES + k,
+ * Sampling: RSM_SAMPLES texels per light and sample (the world's directions, each an estimate
+ * of the one world, share them: RSM_SAMPLES / their count each, rounded up), on a per-pixel
+ * rotation of a 3-D additive recurrence (Roberts' R3 sequence) indexed by frame.sample_index *
+ * (the light's texels) + k,
  * so a frame's samples continue one low-discrepancy sequence and their average converges.
  * Around the pixel's projection c into its map (the paper's importance sampling: nearby
  * texels matter most), at radius r = R * u1 (u1 uniform) and a uniform angle: a density of
@@ -127,8 +129,16 @@ vec3 rsm_texel(LightData L, int t, int face, ivec2 st, vec3 P, vec3 N)
 vec3 indirect_rsm(vec3 P, vec3 N, float view_depth)
 {
   vec3 E = vec3(0.0);
+  /* The directions of the world's light share one light's texels: each is one estimate of the
+   * same light (the world's), so together they take RSM_SAMPLES, not that many each. */
+  int world_lights = 0;
+  for (int i = 0; i < frame.shadowed_count; i++) {
+    world_lights += (lights[i].world != 0) ? 1 : 0;
+  }
+  int world_texels = max(1, (RSM_SAMPLES + max(world_lights, 1) - 1) / max(world_lights, 1));
   for (int i = 0; i < frame.shadowed_count; i++) {
     LightData L = lights[i];
+    int texels = (L.world != 0) ? world_texels : RSM_SAMPLES;
     bool cube = L.shadow_mode == SHADOW_MODE_CUBE;
     int home = rsm_home_tile(L, P, view_depth);
     int home_face = cube ? cube_face(P - L.position) : -1;
@@ -143,9 +153,9 @@ vec3 indirect_rsm(vec3 P, vec3 N, float view_depth)
     }
     uvec3 rot = rsm_hash(uvec3(uvec2(gl_FragCoord.xy), uint(i)));
     vec3 sum = vec3(0.0);
-    for (int k = 0; k < RSM_SAMPLES; k++) {
+    for (int k = 0; k < texels; k++) {
       /* R3: fractional parts of g / phi3^(1, 2, 3), phi3 = 1.2207440846, as 32-bit fixed point. */
-      uint g = uint(frame.sample_index) * uint(RSM_SAMPLES) + uint(k);
+      uint g = uint(frame.sample_index) * uint(texels) + uint(k);
       uvec3 x = rot + g * uvec3(3518319155u, 2882110345u, 2360945575u);
       vec3 u = vec3(x >> 8u) * (1.0 / 16777216.0);
       bool near = !cube || u.z < 0.5;
@@ -184,7 +194,7 @@ vec3 indirect_rsm(vec3 P, vec3 N, float view_depth)
         sum += rsm_texel(L, t, face, ivec2(pos), P, N) / pdf;
       }
     }
-    E += L.color * (L.diffuse_factor / float(RSM_SAMPLES)) * sum;
+    E += L.color * (L.diffuse_factor / float(texels)) * sum;
   }
   return E;
 }
