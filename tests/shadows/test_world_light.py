@@ -109,16 +109,24 @@ def _guided(gpu_call, scene, samples=4):
 
 def test_the_probe_tells_a_room_from_a_house_seen_outside(penumbra, gpu_call):
     """The room without its portal, seen from inside, is an interior (its directions come
-    through the window); the same room on a ground seen from its garden is not (the middle of
-    what that camera sees lies inside the house: the probe looks from the camera); a room lit
-    by lamps is not probed; a closed box (no opening) takes no guide."""
+    through the window), with a 10 km ground outside too; the same room on that ground seen
+    from its garden is not (the middle of what that camera sees lies inside the house: the
+    probe looks from the camera); a room lit by lamps is not probed; a closed box (no opening)
+    takes no guide."""
     scene = ws.build("window_room_bare", 64, 36)
     ws.use_engine(scene, "PENUMBRA", render_samples=4)
     inside = _guided(gpu_call, scene)
     assert inside.world_guided and inside.probe_draws > 0
 
-    scenes.plane(scene, "Garden", size=80.0, z=-0.2, mat=scenes.white())
+    # A 10 km ground outside, the camera in a corner 10 cm from two walls: the probe's near
+    # plane must not cut them (it sees its room though the farthest thing drawn is 7 km away).
+    scenes.plane(scene, "Garden", size=10000.0, z=-0.2, mat=scenes.white())
     cam = scene.camera
+    home = tuple(cam.location), tuple(cam.rotation_euler)
+    cam.location = (1.9, -2.4, 1.4)
+    scenes.aim(cam, (0.0, 2.5, 1.4))
+    assert _guided(gpu_call, scene).world_guided
+    cam.location, cam.rotation_euler = home
     cam.location = (1.5, 9.0, 2.0)
     scenes.aim(cam, (0.0, 0.0, 1.2))
     outside = _guided(gpu_call, scene)

@@ -74,14 +74,16 @@ def probe_due(snapshot, draws, settings):
 
 def face_camera(centre, forward, radius):
     """The raster camera of the cube face looking along ``forward`` from world point ``centre``:
-    a 90-degree square perspective from 1e-4 to 1e3 times ``radius`` (the farthest anything
-    drawn can lie from ``centre``). ``rotation``: its camera-to-world rotation (it
-    looks along -Z)."""
+    a 90-degree square perspective from 1e-6 to 1e3 times ``radius`` (the farthest anything
+    drawn can lie from ``centre``: a room's wall a few centimetres from the camera is drawn
+    though a 10 km ground lies outside its window; only coverage and rough distances are read,
+    so the depth buffer's precision over that range does not matter). ``rotation``: its
+    camera-to-world rotation (it looks along -Z)."""
     rotation = frame_towards(-np.asarray(forward, np.float64))
     view = np.eye(4)
     view[:3, :3] = rotation.T
     view[:3, 3] = -rotation.T @ np.asarray(centre, np.float64)
-    near, far = 1e-4 * radius, 1e3 * radius
+    near, far = 1e-6 * radius, 1e3 * radius
     return SimpleNamespace(
         view=view, projection=lightspace.perspective(0.5 * math.pi, 1.0, near, far), rotation=rotation
     )
