@@ -122,3 +122,43 @@ def test_closed_outward_surfaces_are_told_apart(penumbra):
         assert geometry_from_mesh(mesh(build)).closed is closed, build.__name__
     assert geometry_from_mesh(assets.import_mesh(scene, assets.SPOT).data).closed
     assert not geometry_from_mesh(assets.import_mesh(scene, assets.BUNNY).data).closed  # holes underneath
+
+
+def test_tangents_are_kept_by_content_between_extractions(penumbra, monkeypatch):
+    """MikkTSpace tangents are remembered by what they are made from (every F12 render extracts
+    anew): a second extraction of the same mesh reuses them, bit for bit what Blender computes;
+    moved UVs, or another mesh of the same content but with n-gons named, compute or say anew."""
+    from penumbra.engine.scene import extract
+
+    scene = scenes.empty_scene(32, 32)
+    me = scenes.uv_sphere(scene, "Ball", radius=1.0, segments=16, rings=8).data
+    uv = me.uv_layers.new(name="UVMap")
+    n = len(me.loops)
+    rng = np.random.default_rng(3)
+    uv.data.foreach_set("uv", rng.random(2 * n).astype(np.float32))
+    needs = extract.Needs(uv_map="", tangents=True)
+    extract._TANGENTS.clear()
+    computed = []
+    original = extract._tangents
+    monkeypatch.setattr(extract, "_tangents", lambda *a: computed.append(1) or original(*a))
+    first = extract.geometry_from_mesh(me, needs).tangents
+    again = extract.geometry_from_mesh(me, needs).tangents
+    assert len(computed) == 1 and np.array_equal(first, again) and np.abs(first[:, 3]).min() == 1.0
+    moved = rng.random(2 * n).astype(np.float32)
+    uv.data.foreach_set("uv", moved)
+    changed = extract.geometry_from_mesh(me, needs).tangents
+    assert len(computed) == 2 and not np.array_equal(changed, first)
+    extract._TANGENTS.clear()
+    assert np.array_equal(extract.geometry_from_mesh(me, needs).tangents, changed)
+
+    hexagon = bpy.data.meshes.new("Hexagon")
+    verts = [(-1, -1, 0), (0, -1, 0), (1, -1, 0), (1, 1, 0), (0, 1, 0), (-1, 1, 0)]
+    hexagon.from_pydata(verts, [], [tuple(range(6))])
+    hexagon.uv_layers.new(name="UVMap")
+    twin = hexagon.copy()
+    twin.name = "Twin"
+    said = []
+    for mesh in (hexagon, twin):
+        extract.geometry_from_mesh(mesh, needs)
+    extract._corner_uvs(twin, needs, 6, said, *(lambda g: (g.positions, g.normals))(extract.geometry_from_mesh(twin)))
+    assert said == [extract.NGON_TANGENTS.format(name="Twin")]
