@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import hair
-from .geometry import Geometry
+from .geometry import ContentCache, Geometry, content_key
 from .materials import material_from_blender, world_from_blender
 from .terminator import Terminator
 
@@ -494,23 +494,16 @@ def geometry_from_mesh(mesh, needs=None):
     )
 
 
-_CLOSED = {}  # content digest of (triangles, positions) -> closed_outward: final renders extract anew
+_CLOSED = ContentCache(1024)  # content digest of (triangles, positions) -> closed_outward, a unit each
 
 
 def _closed_cached(tris, co):
     """``closed_outward``, remembered by content: its test costs about an extraction's time on
     a large closed mesh, while hashing the arrays costs a few percent of it."""
-    import hashlib
-
-    digest = hashlib.sha256()
-    digest.update(np.ascontiguousarray(tris, np.int32).data)
-    digest.update(np.ascontiguousarray(co, np.float32).data)
-    key = digest.digest()
+    key = content_key(np.asarray(tris, np.int32), np.asarray(co, np.float32))
     closed = _CLOSED.get(key)
     if closed is None:
-        if len(_CLOSED) >= 1024:
-            _CLOSED.clear()
-        closed = _CLOSED[key] = closed_outward(tris, co)
+        closed = _CLOSED.put(key, closed_outward(tris, co), 1)
     return closed
 
 
@@ -620,8 +613,7 @@ def _tangents(mesh, layer, nc, messages):
     return tangents
 
 
-_TANGENTS = {}  # content digest -> (tangents, n-gons): final renders extract anew
-_TANGENTS_BUDGET = 256 * 2**20  # bytes of tangents kept
+_TANGENTS = ContentCache(256 * 2**20)  # content digest -> (tangents, n-gons): final renders extract anew
 
 
 def _tangents_cached(mesh, layer, uvs, positions, normals, nc, messages):
@@ -629,25 +621,13 @@ def _tangents_cached(mesh, layer, uvs, positions, normals, nc, messages):
     positions, normals and UVs and the faces' first corners (which corners make a face). Every
     F12 render is a new engine that extracts anew, and ``calc_tangents`` took 5.8 ms of a
     32k-corner mesh's render, hashing its inputs 0.7 ms."""
-    import hashlib
-
     faces = len(mesh.polygons)
     loop_start = _read(mesh.polygons, "loop_start", faces, np.int32) if faces else np.zeros(0, np.int32)
-    digest = hashlib.sha256()
-    for a in (positions, normals, uvs, loop_start):
-        a = np.ascontiguousarray(a)
-        digest.update(repr((a.dtype.str, a.shape)).encode())
-        digest.update(a.data)
-    key = digest.digest()
+    key = content_key(positions, normals, uvs, loop_start)
     got = _TANGENTS.get(key)
     if got is None:
         said = []
-        got = (_tangents(mesh, layer, nc, said), bool(said))
-        size = got[0].nbytes
-        while _TANGENTS and sum(t.nbytes for t, _n in _TANGENTS.values()) + size > _TANGENTS_BUDGET:
-            del _TANGENTS[next(iter(_TANGENTS))]  # oldest first
-        if size <= _TANGENTS_BUDGET:
-            _TANGENTS[key] = got
+        got = _TANGENTS.put(key, (_tangents(mesh, layer, nc, said), bool(said)), nc * 16)
         messages.extend(said)
     elif got[1]:
         messages.append(NGON_TANGENTS.format(name=mesh.name))

@@ -1,9 +1,53 @@
 """A mesh's triangles as the GPU draws them: the record extraction, hair and levels of detail
-all build (``extract``, ``hair``, ``simplify``)."""
+all build (``extract``, ``hair``, ``simplify``); and the content keys that let what is derived
+from them outlive an F12 render's engine (``content_key``, ``ContentCache``)."""
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
+
+
+def content_key(*arrays):
+    """A digest of ``arrays``' dtypes, shapes and bytes (SHA-256: three times BLAKE2b's speed
+    where the CPU has SHA extensions): what is derived from a mesh's arrays is kept by it
+    between F12 renders, each a new engine that extracts anew."""
+    digest = hashlib.sha256()
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        digest.update(repr((a.dtype.str, a.shape)).encode())
+        digest.update(a.data)
+    return digest.digest()
+
+
+class ContentCache:
+    """Values kept by ``content_key`` up to ``budget`` bytes, the oldest dropped first."""
+
+    def __init__(self, budget):
+        self.budget = budget
+        self._items = {}  # key -> (value, bytes)
+        self._bytes = 0
+
+    def get(self, key):
+        item = self._items.get(key)
+        return None if item is None else item[0]
+
+    def put(self, key, value, nbytes):
+        """Keep ``value`` (``nbytes`` large) unless it alone exceeds the budget; returns it."""
+        while self._items and self._bytes + nbytes > self.budget:
+            _value, size = self._items.pop(next(iter(self._items)))
+            self._bytes -= size
+        if nbytes <= self.budget:
+            self._items[key] = (value, nbytes)
+            self._bytes += nbytes
+        return value
+
+    def clear(self):
+        self._items.clear()
+        self._bytes = 0
+
+    def __len__(self):
+        return len(self._items)
 
 
 @dataclass

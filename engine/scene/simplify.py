@@ -16,12 +16,11 @@ Only what needs no more than positions and normals is simplified: meshes whose m
 UVs, colour attributes or tangents, or use alpha, are drawn whole, as are meshes that cross the
 camera's near plane and levels that would keep most of the triangles."""
 
-import hashlib
 import math
 
 import numpy as np
 
-from .geometry import Geometry
+from .geometry import Geometry, content_key
 
 MIN_LEVEL = 2  # 4 cells along the longest side: the coarsest level
 MAX_LEVEL = 12  # 4096 cells: finer ones keep nearly every triangle of real meshes
@@ -50,12 +49,8 @@ def simplified(geo, level):
     the level would keep more than WORTH of the triangles or none at all."""
     digest = getattr(geo, "_simplify_digest", None)
     if digest is None:
-        h = hashlib.sha256()
-        h.update(np.ascontiguousarray(geo.indices).data)
-        h.update(np.ascontiguousarray(geo.positions).data)
-        h.update(np.ascontiguousarray(geo.normals).data)
-        h.update(repr(geo.ranges).encode())
-        digest = geo._simplify_digest = h.digest()
+        ranges = np.asarray(geo.ranges, np.int64).reshape(-1, 3)
+        digest = geo._simplify_digest = content_key(geo.indices, geo.positions, geo.normals, ranges)
     key = (digest, level)
     if key not in _CACHE:
         lod = cluster(geo, level)

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import ContentCache, content_key
+
 # Names of the per-corner vertex attributes of ``corner_data`` (and the shader's inputs).
 ATTRIBUTES = ("tbary", "tabc", "tfront", "tback")
 
@@ -62,30 +64,19 @@ class Terminator:
         return value if math.isfinite(value) else 0.0
 
 
-_CORNERS = {}  # content digest of (positions, normals, indices) -> corner_data: final renders build anew
-_CORNERS_BUDGET = 256 * 2**20  # bytes of corner data kept
+# content digest of (positions, normals, indices) -> corner_data: final renders build anew
+_CORNERS = ContentCache(256 * 2**20)
 
 
 def corner_data_cached(positions, normals, indices):
     """``corner_data``, remembered by the content of its inputs (as ``extract._closed_cached``
     remembers closedness): every F12 render is a new engine that builds its batches anew, and
     hashing the arrays costs a small part of computing the corners again."""
-    import hashlib
-
-    digest = hashlib.sha256()
-    for a in (positions, normals, indices):
-        a = np.ascontiguousarray(a)
-        digest.update(repr((a.dtype.str, a.shape)).encode())
-        digest.update(a.data)
-    key = digest.digest()
+    key = content_key(positions, normals, indices)
     got = _CORNERS.get(key)
     if got is None:
         got = corner_data(positions, normals, indices)
-        size = sum(v.nbytes for v in got.values())
-        while _CORNERS and sum(v.nbytes for d in _CORNERS.values() for v in d.values()) + size > _CORNERS_BUDGET:
-            del _CORNERS[next(iter(_CORNERS))]  # oldest first
-        if size <= _CORNERS_BUDGET:
-            _CORNERS[key] = got
+        _CORNERS.put(key, got, sum(v.nbytes for v in got.values()))
     return got
 
 
