@@ -39,7 +39,7 @@ from .world.directions import (
     world_negligible,
 )
 from .world.occlusion import WorldAO
-from .world.probe import WorldProbe, probe_due
+from .world.probe import PROBE_SHARE, WorldProbe
 from .world.sh_light import with_sh_light
 from .world.sun import with_sun
 
@@ -305,15 +305,11 @@ class Renderer:
             )
         threshold = adaptive.threshold if adaptive is not None and accumulate else 0.0
         negligible = world_negligible(snapshot.world if snapshot.world is not None else snapshot.world_color, threshold)
-        directions, cones = (0, []) if negligible else self._world_directions(snapshot, draws, settings, accumulate)
-        if not negligible and not cones and probe_due(snapshot, draws, settings):
-            # No light portal: an interior's openings found by the world's probe stand in for them.
-            cones = self.world_probe.cones(
-                draws, snapshot.world, camera.position, origin, self.shaders, self.materials, self.textures, stats
-            )
-            if cones:
-                directions = int(settings.world_samples)
-                stats.world_guided = True
+        directions, cones = (
+            (0, [])
+            if negligible
+            else self._world_directions(snapshot, draws, settings, accumulate, camera, origin, stats)
+        )
         room = MAX_LIGHTS - directions
         lights = select_lights(snapshot.lights, camera.position, room)
         if len(lights) < len(snapshot.lights):
@@ -371,10 +367,10 @@ class Renderer:
             return None
         return motion
 
-    @staticmethod
-    def _world_directions(snapshot, draws, settings, accumulate):
+    def _world_directions(self, snapshot, draws, settings, accumulate, camera, origin, stats):
         """How many directions of the world's light each sample of the frame draws with maps
-        (``world/directions.py``), and the cones of its light portals that gather them."""
+        (``world/directions.py``), and the cones that gather them: its light portals', or
+        without portals the guide of an interior's openings (``world/probe.py``)."""
         # The world's light with visibility: a multi-sample frame adds ``world_samples``
         # directions of it per sample, each a sun with its own map.
         if not needs_directions(snapshot.world, settings):
@@ -384,15 +380,25 @@ class Renderer:
         # one-sample frame then takes its directions too: the SH light of a room's sky, even
         # occluded on screen, is nothing like the light through its windows.
         seen = [d for d in draws if d.instance.camera]
-        box = corners_of(seen).reshape(-1, 3) if seen else None
-        cones = []
-        if getattr(snapshot, "portals", ()) and seen:
+        if not seen:
+            return (int(settings.world_samples) if accumulate else 0), []
+        box = corners_of(seen).reshape(-1, 3)
+        # The world's share of the light reaching what the camera sees (light_share).
+        share = light_share(snapshot.world, snapshot.lights, 0.5 * (box.min(axis=0) + box.max(axis=0)))
+        if getattr(snapshot, "portals", ()):
             cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
+        elif share >= PROBE_SHARE:
+            # No light portal, and the world lights the frame: an interior's openings, found by
+            # the world's probe, stand in for them.
+            cones = self.world_probe.cones(
+                draws, snapshot.world, camera.position, origin, self.shaders, self.materials, self.textures, stats
+            )
+            stats.world_guided = bool(cones)
+        else:
+            cones = []
         directions = int(settings.world_samples) if accumulate or cones else 0
-        if directions and not cones and seen:
-            # The world's light costs what it adds: directions in proportion to its share of
-            # the light reaching what the camera sees (world.directions.light_share).
-            share = light_share(snapshot.world, snapshot.lights, 0.5 * (box.min(axis=0) + box.max(axis=0)))
+        if directions and not cones:
+            # The world's light costs what it adds: directions in proportion to its share.
             directions = directions_per_sample(share, directions)
         return directions, cones
 

@@ -208,13 +208,9 @@ class WorldDistribution:
         return self.p_texel[r, c] / self.band[r]
 
     def _texel(self, d):
-        h, w = self.env.shape[:2]
         if self.rotation is not None:
             d = d @ self.rotation.T
-        x, y, z = d[:, 0], d[:, 1], d[:, 2]
-        u = 0.5 - np.arctan2(y, x) / (2.0 * math.pi)
-        v = np.arctan2(z, np.hypot(x, y)) / math.pi + 0.5
-        return np.clip((v * h).astype(np.int64), 0, h - 1), np.clip((u * w).astype(np.int64), 0, w - 1)
+        return equirect_cell(d, *self.env.shape[:2])
 
     def directions(self, points):
         """Unit directions (n, 3) from points ``points`` (n, 2) of [0, 1)^2."""
@@ -270,6 +266,16 @@ class WorldDistribution:
         cl = np.cos(lat)
         d = np.stack([np.cos(lon) * cl, np.sin(lon) * cl, np.sin(lat)], axis=-1)
         return d if self.rotation is None else d @ self.rotation  # the image's direction -> the world's
+
+
+def equirect_cell(d, h, w):
+    """(row, column) of unit directions ``d`` (n, 3) on an (h, w) equirectangular grid as
+    Blender maps it (row 0 at the bottom): u = 0.5 - atan2(y, x) / 2 pi, v = atan2(z, hypot(x,
+    y)) / pi + 0.5."""
+    x, y, z = d[:, 0], d[:, 1], d[:, 2]
+    u = 0.5 - np.arctan2(y, x) / (2.0 * math.pi)
+    v = np.arctan2(z, np.hypot(x, y)) / math.pi + 0.5
+    return np.clip((v * h).astype(np.int64), 0, h - 1), np.clip((u * w).astype(np.int64), 0, w - 1)
 
 
 def _in_cone(axis, cos_max, a, b):

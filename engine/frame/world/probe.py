@@ -20,7 +20,7 @@ stays unbiased whatever the guide misses.
 
 Outdoors (the sky over a fifth of the probe or more) and in a closed box (no opening) the
 probe changes nothing; with Cycles' light portals, or where lamps give most of the light
-(``probe_due``), it is not drawn. It costs twelve depth passes of 32² and their read-backs
+(``PROBE_SHARE``), it is not drawn. It costs twelve depth passes of 32² and their read-backs
 (6 x 32² floats each) a frame, kept while the camera, the draws and the world are the same.
 """
 
@@ -30,7 +30,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from ...shadows import lightspace
-from .directions import frame_towards, guide, light_share, needs_directions
+from .directions import equirect_cell, frame_towards, guide
 
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
@@ -48,28 +48,13 @@ GUIDE_SURFACE_POINTS = 400
 GUIDE_OPENING_POINTS = 120
 GUIDE_CELLS = (32, 64)
 # A world that gives less than this share of the unshadowed light at the middle of the view
-# (``directions.light_share``) is not probed: lamps light that frame, whatever comes in.
+# (``directions.light_share``) is not probed (``Renderer._world_directions``): lamps light that
+# frame, whatever comes in. Nor is a frame with light portals.
 PROBE_SHARE = 0.25
 # The faces: the direction each looks along.
 FACES = np.array(
     [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]
 )
-
-
-def probe_due(snapshot, draws, settings):
-    """Whether a frame looks for the world's openings: World > Shadows on, a world that gives
-    light (``directions.needs_directions``) and at least PROBE_SHARE of the light at the middle
-    of what the camera sees, and no light portal (Cycles' portals say where it gets in)."""
-    from ..draw_list import corners_of
-
-    if getattr(snapshot, "portals", ()) or not needs_directions(snapshot.world, settings):
-        return False
-    seen = [d for d in draws if d.instance.camera]
-    if not seen:
-        return False
-    box = corners_of(seen).reshape(-1, 3)
-    centre = 0.5 * (box.min(axis=0) + box.max(axis=0))
-    return np.all(np.isfinite(centre)) and light_share(snapshot.world, snapshot.lights, centre) >= PROBE_SHARE
 
 
 def face_camera(centre, forward, radius):
@@ -170,10 +155,7 @@ def opening_guide(probes, luminance=None):
         return None
     ray_weights = np.ones(len(rays)) if luminance is None else np.maximum(luminance(rays), 0.0)
     h, w = GUIDE_CELLS
-    u = 0.5 - np.arctan2(rays[:, 1], rays[:, 0]) / (2.0 * math.pi)
-    v = np.arctan2(rays[:, 2], np.hypot(rays[:, 0], rays[:, 1])) / math.pi + 0.5
-    r = np.clip((v * h).astype(np.int64), 0, h - 1)
-    c = np.clip((u * w).astype(np.int64), 0, w - 1)
+    r, c = equirect_cell(rays, h, w)
     hist = np.zeros((h, w))
     np.add.at(hist, (r, c), ray_weights)
     # Widened by a cell each way (around the sphere in longitude), at the cell's own weight
