@@ -146,6 +146,21 @@ def test_the_probe_tells_a_room_from_a_house_seen_outside(penumbra, gpu_call):
     assert lit.probe_draws == 0 and not lit.world_guided
 
 
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_the_probe_finds_the_window_at_any_scale(penumbra, gpu_call, scale):
+    """The room without its portal scaled by 1e-3 (a doll's house) and 1e3 (a hangar), the
+    camera with it: still an interior, its light finite and >= 0 (``_guided``)."""
+    scene = ws.build("window_room_bare", 64, 36)
+    ws.use_engine(scene, "PENUMBRA", render_samples=4)
+    for ob in scene.objects:
+        ob.location = tuple(scale * c for c in ob.location)
+        if ob.type != "CAMERA":
+            ob.scale = tuple(scale * c for c in ob.scale)
+    cam = scene.camera.data
+    cam.clip_start, cam.clip_end = cam.clip_start * scale, cam.clip_end * scale
+    assert _guided(gpu_call, scene).world_guided
+
+
 @pytest.mark.parametrize("name", ["sky_outdoor"])
 def test_one_sample_frame_is_close_to_the_converged_one(penumbra, name):
     """The sky-lit one-sample frame (the viewport while the view moves: ambient occlusion for
