@@ -328,6 +328,12 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
 
     # --- final render ---------------------------------------------------------------------
 
+    def break_requested(self):
+        """Whether the user asked the render to stop (Esc, F12's cancel): Blender's
+        ``test_break``, asked before each view and after each sample. (RNA's own method
+        shadows any Python attribute of that name, so the tests stand in for Esc here.)"""
+        return self.test_break()
+
     def update_render_passes(self, scene=None, renderlayer=None):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
         if renderlayer.use_pass_z:
@@ -346,7 +352,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
     def render(self, depsgraph):
         """Render the pixels Blender asks for: the render region of the frame at Blender's
         integer resolution, into this view layer's own result, once per view of a multiview
-        render. Each result is written whole or cancelled, never left half-written."""
+        render. Each result is written whole or cancelled, never left half-written; a render
+        cancelled (Esc) after a sample writes the samples it has."""
         scene = depsgraph.scene
         layer = depsgraph.view_layer.name
         self.texture_pool = gpu_pool.FINAL_RENDERS
@@ -387,7 +394,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                 )
                 return
             for index, view in enumerate(views):
-                if self.test_break():
+                if self.break_requested():
                     return
                 self.update_stats("", f"Penumbra | {layer}{' | ' + view if view else ''} | rendering")
                 if view:
@@ -416,7 +423,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                 def on_sample(done, index=index, count=count, label=label):
                     self.update_stats("", f"{label} | Sample {done}/{count}")
                     self.update_progress((index + done / count) / len(views))
-                    return not self.test_break()
+                    return not self.break_requested()
 
                 out = self.render_frame(
                     depsgraph,
@@ -432,10 +439,13 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     adaptive=adaptive,
                     motion=motion,
                 )
-                if out.stats.cancelled:
-                    return  # cancelled: no result is written for this view
-                if out.stats.stopped:
-                    stopped = f"Sample {out.stats.samples}/{count} | {STOPPED[out.stats.stopped]}"
+                if out.stats.cancelled and out.stats.samples == 0:
+                    return  # cancelled before a sample was drawn: nothing to write
+                if out.stats.stopped or out.stats.cancelled:
+                    # Esc (test_break) keeps what was rendered, as Cycles does: the samples
+                    # drawn so far, resolved and through the post stack, are this view's result.
+                    why = "Cancelled" if out.stats.cancelled else STOPPED[out.stats.stopped]
+                    stopped = f"Sample {out.stats.samples}/{count} | {why}"
                     self.update_stats("", f"{label} | {stopped}")
                     self.report({"INFO"}, f"Penumbra: {label[11:]}: {stopped}")
                 legend = out.stats.debug_legend
@@ -462,6 +472,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     passes[EMISSION_PASS] = window.cut(out.emission_array())
                 self._write_result(window, layer, view, passes)
                 self.update_progress((index + 1) / len(views))
+                if out.stats.cancelled:
+                    return  # the later views are not started
         except Exception as exc:  # a render must end with a message, never a crash
             traceback.print_exc(file=sys.stderr)
             self.report({"ERROR"}, f"Penumbra: render failed: {exc}")

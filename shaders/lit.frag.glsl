@@ -24,12 +24,14 @@
 void main()
 {
   MaterialInputs m = material_inputs();
-  if (coverage_discards(m.coverage)) {
-    discard;
-  }
+  /* Decided here, discarded at the end (lib/lit_inputs.glsl coverage_discards). */
+  bool dropped = coverage_discards(m.coverage);
 #if EMISSION_ONLY
   /* The Emission pass drawn apart, over the z-buffer the lit pass left (a frame whose other
    * targets leave its own no room: lit_pass.py). */
+  if (dropped) {
+    discard;
+  }
   out_color = surface_color(m.emission, 1.0);
   return;
 #endif
@@ -49,5 +51,8 @@ void main()
   /* No film sums for this surface (a blended one): its own ratio within this sample. */
   color = world_ratio_apply(vec4(color, 1.0), world_d, world_s, world_sums).rgb;
 #endif
+  if (dropped) {
+    discard;
+  }
   write_passes(surface_color(color + m.emission, m.coverage), s, arriving, unshadowed, m.emission, HOLDOUT == 0);
 }

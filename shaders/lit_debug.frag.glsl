@@ -9,9 +9,7 @@
 void main()
 {
   MaterialInputs m = material_inputs();
-  if (coverage_discards(m.coverage)) {
-    discard;
-  }
+  bool dropped = coverage_discards(m.coverage); /* discarded at the end (lib/lit_inputs.glsl) */
   vec2 ab[NODE_LOBES];
   Surface s = surface_setup(m, ab);
 #if DEBUG_LIT
@@ -40,5 +38,8 @@ void main()
 #else
   vec4 shown = vec4(debug_term, 1.0);
 #endif
+  if (dropped) {
+    discard;
+  }
   write_passes(shown, s, arriving, unshadowed, m.emission, HOLDOUT == 0 && DEBUG_LIT == 0 && DEBUG_TERM == 1);
 }

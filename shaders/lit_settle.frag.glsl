@@ -6,16 +6,18 @@
 void main()
 {
   MaterialInputs m = material_inputs();
-#if ALPHA_MODE != 0
-  if (m.coverage <= 0.0) {
-    discard; /* never drawn; where it covers some samples, it marks the pixel unsettled */
-  }
-#endif
   vec2 ab[NODE_LOBES];
   Surface s = surface_setup(m, ab);
   vec3 world_term = surface_world_light(s, ab); /* the world's light, unshadowed */
   vec3 color = world_term;
   float arriving = 0.0, unshadowed = 0.0;
   lights_on(s, color, arriving, unshadowed); /* add_light records each light's flags */
+#if ALPHA_MODE != 0
+  /* Never drawn; where it covers some samples, it marks the pixel unsettled. Discarded at the
+   * end, not before the lights' loops (lib/lit_inputs.glsl coverage_discards). */
+  if (m.coverage <= 0.0) {
+    discard;
+  }
+#endif
   out_color = settle_flags(world_term, m.coverage);
 }

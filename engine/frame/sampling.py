@@ -46,6 +46,7 @@ import time
 
 import numpy as np
 
+from ..counts import ceil_count
 from ..enums import DEBUG_VIEW
 from ..shadows.vectors import cross
 
@@ -110,13 +111,16 @@ def _filter_inverse_cdf(u, filter_size):
 GATHER_REACH_MAX = 4
 
 
+MAX_GATHER_REACH = 64  # a bound for any Filter Size (its property's maximum, 10, reaches 10)
+
+
 def gather_reach(filter_size):
     """Sample pixels each way along an axis a film pixel gathers from: those whose shading
     point (within half a pixel of their centre) can lie inside the filter's reach (Filter
     Size pixels): |t| < Filter Size + 1/2."""
     if not filter_size > 0.0:
         return 0
-    return max(0, math.ceil(float(filter_size) + 0.5) - 1)
+    return ceil_count(float(filter_size) + 0.5, 1, MAX_GATHER_REACH + 1) - 1
 
 
 def gathers(filter_size):
@@ -483,12 +487,13 @@ def clock():
 
 
 ADAPTIVE_STEP = 4  # samples between two convergence checks (Cycles' adaptive step)
+MAX_AUTO_MIN_SAMPLES = 4096  # the automatic Min Samples of a Noise Threshold near 0
 THRESHOLD_SCALE = 5.0  # Cycles scales the Noise Threshold by 5 before comparing the error with it
 
 
 def auto_min_samples(threshold):
     """Cycles' automatic Min Samples of a Noise Threshold: 0.1 -> 32, 0.01 -> 64, 0.001 -> 128."""
-    return max(ADAPTIVE_STEP, math.ceil(16.0 / threshold**0.3))
+    return ceil_count(16.0 / max(float(threshold), 1e-12) ** 0.3, ADAPTIVE_STEP, MAX_AUTO_MIN_SAMPLES)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -31,10 +31,10 @@ the first sample missed entirely (a sub-pixel wire between pixel centres).
 """
 
 import functools
-import math
 
 import numpy as np
 
+from ..counts import ceil_count
 from . import sampling
 
 ENDLESS_MOMENTS = 1024  # the samples a frame without end is taken to have (its filter's moments)
@@ -49,7 +49,7 @@ def flag_reach(filter_size, lens=0.0):
     and with depth of field as far as the widest circle of confusion's radius (``lens``, in
     pixels: a blurred surface reaches that far). None where that is beyond MAX_FLAG_REACH
     with depth of field: the frame does not settle (a wider neighbourhood is not tested)."""
-    reach = max(1, math.ceil(float(filter_size) + float(lens) - 1e-6))
+    reach = ceil_count(float(filter_size) + float(lens) - 1e-6, 1, MAX_FLAG_REACH + 1)
     if lens > 0.0 and reach > MAX_FLAG_REACH:
         return None
     return min(reach, MAX_FLAG_REACH)

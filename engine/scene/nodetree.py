@@ -189,8 +189,8 @@ FAMILY_ORDER = (
 )
 # family -> the families its functions call (included with it, earlier in FAMILY_ORDER).
 FAMILY_NEEDS = {
-    "texture_noise": ("texture_hash",),  # lattice hashes, texture_finite
-    "texture_voronoi": ("texture_hash",),
+    "texture_noise": ("common", "texture_hash"),  # node_detail; lattice hashes, texture_finite
+    "texture_voronoi": ("common", "texture_hash"),
     "texture_white_noise": ("texture_hash",),
     "texture_wave": ("texture_noise",),  # fBM of the distortion
     "texture_magic": ("texture_noise",),  # texture_fmod

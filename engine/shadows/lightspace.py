@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from ..counts import ceil_count
 from . import light_bins
 from .vectors import cross
 
@@ -674,9 +675,9 @@ def cascade_count(near, far, requested=0):
     CASCADE_RATIO in depth (1 for most scenes, up to 4 for a long view over a large ground)."""
     if requested:
         return int(min(max(requested, 1), MAX_CASCADES))
-    if near <= 0.0:
+    if not (near > 0.0 and far > near):
         return 1
-    return int(min(max(math.ceil(math.log(far / near) / math.log(CASCADE_RATIO) - 1e-9), 1), MAX_CASCADES))
+    return ceil_count(math.log(far / near) / math.log(CASCADE_RATIO) - 1e-9, 1, MAX_CASCADES)
 
 
 def cascade_splits(near, far, count, lam=CASCADE_LAMBDA):

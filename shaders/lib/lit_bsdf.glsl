@@ -59,10 +59,14 @@ vec2 env_brdf(float f, float f90, float rough, float NdotV)
 {
   vec2 es = ggx_albedo(rough, NdotV);
   float e_avg = ggx_albedo_avg(rough);
-  float f_ss = f + (1.0 - f) * GGX_S_AVG * f90;
+  /* F_ss is a mean reflectance: within [0, 1] whatever f0 is. A metal's f0 is its base colour,
+   * which may exceed 1 (an image's premultiplied texel, an HDR colour): unbounded, F_ss past
+   * 1 / (1 - E_avg) turned the multiple-scattering term negative and the world's light on the
+   * surface below zero. */
+  float f_ss = clamp(f + (1.0 - f) * GGX_S_AVG * f90, 0.0, 1.0);
   float f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg));
   float ms = 1.0 + f_ms * (1.0 - es.x) / max(es.x, 1e-4);
-  return vec2(es.x - es.y, es.y * f90) * ms;
+  return vec2(max(es.x - es.y, 0.0), es.y * f90) * ms;
 }
 
 /* One lobe's shading values from its Principled parameters, with normal ``N`` and ``weight``;

@@ -94,7 +94,15 @@ Surface surface_setup(MaterialInputs m, out vec2 ab[NODE_LOBES])
 
 /* Whether the alpha mode drops this fragment: Hashed (EEVEE's Dithered) covers a pixel in a
  * fraction alpha of the samples (stratified over the frame's samples by frame.alpha_offset);
- * Blend drops only alpha 0 (the rest is blended by coverage, lit_outputs.glsl surface_color). */
+ * Blend drops only alpha 0 (the rest is blended by coverage, lit_outputs.glsl surface_color).
+ *
+ * An entry shader decides it first and discards at its end, never before the lights' and the
+ * world's loops: on Mesa's llvmpipe an early discard ahead of the unrolled lights' shadow loops
+ * sent LLVM's loop strength reduction (ScalarEvolution's guard reasoning over every loop the
+ * discard dominates) into a compile that did not end (a hashed material lit by three sampled
+ * lights with maps). The GPU's result is the same: a discarded fragment writes nothing, and
+ * the lights' texture lookups stay in uniform control flow (their derivatives defined).
+ * tests/blender/test_render_ends.py holds every lit entry shader to it. */
 bool coverage_discards(float coverage)
 {
 #if ALPHA_MODE == 1

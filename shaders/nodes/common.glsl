@@ -8,6 +8,18 @@
 
 #define NODE_PI 3.14159265358979323846
 
+/* The most octaves a fractal texture sums (Noise, Voronoi): Blender clamps Detail to 15. Every
+ * octave loop is bounded by this constant as well as by its Detail, so no input (NaN, 1e30,
+ * whose int() GLSL leaves undefined) can make a loop without end. */
+#define NODE_MAX_OCTAVE 15
+
+/* Detail clamped to [0, 15] before it becomes a count; NaN gives 0 (clamp() leaves NaN to
+ * the implementation, and int(NaN) is undefined). */
+float node_detail(float detail)
+{
+  return (detail >= 0.0) ? min(detail, float(NODE_MAX_OCTAVE)) : 0.0;
+}
+
 float node_safe_divide(float a, float b)
 {
   return (b != 0.0) ? a / b : 0.0;

@@ -231,7 +231,7 @@ NOISE_UNSIGNED(vec4)
     float amp = 1.0; \
     float maxamp = 0.0; \
     float sum = 0.0; \
-    for (int i = 0; i <= int(detail); i++) { \
+    for (int i = 0; i <= NODE_MAX_OCTAVE && i <= int(detail); i++) { \
       float t = noise_snoise(fscale * p); \
       sum += t * amp; \
       maxamp += amp; \
@@ -251,7 +251,7 @@ NOISE_UNSIGNED(vec4)
   { \
     float value = 1.0; \
     float pwr = 1.0; \
-    for (int i = 0; i <= int(detail); i++) { \
+    for (int i = 0; i <= NODE_MAX_OCTAVE && i <= int(detail); i++) { \
       value *= (pwr * noise_snoise(p) + 1.0); \
       pwr *= roughness; \
       p *= lacunarity; \
@@ -267,7 +267,7 @@ NOISE_UNSIGNED(vec4)
     float pwr = roughness; \
     float value = offset + noise_snoise(p); \
     p *= lacunarity; \
-    for (int i = 1; i <= int(detail); i++) { \
+    for (int i = 1; i <= NODE_MAX_OCTAVE && i <= int(detail); i++) { \
       float increment = (noise_snoise(p) + offset) * pwr * value; \
       value += increment; \
       pwr *= roughness; \
@@ -286,7 +286,7 @@ NOISE_UNSIGNED(vec4)
     float pwr = 1.0; \
     float value = 0.0; \
     float weight = 1.0; \
-    for (int i = 0; (weight > 0.001) && (i <= int(detail)); i++) { \
+    for (int i = 0; i <= NODE_MAX_OCTAVE && (weight > 0.001) && (i <= int(detail)); i++) { \
       weight = min(weight, 1.0); \
       float signal = (noise_snoise(p) + offset) * pwr; \
       pwr *= roughness; \
@@ -310,7 +310,7 @@ NOISE_UNSIGNED(vec4)
     signal *= signal; \
     float value = signal; \
     float weight = 1.0; \
-    for (int i = 1; i <= int(detail); i++) { \
+    for (int i = 1; i <= NODE_MAX_OCTAVE && i <= int(detail); i++) { \
       p *= lacunarity; \
       weight = clamp(signal * gain, 0.0, 1.0); \
       signal = offset - abs(noise_snoise(p)); \
@@ -421,7 +421,7 @@ vec4 noise_distort(vec4 p, float distortion)
                          int type, \
                          bool normalize) \
   { \
-    detail = clamp(detail, 0.0, 15.0); \
+    detail = node_detail(detail); \
     roughness = max(roughness, 0.0); \
     if (distortion != 0.0) { \
       p = noise_distort(p, distortion); \

@@ -471,7 +471,7 @@ VORONOI_ND(vec4, ivec4, 81, 625)
     float octave_scale = 1.0; \
     VoronoiOctave result = VoronoiOctave(0.0, vec3(0.0), vec4(0.0)); \
     bool zero_input = detail == 0.0 || roughness == 0.0; \
-    for (int i = 0; i <= int(ceil(detail)); i++) { \
+    for (int i = 0; i <= NODE_MAX_OCTAVE && i <= int(ceil(detail)); i++) { \
       T c = texture_finite(coord * octave_scale); \
       VoronoiOctave octave; \
       if (feature == VORONOI_F2) { \
@@ -528,7 +528,7 @@ VORONOI_ND(vec4, ivec4, 81, 625)
     float octave_scale = 1.0; \
     float dist = 8.0; \
     bool zero_input = detail == 0.0 || roughness == 0.0; \
-    for (int i = 0; i <= int(ceil(detail)); i++) { \
+    for (int i = 0; i <= NODE_MAX_OCTAVE && i <= int(ceil(detail)); i++) { \
       float octave_d = voronoi_distance_to_edge(texture_finite(coord * octave_scale), randomness, hash_mode); \
       if (zero_input) { \
         dist = octave_d; \
@@ -582,7 +582,7 @@ VORONOI_FRACTAL(vec4)
                            out vec4 out_position, \
                            out float out_radius) \
   { \
-    detail = clamp(detail, 0.0, 15.0); \
+    detail = node_detail(detail); \
     roughness = clamp(roughness, 0.0, 1.0); \
     randomness = clamp(randomness, 0.0, 1.0); \
     smoothness = clamp(smoothness / 2.0, 0.0, 0.5); \

@@ -15,8 +15,8 @@ from devkit.texture_gpu import evaluate_many
 from devkit.texture_tiles import NEAR, build_tiles, compare, gpu_scene, points, rounding_spread, tile_errors
 
 HASH = ["texture_hash.glsl"]
-NOISE = HASH + ["texture_noise.glsl"]
-VORONOI = HASH + ["texture_voronoi.glsl"]
+NOISE = ["common.glsl", *HASH, "texture_noise.glsl"]  # what texture_noise needs (nodetree.FAMILY_NEEDS)
+VORONOI = ["common.glsl", *HASH, "texture_voronoi.glsl"]
 WHITE = HASH + ["texture_white_noise.glsl"]
 SWIZZLE = {1: "a0.w", 2: "a0.xy", 3: "a0.xyz", 4: "a0"}
 HASH_MODE = ref.VORONOI_HASH_INT if bpy.app.version >= (5, 0, 0) else ref.VORONOI_HASH_FLOAT
@@ -287,3 +287,28 @@ def test_textures_land_where_blender_puts_them(penumbra):
         limit = 0.0 if label.startswith(("noise", "white")) else 0.01
         assert mismatched <= limit, (label, mismatched, worst)
         assert median < 5e-4, (label, median)
+
+
+def test_noise_and_voronoi_detail_beyond_its_range_is_bounded(penumbra, gpu_call):
+    """Detail is a count of octaves: NaN, 1e30 and -1e30 (a linked input can hold any float)
+    end their loops as Blender's clamp to [0, 15] does: 1e30 gives Detail 15, NaN and -1e30
+    Detail 0 (nodes/common.glsl node_detail; each loop also stops at NODE_MAX_OCTAVE)."""
+    gpu_scene()
+    pts = points()[:64]
+    jobs = []
+    for detail in ("uintBitsToFloat(0x7fc00000u)", "1e30", "-1e30", "15.0", "0.0"):
+        args = f"{detail}, 0.5, 2.0, 0.0, 1.0, 0.0, {ref.NOISE_FBM}, true"
+        jobs.append((NOISE, f"result = node_tex_noise_at(texture_finite(a0.xyz) * 1.7, {args});", [pts]))
+        voronoi = (
+            "float d, r; vec3 c; vec4 q; node_tex_voronoi_at(texture_finite(a0.xyz) * 1.7, VORONOI_F1, "
+            f"VORONOI_EUCLIDEAN, 1.0, {detail}, 0.5, 2.0, 1.0, 0.5, 1.0, true, {HASH_MODE}, d, c, q, r); "
+            "result = vec4(d, c);"
+        )
+        jobs.append((VORONOI, voronoi, [pts]))
+    outs = evaluate_many(gpu_call, jobs)
+    for kind in (0, 1):  # noise, voronoi
+        nan, huge, negative, fifteen, zero = outs[kind::2]
+        np.testing.assert_array_equal(huge, fifteen)
+        np.testing.assert_array_equal(nan, zero)
+        np.testing.assert_array_equal(negative, zero)
+        assert np.all(np.isfinite(fifteen)) and not np.array_equal(fifteen, zero)

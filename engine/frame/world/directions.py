@@ -34,6 +34,7 @@ import math
 
 import numpy as np
 
+from ...counts import ceil_count
 from ...scene.extract import Light
 from ...scene.materials import SH_C0, sh_basis
 from ..sampling import radical_inverse, sobol_2
@@ -111,7 +112,7 @@ def directions_per_sample(share, most):
     what lights the lamps' shadows)."""
     if most <= 0:
         return 0
-    return int(min(most, max(1, math.ceil(most * share / FULL_SHARE - 1e-9))))
+    return ceil_count(most * share / FULL_SHARE - 1e-9, 1, most)
 
 
 def needs_directions(world, settings):
