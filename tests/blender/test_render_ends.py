@@ -3,7 +3,6 @@ is a render that Esc cannot stop. The scenes render in child processes with a wa
 frame that never ends fails its test, not the run."""
 
 import json
-import os
 import re
 import subprocess
 import sys
@@ -22,10 +21,12 @@ FUZZ_FORMS = 6
 SCENE_BUDGET = 90.0  # seconds a scene may take, its cold shader compiles included
 
 
-def _children(commands, timeout):
-    """Run the ``commands`` (argument lists of this Python) at once; their (returncode, output)."""
+def _children(commands, timeout, extra_env=None):
+    """Run the ``commands`` (argument lists of this Python) at once, with ``extra_env`` added to
+    their environment; their (returncode, output)."""
     env = session.child_env()
     env[session.LIGHT_CHECK_ENV] = "child"
+    env.update(extra_env or {})
     procs = [
         subprocess.Popen(
             [sys.executable, *cmd],
@@ -106,17 +107,11 @@ def test_the_transparent_scene_that_hung_renders_like_its_opaque_twin():
     once never finished compiling on llvmpipe) renders, finite, in about the time of the same
     scene with its alpha unlinked: each in a fresh process with Mesa's shader cache off, so
     both pay their whole compile. Measured on 5.2: 9.0 s against 8.7 s (before: no end)."""
-    env_off = {"MESA_SHADER_CACHE_DISABLE": "true"}
-    old = {k: os.environ.get(k) for k in env_off}
-    os.environ.update(env_off)
-    try:
-        results = _children([["-c", _HANG_SCRIPT.format(linked=v)] for v in (True, False)], timeout=240)
-    finally:
-        for k, v in old.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
+    results = _children(
+        [["-c", _HANG_SCRIPT.format(linked=v)] for v in (True, False)],
+        timeout=240,
+        extra_env={"MESA_SHADER_CACHE_DISABLE": "true"},
+    )
     runs = []
     for returncode, out in results:
         line = next((ln for ln in out.splitlines() if ln.startswith("RESULT ")), None)
