@@ -79,7 +79,7 @@ class PenumbraEngineCore:
         post layers' sizes in pixels (a final render's resolution %); ``aux``: also produce the
         depth, shadow and normal targets (passes), not only colour. ``navigating``: a frame
         while the view moves (``Renderer.render``: its maps keep the last such frame's sizes)."""
-        from .frame.renderer import Renderer
+        from .frame.renderer import FrameRequest, Renderer
 
         if self.renderer is None:
             shaders = gpu_pool.final_shaders() if self.texture_pool is not None else None
@@ -92,22 +92,21 @@ class PenumbraEngineCore:
             pixel_scale=pixel_scale,
             use_simplify=scene.render.use_simplify,
         )
-        out = self.renderer.render(
-            snapshot,
+        request = FrameRequest(
             camera,
             settings,
             width,
             height,
-            aux,
-            samples,
-            sample_count,
-            on_sample=on_sample,
+            aux=aux,
+            samples=samples,
+            sample_count=sample_count,
             emission=emission,
             adaptive=adaptive,
             deadline=deadline,
             navigating=navigating,
             motion=motion,
         )
+        out = self.renderer.render(snapshot, request, on_sample=on_sample)
         self.last_stats = out.stats
         return out
 
@@ -397,18 +396,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                 if self.break_requested():
                     return
                 self.update_stats("", f"Penumbra | {layer}{' | ' + view if view else ''} | rendering")
-                if view:
-                    self.active_view_set(view)
-                    camera = camera_from_scene(
-                        depsgraph,
-                        scene,
-                        width,
-                        height,
-                        matrix_world=self.camera_model_matrix(scene.camera),
-                        shift_x=self.camera_shift_x(scene.camera),
-                    )
-                else:
-                    camera = camera_from_scene(depsgraph, scene, width, height)
+                camera = self._view_camera(depsgraph, view, width, height)
                 options = scene.penumbra
                 count = int(options.render_samples)
                 adaptive = adaptive_settings(
@@ -441,35 +429,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                 )
                 if out.stats.cancelled and out.stats.samples == 0:
                     return  # cancelled before a sample was drawn: nothing to write
-                if out.stats.stopped or out.stats.cancelled:
-                    # Esc (test_break) keeps what was rendered, as Cycles does: the samples
-                    # drawn so far, resolved and through the post stack, are this view's result.
-                    why = "Cancelled" if out.stats.cancelled else STOPPED[out.stats.stopped]
-                    stopped = f"Sample {out.stats.samples}/{count} | {why}"
-                    self.update_stats("", f"{label} | {stopped}")
-                    self.report({"INFO"}, f"Penumbra: {label[11:]}: {stopped}")
-                legend = out.stats.debug_legend
-                if legend and legend not in reported:  # what a debug view's colours mean
-                    reported.add(legend)
-                    self.report({"INFO"}, f"Penumbra debug view {legend}")
-                for message in out.stats.messages:
-                    if message not in reported:
-                        reported.add(message)
-                        self.report({"WARNING"}, message)
-                passes = {"Combined": window.cut(out.color_array())}
-                options = depsgraph.view_layer.penumbra
-                if depsgraph.view_layer.use_pass_z:
-                    passes["Depth"] = window.cut(out.depth_array())
-                if options.use_pass_shadow:
-                    passes["Shadow"] = window.cut(out.shadow_array())
-                if options.use_pass_lit:
-                    passes["Lit"] = window.cut(out.lit_array())
-                if depsgraph.view_layer.use_pass_normal:
-                    passes["Normal"] = window.cut(out.normal_array())
-                if depsgraph.view_layer.use_pass_mist:
-                    passes["Mist"] = window.cut(self._mist(scene, camera, out, width, height))
-                if depsgraph.view_layer.use_pass_emit:
-                    passes[EMISSION_PASS] = window.cut(out.emission_array())
+                self._report_frame(out.stats, label, count, reported)
+                passes = self._passes(depsgraph, camera, out, window)
                 self._write_result(window, layer, view, passes)
                 self.update_progress((index + 1) / len(views))
                 if out.stats.cancelled:
@@ -481,6 +442,60 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             # A final-render engine instance renders one frame; free while the context lives.
             self.free_gpu()
             self.texture_pool.end_render()  # the pool keeps what this frame used, no more
+
+    def _view_camera(self, depsgraph, view, width, height):
+        """The scene camera of ``view`` (a multiview render's, made the active view; "" for
+        the one view of a mono render)."""
+        scene = depsgraph.scene
+        if not view:
+            return camera_from_scene(depsgraph, scene, width, height)
+        self.active_view_set(view)
+        return camera_from_scene(
+            depsgraph,
+            scene,
+            width,
+            height,
+            matrix_world=self.camera_model_matrix(scene.camera),
+            shift_x=self.camera_shift_x(scene.camera),
+        )
+
+    def _report_frame(self, stats, label, count, reported):
+        """What a view's frame tells the user: where it stopped early, its debug view's legend
+        and its messages, each once a render (``reported``)."""
+        if stats.stopped or stats.cancelled:
+            # Esc (test_break) keeps what was rendered, as Cycles does: the samples drawn so
+            # far, resolved and through the post stack, are this view's result.
+            why = "Cancelled" if stats.cancelled else STOPPED[stats.stopped]
+            stopped = f"Sample {stats.samples}/{count} | {why}"
+            self.update_stats("", f"{label} | {stopped}")
+            self.report({"INFO"}, f"Penumbra: {label[11:]}: {stopped}")
+        legend = stats.debug_legend
+        if legend and legend not in reported:  # what a debug view's colours mean
+            reported.add(legend)
+            self.report({"INFO"}, f"Penumbra debug view {legend}")
+        for message in stats.messages:
+            if message not in reported:
+                reported.add(message)
+                self.report({"WARNING"}, message)
+
+    def _passes(self, depsgraph, camera, out, window):
+        """{pass name: pixels} the view layer asks for, of the frame ``out``, cut to ``window``."""
+        vl = depsgraph.view_layer
+        width, height = self.resolution_x, self.resolution_y
+        passes = {"Combined": window.cut(out.color_array())}
+        if vl.use_pass_z:
+            passes["Depth"] = window.cut(out.depth_array())
+        if vl.penumbra.use_pass_shadow:
+            passes["Shadow"] = window.cut(out.shadow_array())
+        if vl.penumbra.use_pass_lit:
+            passes["Lit"] = window.cut(out.lit_array())
+        if vl.use_pass_normal:
+            passes["Normal"] = window.cut(out.normal_array())
+        if vl.use_pass_mist:
+            passes["Mist"] = window.cut(self._mist(depsgraph.scene, camera, out, width, height))
+        if vl.use_pass_emit:
+            passes[EMISSION_PASS] = window.cut(out.emission_array())
+        return passes
 
     @staticmethod
     def _mist(scene, camera, out, width, height):

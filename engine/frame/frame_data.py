@@ -6,14 +6,14 @@ to the GPU is unit-tested without one.
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
 from ..enums import DEBUG_VIEW, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE
 from ..shadows import kernels, light_bins, lightspace
 from ..shadows.kernels import RING
-from .lens import coc_row
 from .programs import (
     FRAME_STRUCT,
     LIGHT_STRUCT,
@@ -33,10 +33,17 @@ class FrameData:
     frame: np.ndarray  # FRAME_STRUCT, packed
     lights: np.ndarray  # MAX_LIGHTS x LIGHT_STRUCT
     tiles: np.ndarray  # MAX_SHADOW_TILES x TILE_STRUCT
-    defines: dict  # the lit pass variant
+    variant: LitVariant  # the lit pass's variant, typed
     disk_samples: int  # jittered-disk samples the variant reads (0: it reads none)
     order: list  # the light index of each row of ``lights`` (shadowed lights first)
     bins: np.ndarray = None  # (rows, columns, LIGHT_WORDS) light masks of the screen bins, or None
+    samplers: dict = field(default_factory=dict)  # {name: texture} the techniques' parts bind
+    begins: tuple = ()  # the techniques' GPU work over the frame block before the draws (``LitPart.begin``)
+
+    @cached_property
+    def defines(self):
+        """The variant's defines (``LitVariant.defines``), made once."""
+        return self.variant.defines()
 
 
 def disk_samples(settings, sample_count=1):
@@ -182,116 +189,123 @@ def _debug_lit(settings):
     return view.lit and not view.term
 
 
-def build_frame_data(
-    lights,
-    camera,
-    world_color,
-    settings,
-    plan,
-    tile_size=1,
-    atlas_columns=1,
-    depth_format="FLOAT32",
-    aux_outputs=True,
-    rects=None,
-    size=None,
-    alpha_offset=0.5,
-    origin=_ZERO,
-    sample_count=1,
-    settle=False,
-    pilot=False,
-    world_sampled=False,
-    world_sh=True,
-    world_ao=None,
-    sample_index=0,
-    rsm=False,
-    world_ratio=False,
-):
-    """Everything the lit pass binds for this frame. ``lights``: at most MAX_LIGHTS snapshot
-    lights; ``plan``: the frame's ``shadows.ShadowPlan``; ``tile_size``/``atlas_columns``:
-    the atlas the plan was drawn into (1/1 when no map was drawn); ``aux_outputs``: whether
-    the variant writes the depth, shadow and normal targets as well as colour; ``rects``: per
-    light, the screen rectangle it can light (``light_bins.screen_rects``) on a frame of
-    ``size`` (width, height) pixels, which bins the lights when several are local.
-    ``world_color``: a ``materials.World`` (its SH light) or a constant colour;
-    ``alpha_offset``: this sample's shift of the alpha-hash threshold ((s + 0.5) / N);
-    ``origin``: the frame origin: every position the GPU gets is relative to it;
-    ``sample_count``: the frame's samples, which share the disk filters' taps; ``settle``:
-    for the settle test's variant (``settle.py``); ``pilot``: for a frame's pilot sample;
+@dataclass(frozen=True)
+class AtlasShape:
+    """The shadow atlas a plan was drawn into: its tiles' size in texels, its columns and its
+    depth format (1, 1, FLOAT32 when no map was drawn)."""
+
+    tile_size: int = 1
+    columns: int = 1
+    depth_format: str = "FLOAT32"
+
+
+@dataclass(frozen=True)
+class LitInputs:
+    """What one sample's lit pass is drawn for, besides its lights, camera, world, settings
+    and shadow plan (``build_frame_data``): one field each, with its default.
+
+    ``atlas``: the ``AtlasShape`` the plan was drawn into; ``aux_outputs``: the variant writes
+    the depth, shadow and normal targets as well as colour; ``rects``: per light, the screen
+    rectangle it can light (``light_bins.screen_rects``) on a frame of ``size`` (width,
+    height) pixels, which bins the lights when several are local; ``alpha_offset``: the
+    sample's shift of the alpha-hash threshold ((s + 0.5) / N); ``origin``: the frame origin
+    (every position the GPU gets is relative to it); ``sample_count``: the frame's samples,
+    which share the disk filters' taps; ``sample_index``: this sample's index in its frame;
     ``world_sampled``: the frame samples the world's light with shadow maps (its settle test
     weighs the world's light), whether or not this sample's directions have maps;
     ``world_sh``: the surfaces take the world's SH light (False: this sample's directions of
-    the world carry all of it, ``world.directions.world_lights`` with portals);
-    ``world_ao``: (distance, jitter) when the world's light is occluded by the ambient
-    occlusion over the camera depth prepass (``WORLD_AO``; ``size`` is then the film's);
-    ``sample_index``: this sample's index in its frame; ``rsm``: the atlas holds reflective
-    shadow maps (``indirect_samples``): the variant gathers one diffuse bounce from them when
-    some light has a map (``INDIRECT_RSM`` in its defines); ``world_ratio``: the frame's
-    world directions shadow the SH light as a ratio the film accumulates (``WORLD_RATIO``;
-    never in the settle test's variant)."""
+    the world carry all of it, ``world.directions.world_lights`` with portals); ``parts``: the
+    frame's techniques' ``features.LitPart`` of this sample (fields of the variant, rows of
+    the frame block, samplers)."""
+
+    atlas: AtlasShape = AtlasShape()
+    aux_outputs: bool = True
+    rects: object = None
+    size: tuple | None = None
+    alpha_offset: float = 0.5
+    origin: object = None  # None: world space as it is
+    sample_count: int = 1
+    sample_index: int = 0
+    world_sampled: bool = False
+    world_sh: bool = True
+    parts: tuple = ()
+
+
+def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInputs()):
+    """Everything the lit pass binds for this sample. ``lights``: at most MAX_LIGHTS snapshot
+    lights; ``camera``: the raster camera; ``world_color``: a ``materials.World`` (its SH
+    light) or a constant colour; ``plan``: the frame's ``shadows.ShadowPlan``; ``inputs``:
+    the rest (``LitInputs``), the techniques' parts among them: the typed variant
+    (``programs.LitVariant``) takes their fields, the frame block their rows."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
-    disk = disk_samples(settings, sample_count)
+    extra, rows, samplers = {}, {}, {}
+    for part in inputs.parts:
+        extra.update(part.variant)
+        rows.update(part.rows)
+        samplers.update(part.samplers)
+    disk = disk_samples(settings, inputs.sample_count)
     order, sampled, shadowed = shading_order(lights, plan)
     sh = getattr(world_color, "sh", None)  # a materials.World, or a constant colour
+    atlas, origin = inputs.atlas, (_ZERO if inputs.origin is None else inputs.origin)
     frame = frame_row(
         camera,
         world_color.mean if sh is not None else world_color,
         len(order),
         settings,
-        tile_size,
-        atlas_columns,
+        atlas.tile_size,
+        atlas.columns,
         origin,
     )
-    if sh is not None and world_sh:
+    if sh is not None and inputs.world_sh:
         for k in range(1, 9):
             frame[f"world_sh{k}"] = (*sh[k], 0.0)
-    if not world_sh:
+    if not inputs.world_sh:
         frame["world_color"] = _ZERO
-    frame["alpha_offset"] = alpha_offset
-    if world_ao is not None:
-        frame.update(ao_row(camera.projection, size, *world_ao))
-    frame["sample_index"] = int(sample_index)
-    if settle:  # where the lens blurs, a pixel keeps sampling (lib/lit_settle.glsl)
-        frame["lens_coc"] = coc_row(camera, *size)
-    # One diffuse bounce from the maps' reflective targets: only where some light has a map.
-    indirect = indirect_samples(settings) if rsm and shadowed > 0 else 0
+    frame["alpha_offset"] = inputs.alpha_offset
+    frame["sample_index"] = int(inputs.sample_index)
+    frame.update(rows)
     frame["shadowed_count"] = shadowed
     frame["shadowed_mask"] = light_bins.word_masks(0, shadowed, LIGHT_WORDS)
     frame["sampled_count"] = sampled
     frame["sampled_mask"] = light_bins.word_masks(0, sampled, LIGHT_WORDS)
     bins = None
-    if rects is not None and should_bin(lights):
-        bins = light_bins.bin_masks([rects[i] for i in order], size[0], size[1], LIGHT_WORDS)
+    if inputs.rects is not None and should_bin(lights):
+        size = inputs.size
+        bins = light_bins.bin_masks([inputs.rects[i] for i in order], size[0], size[1], LIGHT_WORDS)
+    # The settle test's variant writes its flags: no debug view's values.
+    settle = bool(extra.get("settle", False))
     term = 0 if settle else DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].term
+    variant = LitVariant(
+        **{
+            "shadow_filter": settings.shadow_filter if shadowed > sampled else "NONE",  # no map: no filter code at all
+            "pcf_weights": tuple(float(w) for w in kernels.pcf_weights(settings.pcf_kernel_size)),
+            "specular_model": settings.specular_model,
+            "depth_format": atlas.depth_format,
+            "disk_samples": int(disk),
+            "early_out": bool(settings.shadow_early_out),
+            "aux_outputs": bool(inputs.aux_outputs),
+            "binned": bins is not None,
+            "pcf_spacing": float(settings.pcf_spacing),
+            "sampled": sampled > 0,
+            "light_counts": (sampled, shadowed, len(order)),
+            "light_linking": any(light.receivers is not None for light in lights),
+            "debug": bool(_debug_lit(settings)) and not settle,
+            "world_lights": bool(inputs.world_sampled) or any(lights[i].world for i in order),
+            "debug_term": int(term),
+            **extra,
+        }
+    )
     return FrameData(
         frame=FRAME_STRUCT.pack([frame]),
         lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i), origin) for i in order], MAX_LIGHTS),
         tiles=packed_tiles(plan, origin),
-        defines=LitVariant(
-            shadow_filter=settings.shadow_filter if shadowed > sampled else "NONE",  # no map: no filter code at all
-            pcf_weights=tuple(float(w) for w in kernels.pcf_weights(settings.pcf_kernel_size)),
-            specular_model=settings.specular_model,
-            depth_format=depth_format,
-            disk_samples=int(disk),
-            early_out=bool(settings.shadow_early_out),
-            aux_outputs=bool(aux_outputs),
-            binned=bins is not None,
-            pcf_spacing=float(settings.pcf_spacing),
-            sampled=sampled > 0,
-            light_counts=(sampled, shadowed, len(order)),
-            light_linking=any(light.receivers is not None for light in lights),
-            debug=bool(_debug_lit(settings)) and not settle,
-            settle=bool(settle),
-            pilot=bool(pilot),
-            world_lights=bool(world_sampled) or any(lights[i].world for i in order),
-            world_ao=world_ao is not None,
-            indirect_samples=int(indirect),
-            debug_term=int(term),
-            world_ratio=bool(world_ratio) and not settle,
-        ).defines(),
+        variant=variant,
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,
         order=order,
         bins=bins,
+        samplers=samplers,
+        begins=tuple(part.begin for part in inputs.parts if part.begin is not None),
     )
 
 

@@ -11,11 +11,7 @@ from ..gpu_pool import UniformBlocks
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
 from .programs import (
-    AO_HORIZONS_SAMPLER,
-    AO_SAMPLER,
     JITTER_SIZE,
-    RSM_FLUX_SAMPLER,
-    RSM_NORMAL_SAMPLER,
     SHADOW_SAMPLER,
     WORLD_RATIO_BLENDED,
     WORLD_RATIO_OPAQUE,
@@ -48,13 +44,15 @@ BACKGROUND = Program(
 
 class LitPass:
     """The lit pass's GPU state of one renderer: its uniform blocks, the jittered-disk and
-    light-bin textures. ``materials``: the renderer's ``MaterialBlocks``; ``textures``: its
-    ``TextureCache``."""
+    light-bin textures. ``caches``: the renderer's ``GpuCaches`` (programs, material blocks,
+    images); ``film``: the film it draws into."""
 
-    def __init__(self, shaders, materials, textures):
-        self.shaders = shaders
-        self.materials = materials
-        self.textures = textures
+    def __init__(self, caches, film):
+        self.caches = caches
+        self.shaders = caches.shaders
+        self.materials = caches.materials
+        self.textures = caches.textures
+        self.film = film
         self._ubos = UniformBlocks()
         self._jitter_tex = None
         self._jitter_dummy = None
@@ -62,30 +60,30 @@ class LitPass:
         self._dummy_shadow = None
         self.uploaded = 0  # bytes sent to the GPU since creation (uniform blocks, textures of data)
 
-    def draw(
-        self, film, draws, camera, data, atlas, world, settings, aux, emission, stats, origin, masks=None, ao=None
-    ):
-        """The film's lit pass: every visible part of ``draws``, grouped by material variant:
-        opaque and alpha-hashed parts nearest first, then alpha-blended parts farthest first,
-        blended over them (their depth, normal and shadow stay those of what is behind; EEVEE
-        too keeps blended surfaces out of its depth). ``atlas``: the shadow atlas, or None when
-        no map was planned; ``world``: the snapshot's World (or None) and ``world_color``.
-        ``ao``: the renderer's ``world.occlusion.WorldAO``, its camera depth prepass drawn, when
-        the variant occludes the world (``WORLD_AO`` in ``data.defines``): its horizons are
-        marched at half resolution first, and the lit pass reads both."""
+    def draw(self, frame, sample):
+        """The film's lit pass of ``sample`` (``renderer.Sample``: its draws the camera sees,
+        view camera, frame data, atlas and light masks) in ``frame`` (``renderer.FramePlan``):
+        every visible part, grouped by material variant: opaque and alpha-hashed parts nearest
+        first, then alpha-blended parts farthest first, blended over them (their depth, normal
+        and shadow stay those of what is behind; EEVEE too keeps blended surfaces out of its
+        depth). The techniques' GPU work over the frame block (``FrameData.begins``: the world
+        occlusion's horizons) runs before the draws."""
         import gpu
 
-        world_data, world_color = world
+        film, data, camera, stats = self.film, sample.data, sample.view_camera, sample.stats
+        aux = frame.aux
+        snapshot = frame.snapshot
+        world_data, world_color = snapshot.world, snapshot.world_color
         # Transparent film: the background is RGBA 0 (premultiplied), as Blender's engines write it.
         # A lit debug view's values start at 0 where no surface is (``DEBUG_LIT``).
-        transparent = settings.film_transparent or bool(data.defines.get("DEBUG_LIT"))
+        transparent = frame.settings.film_transparent or data.variant.debug
         bg = (0.0, 0.0, 0.0, 0.0) if transparent else (*map(float, world_color[:3]), 1.0)
-        emission = aux and emission
+        emission = frame.emission
         counted = film.fb_counted is not None and not aux  # the shading count of tests
         # The world's light as a ratio (WORLD_RATIO): its targets beside the pass's. Blender's
         # gpu module binds six colour targets: with the world ratio's three, the Emission pass
         # is drawn apart, over the z-buffer the lit pass leaves.
-        ratio = bool(data.defines.get("WORLD_RATIO"))
+        ratio = data.variant.world_ratio
         emission_apart = ratio and emission
         fb = film.lit_framebuffer(aux, emission and not emission_apart, counted, ratio)
         film.clear(bg, aux, emission, ratio)
@@ -95,13 +93,13 @@ class LitPass:
         if converged:
             film.mask_depth(fb)
         if world_data is not None and world_data.image is not None and not transparent:
-            self._background(film, world_data, camera, origin, "LESS_EQUAL" if converged else "NONE")
-        opaque, blended, parts = self._entries(draws, camera, atlas, stats, hashed_last=False)
-        if not data.defines.get("WORLD_AO"):
-            ao = None
-        elif ao is not None:
-            ao.march(self._ubo("frame", data.frame), self.shaders, stats)
-        submit = _Submission(self, film, camera, data, atlas, origin, masks, ao, parts, stats)
+            self._background(film, world_data, camera, frame.origin, "LESS_EQUAL" if converged else "NONE")
+        opaque, blended, parts = self._entries(sample.seen, camera, sample.atlas, stats, hashed_last=False)
+        if data.begins:
+            block = self._ubo("frame", data.frame)
+            for begin in data.begins:
+                begin(block, stats)
+        submit = _Submission(self, sample, parts)
         submit.emission = emission and not emission_apart
         submit.counted = counted
         submit.ratio = ratio
@@ -131,16 +129,17 @@ class LitPass:
                 gpu.state.blend_set("NONE")
         _reset_state(stats)
 
-    def draw_settle_test(self, film, draws, camera, data, atlas, stats, origin, masks, target):
-        """The settle test's variant of the lit pass (``data`` built with ``settle``) into
+    def draw_settle_test(self, sample, target):
+        """The settle test's variant of the lit pass (``sample.data`` built for the test) into
         ``target`` (``Film.settle_framebuffer``): the surfaces the pilot drew (its z-buffer,
         kept) and any dithered or blended one in front of them write their flags, the dithered
         and blended last, nothing blended."""
         import gpu
 
-        opaque, blended, parts = self._entries(draws, camera, atlas, stats, hashed_last=True)
-        submit = _Submission(self, film, camera, data, atlas, origin, masks, None, parts, stats)
-        width, height = film.size
+        stats = sample.stats
+        opaque, blended, parts = self._entries(sample.seen, sample.view_camera, sample.atlas, stats, hashed_last=True)
+        submit = _Submission(self, sample, parts)
+        width, height = self.film.size
         with target.bind():
             gpu.state.viewport_set(0, 0, width, height)
             gpu.state.depth_test_set("LESS_EQUAL")
@@ -306,19 +305,21 @@ class _Submission:
     ``emission``, ``counted`` and ``ratio``: what the film's targets take (the settle test's
     take none of them); ``rebind()`` before drawing into other targets."""
 
-    def __init__(self, lit, film, camera, data, atlas, origin, masks, ao, parts, stats):
-        self.lit, self.data, self.atlas, self.origin = lit, data, atlas, origin
-        self.masks, self.ao, self.parts, self.stats = masks, ao, parts, stats
+    def __init__(self, lit, sample, parts):
+        atlas, data = sample.atlas, sample.data
+        self.lit, self.data, self.atlas, self.origin = lit, data, atlas, sample.origin
+        self.masks, self.parts, self.stats = sample.masks, parts, sample.stats
         self.shadow_tex = atlas.texture if atlas is not None else lit._shadow_dummy()
         self.emission = self.counted = self.ratio = False
         self.entry = lit_entry(data.defines)  # the colour, the settle test's flags or a debug view's
-        # One diffuse bounce from the atlas's reflective targets (frame_data: some light has a map).
-        self.rsm = bool(data.defines.get("INDIRECT_RSM"))
+        # One diffuse bounce from the atlas's reflective targets (features/bounce.py).
+        self.rsm = data.variant.indirect_samples > 0
         # The sample's tile records: the instanced depth pass's block when it holds them.
         tiles = atlas.tiles_block(data.tiles) if atlas is not None else None
         self.tiles = tiles if tiles is not None else lit._ubo("tiles", data.tiles)
         # Strand-shaped hair: half a pixel's width per unit of clip w (the camera's y scale).
-        self.hair_pixel = 1.0 / max(abs(float(camera.projection[1, 1])) * film.size[1], 1e-30)
+        camera = sample.view_camera
+        self.hair_pixel = 1.0 / max(abs(float(camera.projection[1, 1])) * lit.film.size[1], 1e-30)
         self.shader = self.model_shader = self.culling = None
         self.solid = {}
 
@@ -344,7 +345,7 @@ class _Submission:
             )
             program = with_entry(program, self.entry)
         defines = data.defines
-        if bool(defines.get("AUX_OUTPUTS")) != with_aux:
+        if data.variant.aux_outputs != with_aux:
             # Blended surfaces of a frame with passes draw into the colour target alone.
             defines = {**defines, "AUX_OUTPUTS": with_aux}
         shader = lit.shaders.get(program, defines)
@@ -360,12 +361,8 @@ class _Submission:
         shader.uniform_sampler(SHADOW_SAMPLER, self.shadow_tex)
         shader.uniform_sampler("jitter_tex", lit._jitter(data.disk_samples))
         shader.uniform_sampler("light_bins", lit._bins_texture(data.bins))
-        if defines.get("WORLD_AO"):
-            shader.uniform_sampler(AO_SAMPLER, self.ao.texture)
-            shader.uniform_sampler(AO_HORIZONS_SAMPLER, self.ao.horizons)
-        if self.rsm:
-            shader.uniform_sampler(RSM_FLUX_SAMPLER, self.atlas.flux)
-            shader.uniform_sampler(RSM_NORMAL_SAMPLER, self.atlas.normal)
+        for name, texture in data.samplers.items():  # the techniques' (``LitPart.samplers``)
+            shader.uniform_sampler(name, texture)
         self.shader = shader
         return shader
 

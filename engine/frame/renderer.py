@@ -1,10 +1,12 @@
-"""One frame as its stages: extract (done by the caller) -> shadows -> lit -> post -> output.
-The same code serves the viewport and final renders; only where the camera comes from and
-where the result goes differ.
+"""One frame as its stages: extract (done by the caller) -> plan -> samples (shadows, lit,
+accumulate) -> resolve -> post -> output. The same code serves the viewport and final renders;
+only where the camera comes from and where the result goes differ.
 
 The renderer only sequences the frame; each stage keeps its own state: the draw list and its
 GPU batches (``draw_list``, ``batches``), the shadow pass (``shadow_pass``), the lit pass
-(``lit_pass``) and the film's targets, accumulation and resolve (``film``).
+(``lit_pass``) and the film's targets, accumulation and resolve (``film``). A technique the
+frame may need (the world's ratio and occlusion, the bounce, settling, depth of field, motion
+blur) is a module of ``features/``, called through its hooks: the renderer does not name it.
 """
 
 import dataclasses
@@ -13,107 +15,134 @@ import numpy as np
 
 from ..enums import DEBUG_VIEW, DEPTH_FORMAT
 from ..post import post_stack
-from ..scene.textures import TextureCache
 from ..shadows import lightspace
 from ..shadows.planning import frame_sizes
 from . import debug_view, sampling
-from . import motion as motion_mod
-from .batches import Batches
 from .draw_list import corners_of, draw_list, frame_light_rects, light_masks, lights_in_view
+from .features import REGISTRY
 from .film import Film, FrameOutput
-from .frame_data import build_frame_data, select_lights
-from .lens import lens_camera, lens_offset, lens_reach
+from .frame_data import AtlasShape, LitInputs, build_frame_data, select_lights
 from .lit_pass import LitPass
-from .material_blocks import MaterialBlocks
 from .programs import MAX_LIGHTS
-from .settle import flag_reach
-from .settle import settle as settle_pixels
+from .request import FrameRequest, GpuCaches
 from .shadow_pass import UNSET, ShadowPass
 from .stats import FrameStats, StageClock
-from .world.directions import (
-    directions_per_sample,
-    light_share,
-    needs_directions,
-    portal_cones,
-    world_lights,
-    world_negligible,
-)
-from .world.occlusion import WorldAO
+from .world.directions import light_share, needs_directions, portal_cones, world_lights, world_negligible
 from .world.probe import PROBE_SHARE, WorldProbe
 from .world.sh_light import with_sh_light
 from .world.sun import with_sun
 
-
-@dataclasses.dataclass(frozen=True)
-class SampleSpec:
-    """What varies from sample to sample of a frame, for ``Renderer._sample`` and ``_lit``:
-    the alpha-hash offset ((s + 1/2) / N), the frame's samples (which share the disk filters'
-    taps), whether it is the frame's pilot, the world's ambient occlusion ((distance, jitter)
-    or None) and its index in the frame."""
-
-    alpha_offset: float = 0.5
-    sample_count: int = 1
-    pilot: bool = False
-    ao: tuple = None
-    index: int = 0
+__all__ = ["FramePlan", "FrameRequest", "GpuCaches", "Renderer", "Sample"]
 
 
 @dataclasses.dataclass
-class SampleResult:
-    """What one sample drew: its lights in view (what its plan indexes), its shadow plan, its
-    lit pass's (raster camera, view camera, light rectangles) and frame data. The settle test
-    draws as the pilot's did; the SHADOW_MAPS view shows the last sample's."""
+class Sample:
+    """One sample of a frame, what its stages read and what they leave (``Renderer.sample``,
+    ``draw_sample``). Inputs: its ``index`` in the frame, the alpha-hash offset ((s + 1/2) /
+    N), the frame's samples (which share the disk filters' taps; 1 for a one-sample frame and
+    the pilot), whether it is the frame's ``pilot`` (settling) or the ``settle_test``, its
+    world occlusion ((distance, jitter) or None), its lights, its unjittered ``camera`` (maps
+    are planned from it), its ``view_camera`` (pixel offset, point of the lens), its ``draws``
+    and its ``stats``. Outputs: its lights in view, shadow ``plan`` and ``atlas`` (None
+    without maps), ``cameras`` (raster camera, view camera, light rectangles), frame ``data``,
+    the draws the camera sees (``seen``) and the light-linking ``masks``. The settle test
+    draws as the pilot did; the SHADOW_MAPS view shows the last sample's."""
 
-    lights: list
-    plan: object
-    cameras: tuple
+    index: int = 0
+    alpha_offset: float = 0.5
+    sample_count: int = 1
+    pilot: bool = False
+    settle_test: bool = False
+    ao: tuple | None = None
+    lights: list = None
+    camera: object = None
+    view_camera: object = None
+    draws: list = None
+    stats: object = None
+    origin: np.ndarray = None
+    weight: float = 1.0
+    offset: tuple = (0.0, 0.0)
+    plan: object = None
+    atlas: object = None
+    cameras: tuple = None
     data: object = None
-    draws: list = None  # its draw list (a motion-blurred sample's own; None: the frame's)
+    seen: list = None
+    masks: dict = None
 
 
 @dataclasses.dataclass
 class FramePlan:
-    """What ``Renderer.render``'s plan stage decided for one frame (``_plan``, ``_plan_samples``):
-    the later stages read this and their own arguments, nothing an earlier call left behind.
+    """What ``Renderer.render``'s plan stage decided for one frame (``_plan``, ``_plan_samples``)
+    and what every later stage reads: none reads what an earlier call left on the renderer.
 
-    ``snapshot``: the scene (its world with the SH light of an Environment Texture);
-    ``draws``: the draw list, positions relative to ``origin``; ``lights``: those it lights
-    with; ``directions``: directions of the world's light per sample with maps, gathered in
-    the light portals' ``cones`` when there are any; ``moving``: indices of the lights that
-    move between samples (``jitter``: every light with a map does); ``rects``: each light's
-    screen rectangle for the whole frame (``draw_list.frame_light_rects``); ``adaptive``,
-    ``noise``, ``settle`` and ``deadline``: what may end the frame early."""
+    ``request``: the ``FrameRequest``; ``snapshot``: the scene (its world with the SH light of
+    an Environment Texture); ``caches``: the renderer's ``GpuCaches``; ``clock`` and
+    ``stats``: the frame's ``StageClock`` and ``FrameStats``; ``features``: the techniques this
+    frame needs (``features.Feature``, in registry order); ``draws``: the draw list, positions
+    relative to ``origin``; ``lights``: those it lights with; ``directions``: directions of
+    the world's light per sample with maps, gathered in the light portals' ``cones`` when there
+    are any (``world_share``: the world's share of the light in view, None where its light is
+    not sampled); ``moving``: indices of the lights that move between samples (``jitter``:
+    every light with a map does); ``rects``: each light's screen rectangle for the whole frame
+    (``draw_list.frame_light_rects``); ``adaptive``, ``noise`` and ``deadline``: what may end
+    the frame early; ``reach``: pixels the samples look beyond the image (pixel filter, lens:
+    ``lens_reach``); ``motion``: what moves in the shutter (motion blur); ``reflective``: its
+    maps are reflective (the bounce)."""
 
+    request: FrameRequest
     snapshot: object
-    camera: object
-    settings: object
-    size: tuple
+    caches: GpuCaches
+    clock: StageClock
+    stats: FrameStats
     origin: np.ndarray
     draws: list
-    lights: list
-    aux: bool
-    emission: bool
-    sample_count: int
     debug: object  # the DEBUG_VIEW entry
+    features: tuple = ()
+    lights: list = dataclasses.field(default_factory=list)
     directions: int = 0
     cones: list = dataclasses.field(default_factory=list)
+    world_share: float | None = None
     world_negligible: bool = False  # the world's light is under the frame's noise (``world_negligible``)
     first_directions: int = 0  # the first sample that takes directions (after one with AO)
     adaptive: object = None
     noise: bool = False
-    settle: bool = False
     deadline: float | None = None
     jitter: bool = False
     moving: set = dataclasses.field(default_factory=set)
     rects: object = None
-    reach: float = 0.0  # pixels the samples look beyond the image (pixel filter, lens)
-    motion: object = None  # ``motion.Motion``: each sample at its own time in the shutter
-    lens_reach: float = 0.0  # of which the lens's: its widest circle of confusion's radius
-    _ao_distance: float | None = None
+    reach: float = 0.0
+    lens_reach: float = 0.0
+    motion: object = None
+    reflective: bool = False
+    ao_distance: float | None = None
+
+    @property
+    def camera(self):
+        return self.request.camera
+
+    @property
+    def settings(self):
+        return self.request.settings
+
+    @property
+    def size(self):
+        return self.request.size
+
+    @property
+    def aux(self):
+        return self.request.aux
+
+    @property
+    def emission(self):
+        return bool(self.request.emission and self.request.aux)
+
+    @property
+    def sample_count(self):
+        return self.request.sample_count
 
     @property
     def accumulate(self):
-        return self.sample_count > 1
+        return self.request.accumulate
 
     @property
     def world_sampled(self):
@@ -125,30 +154,13 @@ class FramePlan:
         """Its surfaces take the world's SH light (not with light portals)."""
         return not self.cones
 
-    @property
-    def world_ratio(self):
-        """Without portals the directions shadow the SH light as a ratio of their sums over
-        the frame's samples (never negative; lit_world.glsl WORLD_RATIO); with portals they
-        carry the whole light, f cos V L / p, never negative either."""
-        return self.directions > 0 and not self.cones
-
-    def world_ao(self, s):
-        """Sample ``s``'s ambient occlusion of the world (``sampling.world_ao_sample``):
-        (distance, jitter), or None: not this sample, or none where light portals send the
-        world's directions into every sample."""
-        snapshot = self.snapshot
-        world = snapshot.world if snapshot.world is not None else snapshot.world_color
-        if self.cones or not sampling.world_ao_sample(s, self.accumulate, self.settings, world, self.debug.id):
-            return None
-        if self.world_negligible and self.debug.id != "WORLD_AO":  # occluding it could change no pixel
-            return None
-        if self._ao_distance is None:
-            self._ao_distance = sampling.world_ao_distance(self.settings, corners_of(self.draws)) if self.draws else 0.0
-        return (self._ao_distance, sampling.ao_jitter(s)) if self._ao_distance > 0.0 else None
+    def has(self, name):
+        """Whether the technique ``name`` (``Feature.name``) works in this frame."""
+        return any(f.name == name for f in self.features)
 
 
 # While the view moves, a frame's maps keep the sizes of the last navigation frame that
-# planned them afresh, this many frames ago at most (``Renderer.render``'s ``navigating``).
+# planned them afresh, this many frames ago at most (``FrameRequest.navigating``).
 NAVIGATION_REPLAN = 8
 
 
@@ -159,99 +171,75 @@ class Renderer:
     # splits CPU time from GPU time (the benchmarks set it; it stalls the pipeline).
     fence_stages = False
 
-    def __init__(self, pool=None, shaders=None):
+    def __init__(self, pool=None, shaders=None, features=None):
         """``pool``: a ``gpu_pool.TexturePool`` the frame's targets and shadow atlas come from
         (final renders); ``release`` gives them back. ``shaders``: a ``ShaderCache`` shared
-        with other renderers (final renders), else one of its own."""
-        from ...shaders.loader import ShaderCache
-
-        self.pool = pool
-        self.shaders = shaders if shaders is not None else ShaderCache()
-        self.textures = TextureCache()
-        self.materials = MaterialBlocks()
-        self.batches = Batches()
-        self.film = Film(self.shaders, pool)
+        with other renderers (final renders), else one of its own. ``features``: the
+        techniques' classes (``features.REGISTRY`` unless given; one left out is off)."""
+        self.caches = GpuCaches.create(pool, shaders)
+        self.film = Film(self.caches.shaders, pool)
         self.shadow_pass = ShadowPass(pool)
-        self.lit_pass = LitPass(self.shaders, self.materials, self.textures)
-        self.world_ao = WorldAO(pool)  # the camera depth prepass of the world's ambient occlusion
+        self.lit_pass = LitPass(self.caches, self.film)
         self.world_probe = WorldProbe(pool)  # where the world's light gets into an interior
         self.post = post_stack()
-        # What the last frame's last sample drew (``SampleResult``), for inspection: nothing
-        # in a frame reads what an earlier call left here.
+        self.features = tuple(cls(self) for cls in (REGISTRY if features is None else features))
+        # What the last frame's last sample drew (``Sample``), for inspection: nothing in a
+        # frame reads what an earlier call left here.
         self.last_sample = None
-        self._clock = StageClock()  # the current frame's (``render``)
         # Kept between calls, keyed by what decides them: (key, moving lights, map sizes) of a
         # frame's first call, for its later calls (the viewport's refinement); (key, map sizes,
         # frames) of the frames drawn while the view moves.
         self._frame_plan = None
         self._navigation = None
 
+    pool = property(lambda self: self.caches.pool)
+    shaders = property(lambda self: self.caches.shaders)
+    textures = property(lambda self: self.caches.textures)
+    materials = property(lambda self: self.caches.materials)
+    batches = property(lambda self: self.caches.batches)
+
     @property
     def shadows(self):
         """The shadow atlas (``shadow_maps.ShadowAtlas``)."""
         return self.shadow_pass.atlas
 
-    def render(
-        self,
-        snapshot,
-        camera,
-        settings,
-        width,
-        height,
-        aux=True,
-        samples=(0, 1),
-        sample_count=1,
-        on_sample=None,
-        emission=False,
-        adaptive=None,
-        deadline=None,
-        navigating=False,
-        motion=None,
-    ):
-        """Samples ``samples[0] .. samples[1] - 1`` of a frame of ``sample_count`` samples
-        (``frame/sampling.py``), added to the samples this renderer already accumulated for
-        it (a start of 0 begins the frame afresh), then the post stack on their filtered
-        average. One sample of one is exactly the single-sample frame, with no accumulation.
-        ``aux``: also write the depth, shadow and normal targets (a final render's passes;
-        depth and normal are the centred sample's, shadow is averaged like colour).
-        ``on_sample(done)`` after each sample; returning False stops the frame there (cancel).
-        ``emission`` (with ``aux``): also write the Emission pass's target, averaged like colour.
-        ``adaptive`` (``sampling.Adaptive``): what may end the frame early. Its Noise
-        Threshold stops converged pixels (checked every few samples on the GPU; they are not
-        shaded again) and ends the frame when every pixel has converged; its time limit ends
-        it after the first sample that reaches it, counted from the first sample of this call
-        unless ``deadline`` (a ``sampling.clock()`` value) says when. Neither looks at a clock
-        when there is no time limit: a frame stays a function of the scene and its settings.
-        ``navigating``: a one-sample frame while the view moves; its lights' maps keep the
-        sizes a navigation frame planned at most NAVIGATION_REPLAN frames before (one fit per
-        map, not two), and the frame after the view stops plans afresh. ``motion``
-        (``motion.Motion``): what moves during the shutter; each sample of a multi-sample
-        frame is drawn at its own time in it (motion blur).
+    def render(self, snapshot, request, on_sample=None):
+        """Samples ``request.samples[0] .. [1] - 1`` of the frame ``request`` asks for (a
+        ``FrameRequest``; ``frame/sampling.py``), added to the samples this renderer already
+        accumulated for it (a start of 0 begins the frame afresh), then the post stack on
+        their filtered average. One sample of one is exactly the single-sample frame, with no
+        accumulation. Depth and normal are the centred sample's, shadow and emission averaged
+        like colour. ``on_sample(done)`` after each sample; returning False stops the frame
+        there (cancel). Adaptive sampling's Noise Threshold stops converged pixels (checked
+        every few samples on the GPU; they are not shaded again) and ends the frame when every
+        pixel has converged; its time limit ends it after the first sample that reaches it,
+        counted from this call's first sample unless ``request.deadline`` says when. Neither
+        looks at a clock when there is no time limit: a frame stays a function of the scene and
+        its settings. A navigating frame's maps keep the sizes a navigation frame planned at
+        most NAVIGATION_REPLAN frames before (one fit per map, not two), and the frame after
+        the view stops plans afresh.
 
         The frame's stages, in order: plan (``_plan``: what the frame draws, its lights and
-        the world's, which lights move and their maps' sizes), then per sample the settle test
-        once (``_settle``), the sample (``_sample_at``: shadow maps, lit pass, accumulate),
-        then resolve (``_resolve``) and post (``_post``). Each takes the ``FramePlan`` and
-        what it needs besides; none reads what an earlier call left on the renderer."""
-        stats = FrameStats()
+        the world's, the techniques it needs and what they add, which lights move and their
+        maps' sizes), then per sample the techniques' stages before it (settling's test), the
+        sample (``_sample_at``: shadow maps, lit pass, accumulate), then resolve
+        (``_resolve``) and post (``_post``). Each takes the ``FramePlan`` (and the ``Sample``)."""
         clock = StageClock(self.wait_gpu if self.fence_stages else None)
         counters = (self._uploaded(), self.shaders.compiled, self.shaders.compile_seconds)
-        self._clock = self.film.clock = clock
+        self.film.clock = clock
         with clock.stage("prepare"):
-            frame = self._plan(
-                snapshot, camera, settings, (width, height), aux, emission, sample_count, adaptive, stats
-            )
-            frame.motion = self._motion(motion, frame.accumulate, stats)
-            self._plan_samples(frame, samples[0], adaptive, deadline, navigating, stats)
+            frame = self._plan(snapshot, request, clock)
+            self._plan_samples(frame)
+        stats = frame.stats
         drawn = None
-        pixels = width * height
-        for s in range(*samples):
-            if frame.settle and s == 1:
-                self._settle(frame, stats)
+        pixels = request.width * request.height
+        for s in range(*request.samples):
+            for feature in frame.features:
+                feature.before_sample(frame, s)
             if frame.accumulate and self.film.converged >= pixels:
                 stats.stopped = "converged"  # every pixel settled, or a later call of a converged frame
                 break
-            drawn = self._sample_at(frame, s, stats)
+            drawn = self._sample_at(frame, s)
             if frame.deadline is not None and frame.accumulate and not stats.stopped:
                 self.film.finish()  # the sample's GPU work done, so the clock counts it
                 if sampling.clock() >= frame.deadline:
@@ -263,294 +251,236 @@ class Renderer:
                 break
         self.last_sample = drawn
         with clock.stage("resolve"):
-            self._resolve(frame, drawn, stats)
+            self._resolve(frame, drawn)
         with clock.stage("post"):
-            color, debug_image = self._post(frame, drawn, stats)
+            color, debug_image = self._post(frame, drawn)
         stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
         stats.cpu_seconds, stats.gpu_seconds = clock.cpu, clock.gpu
         stats.upload_bytes = self._uploaded() - counters[0]
         stats.shaders_compiled = self.shaders.compiled - counters[1]
         stats.compile_seconds = self.shaders.compile_seconds - counters[2]
-        return self._output(frame, color, debug_image, stats)
+        return self._output(frame, color, debug_image)
 
-    def _plan(self, snapshot, camera, settings, size, aux, emission, sample_count, adaptive, stats):
+    def _plan(self, snapshot, request, clock):
         """The plan stage: what the frame draws (the draw list, relative to the frame origin),
-        the world's light (its SH light, directions per sample, light portals; none of them,
-        nor ambient occlusion, where its light is under the frame's Noise Threshold), the lights
-        it lights with and the film it draws into. Returns the ``FramePlan`` the later stages read."""
-        width, height = size
-        accumulate = sample_count > 1
-        emission = bool(emission and aux)
-        self.film.ensure(width, height, aux, emission)
+        the world's light (its SH light, the world's sun, light portals or an interior's
+        openings; none of them where its light is under the frame's Noise Threshold), the
+        techniques the frame needs and what each adds to the plan, the lights it lights with
+        and the film it draws into. Returns the ``FramePlan`` the later stages read."""
+        stats = FrameStats()
+        settings, camera = request.settings, request.camera
+        self.film.ensure(request.width, request.height, request.aux, request.emission and request.aux)
         # The frame origin: the GPU gets every position relative to the camera (model matrices,
         # lights, the camera's and each map's view), computed here in float64, so a scene far
         # from the world origin keeps float32's precision where it is seen. Maps do not depend
         # on it (each is drawn and read through the same shift) and stay reusable when it moves.
         origin = camera.position if np.all(np.isfinite(camera.position)) else np.zeros(3)
-        draws = draw_list(snapshot, self.batches, stats, origin, camera, settings, size)
-        # A multi-sample frame's pixel offsets reach Filter Size pixels beyond the image, and
-        # its points of the lens (depth of field) as far as its widest circle of confusion: its
-        # maps and light bins are planned for what those samples see too.
-        reach, lens = self._sample_reach(camera, draws, settings, size, accumulate, stats)
-        self.shadow_pass.begin_frame(reach)
+        draws = draw_list(snapshot, self.batches, stats, origin, camera, settings, request.size)
         stats.messages.extend(getattr(snapshot, "messages", ()))
         self.textures.forget(getattr(snapshot, "images_changed", ()))
+        snapshot = self._world(snapshot)
+        debug = DEBUG_VIEW[getattr(settings, "debug_view", "NONE")]
+        frame = FramePlan(request, snapshot, self.caches, clock, stats, origin, draws, debug)
+        # A lit debug view's values are not colour: no noise estimate of theirs ends a frame.
+        frame.adaptive = request.adaptive if frame.accumulate and not debug.lit else None
+        frame.noise = frame.adaptive is not None and frame.adaptive.threshold > 0.0
+        # A multi-sample frame's pixel offsets reach Filter Size pixels beyond the image (and
+        # depth of field's points of the lens further): its maps and bins are planned for them.
+        frame.reach = max(float(settings.filter_size), 0.0) if frame.accumulate else 0.0
+        threshold = frame.adaptive.threshold if frame.adaptive is not None else 0.0
+        frame.world_negligible = world_negligible(
+            snapshot.world if snapshot.world is not None else snapshot.world_color, threshold
+        )
+        if not frame.world_negligible:
+            self._world_directions(frame)
+        # The techniques, in registry order: each decides over what is planned so far.
+        features = []
+        for feature in self.features:
+            if feature.wanted(frame):
+                feature.plan(frame)
+                features.append(feature)
+        frame.features = tuple(features)
+        stats.techniques = [f.name for f in features]
+        self.shadow_pass.begin_frame(frame.reach, frame.reflective)
+        room = MAX_LIGHTS - frame.directions
+        frame.lights = select_lights(snapshot.lights, camera.position, room)
+        if len(frame.lights) < len(snapshot.lights):
+            stats.messages.append(
+                f"Penumbra: {len(snapshot.lights)} lights; only the {room} that contribute most to the view are lit"
+            )
+        return frame
+
+    def _world(self, snapshot):
+        """The snapshot with its world's SH light (an Environment Texture's, projected on the
+        GPU) and World > Settings > Sun as a light where it is above the threshold."""
         world = with_sh_light(snapshot.world, self.textures, self.shaders)
-        if world is not snapshot.world:  # an Environment Texture's light, projected on the GPU
+        if world is not snapshot.world:
             snapshot = dataclasses.replace(snapshot, world=world, world_color=world.mean)
-        world, sun = with_sun(snapshot.world)  # World > Settings > Sun: its light above the threshold
+        world, sun = with_sun(snapshot.world)
         if sun is not None:
             snapshot = dataclasses.replace(
                 snapshot, world=world, world_color=world.mean, lights=[*snapshot.lights, sun]
             )
-        threshold = adaptive.threshold if adaptive is not None and accumulate else 0.0
-        negligible = world_negligible(snapshot.world if snapshot.world is not None else snapshot.world_color, threshold)
-        directions, cones = (
-            (0, [])
-            if negligible
-            else self._world_directions(snapshot, draws, settings, accumulate, camera, origin, stats)
-        )
-        room = MAX_LIGHTS - directions
-        lights = select_lights(snapshot.lights, camera.position, room)
-        if len(lights) < len(snapshot.lights):
-            stats.messages.append(
-                f"Penumbra: {len(snapshot.lights)} lights; only the {room} that contribute most to the view are lit"
-            )
-        return FramePlan(
-            snapshot=snapshot,
-            camera=camera,
-            settings=settings,
-            size=size,
-            origin=origin,
-            draws=draws,
-            lights=lights,
-            aux=aux,
-            emission=emission,
-            sample_count=sample_count,
-            debug=DEBUG_VIEW[getattr(settings, "debug_view", "NONE")],
-            directions=directions,
-            cones=cones,
-            world_negligible=negligible,
-            reach=reach,
-            lens_reach=lens,
-        )
+        return snapshot
 
-    @staticmethod
-    def _sample_reach(camera, draws, settings, size, accumulate, stats):
-        """Pixels beyond the image the frame's samples look: the pixel filter's reach and the
-        lens's (``lens.lens_reach`` over the depths of what is drawn), in a multi-sample frame;
-        0 for one sample, which looks through the pixel's and the lens's centres (said so in
-        the report where the camera has depth of field). Returns (the whole reach, the lens's)."""
-        if not accumulate:
-            if camera.lens is not None:
-                stats.messages.append(
-                    "Penumbra: depth of field needs 2 or more samples: one sample is drawn through the lens's centre"
-                )
-            return 0.0, 0.0
-        lens = 0.0
-        if camera.lens is not None and draws:
-            depths = lightspace.box_depth_range(camera.projection, camera.view, corners_of(draws), camera.is_ortho)
-            lens = lens_reach(camera, depths, *size) if depths is not None else 0.0
-        stats.lens_reach = lens
-        return max(float(settings.filter_size), 0.0) + lens, lens
-
-    @staticmethod
-    def _motion(motion, accumulate, stats):
-        """The frame's ``Motion`` where something moves and the frame has samples to spread
-        over the shutter; a one-sample frame is drawn at the frame's time, and says so."""
-        if motion is None or not motion.moves:
-            return None
-        if not accumulate:
-            stats.messages.append(
-                "Penumbra: motion blur needs 2 or more samples: one sample is drawn at the frame's time"
-            )
-            return None
-        return motion
-
-    def _world_directions(self, snapshot, draws, settings, accumulate, camera, origin, stats):
-        """How many directions of the world's light each sample of the frame draws with maps
-        (``world/directions.py``), and the cones that gather them: its light portals', or
-        without portals the guide of an interior's openings (``world/probe.py``)."""
-        # The world's light with visibility: a multi-sample frame adds ``world_samples``
-        # directions of it per sample, each a sun with its own map.
+    def _world_directions(self, frame):
+        """Where the world's light is sampled with maps (``world/directions.py``): the world's
+        share of the light reaching what the camera sees (``frame.world_share``) and the cones
+        that gather its directions: its light portals', or without portals the guide of an
+        interior's openings (``world/probe.py``). Through cones the directions carry all of the
+        world's light, in every sample (``settings.world_samples`` each); without them a
+        technique may sample it (``features/world_ratio.py``)."""
+        snapshot, settings = frame.snapshot, frame.settings
         if not needs_directions(snapshot.world, settings):
-            return 0, []
+            return
         # Light portals: the directions gather where the world's light enters what the camera
         # sees, and carry all of its light (no SH light on the surfaces of those samples). A
         # one-sample frame then takes its directions too: the SH light of a room's sky, even
         # occluded on screen, is nothing like the light through its windows.
-        seen = [d for d in draws if d.instance.camera]
+        seen = [d for d in frame.draws if d.instance.camera]
         if not seen:
-            return (int(settings.world_samples) if accumulate else 0), []
+            frame.world_share = 1.0
+            return
         box = corners_of(seen).reshape(-1, 3)
-        # The world's share of the light reaching what the camera sees (light_share).
-        share = light_share(snapshot.world, snapshot.lights, 0.5 * (box.min(axis=0) + box.max(axis=0)))
+        frame.world_share = light_share(snapshot.world, snapshot.lights, 0.5 * (box.min(axis=0) + box.max(axis=0)))
         if getattr(snapshot, "portals", ()):
-            cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
-        elif share >= PROBE_SHARE:
+            frame.cones = portal_cones(snapshot.portals, box.min(axis=0), box.max(axis=0))
+        elif frame.world_share >= PROBE_SHARE:
             # No light portal, and the world lights the frame: an interior's openings, found by
             # the world's probe, stand in for them.
-            cones = self.world_probe.cones(
-                draws, snapshot.world, camera.position, origin, self.shaders, self.materials, self.textures, stats
+            camera = frame.camera
+            frame.cones = self.world_probe.cones(
+                frame.draws, snapshot.world, camera.position, frame.origin, self.caches, frame.stats
             )
-            stats.world_guided = bool(cones)
-        else:
-            cones = []
-        directions = int(settings.world_samples) if accumulate or cones else 0
-        if directions and not cones:
-            # The world's light costs what it adds: directions in proportion to its share.
-            directions = directions_per_sample(share, directions)
-        return directions, cones
+            frame.stats.world_guided = bool(frame.cones)
+        if frame.cones:
+            frame.directions = int(settings.world_samples)
 
-    def _plan_samples(self, frame, start, adaptive, deadline, navigating, stats):
-        """The rest of the plan stage: what may end the frame early, where its directions
-        start, which lights move between its samples and the sizes of their maps (the frame's
-        first plan; a later call of the same frame keeps the first call's), and the screen
-        rectangles each light can reach."""
-        film, settings, lights = self.film, frame.settings, frame.lights
+    def _plan_samples(self, frame):
+        """The rest of the plan stage: the film's targets (the techniques' among them), which
+        lights move between the frame's samples and the sizes of their maps (the frame's first
+        plan; a later call of the same frame keeps the first call's), the screen rectangles
+        each light can reach and when the frame's time runs out."""
+        film, settings, lights, request = self.film, frame.settings, frame.lights, frame.request
         width, height = frame.size
-        accumulate = frame.accumulate
-        # A sample with ambient occlusion (a frame's first) takes no directions of the world:
-        # the directions' sequence starts at the next one.
-        if frame.directions and accumulate and frame.world_ao(0) is not None:
-            frame.first_directions = 1
-        # A lit debug view's values are not colour: no noise estimate of theirs ends a frame.
-        frame.adaptive = adaptive if accumulate and not frame.debug.lit else None
-        frame.noise = frame.adaptive is not None and frame.adaptive.threshold > 0.0
-        # With depth of field, only where no blur reaches past the settle test's neighbourhood.
-        frame.settle = (
-            frame.motion is None  # a moving surface's pixels change with the sample's time
-            and frame.adaptive is not None
-            and frame.adaptive.settle > 0.0
-            and flag_reach(settings.filter_size, frame.lens_reach) is not None
-        )
-        if not accumulate:
+        stats = frame.stats
+        if not frame.accumulate:
             film.converged = 0  # a single sample shades every pixel, whatever an earlier frame left
             # While the view moves, maps keep the sizes planned NAVIGATION_REPLAN frames ago.
             nav_key = (width, height, tuple(lt.use_shadow for lt in lights))
             last = self._navigation
-            if navigating and last is not None and last[0] == nav_key and last[2] % NAVIGATION_REPLAN:
+            if request.navigating and last is not None and last[0] == nav_key and last[2] % NAVIGATION_REPLAN:
                 self.shadow_pass.use_sizes(last[1])
                 self._navigation = (nav_key, last[1], last[2] + 1)
             else:
-                self._navigation = (nav_key, None, 1) if navigating else None
+                self._navigation = (nav_key, None, 1) if request.navigating else None
         else:
+            targets = {}
+            for feature in frame.features:
+                targets.update(feature.film(frame))
             # The NOISE view shows the estimate even where no threshold uses it.
             film.begin(
                 frame.aux,
                 frame.emission,
-                fresh=start == 0,
+                fresh=request.samples[0] == 0,
                 adaptive=frame.noise or frame.debug.id == "NOISE",
-                settle=frame.settle,
-                world_ratio=frame.world_ratio,
                 gather_reach=sampling.gather_reach(settings.filter_size)
                 if sampling.gathers(settings.filter_size)
                 else 0,
+                **targets,
             )
-            # With map jitter every shadowed light changes from sample to sample (its maps'
-            # texel grid), so lights with an extent are sampled on it however small their
-            # penumbra.
-            frame.jitter = bool(settings.shadow_map_jitter)
-            # The frame's centred plan decides which lights move and the sizes of their maps;
-            # a later call of the same frame (the viewport's next refinement: nothing changed,
-            # or the frame would start afresh) keeps what the first call decided (a cache keyed
-            # by what decides it).
-            frame_key = (frame.sample_count, frame.jitter, tuple(lt.use_shadow for lt in lights))
-            # With motion blur every sample plans its maps from its own scene (``_sample_at``):
-            # the frame's centred plan says only which lights move.
-            cached = self._frame_plan is not None and self._frame_plan[0] == frame_key
-            if start > 0 and cached and frame.motion is None:
-                frame.moving, sizes = self._frame_plan[1:]
-                self.shadow_pass.use_sizes(sizes)
-            else:
-                first = self.shadow_pass.first_plan(frame.draws, lights, frame.camera, settings, film.size, True)
-                frame.moving = sampling.sampled_lights(lights, first, every=frame.jitter)
-                if frame.jitter:
-                    frame.moving |= {i for i in first.lights if i < len(lights)}
-                if frame.motion is None:
-                    self.shadow_pass.keep_sizes(first, settings, lights)
-                    self._frame_plan = (frame_key, frame.moving, self.shadow_pass.sizes)
+            self._moving_lights(frame)
         stats.lights_sampled = len(frame.moving)
         # Which part of the screen each light can reach: once a frame, padded by how far its
         # samples move it and by the camera's pixel offsets (light bins, lights out of view).
         if frame.motion is None:  # with motion blur each sample's own (``lights_in_view``)
             frame.rects = frame_light_rects(lights, frame.draws, frame.camera, width, height, frame.reach)
+        deadline = request.deadline
         if frame.adaptive is not None and frame.adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + frame.adaptive.time_limit
         frame.deadline = deadline
 
-    def _settle(self, frame, stats):
-        """The settle stage, before a frame's second sample (settle.py): the pilot (the centred
-        pixel with every light at its centre, whose maps the settle test reads), the settle
-        test's variant of the lit pass over its surfaces, then the film's settle pass. Settled
-        pixels take the pilot's value in place of the first sample's and take no more samples."""
-        centred = [
-            dataclasses.replace(lt, sampled=True, jittered=frame.jitter) if i in frame.moving else lt
-            for i, lt in enumerate(frame.lights)
-        ]
-        pilot = SampleSpec(pilot=True, ao=frame.world_ao(0))
-        centre = self._sample(frame, centred, frame.camera, stats, pilot)
-        with self._clock.stage("settle"):
-            test = SampleSpec(sample_count=frame.sample_count)
-            target = self.film.settle_framebuffer()
-            self._lit(frame, centre, FrameStats(), test, target)
-            stats.pixels_settled = settle_pixels(
-                self.film,
-                frame.settings,
-                frame.adaptive,
-                frame.sample_count,
-                frame.aux,
-                frame.emission,
-                frame.lens_reach,
-            )
+    def _moving_lights(self, frame):
+        """Which lights of a frame of several samples move between them, and their maps' sizes."""
+        lights, settings = frame.lights, frame.settings
+        # With map jitter every shadowed light changes from sample to sample (its maps'
+        # texel grid), so lights with an extent are sampled on it however small their penumbra.
+        frame.jitter = bool(settings.shadow_map_jitter)
+        # The frame's centred plan decides which lights move and the sizes of their maps; a
+        # later call of the same frame (the viewport's next refinement: nothing changed, or the
+        # frame would start afresh) keeps what the first call decided (a cache keyed by what
+        # decides it). With motion blur every sample plans its maps from its own scene
+        # (``features/motion_blur.py``): the frame's centred plan says only which lights move.
+        frame_key = (frame.sample_count, frame.jitter, tuple(lt.use_shadow for lt in lights))
+        cached = self._frame_plan is not None and self._frame_plan[0] == frame_key
+        if frame.request.samples[0] > 0 and cached and frame.motion is None:
+            frame.moving, sizes = self._frame_plan[1:]
+            self.shadow_pass.use_sizes(sizes)
+            return
+        first = self.shadow_pass.first_plan(frame.draws, lights, frame.camera, settings, self.film.size, True)
+        frame.moving = sampling.sampled_lights(lights, first, every=frame.jitter)
+        if frame.jitter:
+            frame.moving |= {i for i in first.lights if i < len(lights)}
+        if frame.motion is None:
+            self.shadow_pass.keep_sizes(first, settings, lights)
+            self._frame_plan = (frame_key, frame.moving, self.shadow_pass.sizes)
 
-    def _sample_at(self, frame, s, stats):
-        """Sample ``s`` of the frame: its pixel offset, its lights (moving ones at their point
-        for ``s``, the world's directions), the sample itself (``_sample``), then its weight
-        added to the film and, every few samples, the noise check (``stats.stopped``)."""
-        film, settings, camera = self.film, frame.settings, frame.camera
-        width, height = frame.size
+    def sample(self, frame, s, pilot=False, lights=None):
+        """Sample ``s`` of ``frame`` as its stages take it (``Sample``): its pixel offset, its
+        lights (moving ones at their point for ``s``, the world's directions), and what the
+        frame's techniques change of it (``Feature.prepare``). ``pilot``: the frame's pilot
+        sample (settling) instead, with ``lights`` (every moving light at its centre), through
+        the pixel's and the lens's centres, without the world's directions."""
         accumulate, count = frame.accumulate, frame.sample_count
-        sample_start = self._clock.cpu_seconds
-        draws, frame_lights = frame.draws, frame.lights
-        with self._clock.stage("sample set-up"):
-            if frame.motion is not None:
-                # Motion blur: the sample's time in the shutter moves objects, lights and camera.
-                u = motion_mod.sample_time(s, count, frame.motion.curve)
-                moved = motion_mod.instances_at(frame.snapshot.instances, frame.motion, u)
-                snapshot = dataclasses.replace(frame.snapshot, instances=moved)
-                draws = draw_list(snapshot, self.batches, stats, frame.origin, camera, settings, frame.size)
-                frame_lights = motion_mod.lights_at(frame.lights, frame.motion, u)
-                camera = motion_mod.camera_at(camera, frame.motion, u)
-                self.shadow_pass.begin_frame(frame.reach)  # this sample's maps from its own scene
-            dx, dy, weight = sampling.pixel_offset(s, settings.filter_size) if accumulate else (0.0, 0.0, 1.0)
-            # Depth of field: the sample looks from its point of the lens (lens.py).
-            view_camera = lens_camera(camera, lens_offset(s, camera.lens)) if accumulate and camera.lens else camera
-            if dx or dy:
-                jittered = sampling.jittered_projection(view_camera.projection, dx, dy, width, height)
-                view_camera = dataclasses.replace(view_camera, projection=jittered)
-            lights = [
-                sampling.light_at_sample(lt, i, s, count, frame.jitter, progressive=frame.noise)
-                if i in frame.moving
-                else lt
-                for i, lt in enumerate(frame_lights)
-            ]
-            if frame.directions and s >= frame.first_directions:
-                index = (s - frame.first_directions) * frame.directions
-                lights += world_lights(frame.snapshot.world, index, frame.directions, cones=frame.cones)
-                stats.world_directions += frame.directions
-        spec = SampleSpec(
-            alpha_offset=(s + 0.5) / count if accumulate else 0.5,
-            sample_count=count if accumulate else 1,
-            ao=frame.world_ao(s),
+        sample = Sample(
             index=s,
+            alpha_offset=(s + 0.5) / count if accumulate and not pilot else 0.5,
+            sample_count=count if accumulate and not pilot else 1,
+            pilot=pilot,
+            lights=frame.lights if lights is None else lights,
+            camera=frame.camera,
+            view_camera=frame.camera,
+            draws=frame.draws,
+            stats=frame.stats,
+            origin=frame.origin,
         )
-        drawn = self._sample(frame, lights, view_camera, stats, spec, draws, camera)
-        with self._clock.stage("accumulate"):
+        for feature in frame.features:
+            feature.prepare(frame, sample)
+        if pilot:
+            return sample
+        stats = frame.stats
+        if accumulate:
+            dx, dy, sample.weight = sampling.pixel_offset(s, frame.settings.filter_size)
+            sample.offset = (dx, dy)
+            if dx or dy:
+                jittered = sampling.jittered_projection(sample.view_camera.projection, dx, dy, *frame.size)
+                sample.view_camera = dataclasses.replace(sample.view_camera, projection=jittered)
+        sample.lights = [
+            sampling.light_at_sample(lt, i, s, count, frame.jitter, progressive=frame.noise)
+            if i in frame.moving
+            else lt
+            for i, lt in enumerate(sample.lights)
+        ]
+        if frame.directions and s >= frame.first_directions:
+            index = (s - frame.first_directions) * frame.directions
+            sample.lights += world_lights(frame.snapshot.world, index, frame.directions, cones=frame.cones)
+            stats.world_directions += frame.directions
+        return sample
+
+    def _sample_at(self, frame, s):
+        """Sample ``s`` of the frame (``sample``), drawn (``draw_sample``), then its weight
+        added to the film and, every few samples, the noise check (``stats.stopped``)."""
+        film, settings, stats, clock = self.film, frame.settings, frame.stats, frame.clock
+        accumulate, count = frame.accumulate, frame.sample_count
+        sample_start = clock.cpu_seconds
+        with clock.stage("sample set-up"):
+            sample = self.sample(frame, s)
+        self.draw_sample(frame, sample)
+        with clock.stage("accumulate"):
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
-                gather = sampling.gather_uniforms(dx, dy, settings.filter_size)  # the gathering film
-                film.accumulate(weight, frame.aux, frame.emission, s, gather)
+                gather = sampling.gather_uniforms(*sample.offset, settings.filter_size)  # the gathering film
+                film.accumulate(sample.weight, frame.aux, frame.emission, s, gather)
             if frame.aux and accumulate and s == 0:  # the centred sample's depth and normal
                 film.keep_centre()
             stats.samples += 1
@@ -558,18 +488,88 @@ class Renderer:
             adaptive = frame.adaptive
             last = s + 1 == count
             if frame.noise and not last and adaptive.checks_at(s + 1):
-                if film.check(adaptive.threshold) >= width * height:
+                if film.check(adaptive.threshold) >= frame.size[0] * frame.size[1]:
                     stats.stopped = "converged"
-        stats.sample_cpu_seconds.append(self._clock.cpu_seconds - sample_start)
-        return drawn
+        stats.sample_cpu_seconds.append(clock.cpu_seconds - sample_start)
+        return sample
 
-    def _resolve(self, frame, drawn, stats):
-        """The resolve stage: the film's accumulation divided by its weights; the batches the
-        frame did not use let go; a navigation frame that planned afresh keeps its map sizes."""
-        film = self.film
+    def draw_sample(self, frame, sample):
+        """Draw ``sample`` (a ``Sample``) of ``frame``: its shadow maps (planned from its
+        unjittered camera, so a light that does not move between samples keeps its map), the
+        techniques' work before the lit pass (``Feature.before_lit``: the world occlusion's
+        depth prepass through the raster camera), then the lit pass seen through its view
+        camera. Fills in and returns ``sample``."""
+        film, clock = self.film, frame.clock
+        width, height = film.size
+        view_camera, camera = sample.view_camera, sample.camera
+        lights, rects = lights_in_view(
+            sample.lights, sample.draws, view_camera, width, height, sample.stats, frame.rects
+        )
+        sample.lights = lights
+        clock.begin("shadow pass")
+        sample.plan = self.shadow_pass.draw(frame, sample)
+        clock.end()
+        sample.atlas = self.shadows if sample.plan is not None and sample.plan.tiles else None
+        depth_range = self.shadow_pass.depth_range
+        if depth_range is UNSET:  # no shadow plan this frame: the quick, wider bound
+            draws = sample.draws
+            depth_range = lightspace.box_depth_range(camera.projection, camera.view, corners_of(draws), camera.is_ortho)
+        # The lit pass rasterises with the depth buffer spread over what the camera sees.
+        fitted = lightspace.depth_fitted(view_camera.projection, view_camera.is_ortho, depth_range)
+        raster_camera = (
+            view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
+        )
+        sample.cameras = (raster_camera, view_camera, rects)
+        for feature in frame.features:
+            feature.before_lit(frame, sample)
+        with clock.stage("lit pass"):
+            self.lit(frame, sample)
+        sample.stats.binned = sample.data.bins is not None
+        return sample
+
+    def lit(self, frame, sample, target=None):
+        """The lit pass of ``sample`` (its lights, the maps of its plan, its cameras and light
+        rectangles), with the frame's techniques' parts (``Feature.lit``); ``target``: the
+        settle test's framebuffer (``sample.settle_test``, ``features/settling.py``). Fills in
+        ``sample.data`` (the frame data it drew with)."""
+        snapshot, settings = frame.snapshot, frame.settings
+        lights, plan, atlas = sample.lights, sample.plan, sample.atlas
+        raster_camera, view_camera, rects = sample.cameras
+        inputs = LitInputs(
+            atlas=AtlasShape(atlas.size, atlas.columns, atlas.depth_format) if atlas else AtlasShape(),
+            aux_outputs=frame.aux and target is None,
+            rects=rects,
+            size=self.film.size,
+            alpha_offset=sample.alpha_offset,
+            origin=frame.origin,
+            sample_count=sample.sample_count,
+            sample_index=sample.index,
+            world_sampled=frame.world_sampled,
+            world_sh=frame.world_sh or not any(lt.world for lt in lights),
+            parts=tuple(feature.lit(frame, sample) for feature in frame.features),
+        )
+        world = snapshot.world if snapshot.world is not None else snapshot.world_color
+        sample.data = build_frame_data(lights, raster_camera, world, settings, plan, inputs)
+        sample.seen = [d for d in sample.draws if d.instance.camera]
+        sample.masks = (
+            light_masks(sample.seen, lights, sample.data.order) if sample.data.variant.light_linking else None
+        )
+        if target is not None:
+            self.lit_pass.draw_settle_test(sample, target)
+        else:
+            self.lit_pass.draw(frame, sample)
+        return sample.data
+
+    def _resolve(self, frame, drawn):
+        """The resolve stage: the film's accumulation divided by its weights, the techniques'
+        resolves; the batches the frame did not use let go; a navigation frame that planned
+        afresh keeps its map sizes."""
+        film, stats = self.film, frame.stats
         stats.pixels_converged = film.converged if frame.accumulate else 0
         if frame.accumulate and stats.samples:
             film.resolve(frame.aux, frame.emission)
+        for feature in frame.features:
+            feature.resolve(frame)
         self.batches.keep({(key, geo.serial) for key, geo in frame.snapshot.geometry.items()})
         nav = self._navigation
         plan = drawn.plan if drawn is not None else None
@@ -577,10 +577,10 @@ class Renderer:
             sizes = frame_sizes(plan, max(1, int(frame.settings.shadow_map_size)))
             self._navigation = (nav[0], sizes, nav[2])
 
-    def _post(self, frame, drawn, stats):
+    def _post(self, frame, drawn):
         """The post stage: the post stack on the resolved image, or a debug view instead of
-        both; the frame's memory in ``stats``. Returns (colour texture, debug image or None)."""
-        film, settings = self.film, frame.settings
+        both; the frame's memory in its stats. Returns (colour texture, debug image or None)."""
+        film, settings, stats = self.film, frame.settings, frame.stats
         debug_image = None
         if frame.debug.id != "NONE":  # the view instead of the image (and instead of the post stack)
             occluded = stats.ao_prepasses > 0
@@ -596,13 +596,13 @@ class Renderer:
             + stats.shadow_bytes
             + film.post_ctx.memory_bytes
             + self.textures.bytes
-            + (self.world_ao.memory_bytes if stats.ao_prepasses else 0)
+            + sum(feature.memory_bytes(frame) for feature in frame.features)
         )
         return color, debug_image
 
-    def _output(self, frame, color, debug_image, stats):
+    def _output(self, frame, color, debug_image):
         """The frame's ``FrameOutput``: its image and, with ``aux``, its passes."""
-        film = self.film
+        film, stats = self.film, frame.stats
         width, height = frame.size
         if not frame.aux:
             out = FrameOutput(color, None, None, stats, width, height, lit=film.color)
@@ -615,110 +615,9 @@ class Renderer:
             out.depth_data, out.normal_data = film.centre
         return out
 
-    def _sample(self, frame, lights, view_camera, stats, spec, draws=None, camera=None):
-        """One sample (``spec``, a ``SampleSpec``) of ``frame`` with ``lights``: shadow maps
-        (planned from the unjittered ``camera``, the frame's unless given, so a light that does
-        not move between samples keeps its map), then the lit pass seen through ``view_camera``,
-        of ``draws`` (the frame's unless given: a motion-blurred sample's own). With ``spec.ao``
-        the camera depth prepass of the world's ambient occlusion is drawn first through the lit
-        pass's raster camera (``world/occlusion.py``). Returns what it drew (``SampleResult``)."""
-        film = self.film
-        draws = frame.draws if draws is None else draws
-        camera = frame.camera if camera is None else camera
-        width, height = film.size
-        lights, rects = lights_in_view(lights, draws, view_camera, width, height, stats, frame.rects)
-        self._clock.begin("shadow pass")
-        plan = self.shadow_pass.draw(
-            draws,
-            lights,
-            camera,
-            frame.settings,
-            film.size,
-            stats,
-            self.shaders,
-            self.materials,
-            self.textures,
-            self.batches,
-            frame.origin,
-            spec.alpha_offset,
-        )
-        self._clock.end()
-        depth_range = self.shadow_pass.depth_range
-        if depth_range is UNSET:  # no shadow plan this frame: the quick, wider bound
-            depth_range = lightspace.box_depth_range(camera.projection, camera.view, corners_of(draws), camera.is_ortho)
-        # The lit pass rasterises with the depth buffer spread over what the camera sees.
-        fitted = lightspace.depth_fitted(view_camera.projection, view_camera.is_ortho, depth_range)
-        raster_camera = (
-            view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)
-        )
-        result = SampleResult(lights, plan, (raster_camera, view_camera, rects), draws=draws)
-        if spec.ao is not None:
-            with self._clock.stage("world ao"):
-                self.world_ao.draw(
-                    draws,
-                    raster_camera,
-                    film.size,
-                    frame.origin,
-                    self.shaders,
-                    self.materials,
-                    self.textures,
-                    stats,
-                    spec.alpha_offset,
-                )
-        with self._clock.stage("lit pass"):
-            result.data = self._lit(frame, result, stats, spec)
-        stats.binned = result.data.bins is not None
-        return result
-
-    def _lit(self, frame, sample, stats, spec, target=None):
-        """The lit pass of ``sample`` (a ``SampleResult``: its lights, the maps of its plan, its
-        cameras and light rectangles), for sample ``spec`` (``SampleSpec``; its ``ao`` over the
-        prepass just drawn); ``target``: the settle test's framebuffer (the ``SETTLE_TEST``
-        variant drawn into it, ``settle.py``; never occluded). Returns the frame data it drew
-        with."""
-        ao = spec.ao if target is None else None
-        film, snapshot, settings = self.film, frame.snapshot, frame.settings
-        aux = frame.aux and target is None
-        lights, plan = sample.lights, sample.plan
-        raster_camera, view_camera, rects = sample.cameras
-        atlas = self.shadows if plan is not None and plan.tiles else None
-        data = build_frame_data(
-            lights,
-            raster_camera,
-            snapshot.world if snapshot.world is not None else snapshot.world_color,
-            settings,
-            plan,
-            tile_size=atlas.size if atlas else 1,
-            atlas_columns=atlas.columns if atlas else 1,
-            depth_format=atlas.depth_format if atlas else "FLOAT32",
-            aux_outputs=aux,
-            rects=rects,
-            size=film.size,
-            alpha_offset=spec.alpha_offset,
-            origin=frame.origin,
-            sample_count=spec.sample_count,
-            settle=target is not None,
-            pilot=spec.pilot,
-            world_sampled=frame.world_sampled,
-            world_sh=frame.world_sh or not any(lt.world for lt in lights),
-            world_ao=ao,
-            sample_index=spec.index,
-            rsm=atlas is not None and atlas.rsm,
-            world_ratio=frame.world_ratio,
-        )
-        seen = [d for d in (sample.draws if sample.draws is not None else frame.draws) if d.instance.camera]
-        masks = light_masks(seen, lights, data.order) if data.defines.get("LIGHT_LINKING") else None
-        world = (snapshot.world, snapshot.world_color)
-        if target is not None:
-            self.lit_pass.draw_settle_test(film, seen, view_camera, data, atlas, stats, frame.origin, masks, target)
-        else:
-            passes = (settings, aux, frame.emission, stats, frame.origin, masks)
-            self.lit_pass.draw(film, seen, view_camera, data, atlas, world, *passes, ao=self.world_ao if ao else None)
-        return data
-
     def _debug_view(self, view, accumulate, settings, last, occluded=False):
         """The debug view ``view`` of the frame just rendered (``debug_view.DebugImage``);
-        ``last``: its last sample (``SampleResult``: the SHADOW_MAPS view's plan and lights);
+        ``last``: its last sample (``Sample``: the SHADOW_MAPS view's plan and lights);
         ``occluded``: its samples ran the world's ambient occlusion (WORLD_AO)."""
         from .film import texture_array
 
@@ -748,7 +647,7 @@ class Renderer:
 
     def _uploaded(self):
         """Bytes this renderer's stages have sent to the GPU since it was made."""
-        return self.lit_pass.uploaded + self.shadows.uploaded + self.materials.uploaded + self.batches.uploaded
+        return self.lit_pass.uploaded + self.shadows.uploaded + self.caches.uploaded
 
     def wait_gpu(self):
         """Return once the GPU has finished what was asked of it (a one-pixel read-back of the
@@ -773,5 +672,6 @@ class Renderer:
             return
         self.film.release()
         self.shadows.free()
-        self.world_ao.release()
+        for feature in self.features:
+            feature.release()
         self.world_probe.release()

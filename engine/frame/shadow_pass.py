@@ -13,7 +13,6 @@ from ..shadows import light_bins, lightspace
 from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, frame_tiles, plan_shadows
 from . import sampling
 from .draw_list import corners_of
-from .frame_data import indirect_samples
 from .programs import RSM_TEXEL_BYTES, image_premultiplied_bits
 from .shadow_maps import Caster, ShadowAtlas, TreeCutout
 
@@ -32,11 +31,14 @@ class ShadowPass:
         self._derived = None  # {light index: (mode, tiles, position)}: what later samples shear or move
         self._reaches = None  # {light index: reach} the frame's first plan grew the scene by
         self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
+        self.reflective = False  # the maps hold what each light sees too (features/bounce.py)
 
-    def begin_frame(self, reach=0.0):
+    def begin_frame(self, reach=0.0, reflective=False):
         """Forget the last frame's camera-dependent bounds, casters and map sizes. ``reach``:
         how many pixels beyond the image the frame's samples look (the pixel filter's reach in
-        a multi-sample frame; 0 for one sample), so maps are planned for all of them."""
+        a multi-sample frame; 0 for one sample), so maps are planned for all of them;
+        ``reflective``: the maps are reflective shadow maps (``FramePlan.reflective``)."""
+        self.reflective = bool(reflective)
         self.depth_range = UNSET
         self._receivers = None
         self._sun_parts = None
@@ -85,15 +87,17 @@ class ShadowPass:
             }
             reaches = {i: r for i, r in reaches.items() if math.isfinite(r)}
         self._reaches = reaches
-        return self.plan(draws, lights, camera, settings, size, cones=cones, reaches=reaches)
+        return self.plan(draws, lights, camera, settings, size, spread=(cones, reaches))
 
-    def plan(
-        self, draws, lights, camera, settings, size, map_size=None, sizes=None, cones=None, derived=None, reaches=None
-    ):
+    def plan(self, draws, lights, camera, settings, size, map_size=None, known=None, spread=None):
         """The shadow plan of ``lights`` (numpy only, nothing drawn) for a frame of ``size``
-        (width, height), with maps of ``map_size`` (default: the setting). With the diffuse
-        bounce (``indirect_samples``) maps hold every visible surface the light reaches, not
-        only those a caster can shadow (``plan_shadows(reflective=True)``)."""
+        (width, height), with maps of ``map_size`` (default: the setting). ``known``: (map
+        sizes, derived maps) the frame's first plan kept (``sizes``); ``spread``: (sun cones,
+        reaches) a first plan is fitted over (``first_plan``). With reflective maps (the
+        bounce, ``begin_frame``) maps hold every visible surface the light reaches, not only
+        those a caster can shadow (``plan_shadows(reflective=True)``)."""
+        sizes, derived = known if known is not None else (None, None)
+        cones, reaches = spread if spread is not None else (None, None)
         corners = corners_of(draws)
         if self.reach > 0.0 and size is not None:
             projection, size = sampling.widened_projection(camera.projection, self.reach, *size)
@@ -122,21 +126,22 @@ class ShadowPass:
             density=_density(camera, settings, size),
             known_sizes=sizes,
             world_map_size=getattr(settings, "world_map_size", None),
-            reflective=indirect_samples(settings) > 0,
+            reflective=self.reflective,
             sun_parts=self._sun_parts,
             cones=cones,
             derived=derived,
             reaches=reaches,
         )
 
-    def draw(
-        self, draws, lights, camera, settings, size, stats, shaders, materials, textures, batches, origin, alpha_offset
-    ):
-        """Plan the maps this frame needs (numpy) and draw the ones whose content changed.
-        ``materials`` (``MaterialBlocks``) and ``textures`` serve alpha cutouts; ``batches``
-        (``Batches``) the casters' levels of detail in each map. Returns the plan."""
+    def draw(self, frame, sample):
+        """Plan the maps ``sample`` (``renderer.Sample``: its draws and lights, planned from its
+        unjittered camera) of ``frame`` (``renderer.FramePlan``) needs (numpy) and draw the
+        ones whose content changed. The frame's ``GpuCaches`` serve alpha cutouts (material
+        blocks, images) and the casters' levels of detail in each map (batches). Returns the plan."""
+        draws, lights, camera, stats = sample.draws, sample.lights, sample.camera, sample.stats
+        settings, size, caches = frame.settings, frame.size, frame.caches
         map_size = max(1, int(settings.shadow_map_size))
-        plan = self.plan(draws, lights, camera, settings, size, map_size, self._sizes, derived=self._derived)
+        plan = self.plan(draws, lights, camera, settings, size, map_size, (self._sizes, self._derived))
         if not plan.tiles:
             return plan
         columns, _rows = self.atlas.grid(len(plan.tiles))
@@ -149,7 +154,7 @@ class ShadowPass:
             map_size = clamped
             self._sizes = self._derived = None  # planned afresh at the clamped size
             plan = self.plan(draws, lights, camera, settings, size, map_size)
-        rsm = indirect_samples(settings) > 0
+        rsm = self.reflective
         if rsm:  # the bounce's reflective targets, budgeted before they are allocated
             fitted = reflective_map_size(len(plan.tiles), max(t.size for t in plan.tiles))
             if fitted is not None:
@@ -187,12 +192,14 @@ class ShadowPass:
                 "rendered without the bounce"
             )
         if self._casters[0] is not draws or self._casters[2] != rsm:  # the frame's, not the sample's
-            self._casters = (draws, [caster(d, materials, textures, rsm) for d in draws], rsm)
+            self._casters = (draws, [caster(d, caches.materials, caches.textures, rsm) for d in draws], rsm)
         casters = self._casters[1]
         # Reflective maps draw each caster per material (its albedo): whole, not simplified.
         detail = 0.0 if rsm else float(getattr(settings, "shadow_caster_detail", 0.0))
-        levels = map_levels(plan, draws, casters, batches, detail)
-        self.atlas.render(plan, casters, shaders, settings.shadow_cull_front, stats, alpha_offset, origin, levels)
+        levels = map_levels(plan, draws, casters, caches.batches, detail)
+        self.atlas.render(
+            plan, casters, caches.shaders, settings.shadow_cull_front, stats, sample.alpha_offset, frame.origin, levels
+        )
         return plan
 
 

@@ -120,3 +120,4 @@ class FrameStats:
     gpu_seconds: dict = field(default_factory=dict)  # stage -> seconds waiting on the GPU (with a fence only)
     sample_cpu_seconds: list = field(default_factory=list)  # CPU seconds of each sample (its stages)
     messages: list = field(default_factory=list)  # what the user must be told about this frame
+    techniques: list = field(default_factory=list)  # the frame's techniques (``features.Feature.name``)

@@ -15,7 +15,7 @@ load_penumbra()
 from penumbra.engine import settings  # noqa: E402
 from penumbra.engine.enums import LIGHT_TYPE, SHADOW_MODE  # noqa: E402
 from penumbra.engine.frame import programs, shadow_programs  # noqa: E402
-from penumbra.engine.frame.frame_data import build_frame_data  # noqa: E402
+from penumbra.engine.frame.frame_data import AtlasShape, LitInputs, build_frame_data  # noqa: E402
 from penumbra.engine.scene.extract import Camera, Light  # noqa: E402
 from penumbra.engine.shadows import kernels, lightspace  # noqa: E402
 from penumbra.engine.shadows import planning as shadows  # noqa: E402
@@ -82,7 +82,7 @@ def test_frame_data_carries_every_light_its_tiles_and_the_settings():
     ]
     plan = _plan(lights)
     st = _settings(shadow_bias=0.25, pcf_spacing=1.5)
-    data = build_frame_data(lights, _camera(), (0.1, 0.2, 0.3), st, plan, tile_size=256, atlas_columns=3)
+    data = build_frame_data(lights, _camera(), (0.1, 0.2, 0.3), st, plan, LitInputs(atlas=AtlasShape(256, 3)))
     F, L = programs.FRAME_STRUCT, programs.LIGHT_STRUCT
     assert F.unpack(data.frame, 0, "light_count") == 4
     assert F.unpack(data.frame, 0, "tile_size") == 256 and F.unpack(data.frame, 0, "atlas_columns") == 3

@@ -157,11 +157,13 @@ class WorldAO:
             self._triangle.draw(shader)
         stats.ao_texels += width * height
 
-    def draw(self, draws, camera, size, origin, shaders, materials, textures, stats, alpha_offset=0.5):
+    def draw(self, draws, camera, size, origin, caches, stats, alpha_offset=0.5):
         """The view depth of ``draws`` (those the camera sees) through the raster ``camera``
-        into ``texture`` at the film's ``size``; ``alpha_offset``: the sample's, as the lit
-        pass hashes dithered surfaces with it."""
+        into ``texture`` at the film's ``size``; ``caches``: the renderer's ``GpuCaches``;
+        ``alpha_offset``: the sample's, as the lit pass hashes dithered surfaces with it."""
         import gpu
+
+        shaders, materials, textures = caches.shaders, caches.materials, caches.textures
 
         self.ensure(size)
         width, height = size

@@ -191,14 +191,15 @@ class WorldProbe:
         self._last = None  # (key, cones) of the last probe
         self.drawn = 0  # probes drawn since creation (tests read it)
 
-    def cones(self, draws, world, eye, origin, shaders, materials, textures, stats):
+    def cones(self, draws, world, eye, origin, caches, stats):
         """The frame's ``cones`` (``FramePlan.cones``, as light portals give them): [the guide of
         the openings (``opening_guide``)] of the interior ``draws`` (those the camera sees)
         stand in, or [] outdoors, in a closed box or with nothing drawn. ``world``: the
         snapshot's ``materials.World`` (its radiance weighs the directions); ``eye``: the
         camera's position, where the first probe looks from (the middle of the visible box
-        where it is not finite); the second looks from that middle. Each probe's six faces are
-        drawn and read back one after the other (a sync each)."""
+        where it is not finite); the second looks from that middle; ``caches``: the renderer's
+        ``GpuCaches``. Each probe's six faces are drawn and read back one after the other (a
+        sync each)."""
         from ..draw_list import corners_of
         from .directions import distribution
 
@@ -234,7 +235,7 @@ class WorldProbe:
         for point in (
             (centre, middle) if np.linalg.norm(middle - centre) > 1e-6 * (1.0 + np.linalg.norm(hi - lo)) else (centre,)
         ):
-            probes.append(self._probe(seen, point, lo, hi, dist, origin, shaders, materials, textures, scratch))
+            probes.append(self._probe(seen, point, lo, hi, dist, origin, caches, scratch))
         self.depth.release()
         self.drawn += 1
         stats.probe_draws += scratch.ao_draws
@@ -244,7 +245,7 @@ class WorldProbe:
         self._last = (key, result)
         return result
 
-    def _probe(self, seen, centre, lo, hi, dist, origin, shaders, materials, textures, stats):
+    def _probe(self, seen, centre, lo, hi, dist, origin, caches, stats):
         """One probe at world point ``centre``: (directions, weights, depths, open, centre) of
         its six faces' texels (``opening_guide``'s probes)."""
         from ..film import texture_array
@@ -255,7 +256,7 @@ class WorldProbe:
         size = (PROBE_TEXELS, PROBE_TEXELS)
         for forward in FACES:
             camera = face_camera(centre, forward, radius)
-            self.depth.draw(seen, camera, size, origin, shaders, materials, textures, stats)
+            self.depth.draw(seen, camera, size, origin, caches, stats)
             d, solid = texel_directions(camera.rotation)
             # The view depth along the face's axis, as the distance along each texel's direction.
             depth = texture_array(self.depth.texture, 1)[..., 0] / np.maximum(d @ forward, 1e-6)

@@ -1,0 +1,74 @@
+"""The hooks a technique of the frame implements (``Feature``) and its part of a sample's lit
+pass (``LitPart``); the registry is ``features/__init__.py``."""
+
+import dataclasses
+
+
+@dataclasses.dataclass(frozen=True)
+class LitPart:
+    """A technique's part of one sample's lit pass: ``variant``, fields of the lit program's
+    ``programs.LitVariant`` (the program's defines come from it); ``rows``, fields of the frame
+    block (``programs.FRAME_STRUCT``) this technique sets; ``samplers``, {sampler name:
+    texture} the lit program reads (bound with the frame's blocks); ``begin``: GPU work over
+    the sample's frame block before the lit pass's draws (``begin(frame_block, stats)``), or None."""
+
+    variant: dict = dataclasses.field(default_factory=dict)
+    rows: dict = dataclasses.field(default_factory=dict)
+    samplers: dict = dataclasses.field(default_factory=dict)
+    begin: object = None
+
+
+NO_PART = LitPart()
+
+
+class Feature:
+    """One technique of the frame. A renderer makes one of each registered technique
+    (``Feature(renderer)``: the renderer's caches and pool, what GPU state it keeps between
+    frames), and for each frame calls, where ``wanted(frame)`` said yes:
+
+    * ``plan(frame)``: what it adds to the frame's plan (``renderer.FramePlan``), after the
+      base plan (draw list, lights, the world's light) and before the samples;
+    * ``film(frame)``: its film targets, as keywords of ``Film.begin`` (frames of several samples);
+    * ``before_sample(frame, s)``: a stage of its own before sample ``s`` (settling's test);
+    * ``prepare(frame, sample)``: its change to the sample's view, scene or lights (``Sample``);
+    * ``before_lit(frame, sample)``: GPU work the sample's lit pass reads (a depth prepass);
+    * ``lit(frame, sample)``: its ``LitPart`` of the sample's lit pass;
+    * ``resolve(frame)``: after the last sample; ``memory_bytes(frame)``: what it holds.
+
+    Every hook does nothing by default, so a technique implements only those it needs."""
+
+    name = ""
+
+    def __init__(self, renderer):
+        self.renderer = renderer
+
+    def wanted(self, frame):
+        """Whether ``frame`` needs this technique (its other hooks run only then)."""
+        return False
+
+    def plan(self, frame):
+        pass
+
+    def film(self, frame):
+        return {}
+
+    def before_sample(self, frame, s):
+        pass
+
+    def prepare(self, frame, sample):
+        pass
+
+    def before_lit(self, frame, sample):
+        pass
+
+    def lit(self, frame, sample):
+        return NO_PART
+
+    def resolve(self, frame):
+        pass
+
+    def memory_bytes(self, frame):
+        return 0
+
+    def release(self):
+        pass

@@ -1,0 +1,47 @@
+"""Motion blur (Render Properties > Motion Blur; ``motion.py``): each sample of a frame of
+several is drawn at its own time in the shutter, its objects, lights and camera where they are
+then, and plans its maps from its own scene.
+
+A one-sample frame is drawn at the frame's time, and says so. Off (not registered), every
+sample is drawn at the frame's time."""
+
+import dataclasses
+
+from .. import motion as motion_mod
+from ..draw_list import draw_list
+from .base import Feature
+
+
+class MotionBlur(Feature):
+    name = "motion_blur"
+
+    def wanted(self, frame):
+        motion = frame.request.motion
+        if motion is None or not motion.moves:
+            return False
+        if not frame.accumulate:
+            frame.stats.messages.append(
+                "Penumbra: motion blur needs 2 or more samples: one sample is drawn at the frame's time"
+            )
+            return False
+        return True
+
+    def plan(self, frame):
+        frame.motion = frame.request.motion
+
+    def prepare(self, frame, sample):
+        """The sample's time in the shutter moves objects, lights and camera."""
+        if sample.pilot:
+            return
+        motion = frame.motion
+        u = motion_mod.sample_time(sample.index, frame.sample_count, motion.curve)
+        snapshot = dataclasses.replace(
+            frame.snapshot, instances=motion_mod.instances_at(frame.snapshot.instances, motion, u)
+        )
+        renderer = self.renderer
+        sample.draws = draw_list(
+            snapshot, renderer.caches.batches, frame.stats, frame.origin, sample.camera, frame.settings, frame.size
+        )
+        sample.lights = motion_mod.lights_at(sample.lights, motion, u)
+        sample.camera = sample.view_camera = motion_mod.camera_at(sample.camera, motion, u)
+        renderer.shadow_pass.begin_frame(frame.reach, frame.reflective)  # this sample's maps from its own scene
