@@ -72,3 +72,12 @@ class Feature:
 
     def release(self):
         pass
+
+
+def across_samples(frame, what, instead):
+    """Whether ``frame`` has several samples to spread ``what`` over; a one-sample frame is
+    drawn ``instead``, and its report says so."""
+    if frame.accumulate:
+        return True
+    frame.stats.messages.append(f"Penumbra: {what} needs 2 or more samples: one sample is drawn {instead}")
+    return False

@@ -9,21 +9,14 @@ sample looks through the lens's centre."""
 from ...shadows import lightspace
 from ..draw_list import corners_of
 from ..lens import lens_camera, lens_offset, lens_reach
-from .base import Feature
+from .base import Feature, across_samples
 
 
 class DepthOfField(Feature):
     name = "depth_of_field"
 
     def wanted(self, frame):
-        if frame.camera.lens is None:
-            return False
-        if not frame.accumulate:
-            frame.stats.messages.append(
-                "Penumbra: depth of field needs 2 or more samples: one sample is drawn through the lens's centre"
-            )
-            return False
-        return True
+        return frame.camera.lens is not None and across_samples(frame, "depth of field", "through the lens's centre")
 
     def plan(self, frame):
         """The lens's reach: its widest circle of confusion's radius over the depths of what is drawn."""

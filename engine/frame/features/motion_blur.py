@@ -9,7 +9,7 @@ import dataclasses
 
 from .. import motion as motion_mod
 from ..draw_list import draw_list
-from .base import Feature
+from .base import Feature, across_samples
 
 
 class MotionBlur(Feature):
@@ -17,14 +17,7 @@ class MotionBlur(Feature):
 
     def wanted(self, frame):
         motion = frame.request.motion
-        if motion is None or not motion.moves:
-            return False
-        if not frame.accumulate:
-            frame.stats.messages.append(
-                "Penumbra: motion blur needs 2 or more samples: one sample is drawn at the frame's time"
-            )
-            return False
-        return True
+        return motion is not None and motion.moves and across_samples(frame, "motion blur", "at the frame's time")
 
     def plan(self, frame):
         frame.motion = frame.request.motion
