@@ -8,6 +8,10 @@
  * the estimate instead (the NOISE debug view). With WORLD_RATIO both means take the world's
  * light through its ratio, so the noise of its directions counts. */
 
+#ifndef WORLD_RATIO /* on with the world ratio's part of the check (engine/frame/features/world_ratio.py) */
+#  define WORLD_RATIO 0
+#endif
+
 /* The error estimate of pixel q (0 for a pixel with no samples yet). */
 float pixel_error(ivec2 q)
 {

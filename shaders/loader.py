@@ -7,7 +7,7 @@ and are compiled the first time a frame needs them, then cached by (program, def
 """
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
 
@@ -130,6 +130,66 @@ class Program:
     depth_write: str = ""  # 'ANY' etc. when the fragment stage writes gl_FragDepth
     generated: str = ""  # fragment-stage GLSL written by Python (a compiled node tree), after the libs
     entry_libs: tuple = ()  # fragment-stage libraries after the generated code (what calls into it)
+
+
+# The fields a ``ProgramPart`` adds to: tuples a program concatenates, each entry once.
+_PART_LISTS = ("libs", "vertex_in", "varyings", "push_constants", "samplers", "uniform_blocks", "outputs", "entry_libs")
+
+
+@dataclass(frozen=True)
+class ProgramPart:
+    """A piece of a program a technique or a pass brings, as EEVEE's create-infos combine
+    through ``additional_info``: libraries, vertex inputs, varyings, push constants, samplers,
+    uniform blocks and outputs (each added after the program's, once), defines (a part's own
+    win over the program's), and ``fragment``: an entry stage that replaces the program's
+    (the settle test's, a debug view's). ``name`` becomes a suffix of the combined program's
+    name, so equal parts make one program and a program's name lists its parts.
+
+    Frozen and made of tuples: a part is a value, hashable, so a set of parts is a key."""
+
+    name: str
+    libs: tuple = ()
+    vertex_in: tuple = ()
+    varyings: tuple = ()
+    push_constants: tuple = ()
+    samplers: tuple = ()
+    uniform_blocks: tuple = ()
+    outputs: tuple = ()
+    defines: tuple = ()  # (name, value)
+    entry_libs: tuple = ()
+    fragment: str = ""
+    generated: str = ""  # GLSL written by Python (a compiled node tree's code)
+
+    def __post_init__(self):
+        if isinstance(self.defines, dict):
+            object.__setattr__(self, "defines", tuple(self.defines.items()))
+
+
+def with_parts(program, *parts):
+    """``program`` combined with ``parts``, in order (``ProgramPart``). A list field of a part
+    adds its entries that the program does not have yet; a define of a part replaces the
+    program's of that name; a part's ``fragment`` or ``generated`` replaces the program's."""
+    if not parts:
+        return program
+    changes = {f: list(getattr(program, f)) for f in _PART_LISTS}
+    defines = dict(program.defines)
+    fragment, generated, names = program.fragment, program.generated, [program.name]
+    for part in parts:
+        for f in _PART_LISTS:
+            changes[f] += [e for e in getattr(part, f) if e not in changes[f]]
+        defines.update(part.defines)
+        fragment = part.fragment or fragment
+        generated = part.generated or generated
+        if part.name:
+            names.append(part.name)
+    return replace(
+        program,
+        name="_".join(names),
+        fragment=fragment,
+        generated=generated,
+        defines=tuple(defines.items()),
+        **{f: tuple(v) for f, v in changes.items()},
+    )
 
 
 def _read(rel):

@@ -22,9 +22,6 @@ from .film_programs import (
     SETTLED_COPY,
     WEIGHTED_RESOLVE,
     WEIGHTED_RESOLVE_SHADOW,
-    WORLD_RATIO_COPY,
-    WORLD_RATIO_COPY_MASKED,
-    WORLD_RATIO_RESOLVE,
     convergence_program,
     gathering,
 )
@@ -70,15 +67,58 @@ class FrameOutput:
         return texture_array(self.shadow, 1)[..., 0]
 
 
-_WORLD_NAMES = ("world_diffuse", "world_specular", "world_sums")  # the world ratio's targets, in order
+class FilmPart:
+    """A technique's targets in the film (``features.Feature.film_part``): what it keeps per
+    sample and accumulates beside the colour, and how it takes part in each of the film's
+    steps. ``lit_targets``: how many colour targets the lit pass writes for it after the
+    pass's own (its ``ProgramPart``'s outputs; 0: none). Every hook does nothing by default.
+
+    The film calls, for the parts of the frame (``Film.begin``): ``framebuffer`` (the lit
+    pass's targets with its own), ``clear`` (before a sample's lit pass), ``begin`` (a fresh
+    frame), ``accumulate`` (each sample), ``settled`` (what settling copies), ``convergence``
+    (its share of the convergence check), ``resolve`` (after the last sample),
+    ``bytes_per_pixel``, and ``release`` whenever the film's targets go (a new size, the end
+    of a render)."""
+
+    name = ""
+    lit_targets = 0
+
+    def framebuffer(self, film, slots, blended=False):
+        raise NotImplementedError(f"{self.name}: no targets of its own in the lit pass")
+
+    def clear(self, film):
+        pass
+
+    def begin(self, film):
+        pass
+
+    def accumulate(self, film, weight, sample, mask, gather):
+        pass
+
+    def settled(self, film):
+        """(accumulation, this sample's target) pairs settling copies the pilot's value into."""
+        return ()
+
+    def convergence(self, film):
+        """(``ProgramPart`` of the convergence check, {sampler: texture}), or None."""
+        return None
+
+    def resolve(self, film):
+        pass
+
+    def bytes_per_pixel(self, film):
+        return 0
+
+    def release(self, film):
+        pass
 
 
-def _gathered(program, gather, reach):
-    """(``program``, or, when ``gather`` is given, its variant gathering ``reach`` pixels each way,)."""
-    return (gathering(program, reach),) if gather else (program,)
+def gathered(program, gather, reach):
+    """``program``, or, when ``gather`` is given, its variant gathering ``reach`` pixels each way."""
+    return gathering(program, reach) if gather else program
 
 
-def _clear_zero(texture):
+def clear_zero(texture):
     """``texture`` (RGBA or RG float) cleared to 0 in every channel."""
     texture.clear(format="FLOAT", value=(0.0, 0.0) if texture.format == "RG32F" else (0.0, 0.0, 0.0, 0.0))
 
@@ -118,10 +158,8 @@ class Film:
     target), the lit pass does not shade it (``mask_depth``) and ``resolve`` divides by each
     pixel's weight. Until then every step is the plain accumulation's, to the bit.
 
-    The world's light as a ratio (``begin(..., world_ratio=True)``, lit.frag.glsl WORLD_RATIO):
-    the lit pass also writes the SH light by lobe and the ratio's sums (``world_targets``);
-    each is accumulated with the colour's weights, the sums also every other sample for the
-    noise estimate, and ``resolve`` shadows the SH light in the colour by their ratio."""
+    A technique's targets (``FilmPart``, ``begin(..., parts=...)``: the world ratio's) take part
+    in each of these steps through the part's hooks; the film does not name them."""
 
     def __init__(self, shaders, pool=None):
         self.shaders = shaders
@@ -153,13 +191,11 @@ class Film:
         # for every pixel it shades; ``shaded_total`` adds them over the frame's samples.
         self.count_shaded = False
         self.shaded = self.fb_counted = self.shaded_total = self._shaded_total_fb = None
-        # The world ratio's targets (``world_targets``): per sample, accumulated, the sums'
-        # every-other-sample accumulation, and the lit pass's framebuffers that include them.
-        self.world_ratio = False
-        self.world = self._world_accum = None
-        self._world_half = None
-        self._world_accum_fb = None
-        self._world_fbs = {}
+        # The techniques' targets (``FilmPart``): the frame's, and every part the film has met
+        # (each gives its targets back with the film's).
+        self.parts = ()
+        self._known_parts = []
+        self._emission_fb = None
 
     # --- targets --------------------------------------------------------------------------
 
@@ -179,7 +215,7 @@ class Film:
             self.size = (width, height)
         if aux and self.fb is None:
             # The normal target carries the view depth in w (Blender's gpu module binds at most
-            # six colour targets: the world ratio's two need the room).
+            # six colour targets: a technique's targets need the room).
             self.shadow = new_texture(self.pool, (width, height), "R32F")
             self.normal = new_texture(self.pool, (width, height), "RGBA32F")
             self.depth = self.normal
@@ -199,58 +235,41 @@ class Film:
                 color_slots=(self.color, self.shadow, self.normal, self.emission),
             )
 
-    def world_targets(self):
-        """The world ratio's per-sample targets (the SH light diffuse and specular with
-        coverage, the sums N_d, D_d, N_s, D_s), made at this size on first use."""
-        if self.world is None:
-            self.world = [new_texture(self.pool, self.size, "RGBA32F") for _ in range(3)]
-        return self.world
+    @property
+    def lit_part(self):
+        """The frame's part whose targets the lit pass writes beside its own (at most one:
+        Blender's gpu module binds six colour targets), or None."""
+        return next((p for p in self.parts if p.lit_targets), None)
 
-    def lit_framebuffer(self, aux, emission, counted, world_ratio):
+    def lit_framebuffer(self, aux, emission, counted, part=None):
         """The lit pass's framebuffer: colour and z-buffer, with ``aux`` the depth, shadow and
         normal passes, with ``emission`` the Emission pass, ``counted`` (colour only) the
-        shading count; ``world_ratio``: then the world ratio's three targets."""
+        shading count; ``part``: then that ``FilmPart``'s targets."""
         fb = self.fb_emit if emission else (self.fb if aux else (self.fb_counted if counted else self.fb_color))
-        if not world_ratio:
+        if part is None:
             return fb
-        import gpu
-
-        key = (aux, emission, counted)
-        if key not in self._world_fbs:
-            if emission:
-                slots = (self.color, self.shadow, self.normal, self.emission)
-            elif aux:
-                slots = (self.color, self.shadow, self.normal)
-            else:
-                slots = (self.color, self.shaded) if counted else (self.color,)
-            self._world_fbs[key] = gpu.types.GPUFrameBuffer(
-                depth_slot=self.zbuffer, color_slots=slots + tuple(self.world_targets())
-            )
-        return self._world_fbs[key]
+        if emission:
+            slots = (self.color, self.shadow, self.normal, self.emission)
+        elif aux:
+            slots = (self.color, self.shadow, self.normal)
+        else:
+            slots = (self.color, self.shaded) if counted else (self.color,)
+        return part.framebuffer(self, slots)
 
     def emission_framebuffer(self):
         """The Emission pass's target over the z-buffer (its own draw: ``LitPass.draw``)."""
         import gpu
 
-        if "emission" not in self._world_fbs:
-            self._world_fbs["emission"] = gpu.types.GPUFrameBuffer(
-                depth_slot=self.zbuffer, color_slots=(self.emission,)
-            )
-        return self._world_fbs["emission"]
+        if self._emission_fb is None:
+            self._emission_fb = gpu.types.GPUFrameBuffer(depth_slot=self.zbuffer, color_slots=(self.emission,))
+        return self._emission_fb
 
-    def blend_framebuffer(self, world_ratio):
-        """The framebuffer blended surfaces draw into: colour, and with ``world_ratio`` the SH
-        light targets (which they attenuate)."""
-        if not world_ratio:
-            return self.fb_color
-        import gpu
+    def blend_framebuffer(self, part=None):
+        """The framebuffer blended surfaces draw into: colour, and with ``part`` that
+        ``FilmPart``'s targets they write (the world ratio's SH light, which they attenuate)."""
+        return self.fb_color if part is None else part.framebuffer(self, (self.color,), blended=True)
 
-        if "blend" not in self._world_fbs:
-            slots = (self.color, *self.world_targets()[:2])
-            self._world_fbs["blend"] = gpu.types.GPUFrameBuffer(depth_slot=self.zbuffer, color_slots=slots)
-        return self._world_fbs["blend"]
-
-    def clear(self, background, aux, emission, world_ratio=False):
+    def clear(self, background, aux, emission, part=None):
         """Every target the lit pass writes, cleared to what the background is: ``background``
         colour (premultiplied), and for the passes an "infinitely" far depth (as Blender's own
         Depth pass), full light, no normal, no emission."""
@@ -262,14 +281,8 @@ class Film:
             self.emission.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
         if self.shaded is not None:
             self.shaded.clear(format="FLOAT", value=(0.0,))
-        if world_ratio:
-            self.world_targets()
-            if "clear" not in self._world_fbs:
-                import gpu
-
-                self._world_fbs["clear"] = gpu.types.GPUFrameBuffer(color_slots=tuple(self.world))
-            with self._world_fbs["clear"].bind():  # one clear of all three
-                self._world_fbs["clear"].clear(color=(0.0, 0.0, 0.0, 0.0))
+        if part is not None:
+            part.clear(self)
 
     def target_bytes(self, aux, accumulate):
         """Bytes per pixel of the frame's targets: colour, z-buffer, and with ``aux`` depth,
@@ -284,26 +297,26 @@ class Film:
                 per_pixel += 4 + 4 + (8 if self._weight is not None else 0)
             if self._settle is not None:
                 per_pixel += 16
-            if self.world_ratio:
-                per_pixel += 6 * 16 + (16 if self.tracking else 0)
+            per_pixel += sum(part.bytes_per_pixel(self) for part in self.parts)
         return per_pixel * self.size[0] * self.size[1]
 
     # --- samples --------------------------------------------------------------------------
 
-    def begin(self, aux, emission, fresh, adaptive=False, settle=False, world_ratio=False, gather_reach=0):
+    def begin(self, aux, emission, fresh, adaptive=False, settle=False, parts=(), gather_reach=0):
         """Before a multi-sample frame's samples: the accumulation targets, cleared when the
         frame starts afresh (``fresh``); ``adaptive``: the frame estimates each pixel's error
         (from a fresh start on); ``settle``: pixels may settle (``settle``), so the converged
-        masks exist; ``world_ratio``: the frame's world light is a ratio (its targets too);
+        masks exist; ``parts``: the techniques' targets (``FilmPart``);
         ``gather_reach``: the gathering film's reach in pixels (``sampling.gather_reach``; 0:
         each pixel its own samples), which a converged pixel stays shaded for."""
         self.gather_reach = int(gather_reach)
         self._ensure_accumulation(aux)
-        self.world_ratio = bool(world_ratio)
+        self.parts = tuple(parts)
+        self._known_parts += [p for p in self.parts if p not in self._known_parts]
         if fresh:
             self._begin_adaptive(adaptive, settle)
-            if self.world_ratio:
-                self._begin_world_ratio()
+            for part in self.parts:
+                part.begin(self)
             if self.shaded_total is not None:
                 self.shaded_total.clear(format="FLOAT", value=(0.0,))
             self._accum_color.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
@@ -330,48 +343,37 @@ class Film:
             samplers = {"src_color": self.color, "converged": mask}
             if with_shadow:
                 samplers["src_shadow"] = self.shadow
-            program = _gathered(
+            program = gathered(
                 MASKED_COPY_SHADOW_WEIGHT if with_shadow else MASKED_COPY_WEIGHT, gather, self.gather_reach
-            )[0]
+            )
             uniforms = {"scale": weight, **(gather or {})}
             self.fullscreen(program, self._masked_fb(with_shadow), samplers, uniforms, "ADDITIVE_PREMULT")
         if emission:
             _accum, accum_fb, _resolve_fb = self._emission_targets
-            self._copy(accum_fb, self.emission, weight, mask, gather)
+            self.copy(accum_fb, self.emission, weight, mask, gather)
         if self.tracking and sample % 2 == 1:
-            self._copy(self._half_fb, self.color, weight, mask, gather)
+            self.copy(self._half_fb, self.color, weight, mask, gather)
             self._half_weight_sum += weight
         if self._shaded_total_fb is not None:
             self.fullscreen(
                 SCALED_COPY, self._shaded_total_fb, {"src_color": self.shaded}, {"scale": 1.0}, "ADDITIVE_PREMULT"
             )
-        if self.world_ratio:
-            samplers = {name: source for name, source in zip(_WORLD_NAMES, self.world_targets(), strict=True)}
-            if mask is not None:
-                samplers["converged"] = mask
-            else:
-                samplers["converged"] = self.world[2]  # bound, never read
-            program = _gathered(
-                WORLD_RATIO_COPY if mask is None else WORLD_RATIO_COPY_MASKED, gather, self.gather_reach
-            )[0]
-            uniforms = {"scale": weight, **(gather or {})}
-            self.fullscreen(program, self._world_accum_fb, samplers, uniforms, "ADDITIVE_PREMULT")
-            if self.tracking and sample % 2 == 1:
-                self._copy(self._world_half[1], self.world[2], weight, mask, gather)
+        for part in self.parts:
+            part.accumulate(self, weight, sample, mask, gather)
         self._weight_sum += weight
         self.sample_weights.append(float(weight))
 
-    def _copy(self, framebuffer, source, scale, mask, gather=None):
+    def copy(self, framebuffer, source, scale, mask, gather=None):
         """framebuffer += scale * source, where not converged (``mask``, when some pixel is);
         ``gather``: the source gathered over the filter's reach."""
         uniforms = {"scale": scale, **(gather or {})}
         if mask is None:
-            program = _gathered(SCALED_COPY, gather, self.gather_reach)[0]
+            program = gathered(SCALED_COPY, gather, self.gather_reach)
             self.fullscreen(program, framebuffer, {"src_color": source}, uniforms, "ADDITIVE_PREMULT")
         else:
             samplers = {"src_color": source, "converged": mask}
             self.fullscreen(
-                _gathered(MASKED_COPY, gather, self.gather_reach)[0],
+                gathered(MASKED_COPY, gather, self.gather_reach),
                 framebuffer,
                 samplers,
                 uniforms,
@@ -409,44 +411,24 @@ class Film:
             if emission:
                 accum, _accum_fb, resolve_fb = self._emission_targets
                 self.fullscreen(SCALED_COPY, resolve_fb, {"src_color": accum}, {"scale": inverse})
-        if self.world_ratio:
-            self._resolve_world_ratio()
+        for part in self.parts:
+            part.resolve(self)
 
-    def _resolve_world_ratio(self):
-        """The colour resolved anew with the world's light through its ratio (over the shadow
-        and Emission passes the plain resolve wrote)."""
-        per_pixel = self._weight is not None
-        inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
-        samplers = {
-            "src_color": self._accum_color,
-            "weight": self._weight if per_pixel else self._accum_color,
-            **self._world_samplers(),
-        }
-        uniforms = {"scale": inverse, "per_pixel": 1.0 if per_pixel else 0.0}
-        self.fullscreen(WORLD_RATIO_RESOLVE, gpu_framebuffer(self.color), samplers, uniforms)
+    @property
+    def accum_color(self):
+        """The colour's accumulation (weighted sum of the samples)."""
+        return self._accum_color
 
-    def _world_samplers(self):
-        return {name: target for name, (target, _fb) in zip(_WORLD_NAMES, self._world_accum, strict=True)}
+    @property
+    def weight(self):
+        """Each pixel's weight (RG32F: its samples' total weight, their count) once pixels hold
+        different numbers of samples; None while every pixel has them all (``weight_sum``)."""
+        return self._weight
 
-    def _begin_world_ratio(self):
-        """A fresh frame whose world light is a ratio: its accumulations (and, when the noise
-        is estimated, the sums' every-other-sample one) at this size, cleared."""
-        import gpu
-
-        size = self.size
-        if self._world_accum is None or (self._world_accum[0][0].width, self._world_accum[0][0].height) != size:
-            self._give([t for t, _fb in self._world_accum or ()] + [self._world_half[0] if self._world_half else None])
-            self._world_half = None
-            targets = [new_texture(self.pool, size, "RGBA32F") for _ in range(3)]
-            self._world_accum = [(t, gpu.types.GPUFrameBuffer(color_slots=(t,))) for t in targets]
-            self._world_accum_fb = gpu.types.GPUFrameBuffer(color_slots=tuple(targets))
-        if self.tracking and self._world_half is None:
-            half = new_texture(self.pool, size, "RGBA32F")
-            self._world_half = (half, gpu.types.GPUFrameBuffer(color_slots=(half,)))
-        for target, _fb in self._world_accum:
-            _clear_zero(target)
-        if self.tracking:
-            _clear_zero(self._world_half[0])
+    @property
+    def weight_sum(self):
+        """The total weight of the samples accumulated so far."""
+        return self._weight_sum
 
     # --- adaptive sampling ----------------------------------------------------------------
 
@@ -462,14 +444,14 @@ class Film:
 
         self.tracking = bool(adaptive)
         self.converged = 0
-        self._give([self._weight])
+        self.give([self._weight])
         self._weight = None
         self._masked_fbs = {}
         if not (self.tracking or settle):
             return
         size = self.size
         if self._masks is None or (self._masks[0].width, self._masks[0].height) != size:
-            self._give([self._half, *(self._masks or ())])
+            self.give([self._half, *(self._masks or ())])
             self._half = self._half_fb = None
             self._masks = [new_texture(self.pool, size, "R32F") for _ in range(2)]
             self._mask_fbs = [gpu.types.GPUFrameBuffer(color_slots=(m,)) for m in self._masks]
@@ -489,7 +471,7 @@ class Film:
         import gpu
 
         if self._settle is None or self._settle[0] != self.size:
-            self._give([self._settle[1]] if self._settle else [])
+            self.give([self._settle[1]] if self._settle else [])
             flags = new_texture(self.pool, self.size, "RGBA32F")
             self._settle = (self.size, flags, gpu.types.GPUFrameBuffer(depth_slot=self.zbuffer, color_slots=(flags,)))
         self._settle[1].clear(format="FLOAT", value=(1.0, 0.0, 0.0, 0.0))
@@ -526,10 +508,8 @@ class Film:
                 copies.append((self._accum_shadow, self.shadow))
             if emission and self._emission_targets is not None:
                 copies.append((self._emission_targets[0], self.emission))
-            if self.world_ratio:
-                copies += [
-                    (target, source) for (target, _fb), source in zip(self._world_accum, self.world, strict=True)
-                ]
+            for part in self.parts:
+                copies += list(part.settled(self))
             for target, source in copies:
                 framebuffer = gpu_framebuffer(target)
                 scale = self._weight_sum  # the first sample's weight, which the pilot takes over
@@ -554,8 +534,7 @@ class Film:
             "per_pixel": 1.0 if self._weight is not None else 0.0,
             "half_scale": self._half_scale(),
         }
-        samplers.update(self._convergence_world_samplers())
-        self.fullscreen(convergence_program(False, self.world_ratio), self._mask_fbs[dst], samplers, uniforms)
+        self.fullscreen(self._convergence(False, samplers), self._mask_fbs[dst], samplers, uniforms)
         return self._take_mask(dst)
 
     def _half_scale(self):
@@ -564,11 +543,13 @@ class Film:
         samples weigh alike; a gathering film's samples do not)."""
         return float(self._weight_sum / self._half_weight_sum) if self._half_weight_sum > 0.0 else 2.0
 
-    def _convergence_world_samplers(self):
-        """The world ratio's accumulations the convergence check reads (none without it)."""
-        if not self.world_ratio:
-            return {}
-        return {**self._world_samplers(), "half_world_sums": self._world_half[0]}
+    def _convergence(self, error_output, samplers):
+        """The convergence check's program with the frame's parts' shares of it (adding their
+        samplers to ``samplers``)."""
+        shares = [share for share in (part.convergence(self) for part in self.parts) if share is not None]
+        for _part, more in shares:
+            samplers.update(more)
+        return convergence_program(error_output, tuple(part for part, _more in shares))
 
     def _take_mask(self, dst):
         """Mask ``dst`` becomes the converged mask; returns its count (and from the first
@@ -627,10 +608,9 @@ class Film:
             "per_pixel": 1.0 if self._weight is not None else 0.0,
             "half_scale": self._half_scale(),
         }
-        samplers.update(self._convergence_world_samplers())
-        self.fullscreen(convergence_program(True, self.world_ratio), framebuffer, samplers, uniforms)
+        self.fullscreen(self._convergence(True, samplers), framebuffer, samplers, uniforms)
         values = texture_array(target, 1)[..., 0].copy()
-        self._give([target])
+        self.give([target])
         return values
 
     def _masked_fb(self, with_shadow):
@@ -678,7 +658,7 @@ class Film:
 
         width, height = self.size
         if self._accum_color is None or (self._accum_color.width, self._accum_color.height) != (width, height):
-            self._give([self._accum_color, self._accum_shadow])
+            self.give([self._accum_color, self._accum_shadow])
             self._accum_color = new_texture(self.pool, (width, height), "RGBA32F")
             self._accum_shadow = None
             self._accum_fb = gpu.types.GPUFrameBuffer(color_slots=(self._accum_color,))
@@ -712,7 +692,7 @@ class Film:
             samplers["src_shadow"] = sources[1]
         program = (SCALED_RESOLVE_SHADOW if resolve else SCALED_COPY_SHADOW) if with_shadow else SCALED_COPY
         self.fullscreen(
-            *_gathered(program, gather, self.gather_reach),
+            gathered(program, gather, self.gather_reach),
             framebuffer,
             samplers,
             {"scale": scale, **(gather or {})},
@@ -754,7 +734,7 @@ class Film:
 
     # --- resources ------------------------------------------------------------------------
 
-    def _give(self, textures):
+    def give(self, textures):
         """Hand textures back to the pool (final renders); without a pool they are freed when
         the last reference goes."""
         if self.pool is not None:
@@ -763,7 +743,7 @@ class Film:
     def _give_targets(self):
         """Every size-bound target back to the pool: a new size, or the end of the render."""
         accum = self._emission_targets[0] if self._emission_targets is not None else None
-        self._give(
+        self.give(
             [
                 self.color,
                 self.zbuffer,
@@ -779,13 +759,11 @@ class Film:
                 self.shaded,
                 self.shaded_total,
                 self._settle[1] if self._settle else None,
-                *(self.world or ()),
-                *(t for t, _fb in self._world_accum or ()),
-                self._world_half[0] if self._world_half else None,
             ]
         )
-        self.world = self._world_accum = self._world_half = self._world_accum_fb = None
-        self._world_fbs = {}
+        for part in self._known_parts:
+            part.release(self)
+        self._emission_fb = None
         self._settle = None
         self.fb = self.fb_color = self.fb_emit = self._accum_fb = self._resolve_fb = None
         self._half = self._half_fb = self._masks = self._mask_fbs = self._weight = None

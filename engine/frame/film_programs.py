@@ -1,12 +1,11 @@
 """The film's programs (``film.Film``): a sample added to the accumulation and the
 accumulation resolved (by the total weight, or each pixel's with adaptive sampling), the
-convergence check, the world ratio's accumulations and resolve, settling, and the nearest
+convergence check, settling, and the nearest
 depth written where a pixel converged."""
 
 from dataclasses import replace
 
-from ...shaders.loader import Program
-from .programs import WORLD_RATIO_OUTPUTS
+from ...shaders.loader import Program, with_parts
 
 # out = scale * src at (pixel - origin): a shadow tile from the scratch target into its place in
 # the atlas (scale 1, origin the tile's corner; FLOAT16, RGBA8), a sample added to the
@@ -101,59 +100,19 @@ CONVERGENCE = Program(
         ("FLOAT_2D", "weight"),
     ),
     outputs=(("VEC4", "out_color"),),
-    libs=("lib/world_ratio.glsl",),
 )
-CONVERGENCE = replace(CONVERGENCE, defines=(("ERROR_OUTPUT", False), ("WORLD_RATIO", False)))
+CONVERGENCE = replace(CONVERGENCE, defines=(("ERROR_OUTPUT", False),))
 # The NOISE debug view: each pixel's error estimate as the check reads it (``Film.error_array``).
-CONVERGENCE_ERROR = replace(
-    CONVERGENCE, name="convergence_error", defines=(("ERROR_OUTPUT", True), ("WORLD_RATIO", False))
-)
-# The world's light as a ratio (``Film.world_targets``): the accumulations of its SH light by
-# lobe and of its sums, and the every-other-sample accumulation of the sums.
-_WORLD_RATIO_SAMPLERS = (("FLOAT_2D", "world_diffuse"), ("FLOAT_2D", "world_specular"), ("FLOAT_2D", "world_sums"))
+CONVERGENCE_ERROR = replace(CONVERGENCE, name="convergence_error", defines=(("ERROR_OUTPUT", True),))
 
 
-def convergence_program(error_output=False, world_ratio=False):
-    """The convergence check (or, ``error_output``, its estimate for the NOISE view); with
-    ``world_ratio`` both means it compares take the world's light through its ratio."""
-    base = CONVERGENCE_ERROR if error_output else CONVERGENCE
-    if not world_ratio:
-        return base
-    return replace(
-        base,
-        name=f"{base.name}_ratio",
-        samplers=base.samplers + _WORLD_RATIO_SAMPLERS + (("FLOAT_2D", "half_world_sums"),),
-        defines=(("ERROR_OUTPUT", bool(error_output)), ("WORLD_RATIO", True)),
-    )
+def convergence_program(error_output=False, parts=()):
+    """The convergence check (or, ``error_output``, its estimate for the NOISE view), with the
+    frame's techniques' ``parts`` of it (``FilmPart.convergence``: the world ratio's, so the
+    means it compares take the world's light through its ratio)."""
+    return with_parts(CONVERGENCE_ERROR if error_output else CONVERGENCE, *parts)
 
 
-# A sample's world ratio targets added to their accumulations in one pass, where not converged
-# (WITH_MASK, ``converged`` then bound).
-WORLD_RATIO_COPY = Program(
-    name="world_ratio_copy",
-    vertex="fullscreen.vert.glsl",
-    fragment="world_ratio_copy.frag.glsl",
-    libs=("lib/film_gather.glsl",),
-    vertex_in=(("VEC2", "pos"),),
-    push_constants=(("FLOAT", "scale"),),
-    samplers=_WORLD_RATIO_SAMPLERS + (("FLOAT_2D", "converged"),),
-    outputs=WORLD_RATIO_OUTPUTS,
-    defines=(("WITH_MASK", False),),
-)
-WORLD_RATIO_COPY_MASKED = replace(WORLD_RATIO_COPY, name="world_ratio_copy_masked", defines=(("WITH_MASK", True),))
-
-# The resolve of a frame with the world's light as a ratio: colour - U_d (1 - S_d) - U_s (1 - S_s)
-# from the accumulations, over the total weight (``scale``) or each pixel's (per_pixel > 0.5).
-WORLD_RATIO_RESOLVE = Program(
-    name="world_ratio_resolve",
-    vertex="fullscreen.vert.glsl",
-    fragment="world_ratio.frag.glsl",
-    vertex_in=(("VEC2", "pos"),),
-    push_constants=(("FLOAT", "scale"), ("FLOAT", "per_pixel")),
-    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "weight")) + _WORLD_RATIO_SAMPLERS,
-    outputs=(("VEC4", "out_color"),),
-    libs=("lib/world_ratio.glsl",),
-)
 # Settling (``engine/frame/settle.py``): the settle test's flags and the image so far give the
 # pixels no later sample can change; they join the converged mask.
 SETTLE = Program(
@@ -207,7 +166,7 @@ GATHER_PUSH = (("MAT3", "gather_wx"), ("MAT3", "gather_wy"))
 
 
 def gathering(program, reach):
-    """``program`` (SCALED_COPY, MASKED_COPY, WORLD_RATIO_COPY or a variant) gathering its source
+    """``program`` (SCALED_COPY, MASKED_COPY or a variant of theirs) gathering its source
     from the sample pixels ``reach`` each way (``sampling.gather_reach``, compiled in)."""
     return replace(
         program,

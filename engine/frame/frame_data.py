@@ -39,6 +39,10 @@ class FrameData:
     bins: np.ndarray = None  # (rows, columns, LIGHT_WORDS) light masks of the screen bins, or None
     samplers: dict = field(default_factory=dict)  # {name: texture} the techniques' parts bind
     begins: tuple = ()  # the techniques' GPU work over the frame block before the draws (``LitPart.begin``)
+    # The techniques' ``ProgramPart`` values of the lit program (``LitPart.program``), in order,
+    # and those blended surfaces take: what a ``programs.LitKey`` lists after the pass's own.
+    parts: tuple = ()
+    blended_parts: tuple = ()
 
     @cached_property
     def defines(self):
@@ -215,7 +219,7 @@ class LitInputs:
     weighs the world's light), whether or not this sample's directions have maps;
     ``world_sh``: the surfaces take the world's SH light (False: this sample's directions of
     the world carry all of it, ``world.directions.world_lights`` with portals); ``parts``: the
-    frame's techniques' ``features.LitPart`` of this sample (fields of the variant, rows of
+    frame's techniques' ``features.LitPart`` of this sample (parts of the lit program, rows of
     the frame block, samplers)."""
 
     atlas: AtlasShape = AtlasShape()
@@ -235,13 +239,12 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
     """Everything the lit pass binds for this sample. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``camera``: the raster camera; ``world_color``: a ``materials.World`` (its SH
     light) or a constant colour; ``plan``: the frame's ``shadows.ShadowPlan``; ``inputs``:
-    the rest (``LitInputs``), the techniques' parts among them: the typed variant
-    (``programs.LitVariant``) takes their fields, the frame block their rows."""
+    the rest (``LitInputs``), the techniques' parts among them: the lit program takes their
+    ``ProgramPart`` values, the frame block their rows."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
-    extra, rows, samplers = {}, {}, {}
+    rows, samplers = {}, {}
     for part in inputs.parts:
-        extra.update(part.variant)
         rows.update(part.rows)
         samplers.update(part.samplers)
     disk = disk_samples(settings, inputs.sample_count)
@@ -273,8 +276,9 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
     if inputs.rects is not None and should_bin(lights):
         size = inputs.size
         bins = light_bins.bin_masks([inputs.rects[i] for i in order], size[0], size[1], LIGHT_WORDS)
-    # The settle test's variant writes its flags: no debug view's values.
-    settle = bool(extra.get("settle", False))
+    # A part with an entry shader of its own (the settle test's flags): no debug view's values.
+    parts = tuple(p.program for p in inputs.parts if p.program is not None)
+    settle = any(p.fragment for p in parts)
     term = 0 if settle else DEBUG_VIEW[getattr(settings, "debug_view", "NONE")].term
     variant = LitVariant(
         **{
@@ -293,7 +297,6 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
             "debug": bool(_debug_lit(settings)) and not settle,
             "world_lights": bool(inputs.world_sampled) or any(lights[i].world for i in order),
             "debug_term": int(term),
-            **extra,
         }
     )
     return FrameData(
@@ -306,6 +309,8 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
         bins=bins,
         samplers=samplers,
         begins=tuple(part.begin for part in inputs.parts if part.begin is not None),
+        parts=parts,
+        blended_parts=tuple(p.blended_program for p in inputs.parts if p.blended_program is not None),
     )
 
 

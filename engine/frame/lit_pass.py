@@ -1,4 +1,4 @@
-"""The lit pass: every visible part shaded by its material variant (``programs.lit_program``)
+"""The lit pass: every visible part shaded by its material variant (``programs.LitKey``)
 with the frame's lights and shadow atlas, into the film's targets; and the world's
 Environment Texture behind it."""
 
@@ -11,16 +11,15 @@ from ..gpu_pool import UniformBlocks
 from ..shadows import kernels, lightspace
 from .draw_list import front_to_back
 from .programs import (
+    COUNTED_PART,
+    EMISSION_ONLY,
+    EMISSION_PART,
+    ENTRY_PARTS,
     JITTER_SIZE,
     SHADOW_SAMPLER,
-    WORLD_RATIO_BLENDED,
-    WORLD_RATIO_OPAQUE,
-    emission_program,
     image_premultiplied_bits,
-    lit_entry,
-    lit_program,
+    lit_key,
     terminator_uniforms,
-    with_entry,
 )
 
 # The world's Environment Texture behind everything (materials.World.image).
@@ -80,13 +79,15 @@ class LitPass:
         bg = (0.0, 0.0, 0.0, 0.0) if transparent else (*map(float, world_color[:3]), 1.0)
         emission = frame.emission
         counted = film.fb_counted is not None and not aux  # the shading count of tests
-        # The world's light as a ratio (WORLD_RATIO): its targets beside the pass's. Blender's
-        # gpu module binds six colour targets: with the world ratio's three, the Emission pass
-        # is drawn apart, over the z-buffer the lit pass leaves.
-        ratio = data.variant.world_ratio
-        emission_apart = ratio and emission
-        fb = film.lit_framebuffer(aux, emission and not emission_apart, counted, ratio)
-        film.clear(bg, aux, emission, ratio)
+        # A technique's targets of its own beside the pass's (its part adds outputs, the film
+        # holds them: ``film.FilmPart``). Blender's gpu module binds six colour
+        # targets: with them the Emission pass is drawn apart, over the z-buffer the lit pass leaves.
+        own = film.lit_part if any(part.outputs for part in data.parts) else None
+        if own is None and any(part.outputs for part in data.parts):
+            raise RuntimeError("a technique's lit part writes targets the film does not hold")
+        emission_apart = own is not None and emission
+        fb = film.lit_framebuffer(aux, emission and not emission_apart, counted, own)
+        film.clear(bg, aux, emission, own)
         # Adaptive sampling: where a pixel converged the nearest depth goes first, so nothing
         # (surface or world) is drawn there; the pixel is not shaded again.
         converged = film.mask is not None
@@ -102,7 +103,6 @@ class LitPass:
         submit = _Submission(self, sample, parts)
         submit.emission = emission and not emission_apart
         submit.counted = counted
-        submit.ratio = ratio
         width, height = film.size
         with fb.bind():
             gpu.state.viewport_set(0, 0, width, height)
@@ -120,12 +120,12 @@ class LitPass:
                 submit.draw(opaque, False, emission_only=True)
         if blended:
             submit.rebind(counted=False)  # blended surfaces draw into the colour target alone
-            with film.blend_framebuffer(ratio).bind():
+            with film.blend_framebuffer(own).bind():
                 gpu.state.viewport_set(0, 0, width, height)
                 gpu.state.depth_test_set("LESS_EQUAL")
                 gpu.state.depth_mask_set(False)
                 gpu.state.blend_set("ALPHA_PREMULT")
-                submit.draw(blended, False, WORLD_RATIO_BLENDED)
+                submit.draw(blended, False, blended=True)
                 gpu.state.blend_set("NONE")
         _reset_state(stats)
 
@@ -148,7 +148,7 @@ class LitPass:
             submit.draw(opaque, False)
             if blended:
                 submit.rebind()
-                submit.draw(blended, False, WORLD_RATIO_BLENDED)
+                submit.draw(blended, False, blended=True)
         _reset_state(stats)
 
     @staticmethod
@@ -302,18 +302,19 @@ def _reset_state(stats):
 class _Submission:
     """One lit pass's draw calls: each entry's program bound once while it stays the same, its
     frame, light and tile blocks, its maps and textures, its per-object push constants.
-    ``emission``, ``counted`` and ``ratio``: what the film's targets take (the settle test's
-    take none of them); ``rebind()`` before drawing into other targets."""
+    ``emission`` and ``counted``: what the film's targets take (the settle test's take none
+    of them); ``rebind()`` before drawing into other targets."""
 
     def __init__(self, lit, sample, parts):
         atlas, data = sample.atlas, sample.data
         self.lit, self.data, self.atlas, self.origin = lit, data, atlas, sample.origin
         self.masks, self.parts, self.stats = sample.masks, parts, sample.stats
         self.shadow_tex = atlas.texture if atlas is not None else lit._shadow_dummy()
-        self.emission = self.counted = self.ratio = False
-        self.entry = lit_entry(data.defines)  # the colour, the settle test's flags or a debug view's
-        # One diffuse bounce from the atlas's reflective targets (features/bounce.py).
-        self.rsm = data.variant.indirect_samples > 0
+        self.emission = self.counted = False
+        # A debug view's entry shader, unless a technique's part brings its own (the settle test's).
+        variant = data.variant
+        debug = (variant.debug or variant.debug_term) and not any(p.fragment for p in data.parts)
+        self.entry = ENTRY_PARTS["debug"] if debug else None
         # The sample's tile records: the instanced depth pass's block when it holds them.
         tiles = atlas.tiles_block(data.tiles) if atlas is not None else None
         self.tiles = tiles if tiles is not None else lit._ubo("tiles", data.tiles)
@@ -322,6 +323,7 @@ class _Submission:
         self.hair_pixel = 1.0 / max(abs(float(camera.projection[1, 1])) * lit.film.size[1], 1e-30)
         self.shader = self.model_shader = self.culling = None
         self.solid = {}
+        self._shaders = {}  # what a draw binds -> its compiled program (``key``)
 
     def rebind(self, counted=None):
         """Bind afresh at the next draw (other targets); ``counted``: whether they count."""
@@ -329,26 +331,25 @@ class _Submission:
         if counted is not None:
             self.counted = counted
 
-    def bind(self, features, with_aux, tree, ratio_mode, emission_only=False):
+    def key(self, features, with_aux, tree, blended=False, emission_only=False):
+        """The ``programs.LitKey`` of a draw: the pass's targets, the frame's techniques' parts
+        (``blended``: those blended surfaces take), the material's, and the entry shader."""
+        data = self.data
+        if emission_only:  # what the surface emits, nothing of the techniques'
+            return lit_key(False, data.variant, (EMISSION_ONLY,), features, tree)
+        own = (EMISSION_PART,) if self.emission and with_aux else ()
+        own += (COUNTED_PART,) if self.counted and not with_aux else ()
+        techniques = data.blended_parts if blended else data.parts
+        return lit_key(with_aux, data.variant, own + techniques, features, tree, self.entry)
+
+    def bind(self, features, with_aux, tree, blended=False, emission_only=False):
         lit, data = self.lit, self.data
-        if emission_only:
-            program = emission_program(frozenset(features), tree)
-        else:
-            program = lit_program(
-                frozenset(features),
-                with_aux,
-                self.emission and with_aux,
-                self.counted and not with_aux,
-                tree,
-                self.rsm,
-                ratio_mode if self.ratio else 0,
-            )
-            program = with_entry(program, self.entry)
-        defines = data.defines
-        if data.variant.aux_outputs != with_aux:
-            # Blended surfaces of a frame with passes draw into the colour target alone.
-            defines = {**defines, "AUX_OUTPUTS": with_aux}
-        shader = lit.shaders.get(program, defines)
+        which = (features, with_aux, id(tree), blended, emission_only, self.emission, self.counted)
+        shader = self._shaders.get(which)
+        if shader is None:
+            key = self.key(features, with_aux, tree, blended, emission_only)
+            shader = self._shaders[which] = lit.shaders.get(key.program(), key.defines())
+            self.stats.lit_keys.add(key)
         if self.shader is shader:
             return shader
         if tree is not None and "ORIGIN" in tree.needs:
@@ -374,7 +375,7 @@ class _Submission:
                 self.solid[shader] = False
         return self.solid[shader]
 
-    def draw(self, entries, with_aux, ratio_mode=WORLD_RATIO_OPAQUE, emission_only=False):
+    def draw(self, entries, with_aux, blended=False, emission_only=False):
         import gpu
 
         lit, outside, terminators = self.lit, self.parts.outside, self.parts.terminators
@@ -388,7 +389,7 @@ class _Submission:
                 gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
                 gpu.state.front_facing_set(culling[1])
                 self.culling = culling
-            shader = self.bind(features, with_aux, mat.tree, ratio_mode, emission_only)
+            shader = self.bind(features, with_aux, mat.tree, blended, emission_only)
             if last is not d or self.model_shader is not shader:
                 shader.uniform_float("model", d.model)
                 if self._has_solid(shader):  # compiled out where no light reads it

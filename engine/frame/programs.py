@@ -10,11 +10,12 @@ by construction. Every uniform member is named: no packed vec4 whose meaning liv
 comment.
 """
 
+import functools
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from ...shaders.loader import Program, Struct
+from ...shaders.loader import Program, ProgramPart, Struct, with_parts
 from ..enums import DEPTH_FORMAT, LIGHT_TYPE, SHADOW_FILTER, SHADOW_MODE, SPECULAR_MODEL
 from ..scene.materials import CHANNELS
 from ..shadows import light_bins, lightspace
@@ -248,14 +249,11 @@ LIT = Program(
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
     push_constants=(("MAT4", "model"), ("IVEC4", "light_mask"), ("INT", "solid")),
-    # ao_depth: with WORLD_AO, the camera depth prepass (``world.occlusion.WorldAO``), view depth per
-    # pixel; ao_horizons: the horizons marched at half resolution over it (``lib/gtao.glsl``).
+    # The techniques' samplers come with their parts (``features.LitPart.program``).
     samplers=(
         ("FLOAT_2D", SHADOW_SAMPLER),
         ("FLOAT_3D", "jitter_tex"),
         ("FLOAT_2D", "light_bins"),
-        ("FLOAT_2D", AO_SAMPLER),
-        ("FLOAT_2D", AO_HORIZONS_SAMPLER),
     ),
     uniform_blocks=(
         (FRAME_STRUCT, "frame", 0),
@@ -276,8 +274,11 @@ LIT = Program(
             "EMISSION_OUTPUT": False,
             "EMISSION_ONLY": False,
             "COUNT_SHADED": False,
+            # The techniques' switches, off; their parts turn them on (``features.LitPart``).
             "INDIRECT_RSM": False,
             "RSM_SAMPLES": 1,
+            "SETTLE_TEST": False,
+            "PILOT_SAMPLE": False,
             "GTAO_UPSAMPLE": True,
         }.items()
     ),
@@ -325,12 +326,11 @@ def image_premultiplied_bits(premultiplied, channels=(), tree_images=()):
     return bits
 
 
-def _with_image_flags(pushes):
-    return pushes if IMAGE_PREMULTIPLIED in pushes else pushes + (IMAGE_PREMULTIPLIED,)
-
-
-def with_features(program, features, name):
-    """``program`` with the vertex inputs, varyings and texture samplers ``features`` read."""
+@functools.lru_cache(maxsize=256)
+def material_part(features):
+    """The ``ProgramPart`` of a material variant (``features``, a frozenset): the vertex inputs,
+    varyings, texture samplers and per-draw values its features read, and its defines
+    (``material_defines``). Named by its features, so a program's name lists them."""
     defines = material_defines(features)
     kinds = [
         k
@@ -349,22 +349,27 @@ def with_features(program, features, name):
     uniforms = []
     for feature, names in TERMINATOR_UNIFORMS.items():
         uniforms += [n for n in names if defines[feature] and n not in uniforms]
-    pushes = program.push_constants + tuple(("FLOAT", n) for n in uniforms)
+    pushes = tuple(("FLOAT", n) for n in uniforms)
     if defines["HAIR_STRIP"]:
         pushes += (HAIR_PIXEL,)
     bits = ()
     if samplers:
-        pushes = _with_image_flags(pushes)
+        pushes += (IMAGE_PREMULTIPLIED,)
         bits = tuple((f"IMAGE_BIT_{c}", bit) for c, bit in IMAGE_CHANNEL_BITS.items())
-    return replace(
-        program,
-        name=name,
-        vertex_in=program.vertex_in + vertex_in,
-        varyings=program.varyings + varyings,
+    return ProgramPart(
+        name="_".join(sorted(features)).lower(),
+        vertex_in=vertex_in,
+        varyings=varyings,
         push_constants=pushes,
-        samplers=program.samplers + samplers,
-        defines=program.defines + tuple(defines.items()) + bits,
+        samplers=samplers,
+        defines=tuple(defines.items()) + bits,
     )
+
+
+def with_features(program, features, name):
+    """``program`` with the vertex inputs, varyings and texture samplers ``features`` read
+    (``material_part``), named ``name``."""
+    return replace(with_parts(program, material_part(frozenset(features))), name=name)
 
 
 def terminator_uniforms(features, terminator, matrix):
@@ -382,114 +387,125 @@ def terminator_uniforms(features, terminator, matrix):
     return out
 
 
-# A final render with the Emission pass: the lit pass also writes each surface's emission.
-LIT_EMIT = replace(
-    LIT,
-    name="lit_emit",
-    outputs=LIT.outputs + (("VEC4", "out_emission"),),
-    defines=LIT.defines + (("EMISSION_OUTPUT", True),),
-)
-
-
-# The viewport's lit pass that also writes 1 into a second target for every pixel it shades
-# (a fragment that passed the depth test): the shading count adaptive sampling is tested by.
-LIT_COLOR_COUNTED = replace(
-    LIT_COLOR,
-    name="lit_color_counted",
-    outputs=LIT_COLOR.outputs + (("FLOAT", "out_shaded"),),
-    defines=LIT.defines + (("COUNT_SHADED", True),),
-)
-
-
-# The world's light as a ratio (lit.frag.glsl WORLD_RATIO): after the targets of the pass, the
-# SH light by lobe (diffuse, specular: rgb, coverage) and the ratio's sums (N_d, D_d, N_s, D_s),
-# which the film accumulates (``Film.world_targets``); blended surfaces write only the first two
-# (what they leave of the light behind them).
-WORLD_RATIO_OUTPUTS = (("VEC4", "out_world_diffuse"), ("VEC4", "out_world_specular"), ("VEC4", "out_world_sums"))
-WORLD_RATIO_OPAQUE, WORLD_RATIO_BLENDED = 1, 2
-
-
-def with_world_ratio(program, mode):
-    """``program`` writing the world ratio's targets: ``mode`` WORLD_RATIO_OPAQUE (all three)
-    or WORLD_RATIO_BLENDED (the SH lights, blended); 0: ``program`` itself."""
-    if not mode:
-        return program
-    outputs = WORLD_RATIO_OUTPUTS if mode == WORLD_RATIO_OPAQUE else WORLD_RATIO_OUTPUTS[:2]
-    return replace(
-        program,
-        name=f"{program.name}_ratio{mode}",
-        outputs=program.outputs + outputs,
-        defines=program.defines + (("WORLD_RATIO_OUT", int(mode)),),
-    )
-
-
-def emission_program(features=frozenset(), tree=None):
-    """The lit program of a material variant that writes only what the surface emits, as its
-    colour (``EMISSION_ONLY``): the Emission pass of a frame whose lit pass has no room left
-    for its target (the world ratio's three take it; Blender's gpu module binds six)."""
-    base = lit_program(features, aux=False, tree=tree)
-    return replace(base, name=f"{base.name}_emission_only", defines=base.defines + (("EMISSION_ONLY", True),))
+# The lit pass's own parts (``ProgramPart``), by the targets a pass takes:
+# EMISSION_PART   a final render with the Emission pass: each surface's emission too
+# COUNTED_PART    the viewport's pass that also writes 1 into a second target for every pixel
+#                 it shades (a fragment that passed the depth test): adaptive sampling's test
+# EMISSION_ONLY   only what the surface emits, as its colour: the Emission pass of a frame
+#                 whose lit pass has no room left for its target (Blender's gpu module binds
+#                 six colour targets, and a technique's targets took the room)
+EMISSION_PART = ProgramPart("emit", outputs=(("VEC4", "out_emission"),), defines=(("EMISSION_OUTPUT", True),))
+COUNTED_PART = ProgramPart("counted", outputs=(("FLOAT", "out_shaded"),), defines=(("COUNT_SHADED", True),))
+EMISSION_ONLY = ProgramPart("emission_only", defines=(("EMISSION_ONLY", True),))
+LIT_EMIT = with_parts(LIT, EMISSION_PART)
+LIT_COLOR_COUNTED = with_parts(LIT_COLOR, COUNTED_PART)
 
 
 # The lit pass's entry shaders over the same libraries (lit.frag.glsl's header): the surface's
-# colour, the settle test's flags, a debug view's values.
+# colour, the settle test's flags, a debug view's values. A part with a ``fragment`` takes its
+# own (``ENTRY_PARTS``); the surface's is the program's.
 LIT_ENTRIES = {"surface": "lit.frag.glsl", "settle": "lit_settle.frag.glsl", "debug": "lit_debug.frag.glsl"}
+ENTRY_PARTS = {name: ProgramPart(name, fragment=f) for name, f in LIT_ENTRIES.items() if name != "surface"}
 
 
-def lit_entry(defines):
-    """Which entry shader (LIT_ENTRIES) the lit pass's ``defines`` (``lit_defines``) take."""
-    if defines.get("SETTLE_TEST"):
-        return "settle"
-    if defines.get("DEBUG_LIT") or defines.get("DEBUG_TERM"):
-        return "debug"
-    return "surface"
+_TREE_PARTS = {}  # what a compiled tree's program is made of -> its ProgramPart
 
 
-def with_entry(program, entry):
-    """``program`` (a lit program) with entry shader ``entry`` (a key of LIT_ENTRIES)."""
-    if entry == "surface":
-        return program
-    return replace(program, name=f"{program.name}_{entry}", fragment=LIT_ENTRIES[entry])
+def tree_part(tree):
+    """The ``ProgramPart`` of compiled node tree ``tree``: its GLSL families, its generated
+    code, its constants block and image samplers, and the per-draw values it reads. Made once
+    per tree (trees equal in what they compile share it)."""
+    key = (tree.key, tree.families, tree.needs, len(tree.constants), len(tree.images), tree.code)
+    part = _TREE_PARTS.get(key)
+    if part is None:
+        pushes = tuple(p for need in sorted(tree.needs) for p in TREE_UNIFORMS.get(need, ()))
+        part = _TREE_PARTS[key] = ProgramPart(
+            name="",  # the material's features name the tree (NODES_<key>)
+            defines=(("NODE_PROCEDURAL", any(f.startswith("texture_") for f in tree.families)),),
+            libs=tuple(f"nodes/{f}.glsl" for f in tree.families),
+            generated=tree.code,
+            uniform_blocks=((NODE_CONSTANT_STRUCT, "node_constants", max(len(tree.constants), 1)),),
+            samplers=tuple(("FLOAT_2D", f"node_image_{i}") for i in range(len(tree.images))),
+            push_constants=pushes + ((IMAGE_PREMULTIPLIED,) if tree.images else ()),
+        )
+    return part
 
 
-def lit_program(features=frozenset(), aux=True, emission=False, counted=False, tree=None, rsm=False, ratio=0):
+def with_tree(program, tree):
+    """``program`` with compiled node tree ``tree`` (``tree_part``)."""
+    return with_parts(program, tree_part(tree))
+
+
+@dataclass(frozen=True)
+class LitKey:
+    """One lit-pass program as one value: ``aux``, whether it writes the passes' targets
+    (``LIT``; otherwise colour only, ``LIT_COLOR``); ``variant``, the typed switches of the
+    lit pass itself (``LitVariant``: filters, lights, debug view); ``parts``, the
+    ``ProgramPart`` values it combines with, in order: the pass's targets (``EMISSION_PART``,
+    ``COUNTED_PART``), the frame's techniques' (``features.LitPart.program``), the material's
+    (``material_part``), its tree's (``tree_part``) and an entry's (``ENTRY_PARTS``), each
+    carrying its own defines.
+
+    Frozen and hashable: a frame's keys can be listed (``LitPass.keys``), compiled ahead
+    (``precompile``) and each compiled in a test; equal keys are one program."""
+
+    aux: bool
+    variant: "LitVariant"
+    parts: tuple = ()
+
+    def program(self):
+        return _lit_source(self)[0]
+
+    def defines(self):
+        return _lit_source(self)[1]
+
+
+@functools.lru_cache(maxsize=1024)
+def _lit_source(key):
+    program = with_parts(LIT if key.aux else LIT_COLOR, *key.parts)
+    return program, {**key.variant.defines(), "AUX_OUTPUTS": bool(key.aux)}
+
+
+def lit_key(aux, variant, parts=(), features=frozenset(), tree=None, entry=None):
+    """The ``LitKey`` of a draw: the pass's and the techniques' ``parts``, then the material's
+    ``features`` (``Material.features``, plus "HOLDOUT") and ``tree`` (its
+    ``nodetree.CompiledTree``), then ``entry`` (a ``ProgramPart`` with a fragment) if any."""
+    parts = tuple(parts)
+    if features:
+        parts += (material_part(frozenset(features)),)
+    if tree is not None:
+        parts += (tree_part(tree),)
+    if entry is not None:
+        parts += (entry,)
+    return LitKey(bool(aux), variant, parts)
+
+
+def precompile(shaders, keys):
+    """Compile every ``LitKey`` in ``keys`` into ``shaders`` (a ``ShaderCache``) ahead of the
+    frame that draws them; returns how many were new."""
+    before = shaders.compiled
+    for key in keys:
+        shaders.get(key.program(), key.defines())
+    return shaders.compiled - before
+
+
+def lit_program(features=frozenset(), aux=True, emission=False, counted=False, tree=None, parts=()):
     """The lit pass program of a material variant (``Material.features``, plus "HOLDOUT");
     ``emission``: the variant also writes the Emission pass's target; ``counted`` (colour
-    only): it also writes the shading count (``LIT_COLOR_COUNTED``); ``tree``: the
-    material's ``nodetree.CompiledTree`` (its feature NODES_<key> names the variant);
-    ``rsm``: it also gathers one diffuse bounce from the lights' reflective shadow maps
-    (``with_rsm_gather``; the frame's defines carry INDIRECT_RSM); ``ratio``: it writes the
-    world ratio's targets (``with_world_ratio``)."""
-    base = LIT_EMIT if emission else (LIT if aux else (LIT_COLOR_COUNTED if counted else LIT_COLOR))
-    if rsm:
-        base = with_rsm_gather(base)
-    base = with_world_ratio(base, ratio)
-    if not features:
-        return base
-    program = with_features(base, features, f"{base.name}_{'_'.join(sorted(features)).lower()}")
-    return with_tree(program, tree) if tree is not None else program
+    only): it also writes the shading count; ``tree``: the material's
+    ``nodetree.CompiledTree``; ``parts``: the techniques' ``ProgramPart`` values."""
+    own = (EMISSION_PART,) if emission and aux else ((COUNTED_PART,) if counted and not aux else ())
+    return lit_key(aux, LitVariant(aux_outputs=aux), own + tuple(parts), features, tree).program()
 
 
 # Reflective shadow maps (Dachsbacher and Stamminger 2005): with Light Paths > Diffuse Bounces
 # at 1 the shadow atlas has two more colour targets of its size, per texel the diffuse albedo
 # of the surface the light sees there (rgb) and its world normal turned towards the light
-# (xyz), both RGBA16F. The light's irradiance there is evaluated when the lit pass gathers
-# (from the texel's depth), so the stored values stay within half-float range at any light
-# strength and scene scale.
+# (xyz), both RGBA16F (``features/bounce.py`` adds the lit pass's part that reads them).
 RSM_FLUX_SAMPLER = "rsm_flux"
 RSM_NORMAL_SAMPLER = "rsm_normal"
 RSM_FORMAT = "RGBA16F"
 RSM_TEXEL_BYTES = 16  # both targets
-
-
-def with_rsm_gather(program):
-    """A lit program that also reads the atlas's reflective targets (lib/indirect_rsm.glsl)."""
-    return replace(
-        program,
-        name=f"{program.name}_rsm",
-        libs=program.libs + ("lib/indirect_rsm.glsl",),
-        samplers=program.samplers + (("FLOAT_2D", RSM_FLUX_SAMPLER), ("FLOAT_2D", RSM_NORMAL_SAMPLER)),
-    )
 
 
 # Per-draw values a compiled tree may read (set like ``model``): the object's texture space
@@ -499,26 +515,6 @@ def with_rsm_gather(program):
 TREE_UNIFORMS = {"GENERATED": (("VEC3", "node_texspace_scale"), ("VEC3", "node_texspace_offset"))}
 TREE_UNIFORMS["ORIGIN"] = (("VEC3", "node_origin"),)
 TREE_UNIFORMS["OBJECT_INFO"] = (("VEC4", "node_object_color"), ("FLOAT", "node_object_random"))
-
-
-def with_tree(program, tree):
-    """``program`` with compiled node tree ``tree``: its GLSL families, its generated code,
-    its constants block and image samplers, and the per-draw values it reads."""
-    libs = tuple(f"nodes/{f}.glsl" for f in tree.families if f"nodes/{f}.glsl" not in program.libs)
-    pushes = tuple(p for need in sorted(tree.needs) for p in TREE_UNIFORMS.get(need, ()))
-    procedural = any(f.startswith("texture_") for f in tree.families)
-    return replace(
-        program,
-        defines=program.defines + (("NODE_PROCEDURAL", procedural),),
-        libs=program.libs + libs,
-        generated=tree.code,
-        uniform_blocks=program.uniform_blocks
-        + ((NODE_CONSTANT_STRUCT, "node_constants", max(len(tree.constants), 1)),),
-        samplers=program.samplers + tuple(("FLOAT_2D", f"node_image_{i}") for i in range(len(tree.images))),
-        push_constants=_with_image_flags(program.push_constants + pushes)
-        if tree.images
-        else program.push_constants + pushes,
-    )
 
 
 def depth_defines(depth_format):
@@ -560,21 +556,14 @@ class LitVariant:
     it runs zero times). ``light_linking``: some light lights only some objects; each
     object's ``light_mask`` says which. ``debug``: the variant writes what a lit debug view
     shows instead of colour (``DEBUG_LIT``: lights evaluated, sun cascade + 1, texel density
-    of the worst-sampled light, coverage). ``settle``: the variant writes the settle test's
-    flags instead (``SETTLE_TEST``, ``settle.py``), looking at most SETTLE_REACH texels
-    around a point in a map; ``pilot``: a frame's pilot sample (``PILOT_SAMPLE``), which reads
-    moving lights' maps with one bilinear lookup. ``world_lights``: some lights are
-    directions of the world's light (``WORLD_LIGHTS``, ``world/directions.py``).
-    ``world_ao``: the world's light is occluded by screen-space ground-truth ambient
-    occlusion over the camera depth prepass (``WORLD_AO``, ``lib/gtao.glsl``, ``world/occlusion.py``).
-    ``indirect_samples`` > 0: the variant gathers one diffuse bounce from the reflective
-    shadow maps of the lights with maps, that many texels per light and sample
-    (``INDIRECT_RSM``, lib/indirect_rsm.glsl; only with ``lit_program(rsm=True)``); 0 adds no
-    define, so a frame without the bounce compiles exactly what it did before.
-    ``debug_term``: the variant writes one term of its colour alone (``DEBUG_TERM``: 1 the
-    world's light with its visibility, 2 the diffuse bounce; the WORLD_LIGHT and INDIRECT
-    debug views). ``world_ratio``: the world's directions shadow its SH light as a ratio
-    accumulated in the film (``WORLD_RATIO``, lit.frag.glsl) rather than adding to the colour."""
+    of the worst-sampled light, coverage). ``world_lights``: some lights are directions of
+    the world's light (``WORLD_LIGHTS``, ``world/directions.py``). ``debug_term``: the
+    variant writes one term of its colour alone (``DEBUG_TERM``: 1 the world's light with its
+    visibility, 2 the diffuse bounce; the WORLD_LIGHT and INDIRECT debug views).
+
+    The frame's techniques (``features/``) are not fields here: each brings its switches as
+    the defines of its ``ProgramPart`` (``LitKey.parts``), so a technique added or removed
+    changes no field of the lit pass's own."""
 
     shadow_filter: str = "NONE"
     pcf_weights: tuple = (1.0,)
@@ -589,13 +578,8 @@ class LitVariant:
     light_counts: tuple | None = None
     light_linking: bool = False
     debug: bool = False
-    settle: bool = False
-    pilot: bool = False
     world_lights: bool = False
-    world_ao: bool = False
-    indirect_samples: int = 0
     debug_term: int = 0
-    world_ratio: bool = False
 
     def __post_init__(self):
         for f in fields(self):
@@ -641,13 +625,8 @@ _VARIANT_KINDS = {
     "light_counts": None,
     "light_linking": bool,
     "debug": bool,
-    "settle": bool,
-    "pilot": bool,
     "world_lights": bool,
-    "world_ao": bool,
-    "indirect_samples": int,
     "debug_term": int,
-    "world_ratio": bool,
 }
 _VARIANT_ENUMS = {
     "shadow_filter": SHADOW_FILTER,
@@ -675,7 +654,7 @@ def lit_defines(variant):
         v.depth_format,
         v.pcf_spacing,
     )
-    light_counts, binned, indirect_samples, sampled = v.light_counts, v.binned, v.indirect_samples, v.sampled
+    light_counts, binned, sampled = v.light_counts, v.binned, v.sampled
     filt = SHADOW_FILTER[shadow_filter]
     unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
@@ -684,9 +663,7 @@ def lit_defines(variant):
     sampled_n, shadowed_n, total_n = light_counts if light_counts is not None else (0, 1, 2)
     gather = bool(filt.pcf_taps and pcf_spacing == 1.0 and DEPTH_FORMAT[depth_format].channels == 1)
     weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
-    indirect = {"INDIRECT_RSM": True, "RSM_SAMPLES": int(indirect_samples)} if indirect_samples > 0 else {}
     return {
-        **indirect,
         **depth_defines(depth_format),
         "SHADOW_FILTER": SHADOW_FILTER.define(shadow_filter),
         "SPECULAR_MODEL": SPECULAR_MODEL.define(v.specular_model),
@@ -706,11 +683,7 @@ def lit_defines(variant):
         "LIGHT_COUNT": counts[2],
         "LIGHT_LINKING": bool(v.light_linking),
         "DEBUG_LIT": bool(v.debug),
-        "SETTLE_TEST": bool(v.settle),
-        "PILOT_SAMPLE": bool(v.pilot),
         "WORLD_LIGHTS": bool(v.world_lights),
-        "WORLD_AO": bool(v.world_ao),
-        "WORLD_RATIO": bool(v.world_ratio),
         "DEBUG_TERM": int(v.debug_term),
         "SETTLE_REACH": SETTLE_REACH,
         "SETTLE_GRID": SETTLE_GRID,

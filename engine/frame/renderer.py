@@ -366,6 +366,7 @@ class Renderer:
         stats = frame.stats
         if not frame.accumulate:
             film.converged = 0  # a single sample shades every pixel, whatever an earlier frame left
+            film.parts = ()  # nor keeps a technique's targets of its own
             # While the view moves, maps keep the sizes planned NAVIGATION_REPLAN frames ago.
             nav_key = (width, height, tuple(lt.use_shadow for lt in lights))
             last = self._navigation
@@ -378,6 +379,7 @@ class Renderer:
             targets = {}
             for feature in frame.features:
                 targets.update(feature.film(frame))
+            parts = tuple(p for p in (feature.film_part(frame) for feature in frame.features) if p is not None)
             # The NOISE view shows the estimate even where no threshold uses it.
             film.begin(
                 frame.aux,
@@ -387,6 +389,7 @@ class Renderer:
                 gather_reach=sampling.gather_reach(settings.filter_size)
                 if sampling.gathers(settings.filter_size)
                 else 0,
+                parts=parts,
                 **targets,
             )
             self._moving_lights(frame)

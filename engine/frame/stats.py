@@ -121,3 +121,4 @@ class FrameStats:
     sample_cpu_seconds: list = field(default_factory=list)  # CPU seconds of each sample (its stages)
     messages: list = field(default_factory=list)  # what the user must be told about this frame
     techniques: list = field(default_factory=list)  # the frame's techniques (``features.Feature.name``)
+    lit_keys: set = field(default_factory=set)  # the lit programs its draws took (``programs.LitKey``)

@@ -47,7 +47,12 @@ def _frame(gpu_call, scene, without=None):
             depsgraph, cam, *SIZE, aux=False, samples=(0, SAMPLES), sample_count=SAMPLES, adaptive=adaptive
         )
         names = {key[0] for key in engine.renderer.shaders._cache if key[0].startswith("lit")}
-        return out.color_array().copy(), out.stats, names, engine.renderer.film.world_ratio
+        return (
+            out.color_array().copy(),
+            out.stats,
+            names,
+            any(p.name == "world_ratio" for p in engine.renderer.film.parts),
+        )
 
     return gpu_call(job)
 
@@ -96,3 +101,39 @@ def test_a_technique_left_out_of_the_registry_is_off_and_the_frame_renders(gpu_c
     # Without it the picture changes (settling changes it by design only within its threshold).
     if name != "settling":
         assert np.abs(image[..., :3] - full[..., :3]).max() > 1e-3
+
+
+def test_a_frames_lit_programs_are_listed_as_keys_and_compile_ahead(gpu_call, whole):
+    """Each lit program a frame draws with is one ``programs.LitKey`` (its techniques' parts
+    among its parts), listed in the frame's ``stats.lit_keys``: compiled ahead into a fresh
+    cache (``programs.precompile``), each key is one program, and the same frame rendered with
+    that cache compiles no lit program of its own."""
+    scene, (_image, stats, _names, _ratio) = whole
+    keys = stats.lit_keys
+    parts = {part.name for key in keys for part in key.parts}
+    assert {"ratio1", "ao", "rsm", "pilot", "settle"} <= parts, parts
+    assert len({hash(key) for key in keys}) == len(keys)
+
+    def job(engine, depsgraph):
+        from penumbra.engine.frame.programs import precompile
+        from penumbra.engine.frame.renderer import Renderer
+        from penumbra.engine.frame.sampling import adaptive_settings
+        from penumbra.engine.scene.extract import camera_from_scene
+        from penumbra.shaders.loader import ShaderCache
+
+        cache = ShaderCache()
+        ahead = precompile(cache, keys)
+        lit_before = {k for k in cache._cache if k[0].startswith("lit")}
+        engine.renderer = Renderer(shaders=cache)
+        cam = camera_from_scene(depsgraph, scene, *SIZE)
+        adaptive = adaptive_settings(True, 0.01, 0, 0.0, SAMPLES)
+        out = engine.render_frame(
+            depsgraph, cam, *SIZE, aux=False, samples=(0, SAMPLES), sample_count=SAMPLES, adaptive=adaptive
+        )
+        lit_after = {k for k in cache._cache if k[0].startswith("lit")}
+        return ahead, len(lit_before), lit_after - lit_before, out.stats.lit_keys
+
+    ahead, compiled, new, again = gpu_call(job)
+    assert ahead == compiled == len(keys)
+    assert not new, new
+    assert again == keys

@@ -326,8 +326,8 @@ def test_a_lit_variant_is_named_typed_and_every_field_reaches_the_defines():
     with pytest.raises(TypeError):
         LitVariant("PCF")  # by position
     for field, bad in (
-        ("settle", "yes"),
-        ("world_ratio", 1),
+        ("debug", "yes"),
+        ("world_lights", 1),
         ("disk_samples", True),
         ("shadow_filter", "PCF5"),
         ("specular_model", 2),
@@ -351,13 +351,8 @@ def test_a_lit_variant_is_named_typed_and_every_field_reaches_the_defines():
         "light_counts": (0, 1, 1),
         "light_linking": True,
         "debug": True,
-        "settle": True,
-        "pilot": True,
         "world_lights": True,
-        "world_ao": True,
-        "indirect_samples": 4,
         "debug_term": 1,
-        "world_ratio": True,
     }
     # The PCF kernel and its spacing apply to the PCF filter only.
     pcf = dict(base, shadow_filter="PCF", pcf_weights=(0.25, 0.5, 0.25))

@@ -6,16 +6,23 @@ import dataclasses
 
 @dataclasses.dataclass(frozen=True)
 class LitPart:
-    """A technique's part of one sample's lit pass: ``variant``, fields of the lit program's
-    ``programs.LitVariant`` (the program's defines come from it); ``rows``, fields of the frame
-    block (``programs.FRAME_STRUCT``) this technique sets; ``samplers``, {sampler name:
-    texture} the lit program reads (bound with the frame's blocks); ``begin``: GPU work over
-    the sample's frame block before the lit pass's draws (``begin(frame_block, stats)``), or None."""
+    """A technique's part of one sample's lit pass: ``program``, its ``ProgramPart`` of the lit
+    program (libraries, samplers, outputs and the defines that switch it on; None: it changes
+    no program), ``blended`` the one blended surfaces take (None: ``program``'s); ``rows``,
+    fields of the frame block (``programs.FRAME_STRUCT``) this technique sets; ``samplers``,
+    {sampler name: texture} the lit program reads (bound with the frame's blocks); ``begin``:
+    GPU work over the sample's frame block before the lit pass's draws
+    (``begin(frame_block, stats)``), or None."""
 
-    variant: dict = dataclasses.field(default_factory=dict)
+    program: object = None
+    blended: object = None
     rows: dict = dataclasses.field(default_factory=dict)
     samplers: dict = dataclasses.field(default_factory=dict)
     begin: object = None
+
+    @property
+    def blended_program(self):
+        return self.blended if self.blended is not None else self.program
 
 
 NO_PART = LitPart()
@@ -28,7 +35,8 @@ class Feature:
 
     * ``plan(frame)``: what it adds to the frame's plan (``renderer.FramePlan``), after the
       base plan (draw list, lights, the world's light) and before the samples;
-    * ``film(frame)``: its film targets, as keywords of ``Film.begin`` (frames of several samples);
+    * ``film(frame)``: what it asks of the film, as keywords of ``Film.begin``, and
+      ``film_part(frame)``: its own targets there (a ``film.FilmPart``; frames of several samples);
     * ``before_sample(frame, s)``: a stage of its own before sample ``s`` (settling's test);
     * ``prepare(frame, sample)``: its change to the sample's view, scene or lights (``Sample``);
     * ``before_lit(frame, sample)``: GPU work the sample's lit pass reads (a depth prepass);
@@ -51,6 +59,10 @@ class Feature:
 
     def film(self, frame):
         return {}
+
+    def film_part(self, frame):
+        """Its targets in the film (a ``film.FilmPart``), or None."""
+        return None
 
     def before_sample(self, frame, s):
         pass

@@ -5,9 +5,20 @@ what each light sees (albedo and normal, ``shadow_maps``), and each pixel gather
 
 Off (not registered), the maps hold depth alone and the lit pass gathers nothing."""
 
+from ....shaders.loader import ProgramPart
 from ..frame_data import indirect_samples
 from ..programs import RSM_FLUX_SAMPLER, RSM_NORMAL_SAMPLER
 from .base import Feature, LitPart
+
+
+def gather_part(texels):
+    """The lit program's part that gathers the bounce, ``texels`` per light and sample."""
+    return ProgramPart(
+        "rsm",
+        libs=("lib/indirect_rsm.glsl",),
+        samplers=(("FLOAT_2D", RSM_FLUX_SAMPLER), ("FLOAT_2D", RSM_NORMAL_SAMPLER)),
+        defines=(("INDIRECT_RSM", True), ("RSM_SAMPLES", int(texels))),
+    )
 
 
 class Bounce(Feature):
@@ -26,6 +37,6 @@ class Bounce(Feature):
         if atlas is None or not atlas.rsm or not any(i in sample.plan.lights for i in range(len(sample.lights))):
             return super().lit(frame, sample)
         return LitPart(
-            variant={"indirect_samples": indirect_samples(frame.settings)},
+            program=gather_part(indirect_samples(frame.settings)),
             samplers={RSM_FLUX_SAMPLER: atlas.flux, RSM_NORMAL_SAMPLER: atlas.normal},
         )

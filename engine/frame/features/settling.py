@@ -11,12 +11,16 @@ sample the frame's other checks leave it."""
 
 import dataclasses
 
+from ....shaders.loader import ProgramPart
 from ..lens import coc_row
+from ..programs import LIT_ENTRIES
 from ..settle import flag_reach, settle
 from ..stats import FrameStats
 from .base import Feature, LitPart
 
-_PILOT = LitPart(variant={"pilot": True})
+# The lit program's parts: the pilot's, and the settle test's entry shader and its switch.
+_PILOT = LitPart(program=ProgramPart("pilot", defines=(("PILOT_SAMPLE", True),)))
+_TEST = ProgramPart("settle", fragment=LIT_ENTRIES["settle"], defines=(("SETTLE_TEST", True),))
 
 
 class Settling(Feature):
@@ -52,6 +56,7 @@ class Settling(Feature):
             test.stats = FrameStats()  # the test's draws are not the frame's samples
             film = renderer.film
             renderer.lit(frame, test, target=film.settle_framebuffer())
+            frame.stats.lit_keys |= test.stats.lit_keys  # its programs are the frame's to list
             frame.stats.pixels_settled = settle(
                 film,
                 frame.settings,
@@ -64,5 +69,5 @@ class Settling(Feature):
 
     def lit(self, frame, sample):
         if sample.settle_test:  # where the lens blurs, a pixel keeps sampling (lib/lit_settle.glsl)
-            return LitPart(variant={"settle": True}, rows={"lens_coc": coc_row(sample.cameras[0], *frame.size)})
+            return LitPart(program=_TEST, rows={"lens_coc": coc_row(sample.cameras[0], *frame.size)})
         return _PILOT if sample.pilot else super().lit(frame, sample)

@@ -5,12 +5,18 @@ its horizons marched at half resolution (the frame's first image shows contact s
 
 Off (not registered), no sample draws the prepass and the world's light is unoccluded."""
 
+from ....shaders.loader import ProgramPart
 from ..draw_list import corners_of
 from ..frame_data import ao_row
 from ..programs import AO_HORIZONS_SAMPLER, AO_SAMPLER
 from ..sampling import ao_jitter, world_ao_distance, world_ao_sample
 from ..world.occlusion import WorldAO
 from .base import Feature, LitPart
+
+# The lit program's part: the prepass's depth and the horizons marched over it (lib/gtao.glsl).
+_OCCLUSION = ProgramPart(
+    "ao", samplers=(("FLOAT_2D", AO_SAMPLER), ("FLOAT_2D", AO_HORIZONS_SAMPLER)), defines=(("WORLD_AO", True),)
+)
 
 
 class WorldOcclusion(Feature):
@@ -62,7 +68,7 @@ class WorldOcclusion(Feature):
             return super().lit(frame, sample)
         prepass = self.prepass
         return LitPart(
-            variant={"world_ao": True},
+            program=_OCCLUSION,
             rows=ao_row(sample.cameras[0].projection, frame.size, *sample.ao),
             samplers={AO_SAMPLER: prepass.texture, AO_HORIZONS_SAMPLER: prepass.horizons},
             begin=lambda block, stats: prepass.march(block, frame.caches.shaders, stats),
