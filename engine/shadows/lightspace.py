@@ -184,7 +184,7 @@ def sheared(fit, direction):
 def moved(fit, offset):
     """A perspective ``fit`` with its eye moved by ``offset`` (world), its axes, window and
     depth range kept: the off-axis map of a point of a light that the frame planned at its
-    centre (``planning.plan_shadows``' ``reaches``: the plan then holds every point within the
+    centre (``planning.FrameShare.reaches``: the plan then holds every point within the
     light's reach). Returns ``fit`` itself for no move (so an unmoved map is reused)."""
     offset = np.asarray(offset, dtype=np.float64)
     if not np.any(offset) or not np.all(np.isfinite(offset)):
