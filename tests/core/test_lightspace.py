@@ -337,7 +337,7 @@ def test_a_sheared_sun_map_holds_what_each_sampled_direction_fits(seed):
 @pytest.mark.parametrize("seed", range(5))
 def test_a_moved_local_map_holds_what_each_point_of_the_light_plans(seed):
     """A spot's map planned once over the scene grown by the light's reach
-    (``lightspace.dilated_boxes`` and ``dilated_receivers``, as ``plan_shadows(reaches=)``
+    (``lightspace.dilated_boxes`` and ``dilated_receivers``, as a plan with ``FrameShare.reaches``
     does) and ``moved`` to a point of the light: every visible receiver the point's own map
     holds lands inside the moved map (x, y and depth), and its casters are among the planned
     ones, so a sample can move the frame's map instead of planning its own."""
