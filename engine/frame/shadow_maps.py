@@ -59,12 +59,13 @@ class Caster:
     rsm_key: tuple = ()
 
 
-def draw_cutout(program, batch, material_ubo, texture, tree, tile_ubo, alpha_offset, model, origin=None):
-    """Draw one alpha cut-out part (``Caster.cutouts``: its batch, material block, (alpha
+def draw_cutout(program, part, tile_ubo, alpha_offset, model, origin=None):
+    """Draw one alpha cut-out ``part`` (of ``Caster.cutouts``: its batch, material block, (alpha
     texture, premultiplied bits) or None, ``TreeCutout`` or None) with ``program`` (the
     cut-out or node-tree depth program of the map, or of the camera depth prepass) into the
     tile of ``tile_ubo`` at this sample's ``alpha_offset``. ``origin``: the frame origin a
     compiled tree's ORIGIN reads."""
+    batch, material_ubo, texture, tree = part
     program.bind()
     if tree is not None:
         program.uniform_block("node_constants", tree.constants)
@@ -261,27 +262,46 @@ class ShadowAtlas:
         self._ubos[index].update(raw)
         return self._ubos[index]
 
+    def _program(self, shaders, raster, instanced=False):
+        """The map's depth program; ``raster``: an orthographic tile of a depth-buffer map."""
+        defines = depth_defines(self.depth_format)
+        if instanced:
+            return shaders.get(instanced_shadow_program(self.depth_format, raster), defines)
+        return shaders.get(shadow_program(self.depth_format, raster, rsm=self.rsm), defines)
+
+    def _cutout_program(self, shaders, textured, raster):
+        """The map's alpha cut-out program, compiled only when a caster has alpha."""
+        program = shadow_cutout_program(self.depth_format, textured, raster, rsm=self.rsm)
+        return shaders.get(program, depth_defines(self.depth_format))
+
     def render(self, plan, draws, shaders, cull_front, stats, alpha_offset=0.5, origin=None, levels=None):
         """Draw every tile of ``plan`` whose content changed. ``draws``: per instance a
         ``Caster``, or None for an instance that casts no shadow; a tile's key is its fit and
         its casters. ``origin``: the frame origin the casters' model matrices are relative to.
         ``levels``: {(tile index, instance index): (batches, level, triangles)}, casters drawn
         into that tile at a level of detail (``shadow_pass.map_levels``) instead of whole."""
-        levels = levels or {}
-        import gpu
-
+        work = self._changed(plan, draws, cull_front, stats, alpha_offset, levels or {})
         depth_only = DEPTH_FORMAT[self.depth_format].depth_only
-        defines = depth_defines(self.depth_format)
-        rsm = self.rsm
+        # Every map redrawn (a final render's frame) and filling most of the atlas: one clear of
+        # the whole atlas, not one scissored clear per map (which GL may draw as a quad).
+        used = sum(t.size**2 for _i, t, _c, _k in work)
+        cleared = depth_only and len(work) == len(plan.tiles) and 2 * used >= self.count * self.size**2
+        if cleared:
+            with self._framebuffer.bind():
+                if self.rsm:
+                    self._framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                else:
+                    self._framebuffer.clear(depth=1.0)
+        if depth_only and not self.rsm:
+            self._render_depth_maps(plan, work, shaders, cull_front, stats, (alpha_offset, origin), cleared)
+            return
+        for index, tile, casters, key in work:
+            self._render_tile(index, tile, casters, shaders, cull_front, stats, (alpha_offset, origin), cleared)
+            self._drawn(index, key, tile, casters, stats)
 
-        def program(raster, instanced=False):  # raster: an orthographic tile of a depth-buffer map
-            if instanced:
-                return shaders.get(instanced_shadow_program(self.depth_format, raster), defines)
-            return shaders.get(shadow_program(self.depth_format, raster, rsm=rsm), defines)
-
-        def cutout(textured, raster):  # compiled only when a caster has alpha
-            return shaders.get(shadow_cutout_program(self.depth_format, textured, raster, rsm=rsm), defines)
-
+    def _changed(self, plan, draws, cull_front, stats, alpha_offset, levels):
+        """[(tile index, tile, its casters, its content key)] of the tiles of ``plan`` whose
+        content is not already in the atlas (those that are count as reused)."""
         work = []
         for index, tile in enumerate(plan.tiles):
             casters = []
@@ -298,7 +318,7 @@ class ShadowAtlas:
                 cull_front,
                 tuple((c.identity, c.cull_back) for c in casters),
                 # The reflective targets hold the casters' albedo as well.
-                tuple(c.rsm_key for c in casters) if rsm else None,
+                tuple(c.rsm_key for c in casters) if self.rsm else None,
                 # Alpha casters cover other texels in each sample: such a map is redrawn per sample.
                 alpha_offset if any(c.cutouts for c in casters) else None,
             )
@@ -306,127 +326,131 @@ class ShadowAtlas:
                 stats.shadow_maps_reused += 1
                 continue
             work.append((index, tile, casters, key))
-        # Every map redrawn (a final render's frame) and filling most of the atlas: one clear of
-        # the whole atlas, not one scissored clear per map (which GL may draw as a quad).
-        used = sum(t.size**2 for _i, t, _c, _k in work)
-        cleared = depth_only and len(work) == len(plan.tiles) and 2 * used >= self.count * self.size**2
-        if cleared:
-            with self._framebuffer.bind():
-                if rsm:
-                    self._framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
-                else:
-                    self._framebuffer.clear(depth=1.0)
-        if depth_only and not rsm:
-            # Depth-buffer maps: each opaque caster batch is drawn once for all the maps of the
-            # sample it is in (instanced); alpha cut-outs and hair strips tile by tile.
-            if not cleared and work:
-                with self._framebuffer.bind():
-                    gpu.state.scissor_test_set(True)
-                    for _index, tile, _casters, _key in work:
-                        gpu.state.viewport_set(*tile.origin, tile.size, tile.size)
-                        gpu.state.scissor_set(*tile.origin, tile.size, tile.size)
-                        self._framebuffer.clear(depth=1.0)
-                    gpu.state.scissor_test_set(False)
-            self._render_instanced(plan, work, shaders, cull_front, stats, origin, program)
-            for index, tile, casters, key in work:
-                if any(c.cutouts or c.hair is not None for c in casters):
-                    (x0, y0), n = tile.origin, tile.size
-                    with self._framebuffer.bind():
-                        gpu.state.viewport_set(x0, y0, n, n)
-                        gpu.state.depth_test_set("LESS")
-                        gpu.state.depth_mask_set(True)
-                        tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(origin)]))
-                        raster = tile.fit.orthographic and not _crosses_near(tile.fit, casters)
-                        self._draw_strips_and_cutouts(
-                            casters, tile_ubo, raster, shaders, defines, cutout, alpha_offset, origin, stats
-                        )
-                        gpu.state.depth_test_set("NONE")
-                        gpu.state.depth_mask_set(False)
-                self._contents[index] = key
-                stats.shadow_simplified += sum(1 for c in casters if c.level is not None)
-                stats.passes += 1
-                stats.shadow_maps += 1
-                stats.shadow_texels += tile.size * tile.size
-            return
-        for index, tile, casters, key in work:
-            (x0, y0), n = tile.origin, tile.size
-            target = self._framebuffer if depth_only else self._scratch[2]
-            with target.bind():
-                if depth_only:
-                    gpu.state.viewport_set(x0, y0, n, n)
-                    if not cleared:
-                        gpu.state.scissor_set(x0, y0, n, n)
-                        gpu.state.scissor_test_set(True)
-                        if rsm:
-                            target.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
-                        else:
-                            target.clear(depth=1.0)
-                        gpu.state.scissor_test_set(False)
-                else:
-                    gpu.state.viewport_set(0, 0, n, n)
-                    target.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
-                gpu.state.depth_test_set("LESS")
-                gpu.state.depth_mask_set(True)
-                tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(origin)]))
-                # The depth pass flattens casters nearer the light than the near plane per
-                # vertex (pancaking), exact only for triangles wholly nearer: a caster that
-                # crosses the plane (a ground under light from below it) would have its depth
-                # bent, so such a tile writes each fragment's own depth, clamped, instead of the
-                # rasterised one.
-                raster = depth_only and tile.fit.orthographic and not _crosses_near(tile.fit, casters)
-                shader = program(raster)
-                shader.bind()
-                shader.uniform_block("tile", tile_ubo)
-                # Closed casters wholly in front of the light (w > 0 at every corner: no
-                # clipping, and the light outside them) cast with their faces toward the light.
-                front = set()
-                closed = [c for c in casters if c.closed] if not cull_front else []
-                if closed:
-                    w_row = tile.fit.view_proj[3]
-                    ok = np.all(np.stack([c.corners for c in closed]) @ w_row[:3] + w_row[3] > 0.0, axis=1)
-                    front = {id(c) for c, inside in zip(closed, ok, strict=True) if inside}
-                    stats.closed_culled += len(front)
-                for caster in casters:
-                    if caster.hair is not None:
-                        continue  # below, with the strips' program
-                    if cull_front or caster.cull_back or id(caster) in front:
-                        gpu.state.face_culling_set("FRONT" if cull_front else "BACK")
-                        gpu.state.front_facing_set(caster.det < 0.0)
-                    else:
-                        gpu.state.face_culling_set("NONE")
-                    shader.uniform_float("model", caster.model)
-                    if rsm and caster.rsm_parts is not None:  # per material: its albedo
-                        for batch, material_ubo in caster.rsm_parts:
-                            shader.uniform_block("material", material_ubo)
-                            batch.draw(shader)
-                            stats.draws += 1
-                            stats.shadow_draws += 1
-                        stats.shadow_triangles += caster.triangles
-                        continue
-                    for batch in caster.batches:
-                        batch.draw(shader)
-                        stats.draws += 1
-                        stats.shadow_draws += 1
-                    stats.shadow_triangles += caster.triangles
-                self._draw_strips_and_cutouts(
-                    casters, tile_ubo, raster, shaders, defines, cutout, alpha_offset, origin, stats
-                )
-                gpu.state.face_culling_set("NONE")
-                gpu.state.front_facing_set(False)
-                gpu.state.depth_test_set("NONE")
-                gpu.state.depth_mask_set(False)
-            if not depth_only:
-                self._copy_scratch(x0, y0, n, shaders)
-                for src, fb in zip(self._scratch[3], self._rsm_framebuffers, strict=True):
-                    self._copy_scratch(x0, y0, n, shaders, src, fb)
-                stats.passes += 1
-            self._contents[index] = key
-            stats.shadow_simplified += sum(1 for c in casters if c.level is not None)
-            stats.passes += 1
-            stats.shadow_maps += 1
-            stats.shadow_texels += n * n
+        return work
 
-    def _render_instanced(self, plan, work, shaders, cull_front, stats, origin, program):
+    def _drawn(self, index, key, tile, casters, stats):
+        """Tile ``index`` now holds ``key``: remembered, and counted."""
+        self._contents[index] = key
+        stats.shadow_simplified += sum(1 for c in casters if c.level is not None)
+        stats.passes += 1
+        stats.shadow_maps += 1
+        stats.shadow_texels += tile.size * tile.size
+
+    def _render_depth_maps(self, plan, work, shaders, cull_front, stats, sample, cleared):
+        """Depth-buffer maps (FLOAT32, no reflective targets): each opaque caster batch is drawn
+        once for all the maps of the sample it is in (instanced); alpha cut-outs and hair strips
+        tile by tile. ``sample``: (alpha offset, frame origin); ``cleared``: the whole atlas was."""
+        import gpu
+
+        if not cleared and work:
+            with self._framebuffer.bind():
+                gpu.state.scissor_test_set(True)
+                for _index, tile, _casters, _key in work:
+                    gpu.state.viewport_set(*tile.origin, tile.size, tile.size)
+                    gpu.state.scissor_set(*tile.origin, tile.size, tile.size)
+                    self._framebuffer.clear(depth=1.0)
+                gpu.state.scissor_test_set(False)
+        alpha_offset, origin = sample
+        self._render_instanced(plan, work, shaders, cull_front, stats, origin)
+        for index, tile, casters, key in work:
+            if any(c.cutouts or c.hair is not None for c in casters):
+                (x0, y0), n = tile.origin, tile.size
+                with self._framebuffer.bind():
+                    gpu.state.viewport_set(x0, y0, n, n)
+                    gpu.state.depth_test_set("LESS")
+                    gpu.state.depth_mask_set(True)
+                    tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(origin)]))
+                    raster = tile.fit.orthographic and not _crosses_near(tile.fit, casters)
+                    self._draw_strips_and_cutouts(casters, tile_ubo, raster, shaders, sample, stats)
+                    gpu.state.depth_test_set("NONE")
+                    gpu.state.depth_mask_set(False)
+            self._drawn(index, key, tile, casters, stats)
+
+    def _render_tile(self, index, tile, casters, shaders, cull_front, stats, sample, cleared):
+        """Map ``index`` drawn on its own: into its place in a depth atlas (with reflective
+        targets), or into the scratch target and copied into the colour atlas (FLOAT16, RGBA8).
+        ``sample``: (alpha offset, frame origin); ``cleared``: the whole atlas was."""
+        import gpu
+
+        depth_only = DEPTH_FORMAT[self.depth_format].depth_only
+        (x0, y0), n = tile.origin, tile.size
+        target = self._framebuffer if depth_only else self._scratch[2]
+        with target.bind():
+            if depth_only:
+                gpu.state.viewport_set(x0, y0, n, n)
+                if not cleared:
+                    gpu.state.scissor_set(x0, y0, n, n)
+                    gpu.state.scissor_test_set(True)
+                    if self.rsm:
+                        target.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                    else:
+                        target.clear(depth=1.0)
+                    gpu.state.scissor_test_set(False)
+            else:
+                gpu.state.viewport_set(0, 0, n, n)
+                target.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
+            gpu.state.depth_test_set("LESS")
+            gpu.state.depth_mask_set(True)
+            tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(sample[1])]))
+            # The depth pass flattens casters nearer the light than the near plane per
+            # vertex (pancaking), exact only for triangles wholly nearer: a caster that
+            # crosses the plane (a ground under light from below it) would have its depth
+            # bent, so such a tile writes each fragment's own depth, clamped, instead of the
+            # rasterised one.
+            raster = depth_only and tile.fit.orthographic and not _crosses_near(tile.fit, casters)
+            shader = self._program(shaders, raster)
+            shader.bind()
+            shader.uniform_block("tile", tile_ubo)
+            self._draw_casters(shader, tile, casters, cull_front, stats)
+            self._draw_strips_and_cutouts(casters, tile_ubo, raster, shaders, sample, stats)
+            gpu.state.face_culling_set("NONE")
+            gpu.state.front_facing_set(False)
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+        if not depth_only:
+            self._copy_scratch(x0, y0, n, shaders)
+            for src, fb in zip(self._scratch[3], self._rsm_framebuffers, strict=True):
+                self._copy_scratch(x0, y0, n, shaders, src, fb)
+            stats.passes += 1
+
+    def _draw_casters(self, shader, tile, casters, cull_front, stats):
+        """A tile's opaque casters with ``shader`` bound: whole, or per material part into the
+        reflective targets (its albedo); hair strips are drawn apart."""
+        import gpu
+
+        # Closed casters wholly in front of the light (w > 0 at every corner: no
+        # clipping, and the light outside them) cast with their faces toward the light.
+        front = set()
+        closed = [c for c in casters if c.closed] if not cull_front else []
+        if closed:
+            w_row = tile.fit.view_proj[3]
+            ok = np.all(np.stack([c.corners for c in closed]) @ w_row[:3] + w_row[3] > 0.0, axis=1)
+            front = {id(c) for c, inside in zip(closed, ok, strict=True) if inside}
+            stats.closed_culled += len(front)
+        for caster in casters:
+            if caster.hair is not None:
+                continue  # with the strips' program
+            if cull_front or caster.cull_back or id(caster) in front:
+                gpu.state.face_culling_set("FRONT" if cull_front else "BACK")
+                gpu.state.front_facing_set(caster.det < 0.0)
+            else:
+                gpu.state.face_culling_set("NONE")
+            shader.uniform_float("model", caster.model)
+            if self.rsm and caster.rsm_parts is not None:  # per material: its albedo
+                for batch, material_ubo in caster.rsm_parts:
+                    shader.uniform_block("material", material_ubo)
+                    batch.draw(shader)
+                    stats.draws += 1
+                    stats.shadow_draws += 1
+                stats.shadow_triangles += caster.triangles
+                continue
+            for batch in caster.batches:
+                batch.draw(shader)
+                stats.draws += 1
+                stats.shadow_draws += 1
+            stats.shadow_triangles += caster.triangles
+
+    def _render_instanced(self, plan, work, shaders, cull_front, stats, origin):
         """The opaque casters of the maps in ``work`` into the depth atlas, instanced: one draw
         per caster batch and group of its maps that share a program (orthographic tiles take
         the rasterised depth) and face culling, whatever the number of maps. The tiles go in
@@ -476,7 +500,7 @@ class ShadowAtlas:
                 bound, culling_now = None, None
                 for raster, culling, caster, part, base in chunk:
                     if bound is not raster:
-                        shader = program(raster, instanced=True)
+                        shader = self._program(shaders, raster, instanced=True)
                         shader.bind()
                         shader.uniform_block("tiles", tiles_ubo)
                         shader.uniform_block("instance_tiles", table_ubo)
@@ -531,16 +555,17 @@ class ShadowAtlas:
         self.uploaded += len(raw)
         return self._instanced.get(name, raw)
 
-    def _draw_strips_and_cutouts(
-        self, casters, tile_ubo, raster, shaders, defines, cutout, alpha_offset, origin, stats
-    ):
-        """A tile's hair strips and alpha cut-outs (both sides cast), with the tile's block bound."""
+    def _draw_strips_and_cutouts(self, casters, tile_ubo, raster, shaders, sample, stats):
+        """A tile's hair strips and alpha cut-outs (both sides cast), with the tile's block bound.
+        ``sample``: (alpha offset, frame origin)."""
         import gpu
 
         gpu.state.face_culling_set("NONE")  # alpha surfaces are often single planes: both sides cast
         strips = [c for c in casters if c.hair is not None]
         if strips:
-            hair = shaders.get(shadow_hair_program(self.depth_format, raster, rsm=self.rsm), defines)
+            hair = shaders.get(
+                shadow_hair_program(self.depth_format, raster, rsm=self.rsm), depth_defines(self.depth_format)
+            )
             hair.bind()
             hair.uniform_block("tile", tile_ubo)
             for caster in strips:
@@ -551,13 +576,16 @@ class ShadowAtlas:
                     stats.draws += 1
                     stats.shadow_draws += 1
                 stats.shadow_triangles += caster.triangles
+        alpha_offset, origin = sample
         for caster in casters:
-            for batch, material_ubo, texture, tree in caster.cutouts:
+            for part in caster.cutouts:
+                _batch, _material_ubo, texture, tree = part
                 if tree is not None:
-                    cut = shaders.get(shadow_tree_program(self.depth_format, tree.tree, raster, rsm=self.rsm), defines)
+                    program = shadow_tree_program(self.depth_format, tree.tree, raster, rsm=self.rsm)
+                    cut = shaders.get(program, depth_defines(self.depth_format))
                 else:
-                    cut = cutout(texture is not None, raster)
-                draw_cutout(cut, batch, material_ubo, texture, tree, tile_ubo, alpha_offset, caster.model, origin)
+                    cut = self._cutout_program(shaders, texture is not None, raster)
+                draw_cutout(cut, part, tile_ubo, alpha_offset, caster.model, origin)
                 stats.draws += 1
                 stats.shadow_draws += 1
 

@@ -10,7 +10,16 @@ import numpy as np
 from ..scene import simplify
 from ..scene.materials import Material
 from ..shadows import light_bins, lightspace
-from ..shadows.planning import MAX_SHADOW_TILES, Density, frame_sizes, frame_tiles, plan_shadows
+from ..shadows.planning import (
+    MAX_SHADOW_TILES,
+    Density,
+    FrameShare,
+    MapOptions,
+    ViewFit,
+    frame_sizes,
+    frame_tiles,
+    plan_shadows,
+)
 from . import sampling
 from .draw_list import corners_of
 from .programs import RSM_TEXEL_BYTES, image_premultiplied_bits
@@ -70,7 +79,7 @@ class ShadowPass:
 
     def first_plan(self, draws, lights, camera, settings, size, accumulate):
         """The frame's plan with every light at its centre. In a frame of several samples a sun
-        with an angle is fitted to hold every direction its samples take (``plan_shadows``'
+        with an angle is fitted to hold every direction its samples take (``FrameShare``'
         ``cones``), so each sample shears this plan's maps instead of fitting its own."""
         cones = reaches = None
         if accumulate:
@@ -95,7 +104,7 @@ class ShadowPass:
         sizes, derived maps) the frame's first plan kept (``sizes``); ``spread``: (sun cones,
         reaches) a first plan is fitted over (``first_plan``). With reflective maps (the
         bounce, ``begin_frame``) maps hold every visible surface the light reaches, not only
-        those a caster can shadow (``plan_shadows(reflective=True)``)."""
+        those a caster can shadow (``MapOptions.reflective``)."""
         sizes, derived = known if known is not None else (None, None)
         cones, reaches = spread if spread is not None else (None, None)
         corners = corners_of(draws)
@@ -112,26 +121,24 @@ class ShadowPass:
         if view_corners is not None and self._sun_parts is None:
             # Every sun fitted to the whole view (the world's directions too) fits to these.
             self._sun_parts = lightspace.view_parts(corners, view_corners)
-        return plan_shadows(
-            lights,
-            corners,
+        options = MapOptions(
             map_size,
-            view_corners,
-            camera,
             int(settings.shadow_cascades),
-            self.depth_range,
             kernel=fixed_kernel(settings),
             pcss=settings.shadow_filter == "PCSS",
-            receivers=self._receivers,
-            density=_density(camera, settings, size),
-            known_sizes=sizes,
             world_map_size=getattr(settings, "world_map_size", None),
             reflective=self.reflective,
-            sun_parts=self._sun_parts,
-            cones=cones,
-            derived=derived,
-            reaches=reaches,
         )
+        fit = ViewFit(
+            view_corners,
+            camera,
+            self.depth_range,
+            receivers=self._receivers,
+            density=_density(camera, settings, size),
+            sun_parts=self._sun_parts,
+        )
+        share = FrameShare(known_sizes=sizes, cones=cones, reaches=reaches, derived=derived)
+        return plan_shadows(lights, corners, options, fit, share)
 
     def draw(self, frame, sample):
         """Plan the maps ``sample`` (``renderer.Sample``: its draws and lights, planned from its

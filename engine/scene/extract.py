@@ -677,6 +677,120 @@ def _has_shape_keys(ob):
     return getattr(data, "shape_keys", None) is not None
 
 
+@dataclass(frozen=True)
+class _Object:
+    """One drawn instance as ``SceneCache.snapshot`` reads it: the depsgraph instance, its
+    evaluated object and original, its world matrix and whether the camera and shadows see it."""
+
+    inst: object
+    ob: object
+    orig: object
+    matrix: np.ndarray
+    camera: bool
+    shadow: bool
+
+
+class _Reading:
+    """What one ``SceneCache.snapshot`` gathers (instances, lights, portals, messages, the
+    geometry keys still used) and the per-object values it reads once per snapshot."""
+
+    def __init__(self, depsgraph):
+        self.depsgraph = depsgraph
+        self.render = depsgraph.mode == "RENDER"
+        # Render > Curves > Shape: Strand (a pixel wide) or Strip (the strands' radius; Cylinder too).
+        hair_type = getattr(depsgraph.scene.render, "hair_type", "STRIP")
+        self.strip_mode = "STRAND" if hair_type == "STRAND" else "STRIP"
+        self.instances, self.lights, self.portals, self.messages = [], [], [], []
+        self.used = set()
+        self._own, self._held, self._sets, self._terminators = {}, {}, {}, {}
+
+    def own_data(self, orig):
+        """Pointer of ``orig``'s own evaluated geometry (cached for this snapshot)."""
+        key = orig.name_full
+        if key not in self._own:
+            data = orig.evaluated_get(self.depsgraph).data
+            self._own[key] = data.as_pointer() if data is not None else 0
+        return self._own[key]
+
+    def linked(self, collection):
+        """A light linking collection's ``LinkSet``, read once per snapshot."""
+        if collection is None:
+            return None
+        key = collection.original.name_full if collection.original is not None else collection.name_full
+        if key not in self._sets:
+            self._sets[key] = link_set(collection.original or collection)
+        return self._sets[key]
+
+    def holdout(self, orig, inst):
+        """Object > Visibility > Holdout, or a collection set to Holdout in this view layer
+        (an instance takes its instancer's, as Blender's engines do)."""
+        base = inst.parent.original if inst.is_instance and inst.parent is not None else orig
+        key = base.name_full
+        if key not in self._held:
+            self._held[key] = bool(base.holdout_get(view_layer=self.depsgraph.view_layer))
+        return self._held[key] or bool(getattr(orig, "is_holdout", False))
+
+    def terminator(self, ob):
+        """Object > Shading > Shadow Terminator of ``ob`` (the instanced object's own, as
+        Cycles reads it), read once per object and snapshot."""
+        key = ob.name_full
+        if key not in self._terminators:
+            self._terminators[key] = Terminator.of(ob)
+        return self._terminators[key]
+
+    def light(self, inst):
+        """A light instance: a portal, or a light (with its links)."""
+        ob = inst.object
+        if is_portal(ob.data):
+            size_x = float(ob.data.size)
+            size_y = float(ob.data.size_y) if ob.data.shape in {"RECTANGLE", "ELLIPSE"} else size_x
+            self.portals.append((matrix_np(inst.matrix_world), size_x, size_y))
+            return
+        if ob.data.type == "AREA" and float(getattr(ob.data, "spread", math.pi)) < math.pi - 1e-6:
+            self.messages.append(f"area light '{ob.name}': Spread is not rendered (it emits over the whole half-space)")
+        light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
+        if light is not None:
+            light.name = ob.name
+            light.motion_key = motion_key(inst)
+            linking = getattr(ob, "light_linking", None)
+            if linking is not None:
+                light.receivers = self.linked(linking.receiver_collection)
+                light.blockers = self.linked(linking.blocker_collection)
+            self.lights.append(light)
+
+    def add(self, obj, key, geo, materials, strip=None):
+        """The instance of ``geo`` (kept under ``key``) drawn for ``obj`` with ``materials``;
+        ``strip``: hair strips' shape (Render > Curves > Shape), None for a surface."""
+        inst, ob, orig = obj.inst, obj.ob, obj.orig
+        self.used.add(key)
+        self.messages.extend(geo.messages)
+        for mat in materials:
+            if mat is not None:
+                self.messages.extend(mat.messages)
+        if strip is not None and obj.shadow and any(m is not None and m.uses_alpha for m in materials):
+            self.messages.append(
+                f"hair of '{ob.name}': its material's alpha is not drawn in shadows (strands cast solid)"
+            )
+        self.instances.append(
+            MeshInstance(
+                key=key,
+                matrix=obj.matrix,
+                materials=materials,
+                shadow=obj.shadow,
+                camera=obj.camera,
+                holdout=self.holdout(orig, inst),
+                terminator=self.terminator(ob) if strip is None else Terminator(),
+                color=tuple(float(c) for c in orig.color),
+                random=object_random(orig.name, inst),
+                names=(orig.name_full, inst.parent.original.name_full)
+                if inst.is_instance and inst.parent is not None
+                else (orig.name_full,),
+                hair=strip,
+                motion_key=motion_key(inst),
+            )
+        )
+
+
 class SceneCache:
     """Geometry cache of one engine instance, keyed by datablock, invalidated by updates."""
 
@@ -770,176 +884,102 @@ class SceneCache:
         return geo
 
     def snapshot(self, depsgraph):
+        """The scene as the renderer draws it: its instances, lights, portals and world, and
+        what it cannot draw (``messages``). Geometry and materials come from the cache where
+        unchanged; geometry no longer in the scene is forgotten."""
         scene = depsgraph.scene
-        instances = []
-        lights, portals = [], []
-        used = set()
-        own = {}
-
-        def own_data(orig):
-            """Pointer of ``orig``'s own evaluated geometry (cached for this snapshot)."""
-            key = orig.name_full
-            if key not in own:
-                data = orig.evaluated_get(depsgraph).data
-                own[key] = data.as_pointer() if data is not None else 0
-            return own[key]
-
-        held = {}
-        sets = {}
-
-        def linked(collection):
-            """A light linking collection's ``LinkSet``, read once per snapshot."""
-            if collection is None:
-                return None
-            key = collection.original.name_full if collection.original is not None else collection.name_full
-            if key not in sets:
-                sets[key] = link_set(collection.original or collection)
-            return sets[key]
-
-        def holdout(orig, inst):
-            """Object > Visibility > Holdout, or a collection set to Holdout in this view layer
-            (an instance takes its instancer's, as Blender's engines do)."""
-            base = inst.parent.original if inst.is_instance and inst.parent is not None else orig
-            key = base.name_full
-            if key not in held:
-                held[key] = bool(base.holdout_get(view_layer=depsgraph.view_layer))
-            return held[key] or bool(getattr(orig, "is_holdout", False))
-
-        terminators = {}
-
-        def terminator(ob):
-            """Object > Shading > Shadow Terminator of ``ob`` (the instanced object's own, as
-            Cycles reads it), read once per object and snapshot."""
-            key = ob.name_full
-            if key not in terminators:
-                terminators[key] = Terminator.of(ob)
-            return terminators[key]
-
-        messages = []
-        render = depsgraph.mode == "RENDER"
-        # Render > Curves > Shape: Strand (a pixel wide) or Strip (the strands' radius; Cylinder too).
-        strip_mode = "STRAND" if getattr(scene.render, "hair_type", "STRIP") == "STRAND" else "STRIP"
+        reading = _Reading(depsgraph)
         for inst in depsgraph.object_instances:
-            ob = inst.object
-            if ob.type == "LIGHT":
-                if is_portal(ob.data):
-                    size_x = float(ob.data.size)
-                    size_y = float(ob.data.size_y) if ob.data.shape in {"RECTANGLE", "ELLIPSE"} else size_x
-                    portals.append((matrix_np(inst.matrix_world), size_x, size_y))
-                    continue
-                if ob.data.type == "AREA" and float(getattr(ob.data, "spread", math.pi)) < math.pi - 1e-6:
-                    messages.append(
-                        f"area light '{ob.name}': Spread is not rendered (it emits over the whole half-space)"
-                    )
-                light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
-                if light is not None:
-                    light.name = ob.name
-                    light.motion_key = motion_key(inst)
-                    linking = getattr(ob, "light_linking", None)
-                    if linking is not None:
-                        light.receivers = linked(linking.receiver_collection)
-                        light.blockers = linked(linking.blocker_collection)
-                    lights.append(light)
-                continue
-            if ob.type in _NOT_DRAWN:
-                messages.append(f"{_NOT_DRAWN[ob.type]} '{ob.name}' is not drawn")
-                continue
-            if ob.type not in GEOMETRY_TYPES and ob.type != "CURVES":
-                continue
-            systems = hair.particle_hair(ob, render) if ob.type in GEOMETRY_TYPES else []
-            if ob.type != "CURVES" and not systems and not inst.is_instance and not inst.show_self:
-                continue  # a particle emitter with Show Emitter off for this render
-            matrix = matrix_np(inst.matrix_world)
-            if not np.all(np.isfinite(matrix)):
-                print(f"Penumbra: object '{ob.name}' has a non-finite matrix; skipped", file=sys.stderr)
-                continue
-            orig = ob.original if ob.original is not None else ob
-            camera, shadow = bool(orig.visible_camera), bool(orig.visible_shadow)
-            if not (camera or shadow):
-                continue
-
-            def add(key, geo, materials, strip=None):
-                """The instance of ``geo`` (kept under ``key``) with ``materials``."""
-                used.add(key)
-                messages.extend(geo.messages)
-                for mat in materials:
-                    if mat is not None:
-                        messages.extend(mat.messages)
-                if strip is not None and shadow and any(m is not None and m.uses_alpha for m in materials):
-                    messages.append(
-                        f"hair of '{ob.name}': its material's alpha is not drawn in shadows (strands cast solid)"
-                    )
-                instances.append(
-                    MeshInstance(
-                        key=key,
-                        matrix=matrix,
-                        materials=materials,
-                        shadow=shadow,
-                        camera=camera,
-                        holdout=holdout(orig, inst),
-                        terminator=terminator(ob) if strip is None else Terminator(),
-                        color=tuple(float(c) for c in orig.color),
-                        random=object_random(orig.name, inst),
-                        names=(orig.name_full, inst.parent.original.name_full)
-                        if inst.is_instance and inst.parent is not None
-                        else (orig.name_full,),
-                        hair=strip,
-                        motion_key=motion_key(inst),
-                    )
-                )
-
-            slots = [self._material(slot.material) for slot in ob.material_slots]
-            if ob.type == "CURVES":
-                key, deps = _geometry_key(inst, ob, own_data)
-                geo = self._strips_for(key, deps, lambda ob=ob: hair.geometry_from_curves(ob.data))
-                if geo.triangle_count:
-                    add(key, geo, slots, strip_mode)
-                continue
-            for psys in systems:
-                settings = psys.settings
-                key = ("PS", orig.name_full, psys.name)
-                deps = frozenset({orig.name_full, settings.original.name_full if settings.original else settings.name})
-                geo = self._strips_for(
-                    key, deps, lambda ob=ob, psys=psys: hair.geometry_from_particles(ob, psys, render)
-                )
-                index = int(settings.material) - 1  # the particle settings' material slot (1-based)
-                mat = slots[index] if 0 <= index < len(slots) else None
-                if geo.triangle_count:
-                    add(key, geo, [mat], strip_mode)
-            if not inst.is_instance and not inst.show_self:
-                continue  # a particle emitter with Show Emitter off for this render
-            materials = slots
-            needs, extra = Needs.of(materials, ob.data if ob.type == "MESH" else None)
-            if extra[0] or extra[1]:
-                messages.append(
-                    f"object '{ob.name}': its materials read several UV maps or colour attributes; only "
-                    f"{needs.uv_map or 'the active UV map'} / {needs.color_attribute or 'the active colour attribute'} "
-                    "is drawn"
-                )
-            key, deps = _geometry_key(inst, ob, own_data)
-            if needs.any:
-                key = (*key, needs)
-            geo = self._geometry_for(inst, ob, key, deps, needs)
-            if geo is None or geo.triangle_count == 0:
-                continue
-            add(key, geo, materials)
-        if any(i.hair for i in instances) and int(getattr(scene.render, "hair_subdiv", 0)) > 0:
+            if inst.object.type == "LIGHT":
+                reading.light(inst)
+            else:
+                self._read_object(reading, inst)
+        messages = reading.messages
+        if any(i.hair for i in reading.instances) and int(getattr(scene.render, "hair_subdiv", 0)) > 0:
             messages.append("Render > Curves > Additional Subdivision is not drawn (strands keep their own points)")
         # Forget geometry no longer in the scene so its GPU buffers are freed.
-        for key in [k for k in self.geometry if k not in used]:
+        for key in [k for k in self.geometry if k not in reading.used]:
             del self.geometry[key]
         world = self._world(scene)
         messages += world.messages
         return Snapshot(
-            instances=instances,
-            lights=lights,
+            instances=reading.instances,
+            lights=reading.lights,
             world_color=world.mean,
             geometry=self.geometry,
             world=world,
             messages=tuple(f"Penumbra: {m}" for m in dict.fromkeys(messages)),
             images_changed=frozenset(self._take_images_changed()),
-            portals=tuple(portals),
+            portals=tuple(reading.portals),
         )
+
+    def _read_object(self, reading, inst):
+        """A non-light instance: its hair (curves, particle systems) and its surface, where
+        drawn and seen by the camera or shadows."""
+        ob = inst.object
+        if ob.type in _NOT_DRAWN:
+            reading.messages.append(f"{_NOT_DRAWN[ob.type]} '{ob.name}' is not drawn")
+            return
+        if ob.type not in GEOMETRY_TYPES and ob.type != "CURVES":
+            return
+        systems = hair.particle_hair(ob, reading.render) if ob.type in GEOMETRY_TYPES else []
+        if ob.type != "CURVES" and not systems and not inst.is_instance and not inst.show_self:
+            return  # a particle emitter with Show Emitter off for this render
+        matrix = matrix_np(inst.matrix_world)
+        if not np.all(np.isfinite(matrix)):
+            print(f"Penumbra: object '{ob.name}' has a non-finite matrix; skipped", file=sys.stderr)
+            return
+        orig = ob.original if ob.original is not None else ob
+        camera, shadow = bool(orig.visible_camera), bool(orig.visible_shadow)
+        if not (camera or shadow):
+            return
+        obj = _Object(inst, ob, orig, matrix, camera, shadow)
+        slots = [self._material(slot.material) for slot in ob.material_slots]
+        if ob.type == "CURVES":
+            key, deps = _geometry_key(inst, ob, reading.own_data)
+            geo = self._strips_for(key, deps, lambda ob=ob: hair.geometry_from_curves(ob.data))
+            if geo.triangle_count:
+                reading.add(obj, key, geo, slots, reading.strip_mode)
+            return
+        self._read_particle_hair(reading, obj, systems, slots)
+        if not inst.is_instance and not inst.show_self:
+            return  # a particle emitter with Show Emitter off for this render
+        self._read_surface(reading, obj, slots)
+
+    def _read_particle_hair(self, reading, obj, systems, slots):
+        """The strips of the hair particle ``systems`` of ``obj``, each with its settings'
+        material slot of ``slots``."""
+        ob, orig = obj.ob, obj.orig
+        for psys in systems:
+            settings = psys.settings
+            key = ("PS", orig.name_full, psys.name)
+            deps = frozenset({orig.name_full, settings.original.name_full if settings.original else settings.name})
+            geo = self._strips_for(
+                key, deps, lambda ob=ob, psys=psys: hair.geometry_from_particles(ob, psys, reading.render)
+            )
+            index = int(settings.material) - 1  # the particle settings' material slot (1-based)
+            mat = slots[index] if 0 <= index < len(slots) else None
+            if geo.triangle_count:
+                reading.add(obj, key, geo, [mat], reading.strip_mode)
+
+    def _read_surface(self, reading, obj, materials):
+        """The surface of ``obj`` (a mesh, or what another geometry type evaluates to) with
+        the vertex data its ``materials`` read."""
+        inst, ob = obj.inst, obj.ob
+        needs, extra = Needs.of(materials, ob.data if ob.type == "MESH" else None)
+        if extra[0] or extra[1]:
+            reading.messages.append(
+                f"object '{ob.name}': its materials read several UV maps or colour attributes; only "
+                f"{needs.uv_map or 'the active UV map'} / {needs.color_attribute or 'the active colour attribute'} "
+                "is drawn"
+            )
+        key, deps = _geometry_key(inst, ob, reading.own_data)
+        if needs.any:
+            key = (*key, needs)
+        geo = self._geometry_for(inst, ob, key, deps, needs)
+        if geo is None or geo.triangle_count == 0:
+            return
+        reading.add(obj, key, geo, materials)
 
     def _take_images_changed(self):
         changed, self.images_changed = self.images_changed, set()

@@ -90,31 +90,7 @@ def cluster(geo, level):
     if not kept.any() or kept.sum() > WORTH * len(tris):  # nothing, or too much, would be left
         return None
 
-    # Plane quadrics of the triangles (weighted by area), summed per cluster of each corner.
-    a, b, c = p[tris[:, 0]], p[tris[:, 1]], p[tris[:, 2]]
-    n = np.cross(b - a, c - a)
-    length = np.linalg.norm(n, axis=1)
-    unit = n / np.where(length > 0.0, length, 1.0)[:, None]
-    plane = np.concatenate([unit, -np.einsum("ij,ij->i", unit, a)[:, None]], axis=1)
-    plane *= np.sqrt(0.5 * length)[:, None]
-    rows, cols = np.triu_indices(4)
-    quadric = np.zeros((count, 10))  # the upper triangle of each cluster's 4x4 quadric
-    for k, (row, col) in enumerate(zip(rows, cols, strict=True)):
-        q = plane[:, row] * plane[:, col]
-        for j in range(3):
-            quadric[:, k] += np.bincount(corner[:, j], q, count)
-    full = np.zeros((count, 4, 4))
-    full[:, rows, cols] = quadric
-    full[:, cols, rows] = quadric
-    weight = np.bincount(cluster_of, minlength=count).astype(np.float64)
-    mean = np.stack([np.bincount(cluster_of, p[:, k], count) for k in range(3)], axis=1) / weight[:, None]
-    # Minimise x^T A x + 2 b.x, pulled slightly towards the cluster's mean so that flat or
-    # straight clusters (a singular A) stay put; then kept inside the cell and the bounds.
-    big_a, small_b = full[:, :3, :3], full[:, :3, 3]
-    reg = (1e-3 * np.trace(big_a, axis1=1, axis2=2) / 3.0 + 1e-300)[:, None, None] * np.eye(3)
-    rhs = np.einsum("nij,nj->ni", reg, mean) - small_b
-    x = np.linalg.solve(big_a + reg, rhs[..., None])[..., 0]
-    x = np.where(np.isfinite(x), x, mean)
+    x, n, unit, length = _quadric_points(p, tris, corner, cluster_of, count)
     cmin = lo + np.stack([cell_index // (cells * cells), cell_index // cells % cells, cell_index % cells], 1) * cell
     x = np.clip(x, np.maximum(cmin, lo), np.minimum(cmin + cell, hi))
 
@@ -139,7 +115,57 @@ def cluster(geo, level):
     values, starts, counts = np.unique(mats, return_index=True, return_counts=True)
     ranges = [(int(m), int(s), int(k)) for m, s, k in zip(values, starts, counts, strict=True)]
 
-    if _flat(unit, geo.normals, tris, length):
+    positions, normals, indices = _shaded(
+        x, new, cluster_of, count, geo.normals, _flat(unit, geo.normals, tris, length)
+    )
+    return Geometry(
+        np.ascontiguousarray(positions, np.float32),
+        np.ascontiguousarray(normals, np.float32),
+        np.ascontiguousarray(indices, np.int32),
+        ranges,
+        np.array([lo, hi]),
+        smooth=geo.smooth,
+    )
+
+
+def _quadric_points(p, tris, corner, cluster_of, count):
+    """Where each of ``count`` clusters puts its vertex: the point of least squared distance
+    to the planes of its corners' triangles (Lindstrom's quadrics, see the module). ``p``: the
+    vertices, ``tris`` their triangles, ``corner`` the clusters of each triangle's corners and
+    ``cluster_of`` each vertex's. Returns (points, the triangles' normals scaled by twice their
+    area, their unit normals, that length)."""
+    # Plane quadrics of the triangles (weighted by area), summed per cluster of each corner.
+    a, b, c = p[tris[:, 0]], p[tris[:, 1]], p[tris[:, 2]]
+    n = np.cross(b - a, c - a)
+    length = np.linalg.norm(n, axis=1)
+    unit = n / np.where(length > 0.0, length, 1.0)[:, None]
+    plane = np.concatenate([unit, -np.einsum("ij,ij->i", unit, a)[:, None]], axis=1)
+    plane *= np.sqrt(0.5 * length)[:, None]
+    rows, cols = np.triu_indices(4)
+    quadric = np.zeros((count, 10))  # the upper triangle of each cluster's 4x4 quadric
+    for k, (row, col) in enumerate(zip(rows, cols, strict=True)):
+        q = plane[:, row] * plane[:, col]
+        for j in range(3):
+            quadric[:, k] += np.bincount(corner[:, j], q, count)
+    full = np.zeros((count, 4, 4))
+    full[:, rows, cols] = quadric
+    full[:, cols, rows] = quadric
+    weight = np.bincount(cluster_of, minlength=count).astype(np.float64)
+    mean = np.stack([np.bincount(cluster_of, p[:, k], count) for k in range(3)], axis=1) / weight[:, None]
+    # Minimise x^T A x + 2 b.x, pulled slightly towards the cluster's mean so that flat or
+    # straight clusters (a singular A) stay put; then kept inside the cell and the bounds.
+    big_a, small_b = full[:, :3, :3], full[:, :3, 3]
+    reg = (1e-3 * np.trace(big_a, axis1=1, axis2=2) / 3.0 + 1e-300)[:, None, None] * np.eye(3)
+    rhs = np.einsum("nij,nj->ni", reg, mean) - small_b
+    x = np.linalg.solve(big_a + reg, rhs[..., None])[..., 0]
+    return np.where(np.isfinite(x), x, mean), n, unit, length
+
+
+def _shaded(x, new, cluster_of, count, vertex_normals, flat):
+    """(positions, normals, indices) of the triangles ``new`` over the cluster points ``x``:
+    each triangle on three vertices of its own normal when ``flat``, else the clusters'
+    vertices with the mean of their original ``vertex_normals``."""
+    if flat:
         # Flat shading: every triangle its own normal, on its own three vertices.
         pa, pb, pc = x[new[:, 0]], x[new[:, 1]], x[new[:, 2]]
         fn = np.cross(pb - pa, pc - pa)
@@ -149,21 +175,14 @@ def cluster(geo, level):
         indices = np.arange(len(positions)).reshape(-1, 3)
     else:
         # Smooth shading: the cluster's original normals averaged.
-        nsum = np.stack([np.bincount(cluster_of, geo.normals[:, k], count) for k in range(3)], axis=1)
+        nsum = np.stack([np.bincount(cluster_of, vertex_normals[:, k], count) for k in range(3)], axis=1)
         norm = np.linalg.norm(nsum, axis=1)
         normals = np.where(norm[:, None] > 1e-12, nsum / np.where(norm > 0.0, norm, 1.0)[:, None], (0.0, 0.0, 1.0))
         used = np.zeros(count, bool)
         used[new.ravel()] = True
         remap = np.cumsum(used) - 1
         positions, normals, indices = x[used], normals[used], remap[new]
-    return Geometry(
-        np.ascontiguousarray(positions, np.float32),
-        np.ascontiguousarray(normals, np.float32),
-        np.ascontiguousarray(indices, np.int32),
-        ranges,
-        np.array([lo, hi]),
-        smooth=geo.smooth,
-    )
+    return positions, normals, indices
 
 
 def _positions(p):
@@ -192,5 +211,5 @@ def _flat(unit, normals, tris, length):
     ok = length > 0.0
     if not ok.any():
         return True
-    corner_normals = np.asarray(normals, np.float64)[tris[ok]]  # (t, 3, 3)
-    return bool(np.all(np.einsum("tj,tkj->tk", unit[ok], corner_normals) > 1.0 - 1.5e-6))
+    vertex_normals = np.asarray(normals, np.float64)[tris[ok]]  # (t, 3, 3)
+    return bool(np.all(np.einsum("tj,tkj->tk", unit[ok], vertex_normals) > 1.0 - 1.5e-6))

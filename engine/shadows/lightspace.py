@@ -184,7 +184,7 @@ def sheared(fit, direction):
 def moved(fit, offset):
     """A perspective ``fit`` with its eye moved by ``offset`` (world), its axes, window and
     depth range kept: the off-axis map of a point of a light that the frame planned at its
-    centre (``planning.plan_shadows``' ``reaches``: the plan then holds every point within the
+    centre (``planning.FrameShare.reaches``: the plan then holds every point within the
     light's reach). Returns ``fit`` itself for no move (so an unmoved map is reused)."""
     offset = np.asarray(offset, dtype=np.float64)
     if not np.any(offset) or not np.all(np.isfinite(offset)):
@@ -504,9 +504,7 @@ def view_parts(corners, view_corners):
     return clipped_points(boxes, hull_planes(view_corners), per_box=True)
 
 
-def fit_sun_to_view(
-    direction, corners, view_corners, map_size, padding_texels=2.0, soft=0.0, flat_free=None, parts=None, cone=0.0
-):
+def fit_sun_to_view(direction, corners, view_corners, map_size, soft=0.0, flat_free=None, parts=None, cone=0.0):
     """Tight sun fit (a loose box wastes the map's texels; cf. Lauritzen, Salvi and Lefohn 2011,
     "Sample Distribution Shadow Maps"): the map covers only the receivers
     the camera can see that some caster can shadow, and every caster that can shadow them.
@@ -581,7 +579,7 @@ def fit_sun_to_view(
         reach = max_filter_radius(map_size) * texel / float(soft)
         hi[2] = max(hi[2], min(float(bhi[casters, 2].max()), hi[2] + reach))
     scale = float(np.abs(np.concatenate([lo, hi])).max())
-    fit = _ortho_fit(view, lo, hi, scale, map_size, padding_texels)
+    fit = _ortho_fit(view, lo, hi, scale, map_size)
     fit.pivot = pivot
     return fit, casters
 

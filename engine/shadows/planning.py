@@ -15,6 +15,7 @@ Tiles whose fit and casters did not change since the last frame are not redrawn.
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -120,38 +121,66 @@ def needed_size(tile, size, receivers, density, per_pixel):
     return min(size, 2 ** math.ceil(math.log2(need) - 1e-9))
 
 
-def perspective_tile(
-    position,
-    forward,
-    fov,
-    corners,
-    lo,
-    hi,
-    map_size,
-    kernel=0.0,
-    soft_radius=0.0,
-    receivers=None,
-    flat_free=None,
-    memo=None,
-):
-    """A perspective tile at ``position`` along ``forward``, or None without casters in it.
+class Eye(NamedTuple):
+    """Where a perspective map looks from: the light's ``position``, the unit ``forward`` it
+    looks along and the ``fov`` (radians) of its square frustum."""
+
+    position: np.ndarray
+    forward: np.ndarray
+    fov: float
+
+
+class Boxes(NamedTuple):
+    """The boxes a map is planned over: ``corners`` (N, 8, 3) and their (N, 3) bounds."""
+
+    corners: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+
+    @classmethod
+    def of(cls, corners):
+        return cls(corners, corners.min(axis=1), corners.max(axis=1))
+
+
+class Crop(NamedTuple):
+    """What a perspective map is cropped to (``perspective_tile``): the visible ``receivers``
+    (``lightspace.Receivers``) and ``flat_free``, the flat boxes that shadow nothing (None:
+    not tested)."""
+
+    receivers: object
+    flat_free: np.ndarray = None
+
+
+class _Frustum(NamedTuple):
+    """A perspective map's frustum before it is cropped: its view matrix, field of view and depth range."""
+
+    view: np.ndarray
+    fov: float
+    near: float
+    far: float
+
+
+def perspective_tile(eye, boxes, map_size, kernel=0.0, soft_radius=0.0, crop=None, memo=None):
+    """A perspective tile from ``eye`` (an ``Eye``) over ``boxes`` (``Boxes``), or None
+    without casters in it.
 
     ``kernel`` (texels) or ``soft_radius`` (world: a PCSS light's radius) widen the map past
-    ``fov`` by the widest filter kernel it can be read with, so a filter near its edge reads
-    texels of this map instead of "nothing there": cube faces then meet without a lit seam.
-    A PCSS kernel is widest for the nearest caster: radius / near, in texels of the map; the
-    widening stops at CUBE_PAD_FRACTION of the map per side (wider penumbrae may still show a
-    faint seam).
+    the eye's fov by the widest filter kernel it can be read with, so a filter near its edge
+    reads texels of this map instead of "nothing there": cube faces then meet without a lit
+    seam. A PCSS kernel is widest for the nearest caster: radius / near, in texels of the map;
+    the widening stops at CUBE_PAD_FRACTION of the map per side (wider penumbrae may still
+    show a faint seam).
 
-    With ``receivers`` (``lightspace.Receivers``: what the camera sees) the map is cropped to
-    the window, in the light's view, of the visible receivers that some caster can shadow:
-    the casters' window (``flat_free``: flat boxes that shadow nothing are not casters),
-    widened by how far a penumbra reaches out of it, cut to the receivers' window. No
-    visible receiver in reach of a caster: no map.
+    With ``crop`` (a ``Crop``: what the camera sees) the map is cropped to the window, in the
+    light's view, of the visible receivers that some caster can shadow: the casters' window
+    (flat boxes that shadow nothing are not casters), widened by how far a penumbra reaches
+    out of it, cut to the receivers' window. No visible receiver in reach of a caster: no map.
 
     ``memo`` (a dict kept for one light and frame) holds what does not depend on the map's
     size, for planning the same light again at another size."""
     memo = {} if memo is None else memo
+    position, forward, fov = eye
+    corners = boxes.corners
     face = np.asarray(forward, dtype=np.float64).tobytes()
     reach = float(np.linalg.norm(corners.reshape(-1, 3) - position, axis=1).max()) * 1.01
     if not np.isfinite(reach) or reach <= 0.0:
@@ -175,7 +204,7 @@ def perspective_tile(
         far = float(z.max()) * 1.01
         if far <= 0.0:
             return None
-        near = max(_near_bound(position, lo[inside], hi[inside], fov / 2.0) * 0.99, far * 1e-5)
+        near = max(_near_bound(position, boxes.lo[inside], boxes.hi[inside], fov / 2.0) * 0.99, far * 1e-5)
         return inside, near, far
 
     got = fitted(fov)
@@ -192,15 +221,16 @@ def perspective_tile(
     else:
         pad = 0.0
     inside, near, far = got
-    if receivers is not None:
+    if crop is not None:
+        frustum = _Frustum(view, fov, near, far)
         key = (face, "window", fov, near, far)
         if key not in memo:
-            memo[key] = _window(view, fov, near, far, corners, inside, receivers, flat_free, soft_radius)
-        crop = _crop(view, fov, near, far, size, corners, receivers, pad, memo[key])
-        if crop is _NOTHING:
+            memo[key] = _window(frustum, corners, inside, crop, soft_radius)
+        cropped = _crop(frustum, size, corners, crop.receivers, pad, memo[key])
+        if cropped is _NOTHING:
             return None
-        if crop is not None:
-            proj, per_distance, inside, far, held = crop
+        if cropped is not None:
+            proj, per_distance, inside, far, held = cropped
             tile = Tile(lightspace.Fit(view, proj, near, far, texel_per_distance=per_distance), inside)
             tile.held = held
             return tile
@@ -212,10 +242,12 @@ def perspective_tile(
 _NOTHING = object()  # _crop: no visible receiver in reach of a caster
 
 
-def _window(view, fov, near, far, corners, inside, receivers, flat_free, soft_radius):
+def _window(frustum, corners, inside, crop, soft_radius):
     """The window (tangent units, lower and upper corner) of the visible receivers some caster
-    can shadow in a perspective map of ``fov`` and [near, far], with those casters; or
-    _NOTHING. Does not depend on the map's size."""
+    (of ``inside``) can shadow in the perspective map ``frustum`` (a ``_Frustum``), with those
+    casters; or _NOTHING. Does not depend on the map's size."""
+    view, fov, near, far = frustum
+    receivers, flat_free = crop
     half = math.tan(fov / 2.0)
     planes = light_bins.frustum_planes(lightspace.perspective(fov, 1.0, near, far) @ view)
     seen = lightspace.pieces_in(planes, receivers.whole, receivers.pieces)
@@ -238,12 +270,14 @@ def _window(view, fov, near, far, corners, inside, receivers, flat_free, soft_ra
     return w_lo, w_hi, casters
 
 
-def _crop(view, fov, near, far, size, corners, receivers, pad, window):
-    """A perspective map cut to what it must hold (see ``perspective_tile``): (projection,
-    texel per distance, casters, far, the visible receivers' points it holds), None when
-    cropping gains nothing, or _NOTHING. ``window``: ``_window``'s answer."""
+def _crop(frustum, size, corners, receivers, pad, window):
+    """The perspective map ``frustum`` of ``size`` texels cut to what it must hold (see
+    ``perspective_tile``): (projection, texel per distance, casters, far, the visible
+    receivers' points it holds), None when cropping gains nothing, or _NOTHING. ``window``:
+    ``_window``'s answer."""
     if window is _NOTHING:
         return _NOTHING
+    view, fov, near, far = frustum
     w_lo, w_hi, casters = window
     half = math.tan(fov / 2.0)
     # Square texels, the extent quantised in 2^(1/4) steps and the window snapped to whole
@@ -291,220 +325,290 @@ def behind_area_light(face_forward, light_direction):
     return float(np.dot(face_forward, -np.asarray(light_direction))) >= _BEHIND_COS
 
 
-def plan_shadows(
-    lights,
-    corners,
-    map_size,
-    view_corners=None,
-    camera=None,
-    cascades=0,
-    depth_range=None,
-    kernel=2.0,
-    pcss=False,
-    receivers=None,
-    density=None,
-    known_sizes=None,
-    world_map_size=None,
-    reflective=False,
-    sun_parts=None,
-    cones=None,
-    derived=None,
-    reaches=None,
-):
-    """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
-    instance's bounds; ``view_corners``: the camera frustum's corners, to fit suns tightly to
-    what the camera sees (all geometry when None). With ``camera`` (an ``extract.Camera``) a
-    sun splits the visible depth range into ``cascades`` maps (0: chosen from the range, see
-    ``lightspace.cascade_count``), each fitted to its slice; ``depth_range``: the camera's
-    visible (near, far), when the caller already has it. ``kernel``: the radius (texels) of
-    the scene's fixed shadow filter; ``pcss``: the scene's filter is PCSS (lights sampled
-    over their extent always are); maps are widened by what their filter reads.
-    ``receivers``: ``lightspace.visible_receivers`` of the camera, when the caller has them.
-    ``density`` (a ``Density``): each light's maps get the fewest texels (a power of two, at
-    most ``map_size``) that still give every visible receiver they hold that many texels per
-    screen pixel (times the fixed filter's radius: its blur stays within half a pixel); the
-    light is then planned again at that size. Tiles carry the size they were planned with.
+@dataclass(frozen=True)
+class MapOptions:
+    """How a frame's maps are made (``plan_shadows``). ``map_size``: texels a side of a map at
+    most. ``cascades``: the cascades a sun fitted to the view splits its depth range into (0:
+    chosen from the range, see ``lightspace.cascade_count``). ``kernel``: the radius (texels)
+    of the scene's fixed shadow filter; ``pcss``: the scene's filter is PCSS (lights sampled
+    over their extent always are); maps are widened by what their filter reads. A direction
+    of the world's light (``light.world``) gets one map fitted to everything the camera sees
+    (no cascades) of at most ``world_map_size`` texels a side. ``reflective``: the maps are
+    also reflective shadow maps (the diffuse bounce), whose texels are the senders of bounced
+    light: every box counts as a caster (flat ones too), so a map covers every visible
+    receiver its light reaches, not only those a caster can shadow."""
+
+    map_size: int
+    cascades: int = 0
+    kernel: float = 2.0
+    pcss: bool = False
+    world_map_size: int = None
+    reflective: bool = False
+
+
+@dataclass(frozen=True)
+class ViewFit:
+    """What the maps are fitted to (``plan_shadows``). ``view_corners``: the camera frustum's
+    corners, to fit suns tightly to what the camera sees (all geometry when None). With
+    ``camera`` (an ``extract.Camera``) a sun splits the visible depth range into cascades,
+    each fitted to its slice; ``depth_range``: the camera's visible (near, far), when the
+    caller already has it. ``receivers``: ``lightspace.visible_receivers`` of the camera, when
+    the caller has them. ``density`` (a ``Density``): each light's maps get the fewest texels
+    (a power of two, at most the map size) that still give every visible receiver they hold
+    that many texels per screen pixel (times the fixed filter's radius: its blur stays within
+    half a pixel); the light is then planned again at that size. ``sun_parts``:
+    ``lightspace.view_parts(corners, view_corners)``, when the caller keeps them for the frame
+    (every sun fitted to the whole view reads them; else once a plan)."""
+
+    view_corners: np.ndarray = None
+    camera: object = None
+    depth_range: tuple = None
+    receivers: object = None
+    density: Density = None
+    sun_parts: tuple = None
+
+
+@dataclass(frozen=True)
+class FrameShare:
+    """What the samples of one frame share of its first plan (``plan_shadows``).
+
     ``known_sizes``: {light index: texels a side of each of its maps} (``frame_sizes`` of the
     frame's first plan): those lights are planned once, at those sizes, with no density pass;
     so every sample of a frame draws a light's maps at one size, and planning a further
-    sample costs one fit per map, not two. A direction of the world's light (``light.world``)
-    gets one map fitted to everything the camera sees (no cascades) of at most
-    ``world_map_size`` texels a side.
-    ``reflective``: the maps are also reflective shadow maps (the diffuse bounce), whose
-    texels are the senders of bounced light: every box counts as a caster (flat ones too), so
-    a map covers every visible receiver its light reaches, not only those a caster can shadow.
-    ``sun_parts``: ``lightspace.view_parts(corners, view_corners)``, when the caller keeps
-    them for the frame (every sun fitted to the whole view reads them; else once a plan).
-    ``cones``: {light index: tangent of the widest angle its samples turn it} for suns: their
-    maps are fitted to hold every direction of that cone (``fit_sun_to_view(cone=)``), as the
-    frame's first plan does for the suns its samples shear. ``reaches``: {light index: how far
-    its sampled points lie from its centre} for spot, point and area lights: their maps are
-    planned over the scene's boxes and receivers grown by that much
-    (``lightspace.dilated_boxes``), so they hold what any of those points needs, from the
-    same window, once the eye moves there (``lightspace.moved``). ``derived``: {light index:
-    (mode, tiles, position) of the frame's first plan}: those lights are not planned again,
-    each tile is the first plan's sheared to the sun's direction or moved to the light's
-    position (planning a sample costs a matrix product).
+    sample costs one fit per map, not two. ``cones``: {light index: tangent of the widest
+    angle its samples turn it} for suns: their maps are fitted to hold every direction of that
+    cone (``fit_sun_to_view(cone=)``), as the frame's first plan does for the suns its samples
+    shear. ``reaches``: {light index: how far its sampled points lie from its centre} for
+    spot, point and area lights: their maps are planned over the scene's boxes and receivers
+    grown by that much (``lightspace.dilated_boxes``), so they hold what any of those points
+    needs, from the same window, once the eye moves there (``lightspace.moved``).
+    ``derived``: {light index: (mode, tiles, position) of the frame's first plan}: those
+    lights are not planned again, each tile is the first plan's sheared to the sun's direction
+    or moved to the light's position (planning a sample costs a matrix product)."""
+
+    known_sizes: dict = None
+    cones: dict = None
+    reaches: dict = None
+    derived: dict = None
+
+
+@dataclass
+class _Scene:
+    """What every light of one ``plan_shadows`` call is planned over: the boxes, the options
+    and view, the sun's cascade slices and what the camera sees."""
+
+    boxes: Boxes
+    options: MapOptions
+    view: ViewFit
+    slices: list
+    receivers: object
+    sun_parts: tuple  # what the camera sees of every box, once a sun fitted to the whole view needs it
+
+    def parts(self):
+        if self.sun_parts is None:
+            self.sun_parts = lightspace.view_parts(self.boxes.corners, self.view.view_corners)
+        return self.sun_parts
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One light as it is planned: ``flat_free`` (flat boxes that shadow nothing under it, or
+    None: not tested), ``memo`` (``perspective_tile``'s, kept for the light), its sun ``cone``
+    and its ``reach`` (``FrameShare``), and whether its maps are read with PCSS (``soft``: the
+    scene's filter is PCSS, or the light is sampled over its extent)."""
+
+    light: object
+    flat_free: np.ndarray
+    memo: dict
+    cone: float
+    reach: float
+    soft: bool
+
+
+def plan_shadows(lights, corners, options, view=None, share=None):
+    """Decide the maps of a frame. ``corners``: (N, 8, 3) world corners of every drawn
+    instance's bounds; ``options`` (``MapOptions``): how the maps are made; ``view``
+    (``ViewFit``): what they are fitted to (all geometry when None); ``share``
+    (``FrameShare``): what a frame's later samples take from its first plan.
+    Tiles carry the size they were planned with.
     Returns a ShadowPlan; tiles beyond MAX_SHADOW_TILES are not planned (``plan.unshadowed``
     counts those lights, which render unshadowed)."""
+    view = ViewFit() if view is None else view
+    share = FrameShare() if share is None else share
     plan = ShadowPlan()
     corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(corners) == 0:
         return plan
-    slices = _cascade_slices(corners, view_corners, camera, cascades, depth_range)
+    slices = _cascade_slices(corners, view.view_corners, view.camera, options.cascades, view.depth_range)
     # What the camera sees, once for every spot, point and area map of the frame.
-    if receivers is None and camera is not None:
-        receivers = lightspace.visible_receivers(corners, camera.projection @ camera.view)
-    lo = corners.min(axis=1)
-    hi = corners.max(axis=1)
-    everything = np.arange(len(corners))
-    memo_parts = [sun_parts]  # what the camera sees of every box, for suns fitted to the whole view
-
-    def flat_free_of(light):
-        """Flat boxes that shadow nothing under ``light`` (None: not tested)."""
-        if reflective:  # every lit surface sends light: none is left out
-            return np.zeros(len(corners), dtype=bool) if light.type == "SUN" and view_corners is not None else None
-        if light.type != "SUN":
-            return lightspace.flat_casters_without_shadow(corners, position=light.position)
-        return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
-
-    def grown(memo, reach):
-        """The boxes (corners, lo, hi) and receivers a local light is planned over: the
-        scene's, or grown by ``reach`` (see ``reaches``; kept in the light's ``memo``)."""
-        if not reach > 0.0 or not math.isfinite(reach):
-            return corners, lo, hi, receivers
-        if "grown" not in memo:
-            boxes = lightspace.dilated_boxes(corners, reach)
-            seen = None if receivers is None else lightspace.dilated_receivers(receivers, reach)
-            memo["grown"] = (boxes, boxes.min(axis=1), boxes.max(axis=1), seen)
-        return memo["grown"]
-
-    def light_tiles(light, sizes, flat_free, memo, cone=0.0, reach=0.0):
-        """The tiles of ``light`` (per cascade or cube face: None where it needs no map) and
-        their mode; ``sizes[k]``: texels a side of the k-th one; ``cone``: see ``cones``;
-        ``reach``: see ``reaches``."""
-        soft = light.sampled or pcss
-        if light.type == "SUN":
-            # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
-            angle = min(max(light.angle, 0.0), math.pi * 0.99)
-            spread = math.tan(0.5 * angle) * light.penumbra_scale if soft else 0.0
-            if view_corners is None:
-                fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), sizes[0])
-                tiles = [Tile(fit, everything)] if fit is not None else []
-            elif slices is None or light.world:
-                if memo_parts[0] is None:
-                    memo_parts[0] = lightspace.view_parts(corners, view_corners)
-                fitted = lightspace.fit_sun_to_view(
-                    light.direction,
-                    corners,
-                    view_corners,
-                    sizes[0],
-                    soft=spread,
-                    flat_free=flat_free,
-                    parts=memo_parts[0],
-                    cone=cone,
-                )
-                tiles = [Tile(*fitted)] if fitted is not None else []
-            else:
-                fits = [
-                    lightspace.fit_sun_to_view(
-                        light.direction, corners, sc, sizes[k], soft=spread, flat_free=flat_free, cone=cone
-                    )
-                    for k, (sc, _end) in enumerate(slices)
-                ]
-                tiles = [Tile(*f) if f is not None else None for f in fits]
-            cascaded = view_corners is not None and slices is not None and len(slices) > 1 and not light.world
-            mode = "CASCADE" if cascaded else "SINGLE"
-        elif light.type == "SPOT":
-            fov = min(light.cone_size * 1.05 + 4.0 / max(map_size, 1), math.radians(170.0))
-            boxes, box_lo, box_hi, seen = grown(memo, reach)
-            tile = perspective_tile(
-                light.position,
-                light.direction,
-                fov,
-                boxes,
-                box_lo,
-                box_hi,
-                sizes[0],
-                receivers=seen,
-                flat_free=flat_free,
-                memo=memo,
-            )
-            tiles = [tile] if tile is not None else []
-            mode = "SINGLE"
-        else:  # POINT, AREA
-            boxes, box_lo, box_hi, seen = grown(memo, reach)
-            tiles = [
-                None
-                if light.type == "AREA" and behind_area_light(fwd, light.direction)
-                else perspective_tile(
-                    light.position,
-                    fwd,
-                    math.pi / 2.0,
-                    boxes,
-                    box_lo,
-                    box_hi,
-                    sizes[k],
-                    kernel=1.0 if soft else kernel,
-                    soft_radius=light.shadow_radius * light.penumbra_scale if soft else 0.0,
-                    receivers=seen,
-                    flat_free=flat_free,
-                    memo=memo,
-                )
-                for k, fwd in enumerate(lightspace.CUBE_FORWARDS)
-            ]
-            mode = "CUBE"
-        for k, t in enumerate(tiles):
-            if t is not None:
-                t.size = sizes[k]
-        return tiles, mode
-
+    receivers = view.receivers
+    if receivers is None and view.camera is not None:
+        receivers = lightspace.visible_receivers(corners, view.camera.projection @ view.camera.view)
+    scene = _Scene(Boxes.of(corners), options, view, slices, receivers, view.sun_parts)
     for i, light in enumerate(lights):
         if not light.use_shadow:
             continue
-        if derived is not None and i in derived and not light.world:
-            mode, first, position = derived[i]
-            if light.type == "SUN":
-                fits = [None if t is None else lightspace.sheared(t.fit, light.direction) for t in first]
-            else:
-                offset = light.position - position
-                fits = [None if t is None else lightspace.moved(t.fit, offset) for t in first]
-            tiles = [
-                None if t is None else Tile(f, t.casters, t.size, held=t.held) for t, f in zip(first, fits, strict=True)
-            ]
-            _add(plan, i, mode, tiles, slices, depth_range)
-            continue
-        flat_free = flat_free_of(light)
-        memo = {}
-        world = light.world
-        cone = cones.get(i, 0.0) if cones is not None and light.type == "SUN" and not world else 0.0
-        reach = reaches.get(i, 0.0) if reaches is not None and light.type != "SUN" else 0.0
-        known = known_sizes.get(i) if known_sizes is not None and not world else None
-        largest = min(map_size, max(1, int(world_map_size))) if world and world_map_size else map_size
-        if world:
-            known = [largest] * 6  # a direction of the world is drawn once: one fit, no density pass
-        tiles, mode = light_tiles(light, list(known) if known else [largest] * 6, flat_free, memo, cone, reach)
-        # A map needs no more texels than the pixels it shadows can show (density): each map
-        # (cascade, cube face) of the light is planned again at the size it needs. A sun
-        # fitted to the whole scene (no view corners) keeps its size: it must not depend on
-        # the camera, so moving the view never redraws it.
-        camera_bound = light.type != "SUN" or view_corners is not None
-        if (
-            not known
-            and density is not None
-            and receivers is not None
-            and camera_bound
-            and any(t is not None for t in tiles)
-        ):
-            soft = light.sampled or pcss
-            per_pixel = density.texels_per_pixel * (1.0 if soft else max(1.0, kernel - 1.0))
-            sizes = [largest if t is None else needed_size(t, largest, receivers, density, per_pixel) for t in tiles]
-            if min(sizes, default=largest) < largest:
-                smaller, smaller_mode = light_tiles(light, sizes, flat_free, memo, cone, reach)
-                if [t is None for t in smaller] == [t is None for t in tiles]:
-                    tiles, mode = smaller, smaller_mode
-        _add(plan, i, mode, tiles, slices, depth_range)
+        if share.derived is not None and i in share.derived and not light.world:
+            mode, tiles = _derived_tiles(light, *share.derived[i])
+        else:
+            mode, tiles = _planned_tiles(scene, share, i, light)
+        _add(plan, i, mode, tiles, slices, view.depth_range)
     return plan
+
+
+def _derived_tiles(light, mode, first, position):
+    """(mode, tiles) of ``light`` from the frame's first plan's (``FrameShare.derived``): each
+    sheared to the sun's direction, or moved to the light's position."""
+    if light.type == "SUN":
+        fits = [None if t is None else lightspace.sheared(t.fit, light.direction) for t in first]
+    else:
+        offset = light.position - position
+        fits = [None if t is None else lightspace.moved(t.fit, offset) for t in first]
+    tiles = [None if t is None else Tile(f, t.casters, t.size, held=t.held) for t, f in zip(first, fits, strict=True)]
+    return mode, tiles
+
+
+def _planned_tiles(scene, share, index, light):
+    """(mode, tiles) of light ``index`` planned afresh: at its known sizes, or at the largest
+    and then again at the sizes density asks for (``ViewFit.density``)."""
+    options = scene.options
+    world = light.world
+    cone = share.cones.get(index, 0.0) if share.cones is not None and light.type == "SUN" and not world else 0.0
+    reach = share.reaches.get(index, 0.0) if share.reaches is not None and light.type != "SUN" else 0.0
+    job = _Job(light, _flat_free(scene, light), {}, cone, reach, light.sampled or options.pcss)
+    known = share.known_sizes.get(index) if share.known_sizes is not None and not world else None
+    map_size = options.map_size
+    largest = min(map_size, max(1, int(options.world_map_size))) if world and options.world_map_size else map_size
+    if world:
+        known = [largest] * 6  # a direction of the world is drawn once: one fit, no density pass
+    tiles, mode = _light_tiles(scene, job, list(known) if known else [largest] * 6)
+    if not known:
+        tiles, mode = _at_density(scene, job, tiles, mode, largest)
+    return mode, tiles
+
+
+def _at_density(scene, job, tiles, mode, largest):
+    """A map needs no more texels than the pixels it shadows can show (density): each map
+    (cascade, cube face) of the light, planned at ``largest``, is planned again at the size
+    it needs. A sun fitted to the whole scene (no view corners) keeps its size: it must not
+    depend on the camera, so moving the view never redraws it. Returns (tiles, mode)."""
+    density, receivers = scene.view.density, scene.receivers
+    camera_bound = job.light.type != "SUN" or scene.view.view_corners is not None
+    if density is None or receivers is None or not camera_bound or not any(t is not None for t in tiles):
+        return tiles, mode
+    per_pixel = density.texels_per_pixel * (1.0 if job.soft else max(1.0, scene.options.kernel - 1.0))
+    sizes = [largest if t is None else needed_size(t, largest, receivers, density, per_pixel) for t in tiles]
+    if min(sizes, default=largest) < largest:
+        smaller, smaller_mode = _light_tiles(scene, job, sizes)
+        if [t is None for t in smaller] == [t is None for t in tiles]:
+            return smaller, smaller_mode
+    return tiles, mode
+
+
+def _flat_free(scene, light):
+    """Flat boxes that shadow nothing under ``light`` (None: not tested)."""
+    corners, view_corners = scene.boxes.corners, scene.view.view_corners
+    if scene.options.reflective:  # every lit surface sends light: none is left out
+        return np.zeros(len(corners), dtype=bool) if light.type == "SUN" and view_corners is not None else None
+    if light.type != "SUN":
+        return lightspace.flat_casters_without_shadow(corners, position=light.position)
+    return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
+
+
+def _grown(scene, job):
+    """The boxes and the crop a local light is planned over: the scene's, or grown by the
+    job's reach (see ``FrameShare.reaches``; kept in its ``memo``)."""
+    reach, memo = job.reach, job.memo
+    if not reach > 0.0 or not math.isfinite(reach):
+        return scene.boxes, scene.receivers
+    if "grown" not in memo:
+        receivers = scene.receivers
+        seen = None if receivers is None else lightspace.dilated_receivers(receivers, reach)
+        memo["grown"] = (Boxes.of(lightspace.dilated_boxes(scene.boxes.corners, reach)), seen)
+    return memo["grown"]
+
+
+def _light_tiles(scene, job, sizes):
+    """The tiles of the job's light (per cascade or cube face: None where it needs no map)
+    and their mode; ``sizes[k]``: texels a side of the k-th one."""
+    kind = job.light.type
+    if kind == "SUN":
+        tiles, mode = _sun_tiles(scene, job, sizes)
+    elif kind == "SPOT":
+        tiles, mode = _spot_tiles(scene, job, sizes)
+    else:  # POINT, AREA
+        tiles, mode = _cube_tiles(scene, job, sizes)
+    for k, t in enumerate(tiles):
+        if t is not None:
+            t.size = sizes[k]
+    return tiles, mode
+
+
+def _sun_tiles(scene, job, sizes):
+    """A sun's map fitted to the whole scene, to the whole view, or one per cascade."""
+    light, corners = job.light, scene.boxes.corners
+    view_corners, slices = scene.view.view_corners, scene.slices
+    # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
+    angle = min(max(light.angle, 0.0), math.pi * 0.99)
+    spread = math.tan(0.5 * angle) * light.penumbra_scale if job.soft else 0.0
+    if view_corners is None:
+        fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), sizes[0])
+        tiles = [Tile(fit, np.arange(len(corners)))] if fit is not None else []
+    elif slices is None or light.world:
+        fitted = lightspace.fit_sun_to_view(
+            light.direction,
+            corners,
+            view_corners,
+            sizes[0],
+            soft=spread,
+            flat_free=job.flat_free,
+            parts=scene.parts(),
+            cone=job.cone,
+        )
+        tiles = [Tile(*fitted)] if fitted is not None else []
+    else:
+        fits = [
+            lightspace.fit_sun_to_view(
+                light.direction, corners, sc, sizes[k], soft=spread, flat_free=job.flat_free, cone=job.cone
+            )
+            for k, (sc, _end) in enumerate(slices)
+        ]
+        tiles = [Tile(*f) if f is not None else None for f in fits]
+    cascaded = view_corners is not None and slices is not None and len(slices) > 1 and not light.world
+    return tiles, "CASCADE" if cascaded else "SINGLE"
+
+
+def _spot_tiles(scene, job, sizes):
+    """A spot's one perspective map, a little wider than its cone."""
+    light = job.light
+    fov = min(light.cone_size * 1.05 + 4.0 / max(scene.options.map_size, 1), math.radians(170.0))
+    boxes, seen = _grown(scene, job)
+    crop = None if seen is None else Crop(seen, job.flat_free)
+    tile = perspective_tile(Eye(light.position, light.direction, fov), boxes, sizes[0], crop=crop, memo=job.memo)
+    return [tile] if tile is not None else [], "SINGLE"
+
+
+def _cube_tiles(scene, job, sizes):
+    """A point or area light's cube faces (None for an area light's face wholly behind it)."""
+    light = job.light
+    boxes, seen = _grown(scene, job)
+    crop = None if seen is None else Crop(seen, job.flat_free)
+    soft = job.soft
+    tiles = [
+        None
+        if light.type == "AREA" and behind_area_light(fwd, light.direction)
+        else perspective_tile(
+            Eye(light.position, fwd, math.pi / 2.0),
+            boxes,
+            sizes[k],
+            kernel=1.0 if soft else scene.options.kernel,
+            soft_radius=light.shadow_radius * light.penumbra_scale if soft else 0.0,
+            crop=crop,
+            memo=job.memo,
+        )
+        for k, fwd in enumerate(lightspace.CUBE_FORWARDS)
+    ]
+    return tiles, "CUBE"
 
 
 def _add(plan, index, mode, tiles, slices, depth_range):
@@ -533,7 +637,7 @@ def frame_tiles(plan, lights, reaches=None):
     """{light index: (mode, its tiles or None per map, its position)} of ``plan`` (a frame's
     first plan, fitted with ``cones`` and ``reaches``): its suns other than the world's
     directions, and the local lights in ``reaches``; what the frame's later samples shear or
-    move (``plan_shadows(derived=)``)."""
+    move (``FrameShare.derived``)."""
     reaches = reaches or {}
     return {
         i: (entry.mode, [plan.tiles[t] if t >= 0 else None for t in entry.tiles], lights[i].position)
@@ -544,7 +648,7 @@ def frame_tiles(plan, lights, reaches=None):
 
 def frame_sizes(plan, map_size):
     """{light index: texels a side of each of its maps (``map_size`` where it needs none)} of
-    ``plan``: what ``plan_shadows(known_sizes=...)`` takes for the frame's later samples."""
+    ``plan``: what ``FrameShare.known_sizes`` takes for the frame's later samples."""
     return {
         i: [plan.tiles[t].size if t >= 0 else map_size for t in entry.tiles] + [map_size] * (6 - len(entry.tiles))
         for i, entry in plan.lights.items()

@@ -70,7 +70,7 @@ def _plan(lights):
     """A real plan over a ground box and a caster box above it."""
     ground = lightspace.box_corners(np.array([-5.0, -5.0, -0.1]), np.array([5.0, 5.0, 0.0]))
     caster = lightspace.box_corners(np.array([-0.5, -0.5, 0.5]), np.array([0.5, 0.5, 1.5]))
-    return shadows.plan_shadows(lights, np.stack([ground, caster]), 256)
+    return shadows.plan_shadows(lights, np.stack([ground, caster]), shadows.MapOptions(256))
 
 
 def test_frame_data_carries_every_light_its_tiles_and_the_settings():
@@ -207,8 +207,8 @@ def test_an_area_light_plans_no_map_for_the_face_behind_it():
     down[:3, 3] = (0.0, 0.0, 4.0)  # lights look along local -Z: straight down
     point = Light(type="POINT", color=np.ones(3), matrix=down, radius=0.1)
     area = Light(type="AREA", color=np.ones(3), matrix=down, radius=0.0, size=1.0, size_x=1.0, size_y=1.0)
-    point_faces = shadows.plan_shadows([point], corners, 64).lights[0].tiles
-    area_faces = shadows.plan_shadows([area], corners, 64).lights[0].tiles
+    point_faces = shadows.plan_shadows([point], corners, shadows.MapOptions(64)).lights[0].tiles
+    area_faces = shadows.plan_shadows([area], corners, shadows.MapOptions(64)).lights[0].tiles
     plus_z = 4  # CUBE_FORWARDS order: +X, -X, +Y, -Y, +Z, -Z
     assert np.allclose(lightspace.CUBE_FORWARDS[plus_z], (0, 0, 1))
     assert point_faces[plus_z] >= 0 and area_faces[plus_z] == -1
@@ -272,7 +272,9 @@ def test_cropped_plans_stay_finite_at_degenerate_and_extreme_inputs(case):
         ]
         for light in lights:
             light.radius *= scale  # the light's size scales with the scene
-        return shadows.plan_shadows(lights, corners, 512, view_corners, camera, pcss=pcss)
+        return shadows.plan_shadows(
+            lights, corners, shadows.MapOptions(512, pcss=pcss), shadows.ViewFit(view_corners, camera)
+        )
 
     for pcss in (False, True):
         plan = plan_at(scale, pcss)

@@ -111,18 +111,18 @@ def test_sun_fit_empty_and_nonfinite():
 def test_perspective_tile_covers_the_casters_in_front_only():
     """The fit spot and cube-face maps use: near/far bracket every caster in the cone, all their
     corners project inside the map, and a light with every caster behind it gets no tile."""
-    from penumbra.engine.shadows.planning import perspective_tile
+    from penumbra.engine.shadows.planning import Boxes, Eye, perspective_tile
 
     boxes = [((-0.5, -0.5, -2.5), (0.5, 0.5, -2.0)), ((0.0, 0.0, -6.5), (1.0, 1.0, -6.0)), ((0, 0, 4), (1, 1, 5))]
     corners = np.stack([lightspace.box_corners(np.array(lo, float), np.array(hi, float)) for lo, hi in boxes])
     lo, hi = corners.min(axis=1), corners.max(axis=1)
-    tile = perspective_tile(np.zeros(3), np.array([0, 0, -1.0]), np.radians(90), corners, lo, hi, 256)
+    tile = perspective_tile(Eye(np.zeros(3), np.array([0, 0, -1.0]), np.radians(90)), Boxes(corners, lo, hi), 256)
     assert list(tile.casters) == [0, 1]  # the box behind the light casts nothing into the cone
     assert tile.fit.near <= 2.0 and tile.fit.far >= 6.5
     ndc = lightspace.transform_points(tile.fit.view_proj, corners[:2].reshape(-1, 3))
     assert np.all(np.abs(ndc) <= 1.0 + 1e-9)
     assert tile.fit.texel_per_distance == pytest.approx(2.0 / 256)
-    behind = perspective_tile(np.zeros(3), np.array([0, 0, 1.0]), 0.5, corners[:2], lo[:2], hi[:2], 256)
+    behind = perspective_tile(Eye(np.zeros(3), np.array([0, 0, 1.0]), 0.5), Boxes(corners[:2], lo[:2], hi[:2]), 256)
     assert behind is None
 
 
@@ -252,7 +252,7 @@ def test_off_center_perspective_maps_its_window_to_the_unit_square():
 def test_local_light_maps_crop_to_what_the_camera_sees_and_the_casters_can_shadow():
     """A point light 5 m over a 2 km flat ground with a 20 cm box: the ground casts nothing, so
     the downward face covers the box's window (and its shadow in view), not the whole face."""
-    from penumbra.engine.shadows.planning import perspective_tile
+    from penumbra.engine.shadows.planning import Boxes, Crop, Eye, perspective_tile
 
     ground = _flat((-1000, -1000, 0), (1000, 1000, 0))
     box = lightspace.box_corners((0.4, -0.1, 0.0), (0.6, 0.1, 0.2))
@@ -265,8 +265,9 @@ def test_local_light_maps_crop_to_what_the_camera_sees_and_the_casters_can_shado
     flat_free = lightspace.flat_casters_without_shadow(corners, position=light)
     assert flat_free.tolist() == [True, False]
     down = np.array([0.0, 0.0, -1.0])
-    full = perspective_tile(light, down, np.pi / 2, corners, lo, hi, 1024)
-    tile = perspective_tile(light, down, np.pi / 2, corners, lo, hi, 1024, receivers=receivers, flat_free=flat_free)
+    eye, boxes = Eye(light, down, np.pi / 2), Boxes(corners, lo, hi)
+    full = perspective_tile(eye, boxes, 1024)
+    tile = perspective_tile(eye, boxes, 1024, crop=Crop(receivers, flat_free))
     assert tile.casters.tolist() == [1]
     assert tile.fit.texel_per_distance < full.fit.texel_per_distance / 20  # the box spans ~0.05 of the 2.0 face
     ndc = lightspace.transform_points(tile.fit.view_proj, box)
@@ -276,16 +277,11 @@ def test_local_light_maps_crop_to_what_the_camera_sees_and_the_casters_can_shado
     assert np.all(np.abs(lightspace.transform_points(tile.fit.view_proj, shadow)[:, :2]) <= 1.0)
     assert np.all(lightspace.transform_points(tile.fit.view_proj, shadow)[:, 2] <= 1.0)  # before the far plane
     # Only the ground in reach: nothing to shadow, no map; the box out of view: no map either.
-    assert (
-        perspective_tile(
-            light, down, np.pi / 2, corners[:1], lo[:1], hi[:1], 1024, receivers=receivers, flat_free=flat_free[:1]
-        )
-        is None
-    )
+    assert perspective_tile(eye, Boxes(corners[:1], lo[:1], hi[:1]), 1024, crop=Crop(receivers, flat_free[:1])) is None
     away = lightspace.visible_receivers(
         corners, lightspace.perspective(np.radians(40), 1.5, 0.1, 100.0) @ lightspace.look_at((300, 0, 4), (1, 0, -0.2))
     )
-    assert perspective_tile(light, down, np.pi / 2, corners, lo, hi, 1024, receivers=away, flat_free=flat_free) is None
+    assert perspective_tile(eye, boxes, 1024, crop=Crop(away, flat_free)) is None
 
 
 def _ground_and_boxes(rng, half, centres, sizes, count=8):
@@ -341,11 +337,11 @@ def test_a_sheared_sun_map_holds_what_each_sampled_direction_fits(seed):
 @pytest.mark.parametrize("seed", range(5))
 def test_a_moved_local_map_holds_what_each_point_of_the_light_plans(seed):
     """A spot's map planned once over the scene grown by the light's reach
-    (``lightspace.dilated_boxes`` and ``dilated_receivers``, as ``plan_shadows(reaches=)``
+    (``lightspace.dilated_boxes`` and ``dilated_receivers``, as a plan with ``FrameShare.reaches``
     does) and ``moved`` to a point of the light: every visible receiver the point's own map
     holds lands inside the moved map (x, y and depth), and its casters are among the planned
     ones, so a sample can move the frame's map instead of planning its own."""
-    from penumbra.engine.shadows.planning import perspective_tile
+    from penumbra.engine.shadows.planning import Boxes, Crop, Eye, perspective_tile
 
     rng = np.random.default_rng(seed)
     corners = _ground_and_boxes(rng, 20.0, ((-4, -4, 0.3), (4, 4, 2.0)), (0.1, 0.8))
@@ -358,22 +354,17 @@ def test_a_moved_local_map_holds_what_each_point_of_the_light_plans(seed):
     free = lightspace.flat_casters_without_shadow(corners, position=position)
     grown = lightspace.dilated_boxes(corners, reach)
     planned = perspective_tile(
-        position,
-        forward,
-        fov,
-        grown,
-        grown.min(axis=1),
-        grown.max(axis=1),
+        Eye(position, forward, fov),
+        Boxes(grown, grown.min(axis=1), grown.max(axis=1)),
         size,
-        receivers=lightspace.dilated_receivers(receivers, reach),
-        flat_free=free,
+        crop=Crop(lightspace.dilated_receivers(receivers, reach), free),
     )
     assert planned is not None
     for _ in range(8):
         offset = rng.normal(size=3)
         offset *= reach * rng.uniform(0.0, 1.0) ** (1 / 3) / np.linalg.norm(offset)
         own = perspective_tile(
-            position + offset, forward, fov, corners, lo, hi, size, receivers=receivers, flat_free=free
+            Eye(position + offset, forward, fov), Boxes(corners, lo, hi), size, crop=Crop(receivers, free)
         )
         if own is None:
             continue

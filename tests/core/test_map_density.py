@@ -47,7 +47,12 @@ def _plan(light, camera, width, per_pixel=2.0, size=8192, scale=1.0, kernel=1.0)
         footprint = lightspace.pixel_footprint(camera.projection, camera.is_ortho, width, width * 9 // 16)
         density = shadows.Density(camera.view, *footprint, per_pixel)
     view_corners = lightspace.frustum_corners(camera.projection @ camera.view)
-    return shadows.plan_shadows([light], corners, size, view_corners, camera, kernel=kernel, density=density)
+    return shadows.plan_shadows(
+        [light],
+        corners,
+        shadows.MapOptions(size, kernel=kernel),
+        shadows.ViewFit(view_corners, camera, density=density),
+    )
 
 
 def _ratio(tile, camera, width):
@@ -166,7 +171,12 @@ def test_a_sun_fitted_to_the_whole_scene_keeps_its_size():
     density = shadows.Density(camera.view, *footprint, 4.0)
     corners = _corners()
     receivers = lightspace.visible_receivers(corners, camera.projection @ camera.view)
-    scene_fit = shadows.plan_shadows([_light("SUN")], corners, 4096, None, camera, receivers=receivers, density=density)
+    scene_fit = shadows.plan_shadows(
+        [_light("SUN")],
+        corners,
+        shadows.MapOptions(4096),
+        shadows.ViewFit(None, camera, receivers=receivers, density=density),
+    )
     view_fit = _plan(_light("SUN"), camera, 160, per_pixel=4.0, size=4096)
     assert [t.size for t in scene_fit.tiles] == [4096]
     assert view_fit.tiles[0].size < 4096

@@ -234,7 +234,7 @@ class WorldAO:
                     else:
                         program = shadow_cutout_program("FLOAT32", texture is not None, camera=True)
                     cut = shaders.get(program, defines)
-                    draw_cutout(cut, batch, material_ubo, texture, tree, self._ubo, alpha_offset, d.model, origin)
+                    draw_cutout(cut, (batch, material_ubo, texture, tree), self._ubo, alpha_offset, d.model, origin)
                     bound["draws"] += 1
             gpu.state.face_culling_set("NONE")
             gpu.state.front_facing_set(False)
