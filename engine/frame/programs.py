@@ -224,20 +224,13 @@ LIT = Program(
         ("smooth", "VEC3", "v_normal"),
         ("smooth", "FLOAT", "v_view_depth"),
     ),
+    # What the three entry shaders (LIT_ENTRIES) call directly; the libraries under them (the
+    # lights, shadow filters, BSDF, ...) come from these files' ``// requires:`` lines.
     libs=(
-        "lib/common.glsl",
-        "lib/lights.glsl",
-        "lib/depth_encoding.glsl",
         "lib/lit_debug.glsl",
-        "lib/shadow_filters.glsl",
-        "lib/material.glsl",
-        "lib/ggx_albedo.glsl",
         "lib/gtao.glsl",
         "lib/world_ratio.glsl",
-        # The lit shader by concern (lit.frag.glsl's header), in this order.
         "lib/lit_surface.glsl",
-        "lib/lit_terminator.glsl",
-        "lib/lit_bsdf.glsl",
         "lib/lit_world.glsl",
         "lib/lit_settle.glsl",
         "lib/lit_lights.glsl",
@@ -504,7 +497,10 @@ TREE_UNIFORMS["OBJECT_INFO"] = (("VEC4", "node_object_color"), ("FLOAT", "node_o
 def with_tree(program, tree):
     """``program`` with compiled node tree ``tree``: its GLSL families, its generated code,
     its constants block and image samplers, and the per-draw values it reads."""
-    libs = tuple(f"nodes/{f}.glsl" for f in tree.families if f"nodes/{f}.glsl" not in program.libs)
+    # The generated code calls the families' functions (which bring what they need by their
+    # ``// requires:`` lines) and, for its image textures, lib/material.glsl's sample_image.
+    libs = ("lib/material.glsl",) if tree.images else ()
+    libs += tuple(f"nodes/{f}.glsl" for f in tree.families)
     pushes = tuple(p for need in sorted(tree.needs) for p in TREE_UNIFORMS.get(need, ()))
     procedural = any(f.startswith("texture_") for f in tree.families)
     return replace(
