@@ -1,6 +1,6 @@
 /* The lit pass (engine/frame/lit_pass.py): the surface's material, its lobes, the world's light
  * and every light's, with their shadows. By concern, in the libraries the program lists
- * (engine/frame/programs.py LIT), in this order:
+ * (engine/frame/programs.py LIT; each after the ones its ``// requires:`` line names):
  *   lib/lit_debug.glsl       what the debug views record (declared only in their variants)
  *   lib/lit_surface.glsl     the Surface and its lobes; point, view, normals, normal maps, hair
  *   lib/lit_terminator.glsl  Shadow Terminator: where a light's shadow is looked up, the cosine

@@ -1,14 +1,17 @@
 """Builds GPU shaders from the .glsl files in this folder.
 
 Blender's gpu module has no ``#include``: a program is described as data (``Program``), the
-loader concatenates its ordered list of library files in front of each stage, turns the
-interface into a ``GPUShaderCreateInfo`` and compiles. Variants differ only by their defines
-and are compiled the first time a frame needs them, then cached by (program, defines).
+loader concatenates the library files it names in front of each stage, turns the interface
+into a ``GPUShaderCreateInfo`` and compiles. Each library's first line names the libraries it
+uses directly (``// requires: lib/a.glsl lib/b.glsl``, empty when none); a program lists only
+the libraries its own stage (or generated code) uses, and ``resolve_libs`` brings in the rest,
+each before what needs it and once. Variants differ only by their defines and are compiled the
+first time a frame needs them, then cached by (program, defines).
 """
 
 import time
 from dataclasses import dataclass, replace
-from functools import cached_property
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -118,7 +121,7 @@ class Program:
     name: str
     vertex: str
     fragment: str
-    libs: tuple = ()  # fragment-stage libraries
+    libs: tuple = ()  # fragment-stage libraries it uses directly (their needs: resolve_libs)
     vertex_libs: tuple = ()
     vertex_in: tuple = ()  # (type, name)
     varyings: tuple = ()  # (qualifier 'smooth'|'flat'|'no_perspective', type, name)
@@ -196,13 +199,64 @@ def _read(rel):
     return (SHADER_DIR / rel).read_text(encoding="utf-8")
 
 
+REQUIRES = "// requires:"
+
+
+@lru_cache(maxsize=None)
+def _requires_at(path):
+    """The libraries the file at ``path`` names on its first line (see ``lib_requires``).
+    Cached by path: the files do not change while Blender runs, and a test's files in a
+    temporary folder have paths of their own."""
+    with open(path, encoding="utf-8") as f:
+        first = f.readline().rstrip("\r\n")
+    if not first.startswith(REQUIRES):
+        raise ValueError(f"shader library {path}: its first line is not '{REQUIRES} ...'")
+    return tuple(first[len(REQUIRES) :].split())
+
+
+def lib_requires(rel):
+    """The libraries (paths relative to SHADER_DIR) that library ``rel`` uses directly: its
+    ``// requires:`` line, in its order."""
+    return _requires_at(SHADER_DIR / rel)
+
+
+def resolve_libs(names, exclude=()):
+    """``names`` (library paths relative to SHADER_DIR) with everything they require, depth
+    first: each library after the ones it requires, each once, otherwise in the order listed.
+    Libraries in ``exclude`` (already in the stage's text) are left out, with what they
+    require. A cycle of requirements or a missing file raises ValueError naming it."""
+    done, order = set(exclude), []
+
+    def visit(rel, chain):
+        if rel in done:
+            return
+        if rel in chain:
+            cycle = chain[chain.index(rel) :] + (rel,)
+            raise ValueError("shader libraries require each other in a cycle: " + " -> ".join(cycle))
+        if not (SHADER_DIR / rel).is_file():
+            by = f" (required by {chain[-1]})" if chain else ""
+            raise ValueError(f"shader library {rel}{by} does not exist under {SHADER_DIR}")
+        for need in lib_requires(rel):
+            visit(need, chain + (rel,))
+        done.add(rel)
+        order.append(rel)
+
+    for rel in names:
+        visit(rel, ())
+    return tuple(order)
+
+
 def program_sources(program):
-    """The (vertex, fragment) GLSL text, libraries first, in the order the program lists them;
-    the fragment stage: libs, generated code, entry libs, the stage file."""
-    vlibs = "".join(_read(p) + "\n" for p in program.vertex_libs)
-    flibs = "".join(_read(p) + "\n" for p in program.libs)
-    entry = "".join(_read(p) + "\n" for p in program.entry_libs)
-    return vlibs + _read(program.vertex), flibs + program.generated + "\n" + entry + _read(program.fragment)
+    """The (vertex, fragment) GLSL text, libraries first (``resolve_libs``). The fragment
+    stage: its libs, the generated code (a compiled node tree, which calls into the libs),
+    the entry libs not already included (which call into the generated code), the stage file."""
+    vlibs = resolve_libs(program.vertex_libs)
+    flibs = resolve_libs(program.libs)
+    entry = resolve_libs(program.entry_libs, exclude=flibs)
+    vert = "".join(_read(p) + "\n" for p in vlibs) + _read(program.vertex)
+    frag = "".join(_read(p) + "\n" for p in flibs) + program.generated + "\n"
+    frag += "".join(_read(p) + "\n" for p in entry) + _read(program.fragment)
+    return vert, frag
 
 
 def _format_define(value):

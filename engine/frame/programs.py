@@ -225,20 +225,13 @@ LIT = Program(
         ("smooth", "VEC3", "v_normal"),
         ("smooth", "FLOAT", "v_view_depth"),
     ),
+    # What the three entry shaders (LIT_ENTRIES) call directly; the libraries under them (the
+    # lights, shadow filters, BSDF, ...) come from these files' ``// requires:`` lines.
     libs=(
-        "lib/common.glsl",
-        "lib/lights.glsl",
-        "lib/depth_encoding.glsl",
         "lib/lit_debug.glsl",
-        "lib/shadow_filters.glsl",
-        "lib/material.glsl",
-        "lib/ggx_albedo.glsl",
         "lib/gtao.glsl",
         "lib/world_ratio.glsl",
-        # The lit shader by concern (lit.frag.glsl's header), in this order.
         "lib/lit_surface.glsl",
-        "lib/lit_terminator.glsl",
-        "lib/lit_bsdf.glsl",
         "lib/lit_world.glsl",
         "lib/lit_settle.glsl",
         "lib/lit_lights.glsl",
@@ -422,7 +415,9 @@ def tree_part(tree):
         part = _TREE_PARTS[key] = ProgramPart(
             name="",  # the material's features name the tree (NODES_<key>)
             defines=(("NODE_PROCEDURAL", any(f.startswith("texture_") for f in tree.families)),),
-            libs=tuple(f"nodes/{f}.glsl" for f in tree.families),
+            # The generated code calls the families' functions (which bring what they need by
+            # their ``// requires:`` lines) and, for its image textures, lib/material.glsl's sample_image.
+            libs=(("lib/material.glsl",) if tree.images else ()) + tuple(f"nodes/{f}.glsl" for f in tree.families),
             generated=tree.code,
             uniform_blocks=((NODE_CONSTANT_STRUCT, "node_constants", max(len(tree.constants), 1)),),
             samplers=tuple(("FLOAT_2D", f"node_image_{i}") for i in range(len(tree.images))),

@@ -51,8 +51,8 @@ Adding a node is one registry entry: a function decorated ``@node("ShaderNodeX",
 that takes (compiler, node, output socket, context) and returns a ``Value`` (GLSL expression,
 type), reading its inputs with ``c.input(node, name, ctx, type)`` (constants become uniforms
 by themselves) and naming its ``family`` file under ``shaders/nodes/`` (e.g. ``texture_noise``
-for a ``shaders/nodes/texture_noise.glsl``); a new family takes its place in ``FAMILY_ORDER``
-(after the families it calls) and names them in ``FAMILY_NEEDS``, which includes them with it.
+for a ``shaders/nodes/texture_noise.glsl``); a family's file names the families it calls on its
+``// requires:`` line, and the shader loader includes them before it (``resolve_libs``).
 Procedural textures read their coordinates with ``c.texture_vector(node, ctx)`` (Generated when
 unlinked, as Blender does) and call the per-dimension entry points (``node_tex_noise_at``,
 ``node_tex_voronoi_at``): the all-dimension functions compile several times slower.
@@ -138,7 +138,7 @@ class NodeImage:
 class CompiledTree:
     key: str  # hash of the code and what it reads: equal trees share one program
     code: str  # the GLSL function node_tree(...)
-    families: tuple  # shaders/nodes/*.glsl files, in include order
+    families: tuple  # shaders/nodes/*.glsl stems its nodes call, sorted (their needs: // requires:)
     constants: np.ndarray  # (n, 4) float32: the node_constants rows
     images: tuple  # NodeImage per sampler node_image_<i>
     needs: frozenset  # surface data read: UV, VCOL, GENERATED, ORIGIN, OBJECT_INFO, FRAME (the camera)
@@ -166,49 +166,6 @@ def node(*idnames, family=None):
         return fn
 
     return register
-
-
-# The GLSL families in include order: each after the families it calls (FAMILY_NEEDS).
-FAMILY_ORDER = (
-    "common",
-    "math",
-    "vector",
-    "color",
-    "converter",
-    "input",
-    "texture_hash",
-    "texture_noise",
-    "texture_voronoi",
-    "texture_white_noise",
-    "texture_wave",
-    "texture_magic",
-    "texture_brick",
-    "texture_checker",
-    "texture_gradient",
-    "shader",
-)
-# family -> the families its functions call (included with it, earlier in FAMILY_ORDER).
-FAMILY_NEEDS = {
-    "texture_noise": ("common", "texture_hash"),  # node_detail; lattice hashes, texture_finite
-    "texture_voronoi": ("common", "texture_hash"),
-    "texture_white_noise": ("texture_hash",),
-    "texture_wave": ("texture_noise",),  # fBM of the distortion
-    "texture_magic": ("texture_noise",),  # texture_fmod
-    "texture_brick": ("texture_hash",),
-    "texture_checker": ("texture_hash",),
-    "texture_gradient": ("texture_hash",),
-}
-
-
-def family_closure(families):
-    """``families`` with every family they need, in FAMILY_ORDER (unknown ones last, sorted)."""
-    found, todo = set(), list(families)
-    while todo:
-        f = todo.pop()
-        if f not in found:
-            found.add(f)
-            todo.extend(FAMILY_NEEDS.get(f, ()))
-    return tuple(f for f in FAMILY_ORDER if f in found) + tuple(sorted(found - set(FAMILY_ORDER)))
 
 
 # --- the compiler -------------------------------------------------------------------------
@@ -527,7 +484,7 @@ class Compiler:
                 "                       emission, normal);\n"
                 "}\n"
             )
-        families = family_closure(self.families)
+        families = tuple(sorted(self.families))
         needs = frozenset(self.needs)
         images = tuple(self.images)
         modes = ",".join(f"{i.interpolation}/{i.extension}" for i in images)

@@ -1,5 +1,6 @@
-#ifndef COMMON_GLSL
-#define COMMON_GLSL
+// requires:
+#ifndef PENUMBRA_LIB_COMMON
+#define PENUMBRA_LIB_COMMON
 
 #define M_PI 3.14159265358979323846
 
@@ -16,4 +17,4 @@ vec4 sanitize(vec4 c)
               is_finite(c.a) ? c.a : 0.0);
 }
 
-#endif
+#endif /* PENUMBRA_LIB_COMMON */

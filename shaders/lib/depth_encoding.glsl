@@ -1,5 +1,6 @@
-#ifndef DEPTH_ENCODING_GLSL
-#define DEPTH_ENCODING_GLSL
+// requires:
+#ifndef PENUMBRA_LIB_DEPTH_ENCODING
+#define PENUMBRA_LIB_DEPTH_ENCODING
 
 /* Shadow depth in [0, 1] as stored in the atlas. FLOAT32/FLOAT16 use the red channel of a
  * float texture; RGBA8 packs it into four 8-bit channels (the fixed-point split used where
@@ -25,4 +26,4 @@ float decode_depth(vec4 texel)
 #endif
 }
 
-#endif
+#endif /* PENUMBRA_LIB_DEPTH_ENCODING */

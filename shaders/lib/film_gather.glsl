@@ -1,3 +1,7 @@
+// requires:
+#ifndef PENUMBRA_LIB_FILM_GATHER
+#define PENUMBRA_LIB_FILM_GATHER
+
 /* The gathering film (engine/frame/sampling.py ``gathers``, film.Film.accumulate): a film
  * pixel takes each sample from every sample pixel within the filter's reach, each weighted by
  * the Blackman-Harris window at the distance between the pixel's centre and the point the
@@ -9,9 +13,6 @@
  * takes no part (it does not spread). Under adaptive sampling a converged pixel stays shaded
  * while a pixel within the reach has not converged (converged_depth.frag.glsl), so every
  * sample gathered is this sample's. Without GATHER, the pixel's own sample. */
-
-#ifndef FILM_GATHER_GLSL
-#define FILM_GATHER_GLSL
 
 #ifndef GATHER
 #  define GATHER 0
@@ -52,4 +53,4 @@ vec4 film_source(sampler2D tex, ivec2 p)
 }
 #endif
 
-#endif
+#endif /* PENUMBRA_LIB_FILM_GATHER */

@@ -1,5 +1,6 @@
-#ifndef GTAO_GLSL
-#define GTAO_GLSL
+// requires: lib/common.glsl lib/material.glsl
+#ifndef PENUMBRA_LIB_GTAO
+#define PENUMBRA_LIB_GTAO
 
 #ifndef WORLD_AO
 #  define WORLD_AO 0
@@ -324,4 +325,4 @@ float gtao_specular(float visibility, float NdotV, float alpha)
 }
 #endif
 
-#endif
+#endif /* PENUMBRA_LIB_GTAO */

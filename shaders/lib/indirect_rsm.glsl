@@ -1,5 +1,6 @@
-#ifndef INDIRECT_RSM_GLSL
-#define INDIRECT_RSM_GLSL
+// requires: lib/common.glsl lib/depth_encoding.glsl lib/lights.glsl lib/lit_surface.glsl lib/shadow_filters.glsl
+#ifndef PENUMBRA_LIB_INDIRECT_RSM
+#define PENUMBRA_LIB_INDIRECT_RSM
 
 /* One diffuse bounce from reflective shadow maps (Dachsbacher and Stamminger 2005, "Reflective
  * Shadow Maps"), with Light Paths > Diffuse Bounces at 1 (INDIRECT_RSM).
@@ -210,4 +211,4 @@ vec3 surface_bounce(Surface s)
   return indirect_rsm(s.P, s.lobe[0].N, v_view_depth) / M_PI * albedo;
 }
 
-#endif
+#endif /* PENUMBRA_LIB_INDIRECT_RSM */

@@ -1,5 +1,6 @@
-#ifndef LIGHTS_GLSL
-#define LIGHTS_GLSL
+// requires: lib/common.glsl
+#ifndef PENUMBRA_LIB_LIGHTS
+#define PENUMBRA_LIB_LIGHTS
 
 /* Blender's light conventions, measured against Cycles:
  *   sun   irradiance  E = strength * cos
@@ -46,4 +47,4 @@ void light_incident(LightData L, vec3 P, out vec3 to_light, out float irradiance
   }
 }
 
-#endif
+#endif /* PENUMBRA_LIB_LIGHTS */

@@ -1,3 +1,7 @@
+// requires: lib/common.glsl lib/ggx_albedo.glsl lib/lit_surface.glsl
+#ifndef PENUMBRA_LIB_LIT_BSDF
+#define PENUMBRA_LIB_LIT_BSDF
+
 /* The surface's BSDF: Lambert diffuse under a GGX (or normalised Blinn/Phong, SPECULAR_MODEL)
  * specular layer, as the Principled BSDF layers them; the environment BRDF that weighs the
  * world's specular and takes the specular layer's energy out of the diffuse one below. */
@@ -102,3 +106,5 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   b.albedo *= clamp(1.0 - (spec.rgb * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
   return b;
 }
+
+#endif /* PENUMBRA_LIB_LIT_BSDF */

@@ -1,3 +1,7 @@
+// requires:
+#ifndef PENUMBRA_LIB_LIT_DEBUG
+#define PENUMBRA_LIB_LIT_DEBUG
+
 /* What the lit debug views record (engine/frame/debug_view.py; lit_debug.frag.glsl writes it):
  * globals the libraries add to as they evaluate a surface, declared only in the variants that
  * show them.
@@ -21,3 +25,5 @@ float debug_world_ao = 0.0;
 #if DEBUG_TERM
 vec3 debug_term = vec3(0.0);
 #endif
+
+#endif /* PENUMBRA_LIB_LIT_DEBUG */

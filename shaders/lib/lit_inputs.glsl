@@ -1,6 +1,12 @@
+// requires: lib/material.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl
+#ifndef PENUMBRA_LIB_LIT_INPUTS
+#define PENUMBRA_LIB_LIT_INPUTS
+
 /* The lit entry shaders' common start (lit.frag.glsl, lit_settle.frag.glsl, lit_debug.frag.glsl):
  * the material at this fragment and the surface with its lobes. After the compiled node tree's
- * code (programs.LIT ``entry_libs``), which material_inputs calls. */
+ * code (programs.LIT ``entry_libs``), which material_inputs calls. With NODE_TREE it also calls
+ * node_closure_resolve_lobes (shaders/nodes/shader.glsl): not a requirement here, the tree's
+ * families bring it (programs.with_tree), and a variant without a tree never reads it. */
 
 /* The material's parameters at this fragment: the MaterialData block, its image textures and
  * colour attribute, or its compiled node tree (engine/scene/nodetree.py), which gives every
@@ -113,3 +119,5 @@ bool coverage_discards(float coverage)
   return false;
 #endif
 }
+
+#endif /* PENUMBRA_LIB_LIT_INPUTS */

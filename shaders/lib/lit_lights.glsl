@@ -1,3 +1,7 @@
+// requires: lib/lights.glsl lib/lit_debug.glsl lib/shadow_filters.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl lib/lit_world.glsl lib/lit_settle.glsl
+#ifndef PENUMBRA_LIB_LIT_LIGHTS
+#define PENUMBRA_LIB_LIT_LIGHTS
+
 /* The lights on the surface. Each light's shadow is looked up once, then every lobe's BSDF
  * under it. The lit pass pays only for what it uses: lights sampled over their extent come
  * first (frame.sampled_count, PCSS of their per-sample size), then the other lights with a
@@ -150,3 +154,5 @@ void lights_on(Surface s, inout vec3 color, inout float arriving, inout float un
 #  endif
 #endif
 }
+
+#endif /* PENUMBRA_LIB_LIT_LIGHTS */

@@ -1,3 +1,7 @@
+// requires: lib/lit_surface.glsl lib/lit_world.glsl
+#ifndef PENUMBRA_LIB_LIT_OUTPUTS
+#define PENUMBRA_LIB_LIT_OUTPUTS
+
 /* What a lit variant writes besides its colour (lit.frag.glsl, lit_debug.frag.glsl): the
  * Shadow, Normal and Depth passes (AUX_OUTPUTS), the Emission pass (EMISSION_OUTPUT), the world
  * ratio's targets (WORLD_RATIO_OUT, lit_world.glsl) and the shading count (COUNT_SHADED). */
@@ -56,3 +60,5 @@ void write_passes(vec4 color, Surface s, float arriving, float unshadowed, vec3 
   out_shaded = 1.0; /* this pixel was shaded in this sample (programs.LIT_COLOR_COUNTED) */
 #endif
 }
+
+#endif /* PENUMBRA_LIB_LIT_OUTPUTS */

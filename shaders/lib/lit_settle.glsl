@@ -1,3 +1,7 @@
+// requires: lib/lights.glsl lib/shadow_filters.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl
+#ifndef PENUMBRA_LIB_LIT_SETTLE
+#define PENUMBRA_LIB_LIT_SETTLE
+
 /* SETTLE_TEST (engine/frame/settle.py, after a frame's pilot sample, lights at their centres):
  * the pixel writes whether any later sample could change it through a light (1 in red where
  * none can: every moving light's visibility is the same from all of the light,
@@ -131,3 +135,5 @@ vec4 settle_flags(vec3 world_term, float coverage)
   return vec4(settled ? 1.0 : 0.0, settle_spread, 0.0, 1.0);
 }
 #endif
+
+#endif /* PENUMBRA_LIB_LIT_SETTLE */

@@ -1,3 +1,7 @@
+// requires: lib/material.glsl
+#ifndef PENUMBRA_LIB_LIT_SURFACE
+#define PENUMBRA_LIB_LIT_SURFACE
+
 /* The surface the lit pass shades (lit.frag.glsl): its point, the view, its geometric normals,
  * and its lobes. A material is one lobe. A compiled node tree whose Mix / Add Shader joins two
  * surfaces (engine/scene/nodetree.py) is NODE_LOBES == 2: each lobe its own Principled
@@ -120,3 +124,5 @@ vec3 shading_normal(vec3 N, vec3 tree_normal, Surface s)
 #endif
   return (dot(N, s.V) < 0.0) ? -N : N;
 }
+
+#endif /* PENUMBRA_LIB_LIT_SURFACE */

@@ -1,3 +1,7 @@
+// requires: lib/lit_surface.glsl
+#ifndef PENUMBRA_LIB_LIT_TERMINATOR
+#define PENUMBRA_LIB_LIT_TERMINATOR
+
 /* Object > Shading > Shadow Terminator (engine/scene/terminator.py), per object variant:
  * TERMINATOR_OFFSET lifts each light's shadow point towards the smooth surface the vertex
  * normals imply (Cycles' Geometry Offset), TERMINATOR_NORMAL moves it along the normal (EEVEE's
@@ -84,3 +88,5 @@ bool facet_turned(Surface s, LightData L, vec3 to_light)
   return solid != 0 && L.jittered != 0 && dot(s.Nf, to_light) <= 0.0;
 #endif
 }
+
+#endif /* PENUMBRA_LIB_LIT_TERMINATOR */

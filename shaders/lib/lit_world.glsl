@@ -1,3 +1,7 @@
+// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl
+#ifndef PENUMBRA_LIB_LIT_WORLD
+#define PENUMBRA_LIB_LIT_WORLD
+
 /* The world's light on the surface (engine/frame/world/sh_light.py, world/directions.py, world/occlusion.py):
  * diffuse from its spherical-harmonic irradiance, specular (what makes metals look like metal)
  * from its radiance around the reflected direction, blurred by roughness and weighted by the
@@ -153,3 +157,5 @@ void world_direction(Surface s, LightData L, vec3 to_light, float irradiance, fl
   world_sums += vec4(visibility * w.x, w.x, visibility * w.y, w.y);
 }
 #endif
+
+#endif /* PENUMBRA_LIB_LIT_WORLD */

@@ -1,3 +1,7 @@
+// requires:
+#ifndef PENUMBRA_LIB_MATERIAL
+#define PENUMBRA_LIB_MATERIAL
+
 /* Image textures as Blender's Image Texture node reads them. The textures are Blender's own
  * (gpu.texture.from_image: colour-managed to scene linear, with its mipmaps), filtered here
  * with texelFetch so the result does not depend on a sampler state: interpolation (0 Closest,
@@ -8,9 +12,6 @@
  * Blender stores premultiplied (a float image whose alpha mode is not Straight) is divided by
  * its alpha after filtering, so the node's Color output is straight, as in EEVEE. NaN texels
  * read as 0 and infinite ones as +-65504. */
-
-#ifndef MATERIAL_GLSL
-#define MATERIAL_GLSL
 
 #define EXTENSION_REPEAT 0
 #define EXTENSION_EXTEND 1
@@ -183,4 +184,4 @@ float pixel_hash(vec2 frag)
   return float(h >> 8) / 16777216.0;
 }
 
-#endif
+#endif /* PENUMBRA_LIB_MATERIAL */

@@ -1,5 +1,6 @@
-#ifndef POST_COMMON_GLSL
-#define POST_COMMON_GLSL
+// requires: lib/common.glsl
+#ifndef PENUMBRA_LIB_POST_COMMON
+#define PENUMBRA_LIB_POST_COMMON
 
 /* The layer's input at this pixel, NaN/Inf removed. */
 vec4 post_source()
@@ -36,4 +37,4 @@ vec3 texel_bilinear(sampler2D tex, vec2 t)
   return texel_bilinear_rgba(tex, t).rgb;
 }
 
-#endif
+#endif /* PENUMBRA_LIB_POST_COMMON */

@@ -1,5 +1,6 @@
-#ifndef SHADOW_FILTERS_GLSL
-#define SHADOW_FILTERS_GLSL
+// requires: lib/depth_encoding.glsl lib/lit_debug.glsl lib/material.glsl
+#ifndef PENUMBRA_LIB_SHADOW_FILTERS
+#define PENUMBRA_LIB_SHADOW_FILTERS
 
 /* Shadow visibility of world point P for light L (1 = lit, 0 = shadowed).
  *
@@ -27,8 +28,6 @@
  * The angle-dependent terms (normal offset and slope bias, which grow without bound at the
  * terminator and would hide that self-shadowing) are left out there; only the constant bias
  * remains. Object > Shading > Shadow Terminator (lit.frag.glsl) then moves the point itself. */
-
-float pixel_hash(vec2 frag); /* lib/material.glsl */
 
 int cube_face(vec3 d)
 {
@@ -349,4 +348,4 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
 #undef SHADOW_REF
 }
 
-#endif
+#endif /* PENUMBRA_LIB_SHADOW_FILTERS */

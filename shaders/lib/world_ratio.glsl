@@ -1,5 +1,6 @@
-#ifndef WORLD_RATIO_GLSL
-#define WORLD_RATIO_GLSL
+// requires:
+#ifndef PENUMBRA_LIB_WORLD_RATIO
+#define PENUMBRA_LIB_WORLD_RATIO
 
 /* The world's light as a ratio (Heitz, Hill and McGuire 2018): U x S per lobe, U the SH light
  * unshadowed, S = N / D the ratio of the world directions' sums of f cos V L / p (N) and
@@ -30,4 +31,4 @@ vec4 world_ratio_apply(vec4 color, vec3 u_d, vec3 u_s, vec4 sums)
   return vec4(max(color.rgb - taken, min(color.rgb, vec3(0.0))), color.a);
 }
 
-#endif
+#endif /* PENUMBRA_LIB_WORLD_RATIO */

@@ -1,9 +1,10 @@
+// requires: nodes/common.glsl
+#ifndef PENUMBRA_LIB_NODES_COLOR
+#define PENUMBRA_LIB_NODES_COLOR
+
 /* Colour nodes (Blender manual: Mix Color, Hue/Saturation/Value, Invert Color, Gamma,
  * Brightness/Contrast). The Mix node's blend modes take ``mode`` as a literal
  * (NODE_BLEND_* in engine/scene/nodetree.py); the result keeps A's alpha, as Blender's does. */
-
-#ifndef NODE_COLOR_GLSL
-#define NODE_COLOR_GLSL
 
 float node_dodge(float a, float b, float f)
 {
@@ -127,4 +128,4 @@ vec4 node_combine_color(const int mode, float x, float y, float z)
   return (mode == 1) ? node_hsv_to_rgb(c) : (mode == 2) ? node_hsl_to_rgb(c) : c;
 }
 
-#endif
+#endif /* PENUMBRA_LIB_NODES_COLOR */

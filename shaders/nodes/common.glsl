@@ -1,10 +1,11 @@
+// requires:
+#ifndef PENUMBRA_LIB_NODES_COMMON
+#define PENUMBRA_LIB_NODES_COMMON
+
 /* Helpers every shader-node family shares: safe arithmetic as Blender's node maths defines
  * it (a division by zero gives 0, a power of a negative base needs an integer exponent) and
  * the colour models (HSV, HSL) of Blender's colour nodes. Each function has a numpy twin in
  * devkit/node_reference.py. */
-
-#ifndef NODE_COMMON_GLSL
-#define NODE_COMMON_GLSL
 
 #define NODE_PI 3.14159265358979323846
 
@@ -151,4 +152,4 @@ float node_vector_to_float(vec3 v)
   return (v.x + v.y + v.z) / 3.0;
 }
 
-#endif
+#endif /* PENUMBRA_LIB_NODES_COMMON */

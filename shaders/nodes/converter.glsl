@@ -1,9 +1,10 @@
+// requires: nodes/common.glsl
+#ifndef PENUMBRA_LIB_NODES_CONVERTER
+#define PENUMBRA_LIB_NODES_CONVERTER
+
 /* Converter nodes (Blender manual: Map Range, Clamp, Color Ramp). The Color Ramp's stops are
  * constants of the material (its node_constants block, two vec4 each: colour, then position
  * in x), read from ``first``; their count, interpolation and colour mode are compiled in. */
-
-#ifndef NODE_CONVERTER_GLSL
-#define NODE_CONVERTER_GLSL
 
 float node_smootherstep(float e0, float e1, float x)
 {
@@ -150,4 +151,4 @@ float node_curve(float x, const int first, const int count, vec4 head)
 
 #undef NODE_CURVE_Y
 
-#endif
+#endif /* PENUMBRA_LIB_NODES_CONVERTER */

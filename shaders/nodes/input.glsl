@@ -1,9 +1,10 @@
+// requires: nodes/common.glsl
+#ifndef PENUMBRA_LIB_NODES_INPUT
+#define PENUMBRA_LIB_NODES_INPUT
+
 /* Input nodes that compute something (Blender manual: Fresnel, Layer Weight). ``V`` points
  * from the surface towards the viewer, ``front``: the side of the surface the mesh's normal
  * points to is seen. */
-
-#ifndef NODE_INPUT_GLSL
-#define NODE_INPUT_GLSL
 
 float node_fresnel_dielectric(float cosi, float eta)
 {
@@ -57,4 +58,4 @@ vec3 node_bump(float strength, float dist, float height, vec3 N, bool front, boo
   return node_safe_normalize(mix(N, bumped, max(strength, 0.0)));
 }
 
-#endif
+#endif /* PENUMBRA_LIB_NODES_INPUT */

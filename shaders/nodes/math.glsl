@@ -1,10 +1,11 @@
+// requires: nodes/common.glsl
+#ifndef PENUMBRA_LIB_NODES_MATH
+#define PENUMBRA_LIB_NODES_MATH
+
 /* The Math node: every operation of Blender's (the manual's Math node page), with its safe
  * definitions (a division by zero is 0, the square root of a negative number 0, ...). ``op``
  * is a literal at each call (NODE_MATH_* from engine/scene/nodetree.py), so the compiler keeps
  * only that branch. */
-
-#ifndef NODE_MATH_GLSL
-#define NODE_MATH_GLSL
 
 float node_math_wrap(float a, float b, float c)
 {
@@ -83,4 +84,4 @@ float node_math(const int op, float a, float b, float c)
   return 0.0;
 }
 
-#endif
+#endif /* PENUMBRA_LIB_NODES_MATH */

@@ -1,3 +1,7 @@
+// requires:
+#ifndef PENUMBRA_LIB_NODES_SHADER
+#define PENUMBRA_LIB_NODES_SHADER
+
 /* Shader sockets of a compiled node tree (engine/scene/nodetree.py): a closure is up to TWO
  * lobes, each the Principled parameters Penumbra shades with as sums weighted by how much of
  * that surface there is, plus the coverage and emission the lobes share:
@@ -17,9 +21,6 @@
  * are left. node_closure_resolve gives one set of parameters (the lobes summed: trees of one
  * lobe, and the shadow pass's alpha); node_closure_resolve_lobes the two lobes and their
  * weights (the lit pass under NODE_LOBES == 2). */
-
-#ifndef NODE_SHADER_GLSL
-#define NODE_SHADER_GLSL
 
 struct NodeLobe {
   vec3 color;
@@ -269,4 +270,4 @@ void node_closure_resolve_lobes(NodeClosure c, inout vec4 base, inout float roug
   alpha = node_finite3(vec3(coverage), 1.0).x;
 }
 
-#endif
+#endif /* PENUMBRA_LIB_NODES_SHADER */

@@ -1,3 +1,7 @@
+// requires: nodes/texture_hash.glsl
+#ifndef PENUMBRA_LIB_NODES_TEXTURE_BRICK
+#define PENUMBRA_LIB_NODES_TEXTURE_BRICK
+
 /* Blender's Brick Texture node: rows of Row Height, bricks of Brick Width, every Offset
  * Frequency-th row shifted by Offset times the brick width and every Squash Frequency-th row's
  * bricks Squash times as wide (both only when both frequencies are non-zero); mortar of Mortar
@@ -9,9 +13,6 @@
  *
  * Row and brick numbers convert to int as x86 does (INT_MIN out of range); a non-finite
  * coordinate, or one that overflows with Scale, reads as 0 where Blender would give NaN. */
-
-#ifndef TEXTURE_BRICK_GLSL
-#define TEXTURE_BRICK_GLSL
 
 /* Blender's brick noise of an integer, in [0, 1). */
 float brick_noise(uint n)
@@ -113,4 +114,4 @@ vec4 node_tex_brick(vec3 vector,
   return vec4(color1 * (1.0 - f) + mortar * f, f);
 }
 
-#endif /* TEXTURE_BRICK_GLSL */
+#endif /* PENUMBRA_LIB_NODES_TEXTURE_BRICK */

@@ -1,3 +1,7 @@
+// requires: nodes/texture_hash.glsl
+#ifndef PENUMBRA_LIB_NODES_TEXTURE_GRADIENT
+#define PENUMBRA_LIB_NODES_TEXTURE_GRADIENT
+
 /* Blender's Gradient Texture node, of the point as given (no scale), clamped to [0, 1]:
  * Linear x; Quadratic max(x, 0)^2; Easing the cubic 3t^2 - 2t^3 of t = clamp(x, 0, 1); Diagonal
  * (x + y) / 2; Radial the angle atan2(y, x) / 2pi + 0.5; Spherical max(0.999999 - |p|, 0) and
@@ -5,9 +9,6 @@
  *
  * A non-finite coordinate reads as 0; values that overflow clamp as Blender's (a length that
  * overflows gives 0). */
-
-#ifndef TEXTURE_GRADIENT_GLSL
-#define TEXTURE_GRADIENT_GLSL
 
 /* Gradient Texture node `gradient_type`. */
 #define GRADIENT_LINEAR 0
@@ -56,4 +57,4 @@ vec4 node_tex_gradient(vec3 vector, int type)
   return vec4(f, f, f, f);
 }
 
-#endif /* TEXTURE_GRADIENT_GLSL */
+#endif /* PENUMBRA_LIB_NODES_TEXTURE_GRADIENT */

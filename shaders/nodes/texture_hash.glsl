@@ -1,3 +1,7 @@
+// requires:
+#ifndef PENUMBRA_LIB_NODES_TEXTURE_HASH
+#define PENUMBRA_LIB_NODES_TEXTURE_HASH
+
 /* Hashes of Blender's procedural textures, bit for bit.
  *
  * - Bob Jenkins' lookup3 (http://burtleburtle.net/bob/c/lookup3.c, "final" and "mix"), seeded
@@ -9,9 +13,6 @@
  *   the Voronoi texture hashes its integer cell coordinates with them (hash_int*_to_vec*).
  *
  * uint arithmetic wraps modulo 2^32 in GLSL, as lookup3 expects. */
-
-#ifndef TEXTURE_HASH_GLSL
-#define TEXTURE_HASH_GLSL
 
 uint hash_rotl(uint x, uint k)
 {
@@ -297,4 +298,4 @@ vec4 texture_finite(vec4 v)
   return vec4(texture_finite(v.x), texture_finite(v.y), texture_finite(v.z), texture_finite(v.w));
 }
 
-#endif /* TEXTURE_HASH_GLSL */
+#endif /* PENUMBRA_LIB_NODES_TEXTURE_HASH */

@@ -1,3 +1,7 @@
+// requires: nodes/texture_hash.glsl nodes/texture_noise.glsl
+#ifndef PENUMBRA_LIB_NODES_TEXTURE_MAGIC
+#define PENUMBRA_LIB_NODES_TEXTURE_MAGIC
+
 /* Blender's Magic Texture node: three waves of the point, sin(5 (x + y + z)), cos(5 (-x + y - z))
  * and -cos(5 (-x - y + z)), fed Depth times (0 to 10) through Blender's fixed chain of sines and
  * cosines of each other, each step scaled by Distortion; the colour is 0.5 minus the three
@@ -14,9 +18,6 @@
  *
  * Deviation, on purpose: a non-finite coordinate, or one that overflows with Scale, reads as 0
  * where Blender would return NaN. Depth is clamped to [0, 10] as Blender's property is. */
-
-#ifndef TEXTURE_MAGIC_GLSL
-#define TEXTURE_MAGIC_GLSL
 
 #define MAGIC_WRAP_UNSCALED 0
 #define MAGIC_WRAP_SCALED 1
@@ -82,4 +83,4 @@ vec4 node_tex_magic(vec3 vector, float scale, float distortion, int depth, int w
   return vec4(color, (color.x + color.y + color.z) * (1.0 / 3.0));
 }
 
-#endif /* TEXTURE_MAGIC_GLSL */
+#endif /* PENUMBRA_LIB_NODES_TEXTURE_MAGIC */

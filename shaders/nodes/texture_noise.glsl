@@ -1,3 +1,7 @@
+// requires: nodes/common.glsl nodes/texture_hash.glsl
+#ifndef PENUMBRA_LIB_NODES_TEXTURE_NOISE
+#define PENUMBRA_LIB_NODES_TEXTURE_NOISE
+
 /* Blender's Noise Texture node: gradient noise in 1 to 4 dimensions and its fractal sums.
  *
  * - Gradient noise after Ken Perlin, "Improving Noise", SIGGRAPH 2002: the quintic fade
@@ -16,9 +20,6 @@
  *
  * Deviation, on purpose: a non-finite coordinate (NaN, +-inf, or overflow from Scale or
  * Lacunarity) reads as signed noise 0 where Blender would return NaN. */
-
-#ifndef TEXTURE_NOISE_GLSL
-#define TEXTURE_NOISE_GLSL
 
 /* Noise Texture node `noise_type`. */
 #define NOISE_FBM 0
@@ -467,4 +468,4 @@ vec4 node_tex_noise(int dimensions,
   return node_tex_noise_at(vec4(vector, w), detail, roughness, lacunarity, offset, gain, distortion, type, normalize);
 }
 
-#endif /* TEXTURE_NOISE_GLSL */
+#endif /* PENUMBRA_LIB_NODES_TEXTURE_NOISE */

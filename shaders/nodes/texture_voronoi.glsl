@@ -1,3 +1,7 @@
+// requires: nodes/common.glsl nodes/texture_hash.glsl
+#ifndef PENUMBRA_LIB_NODES_TEXTURE_VORONOI
+#define PENUMBRA_LIB_NODES_TEXTURE_VORONOI
+
 /* Blender's Voronoi Texture node: cellular noise after Steven Worley, "A Cellular Texture Basis
  * Function", SIGGRAPH 1996 (one jittered feature point per unit cell, the 3^d neighbourhood
  * searched), with Blender's outputs and options:
@@ -14,9 +18,6 @@
  *
  * Out-of-range cells convert to int as x86 does (INT_MIN); a non-finite coordinate reads as 0
  * (Blender would return NaN), so every output is finite. */
-
-#ifndef TEXTURE_VORONOI_GLSL
-#define TEXTURE_VORONOI_GLSL
 
 /* Voronoi Texture node `feature`. */
 #define VORONOI_F1 0
@@ -656,4 +657,4 @@ void node_tex_voronoi(int dimensions,
   }
 }
 
-#endif /* TEXTURE_VORONOI_GLSL */
+#endif /* PENUMBRA_LIB_NODES_TEXTURE_VORONOI */

@@ -1,3 +1,7 @@
+// requires: nodes/texture_hash.glsl nodes/texture_noise.glsl
+#ifndef PENUMBRA_LIB_NODES_TEXTURE_WAVE
+#define PENUMBRA_LIB_NODES_TEXTURE_WAVE
+
 /* Blender's Wave Texture node: bands or rings of a periodic profile, perturbed by fBM noise.
  *
  * - Bands run along X, Y, Z (the coordinate times 20) or the diagonal (the sum of the three
@@ -15,9 +19,6 @@
  * Blender would return NaN; Detail is clamped to [0, 15] and Detail Roughness to >= 0 (the
  * sockets' own ranges) so the octave loop stays bounded; the profile is clamped to [0, 1]
  * (Blender's is not: its sin may round past 1). Color is Fac in every channel. */
-
-#ifndef TEXTURE_WAVE_GLSL
-#define TEXTURE_WAVE_GLSL
 
 /* Wave Texture node `wave_type`. */
 #define WAVE_BANDS 0
@@ -109,4 +110,4 @@ vec4 node_tex_wave(vec3 vector,
   return vec4(f, f, f, f);
 }
 
-#endif /* TEXTURE_WAVE_GLSL */
+#endif /* PENUMBRA_LIB_NODES_TEXTURE_WAVE */

@@ -1,10 +1,11 @@
+// requires: nodes/common.glsl nodes/math.glsl
+#ifndef PENUMBRA_LIB_NODES_VECTOR
+#define PENUMBRA_LIB_NODES_VECTOR
+
 /* The Vector Math and Mapping nodes (Blender manual: Vector Math, Mapping). ``op`` is a
  * literal (NODE_VECTOR_MATH_* in engine/scene/nodetree.py). Vector Math gives a vector and
  * a value; the operations that give a value (Dot Product, Distance, Length) leave the vector 0,
  * the others leave the value 0. */
-
-#ifndef NODE_VECTOR_GLSL
-#define NODE_VECTOR_GLSL
 
 vec3 node_vector_wrap(vec3 a, vec3 b, vec3 c)
 {
@@ -65,4 +66,4 @@ vec3 node_mapping(const int type, vec3 v, vec3 location, vec3 rotation, vec3 sca
   return v;
 }
 
-#endif
+#endif /* PENUMBRA_LIB_NODES_VECTOR */

@@ -1,3 +1,7 @@
+// requires:
+#ifndef PENUMBRA_LIB_POST_NOISE
+#define PENUMBRA_LIB_POST_NOISE
+
 /* Film grain as a point layer; see noise.py (grain_reference is the numpy twin of
  * noise_grain()). point[o]: amount, then as int bits grain size, frame, seed;
  * point[o + 1].x: monochrome (int bits). */
@@ -37,3 +41,5 @@ vec4 noise_point(vec4 c, int o)
   /* No stronger than the channel itself: light never goes negative, the mean stays. */
   return vec4(c.rgb + min(vec3(amount), max(c.rgb, vec3(0.0))) * g, c.a);
 }
+
+#endif /* PENUMBRA_LIB_POST_NOISE */

@@ -1,3 +1,7 @@
+// requires:
+#ifndef PENUMBRA_LIB_POST_SCANLINES
+#define PENUMBRA_LIB_POST_SCANLINES
+
 /* SCANLINES as a point layer. line_count periods over the image height (periods_per_pixel per
  * pixel), a dark band of thickness periods in each, scrolled by scroll periods. Mirrors
  * scanlines.py's scanline_darkness; rows count from the bottom. point[o]: periods per pixel,
@@ -43,3 +47,5 @@ vec4 scanlines_point(vec4 c, int o)
   }
   return vec4(c.rgb * (1.0 - intensity * dark), c.a);
 }
+
+#endif /* PENUMBRA_LIB_POST_SCANLINES */

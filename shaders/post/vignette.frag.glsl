@@ -1,3 +1,7 @@
+// requires: lib/common.glsl
+#ifndef PENUMBRA_LIB_POST_VIGNETTE
+#define PENUMBRA_LIB_POST_VIGNETTE
+
 /* VIGNETTE as a point layer; see vignette.py's vignette_factor. point[o]: colour (xyz),
  * radius (w); point[o + 1]: softness, roundness. */
 vec4 vignette_point(vec4 c, int o)
@@ -20,3 +24,5 @@ vec4 vignette_point(vec4 c, int o)
   }
   return vec4(mix(c.rgb, color, f), c.a);
 }
+
+#endif /* PENUMBRA_LIB_POST_VIGNETTE */

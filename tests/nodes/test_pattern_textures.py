@@ -14,7 +14,7 @@ from devkit.texture_gpu import evaluate_many
 from devkit.texture_tiles import NEAR, TILE, build_tiles, gpu_scene, pixel_points, points, swizzle, tile_errors
 
 HASH = ["texture_hash.glsl"]
-NOISE = ["common.glsl", *HASH, "texture_noise.glsl"]  # what texture_noise needs (nodetree.FAMILY_NEEDS)
+NOISE = ["common.glsl", *HASH, "texture_noise.glsl"]  # texture_noise and its requires line
 WAVE = NOISE + ["texture_wave.glsl"]
 MAGIC = NOISE + ["texture_magic.glsl"]
 BRICK = HASH + ["texture_brick.glsl"]

@@ -15,7 +15,7 @@ from devkit.texture_gpu import evaluate_many
 from devkit.texture_tiles import NEAR, build_tiles, compare, gpu_scene, points, rounding_spread, tile_errors
 
 HASH = ["texture_hash.glsl"]
-NOISE = ["common.glsl", *HASH, "texture_noise.glsl"]  # what texture_noise needs (nodetree.FAMILY_NEEDS)
+NOISE = ["common.glsl", *HASH, "texture_noise.glsl"]  # texture_noise and its requires line
 VORONOI = ["common.glsl", *HASH, "texture_voronoi.glsl"]
 WHITE = HASH + ["texture_white_noise.glsl"]
 SWIZZLE = {1: "a0.w", 2: "a0.xy", 3: "a0.xyz", 4: "a0"}
