@@ -1,4 +1,4 @@
-/* The settle test (engine/frame/settle.py, lib/lit_settle.glsl): the lit pass's libraries over
+/* The settle test (engine/frame/features/settling.py, lib/lit_settle.glsl): the lit pass's libraries over
  * the surfaces a frame's pilot sample drew, lights at their centres, writing per pixel whether
  * a later sample could change it through a light, and how far its light is from the light's
  * average over each extent (settle_flags). No colour, no passes. */

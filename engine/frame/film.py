@@ -17,9 +17,6 @@ from .film_programs import (
     SCALED_COPY,
     SCALED_COPY_SHADOW,
     SCALED_RESOLVE_SHADOW,
-    SETTLE,
-    SETTLE_SHADOW,
-    SETTLED_COPY,
     WEIGHTED_RESOLVE,
     WEIGHTED_RESOLVE_SHADOW,
     convergence_program,
@@ -75,7 +72,7 @@ class FilmPart:
 
     The film calls, for the parts of the frame (``Film.begin``): ``framebuffer`` (the lit
     pass's targets with its own), ``clear`` (before a sample's lit pass), ``begin`` (a fresh
-    frame), ``accumulate`` (each sample), ``settled`` (what settling copies), ``convergence``
+    frame), ``accumulate`` (each sample), ``accumulated`` (what a sample's value kept copies), ``convergence``
     (its share of the convergence check), ``resolve`` (after the last sample),
     ``bytes_per_pixel``, and ``release`` whenever the film's targets go (a new size, the end
     of a render)."""
@@ -95,8 +92,9 @@ class FilmPart:
     def accumulate(self, film, weight, sample, mask, gather):
         pass
 
-    def settled(self, film):
-        """(accumulation, this sample's target) pairs settling copies the pilot's value into."""
+    def accumulated(self, film):
+        """(accumulation, this sample's target) pairs: where a technique that keeps one
+        sample's value in the pixels it converges (settling's pilot) copies that value."""
         return ()
 
     def convergence(self, film):
@@ -186,7 +184,6 @@ class Film:
         self._mask_index = 0
         self._weight = None
         self._masked_fbs = {}
-        self._settle = None  # (size, the settle test's flags, their framebuffer over the z-buffer)
         # The shading count of tests (``count_shaded``): the lit pass writes 1 into ``shaded``
         # for every pixel it shades; ``shaded_total`` adds them over the frame's samples.
         self.count_shaded = False
@@ -295,17 +292,15 @@ class Film:
                 per_pixel += 16
             if self._masks is not None:
                 per_pixel += 4 + 4 + (8 if self._weight is not None else 0)
-            if self._settle is not None:
-                per_pixel += 16
             per_pixel += sum(part.bytes_per_pixel(self) for part in self.parts)
         return per_pixel * self.size[0] * self.size[1]
 
     # --- samples --------------------------------------------------------------------------
 
-    def begin(self, aux, emission, fresh, adaptive=False, settle=False, parts=(), gather_reach=0):
+    def begin(self, aux, emission, fresh, adaptive=False, masks=False, parts=(), gather_reach=0):
         """Before a multi-sample frame's samples: the accumulation targets, cleared when the
         frame starts afresh (``fresh``); ``adaptive``: the frame estimates each pixel's error
-        (from a fresh start on); ``settle``: pixels may settle (``settle``), so the converged
+        (from a fresh start on); ``masks``: a technique converges pixels (``update_mask``), so the converged
         masks exist; ``parts``: the techniques' targets (``FilmPart``);
         ``gather_reach``: the gathering film's reach in pixels (``sampling.gather_reach``; 0:
         each pixel its own samples), which a converged pixel stays shaded for."""
@@ -314,7 +309,7 @@ class Film:
         self.parts = tuple(parts)
         self._known_parts += [p for p in self.parts if p not in self._known_parts]
         if fresh:
-            self._begin_adaptive(adaptive, settle)
+            self._begin_adaptive(adaptive, masks)
             for part in self.parts:
                 part.begin(self)
             if self.shaded_total is not None:
@@ -437,9 +432,9 @@ class Film:
         """The converged mask (R32F, 1 where a pixel converged), or None while no pixel has."""
         return self._masks[self._mask_index] if self.converged and self._masks is not None else None
 
-    def _begin_adaptive(self, adaptive, settle=False):
+    def _begin_adaptive(self, adaptive, masks=False):
         """A fresh frame: no pixel converged; with ``adaptive`` the second accumulation, with
-        it or ``settle`` the masks exist (at this size) and are cleared."""
+        it or ``masks`` the masks exist (at this size) and are cleared."""
         import gpu
 
         self.tracking = bool(adaptive)
@@ -447,7 +442,7 @@ class Film:
         self.give([self._weight])
         self._weight = None
         self._masked_fbs = {}
-        if not (self.tracking or settle):
+        if not (self.tracking or masks):
             return
         size = self.size
         if self._masks is None or (self._masks[0].width, self._masks[0].height) != size:
@@ -464,57 +459,23 @@ class Film:
             m.clear(format="FLOAT", value=(0.0,))
         self._mask_index = 0
 
-    def settle_framebuffer(self):
-        """The settle test's target (RGBA32F flags, ``settle.py``) over the lit pass's z-buffer,
-        cleared to settled (1) with no change: where no surface is drawn, only the image
-        decides."""
-        import gpu
-
-        if self._settle is None or self._settle[0] != self.size:
-            self.give([self._settle[1]] if self._settle else [])
-            flags = new_texture(self.pool, self.size, "RGBA32F")
-            self._settle = (self.size, flags, gpu.types.GPUFrameBuffer(depth_slot=self.zbuffer, color_slots=(flags,)))
-        self._settle[1].clear(format="FLOAT", value=(1.0, 0.0, 0.0, 0.0))
-        return self._settle[2]
-
-    def settle(self, threshold, shifts, aux=False, emission=False, reach=1):
-        """After the first sample, with the pilot sample in the colour (and shadow, Emission)
-        targets: settle the pixels no later sample can change by ``threshold`` (the flags in
-        ``settle_framebuffer`` and the pilot's image; ``shifts``: ``settle.settle_shifts``).
-        They join the converged pixels with the pilot's value in place of the first sample's
-        (the same weight); the others keep their first sample. ``aux``/``emission``: the frame
-        has the Shadow / Emission pass; ``reach``: how many pixels away the pixel filter still
-        reads (its light test must hold that far). Returns the number of converged pixels."""
-        (mx, my), (sxx, syy, sxy) = shifts
+    def update_mask(self, program, samplers, uniforms):
+        """One pass of ``program`` from the converged mask (its sampler ``converged``) into the
+        other mask, which becomes the converged mask (a technique's test: settling's); returns
+        the number of converged pixels."""
         src, dst = self._mask_index, 1 - self._mask_index
-        samplers = {"accum": self.color, "flags": self._settle[1], "converged": self._masks[src]}
-        with_shadow = aux and self._accum_shadow is not None
-        if with_shadow:
-            samplers["accum_shadow"] = self.shadow
-        uniforms = {
-            "threshold": float(threshold),
-            "weight_sum": 1.0,  # the pilot alone
-            "mean_shift": (float(mx), float(my)),
-            "moment_shift": (float(sxx), float(syy), float(sxy)),
-            "flag_reach": float(reach),
-        }
-        program = SETTLE_SHADOW if with_shadow else SETTLE
-        self.fullscreen(program, self._mask_fbs[dst], samplers, uniforms)
-        count = self._take_mask(dst)
-        if count:
-            mask = self._masks[dst]
-            copies = [(self._accum_color, self.color)]
-            if with_shadow:
-                copies.append((self._accum_shadow, self.shadow))
-            if emission and self._emission_targets is not None:
-                copies.append((self._emission_targets[0], self.emission))
-            for part in self.parts:
-                copies += list(part.settled(self))
-            for target, source in copies:
-                framebuffer = gpu_framebuffer(target)
-                scale = self._weight_sum  # the first sample's weight, which the pilot takes over
-                self.fullscreen(SETTLED_COPY, framebuffer, {"src_color": source, "converged": mask}, {"scale": scale})
-        return count
+        self.fullscreen(program, self._mask_fbs[dst], {**samplers, "converged": self._masks[src]}, uniforms)
+        return self._take_mask(dst)
+
+    def accumulations(self, aux, emission):
+        """{target: (its accumulation, this sample's)} of the colour, and of the Shadow pass
+        (``aux``, once accumulated) and the Emission pass (``emission``) where the frame has them."""
+        out = {"color": (self._accum_color, self.color)}
+        if aux and self._accum_shadow is not None:
+            out["shadow"] = (self._accum_shadow, self.shadow)
+        if emission and self._emission_targets is not None:
+            out["emission"] = (self._emission_targets[0], self.emission)
+        return out
 
     def check(self, threshold):
         """The convergence check after an even number of samples: a pixel converges when the
@@ -758,13 +719,11 @@ class Film:
                 self._weight,
                 self.shaded,
                 self.shaded_total,
-                self._settle[1] if self._settle else None,
             ]
         )
         for part in self._known_parts:
             part.release(self)
         self._emission_fb = None
-        self._settle = None
         self.fb = self.fb_color = self.fb_emit = self._accum_fb = self._resolve_fb = None
         self._half = self._half_fb = self._masks = self._mask_fbs = self._weight = None
         self._masked_fbs = {}

@@ -1,7 +1,7 @@
 """The film's programs (``film.Film``): a sample added to the accumulation and the
 accumulation resolved (by the total weight, or each pixel's with adaptive sampling), the
-convergence check, settling, and the nearest
-depth written where a pixel converged."""
+convergence check, and the nearest depth written where a pixel converged. A technique's own
+film programs live in its module (``features/``)."""
 
 from dataclasses import replace
 
@@ -113,39 +113,6 @@ def convergence_program(error_output=False, parts=()):
     return with_parts(CONVERGENCE_ERROR if error_output else CONVERGENCE, *parts)
 
 
-# Settling (``engine/frame/settle.py``): the settle test's flags and the image so far give the
-# pixels no later sample can change; they join the converged mask.
-SETTLE = Program(
-    name="settle",
-    vertex="fullscreen.vert.glsl",
-    fragment="settle.frag.glsl",
-    vertex_in=(("VEC2", "pos"),),
-    push_constants=(
-        ("FLOAT", "threshold"),
-        ("FLOAT", "weight_sum"),
-        ("VEC2", "mean_shift"),
-        ("VEC3", "moment_shift"),
-        ("FLOAT", "flag_reach"),
-    ),
-    samplers=(("FLOAT_2D", "accum"), ("FLOAT_2D", "flags"), ("FLOAT_2D", "converged")),
-    outputs=(("VEC4", "out_color"),),
-    defines=(("WITH_SHADOW", False),),
-)
-SETTLE_SHADOW = replace(
-    SETTLE,
-    name="settle_shadow",
-    samplers=SETTLE.samplers + (("FLOAT_2D", "accum_shadow"),),
-    defines=(("WITH_SHADOW", True),),
-)
-SETTLED_COPY = Program(
-    name="settled_copy",
-    vertex="fullscreen.vert.glsl",
-    fragment="settled_copy.frag.glsl",
-    vertex_in=(("VEC2", "pos"),),
-    push_constants=(("FLOAT", "scale"),),
-    samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "converged")),
-    outputs=(("VEC4", "out_color"),),
-)
 CONVERGED_DEPTH = Program(
     name="converged_depth",
     vertex="fullscreen.vert.glsl",

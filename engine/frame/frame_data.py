@@ -158,21 +158,6 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
     }
 
 
-def ao_row(projection, size, distance, jitter):
-    """The frame row's WORLD_AO fields (``lib/gtao.glsl``): the terms of the raster camera's
-    ``projection`` that take a view depth at a pixel to a view-space position and back, the
-    film's ``size`` (width, height), the distance in world units and the sample's ``jitter``
-    (``sampling.ao_jitter``)."""
-    p = np.asarray(projection, np.float64)
-    return {
-        "ao_projection": (p[0, 0], p[1, 1], p[0, 2], p[1, 2]),
-        "ao_projection_w": (p[0, 3], p[1, 3], p[3, 2], p[3, 3]),
-        "ao_viewport": (float(size[0]), float(size[1])),
-        "ao_distance": float(distance),
-        "ao_jitter": tuple(float(j) for j in jitter),
-    }
-
-
 def shading_order(lights, plan):
     """Light indices as the lit pass loops over them: lights sampled over their extent with a
     map first, then the other lights with a map, then the rest (each group in its own order).

@@ -272,7 +272,6 @@ LIT = Program(
             "RSM_SAMPLES": 1,
             "SETTLE_TEST": False,
             "PILOT_SAMPLE": False,
-            "GTAO_UPSAMPLE": True,
         }.items()
     ),
 )
@@ -521,13 +520,6 @@ def depth_defines(depth_format):
 UNROLLED_LIGHTS = 4
 
 
-# The settle test reads a map's region up to SETTLE_REACH texels around a point (the light's
-# half width seen from there); a wider region (a large light far from its casters) may change.
-# It reads every texel up to SETTLE_GRID texels away, beyond that (2 SETTLE_GRID + 1)^2 taps.
-SETTLE_REACH = 128
-SETTLE_GRID = 4
-
-
 @dataclass(frozen=True, kw_only=True)
 class LitVariant:
     """Which lit-pass program a draw takes: every field named (keyword-only: no variant is
@@ -680,6 +672,4 @@ def lit_defines(variant):
         "DEBUG_LIT": bool(v.debug),
         "WORLD_LIGHTS": bool(v.world_lights),
         "DEBUG_TERM": int(v.debug_term),
-        "SETTLE_REACH": SETTLE_REACH,
-        "SETTLE_GRID": SETTLE_GRID,
     }

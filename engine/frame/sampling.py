@@ -47,7 +47,6 @@ import time
 import numpy as np
 
 from ..counts import ceil_count
-from ..enums import DEBUG_VIEW
 from ..shadows.vectors import cross
 
 PIXEL_BASES = (2, 3)
@@ -503,7 +502,7 @@ class Adaptive:
     neighbours') is below it after ``min_samples`` takes no more samples, checked every
     ``step`` samples. ``time_limit``: seconds the samples may take (0: none).
     ``settle``: the Noise Threshold a pixel settles by after the frame's pilot sample (0:
-    none; ``settle.py``): no sample could change it by as much (no moving shadow edge,
+    none; ``features/settling.py``): no sample could change it by as much (no moving shadow edge,
     highlight or facet, no edge or detail under the pixel filter), so it takes no other."""
 
     threshold: float = 0.0
@@ -543,12 +542,6 @@ def adaptive_settings(use, threshold, min_samples, time_limit, sample_count):
     )
 
 
-# The world's ambient occlusion (``world/occlusion.py``, ``shaders/lib/gtao.glsl``): with World ›
-# Ambient Occlusion › Distance at 0 (automatic) it looks this fraction of the diagonal of the
-# bounds of what the frame draws, so it does the same in a scene of millimetres or kilometres.
-AO_AUTO_FRACTION = 0.1
-
-
 def world_is_black(world):
     """Whether ``world`` (a ``materials.World`` with its SH light, or a constant colour) gives
     no light at all."""
@@ -560,44 +553,3 @@ def world_is_black(world):
     else:
         values = np.asarray(world if world is not None else (0.0, 0.0, 0.0), np.float64)
     return not bool(np.any(values[np.isfinite(values)] != 0.0))
-
-
-def world_ao_sample(s, accumulate, settings, world, debug="NONE"):
-    """Whether sample ``s`` of a frame (``accumulate``: one of several samples) occludes the
-    world's light by screen-space ambient occlusion (``world/occlusion.py``): with World › Ambient
-    Occlusion on and a world that gives light, a one-sample frame (the viewport while the view
-    moves, a render of one sample) and the first sample of a frame of several, so the frame's
-    first image shows contact shadows at once (a frame's pilot sample stands in for its first,
-    ``settle.py``: ask with ``s`` 0). The WORLD_AO debug view occludes every sample (it shows
-    that estimate), the other lit debug views none. A black world, or the setting off, costs
-    nothing: no prepass, no occlusion code in the lit pass."""
-    if not bool(getattr(settings, "world_ao", False)) or world_is_black(world):
-        return False
-    if debug == "WORLD_AO":
-        return True
-    if DEBUG_VIEW[debug].lit and not DEBUG_VIEW[debug].term:
-        return False  # the other lit debug views show the lights' numbers, not the world's
-    return not accumulate or s == 0
-
-
-def world_ao_distance(settings, corners):
-    """How far (world units) the ambient occlusion looks: World › Ambient Occlusion ›
-    Distance, or with 0 (automatic) AO_AUTO_FRACTION of the diagonal of the box around
-    ``corners`` ((n, 3) world points: the bounds of what the frame draws); 0 when there is
-    nothing (no occlusion)."""
-    distance = float(getattr(settings, "world_ao_distance", 0.0))
-    if distance > 0.0 and math.isfinite(distance):
-        return distance
-    pts = np.asarray(corners, np.float64).reshape(-1, 3) if corners is not None else np.zeros((0, 3))
-    pts = pts[np.all(np.isfinite(pts), axis=1)]
-    if len(pts) == 0:
-        return 0.0
-    diagonal = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
-    return AO_AUTO_FRACTION * diagonal if math.isfinite(diagonal) else 0.0
-
-
-def ao_jitter(s):
-    """Sample ``s``'s rotation of the ambient occlusion's slices and offset of its steps, each
-    in [0, 1): the additive recurrence of the plastic number's powers (an R2 sequence), so the
-    samples of a frame spread evenly over both; sample 0 unshifted."""
-    return (math.fmod(s * 0.7548776662466927, 1.0), math.fmod(s * 0.5698402909980532, 1.0))

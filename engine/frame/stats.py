@@ -100,7 +100,7 @@ class FrameStats:
     cancelled: bool = False  # on_sample asked to stop before the last sample
     stopped: str = ""  # why the frame ended before its last sample: "converged" or "time limit"
     pixels_converged: int = 0  # pixels adaptive sampling stopped (Noise Threshold)
-    pixels_settled: int = 0  # of those, pixels settled after the first sample(s) (``settle.py``)
+    pixels_settled: int = 0  # of those, pixels settled after the first sample(s) (``features/settling.py``)
     pixel_samples_skipped: int = 0  # of the samples taken, those converged pixels were not shaded in (summed)
     lights_out_of_view: int = 0  # lights that reach no visible surface: no map, no shading
     closed_culled: int = 0  # closed instances drawn without back faces (lit pass and each map)

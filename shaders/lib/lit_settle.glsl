@@ -2,7 +2,7 @@
 #ifndef PENUMBRA_LIB_LIT_SETTLE
 #define PENUMBRA_LIB_LIT_SETTLE
 
-/* SETTLE_TEST (engine/frame/settle.py, after a frame's pilot sample, lights at their centres):
+/* SETTLE_TEST (engine/frame/features/settling.py, after a frame's pilot sample, lights at their centres):
  * the pixel writes whether any later sample could change it through a light (1 in red where
  * none can: every moving light's visibility is the same from all of the light,
  * lib/shadow_filters.glsl, and no facet turns across it; a dithered or blended surface never

@@ -282,13 +282,13 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
                              2.0 * L.shadow_radius * (receiver - near) / max(receiver, 1e-30);
   float search = clamp(0.5 * search_world / texel, 1.0, max_r);
 #if PILOT_SAMPLE
-  /* A frame's pilot sample (engine/frame/settle.py) is kept only where every moving light's
+  /* A frame's pilot sample (engine/frame/features/settling.py) is kept only where every moving light's
    * visibility is the same from all of the light: there one bilinear lookup reads it. */
   return shadow_bilinear(origin, st, SHADOW_REF(1.0), grad);
 #endif
 #if SETTLE_TEST
   {
-    /* The settle test (engine/frame/settle.py), with the light at its whole size: whether
+    /* The settle test (engine/frame/features/settling.py), with the light at its whole size: whether
      * every point of the light, on every shift of the map, sees P the same. The map was drawn
      * from the light's centre, so the region it must show is the light's half width
      * (PCSS's blocker search region) around P, plus a texel and a half for the maps'

@@ -135,7 +135,7 @@ def test_defocused_pixels_keep_sampling_in_focus_ones_may_settle(penumbra, gpu_c
     from penumbra.engine.frame.lens import coc_pixels, lens_reach
     from penumbra.engine.frame.renderer import Renderer
     from penumbra.engine.frame.sampling import adaptive_settings
-    from penumbra.engine.frame.settle import flag_reach
+    from penumbra.engine.frame.features.settling import flag_reach
     from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.demo_scene(160, 90)

@@ -278,7 +278,7 @@ def test_widened_projection_keeps_every_offset_of_the_filter_inside():
 
 
 def test_filter_reach_at_its_extremes():
-    from penumbra.engine.frame.settle import MAX_FLAG_REACH, flag_reach
+    from penumbra.engine.frame.features.settling import MAX_FLAG_REACH, flag_reach
 
     assert sampling.filter_width(0.0) == 0.0 and sampling.filter_width(10.0) == 20.0
     assert [flag_reach(f) for f in (0.0, 0.5, 1.0, 1.5, 2.0, 10.0)] == [1, 1, 1, 2, 2, MAX_FLAG_REACH]

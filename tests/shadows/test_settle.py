@@ -1,4 +1,4 @@
-"""Settling (engine/frame/settle.py): after the first sample, a pilot sample (lights at their
+"""Settling (engine/frame/features/settling.py): after the first sample, a pilot sample (lights at their
 centres) settles the pixels no later sample can change by the Noise Threshold: they take the
 pilot's value and no more samples.
 

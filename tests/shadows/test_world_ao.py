@@ -194,12 +194,12 @@ def test_black_world_or_ao_off_cost_nothing(penumbra, gpu_call):
 
 
 def test_world_ao_sample_decision():
-    """``sampling.world_ao_sample``: a one-sample frame and sample 0 of several, with the
+    """``features.world_occlusion.world_ao_sample``: a one-sample frame and sample 0 of several, with the
     setting on and a world that gives light; the WORLD_AO debug view every sample, the other
     lit debug views none."""
     from types import SimpleNamespace
 
-    from penumbra.engine.frame.sampling import ao_jitter, world_ao_distance, world_ao_sample
+    from penumbra.engine.frame.features.world_occlusion import ao_jitter, world_ao_distance, world_ao_sample
 
     on, off = SimpleNamespace(world_ao=True), SimpleNamespace(world_ao=False)
     grey = np.array((0.2, 0.2, 0.2))

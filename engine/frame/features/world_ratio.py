@@ -139,7 +139,7 @@ class RatioTargets(FilmPart):
     def _accumulations(self):
         return {name: target for name, (target, _fb) in zip(NAMES, self.accum, strict=True)}
 
-    def settled(self, film):
+    def accumulated(self, film):
         return [(target, source) for (target, _fb), source in zip(self.accum, self.sample, strict=True)]
 
     def convergence(self, film):

@@ -1,6 +1,6 @@
 """The world's ambient occlusion: the camera depth prepass its samples read.
 
-A sample that occludes the world's light (``sampling.world_ao_sample``: a one-sample frame, a
+A sample that occludes the world's light (``features.world_occlusion.world_ao_sample``: a one-sample frame, a
 frame's first sample) first draws the view depth of what the lit pass will show through the
 lit pass's own raster camera into a float target of the film's size; the lit pass's
 ``WORLD_AO`` variant then marches it for horizons around each fragment (screen-space
