@@ -3,6 +3,7 @@
 
     python -m tools.code_counts                  # engine/, over 100 lines or over 8 parameters
     python -m tools.code_counts --lines 60 engine/shadows
+    python -m tools.code_counts --techniques     # the files of engine/ and shaders/ naming each technique
 
 A function's lines run from its first decorator to its last line (docstring included); its
 parameters are every kind Python has (positional-only, ordinary, keyword-only, ``*args``,
@@ -12,8 +13,11 @@ alone, so it needs no Blender."""
 
 import argparse
 import ast
+import io
 import pathlib
+import re
 import sys
+import tokenize
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
@@ -54,12 +58,70 @@ def measure(paths):
     return rows
 
 
+# The frame's techniques (engine/frame/features/) and the names that mark them, as issue 49
+# counted them (``git grep -il``).
+TECHNIQUES = {
+    "world ratio": "world_ratio",
+    "settling": "settle",
+    "bounce": "rsm|bounce",
+    "world occlusion": "world_ao|gtao",
+}
+
+
+def _python_code(text):
+    """``text`` (Python) without its comments and docstrings."""
+    tree = ast.parse(text)
+    lines = text.splitlines(keepends=True)
+    for node in ast.walk(tree):
+        body = getattr(node, "body", None)
+        if isinstance(body, list) and body and isinstance(body[0], ast.Expr):
+            value = body[0].value
+            if isinstance(value, ast.Constant) and isinstance(value.value, str):
+                for i in range(body[0].lineno - 1, body[0].end_lineno):
+                    lines[i] = "\n"
+    out = []
+    for tok in tokenize.generate_tokens(io.StringIO("".join(lines)).readline):
+        if tok.type != tokenize.COMMENT:
+            out.append(tok.string)
+    return " ".join(out)
+
+
+def _glsl_code(text):
+    """``text`` (GLSL) without its comments."""
+    return re.sub(r"//[^\n]*", "", re.sub(r"/\*.*?\*/", "", text, flags=re.S))
+
+
+def technique_files(roots=("engine", "shaders")):
+    """{technique: (files naming it anywhere, files naming it in code)} over ``roots``."""
+    files = [p for r in roots for p in sorted((ROOT / r).rglob("*")) if p.suffix in (".py", ".glsl")]
+    out = {}
+    for name, pattern in TECHNIQUES.items():
+        rx = re.compile(pattern, re.I)
+        anywhere, code = [], []
+        for path in files:
+            text = path.read_text(encoding="utf-8")
+            if not rx.search(text):
+                continue
+            rel = path.relative_to(ROOT).as_posix()
+            anywhere.append(rel)
+            if rx.search(_python_code(text) if path.suffix == ".py" else _glsl_code(text)):
+                code.append(rel)
+        out[name] = (anywhere, code)
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("paths", nargs="*", default=[str(ROOT / "engine")], help="files or folders to read")
     parser.add_argument("--lines", type=int, default=100, help="report functions over this many lines")
     parser.add_argument("--params", type=int, default=8, help="report functions with more parameters than this")
+    parser.add_argument("--techniques", action="store_true", help="count the files naming each technique")
     args = parser.parse_args(argv)
+    if args.techniques:
+        for name, (anywhere, code) in technique_files().items():
+            print(f"{name} ({TECHNIQUES[name]}): {len(anywhere)} files, {len(code)} in code")
+            print("  " + " ".join(code))
+        return 0
     rows = measure(args.paths)
 
     def where(path):
