@@ -448,16 +448,16 @@ class LitKey:
     parts: tuple = ()
 
     def program(self):
-        return _lit_source(self)[0]
+        return _lit_program(self.aux, self.parts)
 
     def defines(self):
-        return _lit_source(self)[1]
+        """The variant's defines (``lit_defines``, made anew: they read the module's sizes)."""
+        return {**self.variant.defines(), "AUX_OUTPUTS": bool(self.aux)}
 
 
 @functools.lru_cache(maxsize=1024)
-def _lit_source(key):
-    program = with_parts(LIT if key.aux else LIT_COLOR, *key.parts)
-    return program, {**key.variant.defines(), "AUX_OUTPUTS": bool(key.aux)}
+def _lit_program(aux, parts):
+    return with_parts(LIT if aux else LIT_COLOR, *parts)
 
 
 def lit_key(aux, variant, parts=(), features=frozenset(), tree=None, entry=None):

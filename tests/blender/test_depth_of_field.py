@@ -131,11 +131,11 @@ def test_defocused_pixels_keep_sampling_in_focus_ones_may_settle(penumbra, gpu_c
     a blurred surface: at f/0.35 (the widest circle of confusion within the settle test's
     neighbourhood) pixels around the focus distance settle; at f/0.15 (blur wider than the
     neighbourhood it tests) none does."""
+    from penumbra.engine.frame.features.settling import flag_reach
     from penumbra.engine.frame.film import texture_array
     from penumbra.engine.frame.lens import coc_pixels, lens_reach
     from penumbra.engine.frame.renderer import Renderer
     from penumbra.engine.frame.sampling import adaptive_settings
-    from penumbra.engine.frame.features.settling import flag_reach
     from penumbra.engine.scene.extract import camera_from_scene
 
     scene = scenes.demo_scene(160, 90)

@@ -3,9 +3,12 @@ key (``programs.LitKey``): a part adds what the program lacks, once; its defines
 replaces the program's; each technique's part switches its technique on in the program's
 defines and brings its samplers and targets, and a key is one hashable value."""
 
-from penumbra.engine.frame import programs
-from penumbra.engine.frame.features import bounce, settling, world_occlusion, world_ratio
-from penumbra.shaders.loader import Program, ProgramPart, with_parts
+from devkit.session import load_penumbra
+
+load_penumbra()
+from penumbra.engine.frame import programs  # noqa: E402
+from penumbra.engine.frame.features import bounce, settling, world_occlusion, world_ratio  # noqa: E402
+from penumbra.shaders.loader import Program, ProgramPart, with_parts  # noqa: E402
 
 BASE = Program(
     name="base",
