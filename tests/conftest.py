@@ -2,10 +2,17 @@
 ``penumbra`` package, and draw through the real gpu module (Mesa llvmpipe via EGL); nothing is
 mocked. Shared code lives in ``devkit`` (tests never import each other)."""
 
+import os
+
 from devkit import session
 
 # Before Blender starts: presets and preferences go to a throw-away HOME, never a real user's.
 HOME = session.isolate()
+# On Mesa's llvmpipe, the GPU of this harness, a test's small frames cost less to draw than
+# their programs cost to compile, and a fresh machine (no Mesa shader cache) compiles every
+# program anew: compiled without LLVM's optimisation passes, a cold run takes about half the
+# time (README). A GPU's driver ignores it; set GALLIVM_PERF yourself to choose otherwise.
+os.environ.setdefault("GALLIVM_PERF", "nopt")
 
 import bpy  # noqa: E402
 import pytest  # noqa: E402
