@@ -14,7 +14,7 @@
  * The material comes from the MaterialData block and, per variant (programs.material_defines),
  * image textures, a colour attribute, a normal map, the alpha mode, or a compiled node tree.
  *
- * Three entry shaders share these libraries (programs.lit_entry): this one, the surface's
+ * Three entry shaders share these libraries (programs.ENTRY_PARTS): this one, the surface's
  * colour; lit_settle.frag.glsl, the settle test's flags (SETTLE_TEST); lit_debug.frag.glsl, a
  * debug view's values (DEBUG_LIT, DEBUG_TERM). This one writes, per variant:
  *   default        colour (+ Shadow, Normal and Depth with AUX_OUTPUTS, Emission with

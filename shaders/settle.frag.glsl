@@ -1,4 +1,4 @@
-/* The settle mask (film_programs.SETTLE, engine/frame/features/settling.py), once after a frame's first
+/* The settle mask (features.settling.SETTLE), once after a frame's first
  * sample(s): a pixel settles, taking no further samples, when no later sample can move it
  * by the Noise Threshold. Two causes could:
  *   - a light: the settle test's flags (``flags``: red 1 where no moving light's visibility

@@ -1,4 +1,4 @@
-/* Where a pixel settled (film_programs.SETTLED_COPY, engine/frame/features/settling.py): the pilot's value,
+/* Where a pixel settled (features.settling.SETTLED_COPY): the pilot's value,
  * times the first sample's weight, replaces what the first sample added; elsewhere nothing
  * is written. */
 void main()

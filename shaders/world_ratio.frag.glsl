@@ -1,4 +1,4 @@
-/* The resolve of a frame whose world light is a ratio (film_programs.WORLD_RATIO_RESOLVE,
+/* The resolve of a frame whose world light is a ratio (features.world_ratio.RESOLVE,
  * lib/world_ratio.glsl): the accumulated colour and SH light by lobe over the pixel's weight
  * (per_pixel > 0.5: its own, else ``scale`` = 1 / the total), shadowed by the ratio of the
  * accumulated sums (which needs no weight: both sums carry the same). */

@@ -1,5 +1,5 @@
 /* The world ratio's three per-sample targets (the SH light diffuse and specular, the sums)
- * times ``scale`` into their accumulations in one pass (film_programs.WORLD_RATIO_COPY; the blend
+ * times ``scale`` into their accumulations in one pass (features.world_ratio.COPY; the blend
  * state adds); WITH_MASK: not where the pixel converged (adaptive sampling). */
 void main()
 {

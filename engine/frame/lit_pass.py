@@ -131,9 +131,9 @@ class LitPass:
 
     def draw_settle_test(self, sample, target):
         """The settle test's variant of the lit pass (``sample.data`` built for the test) into
-        ``target`` (``Film.settle_framebuffer``): the surfaces the pilot drew (its z-buffer,
-        kept) and any dithered or blended one in front of them write their flags, the dithered
-        and blended last, nothing blended."""
+        ``target`` (``features.settling.SettleTargets.test_framebuffer``): the surfaces the
+        pilot drew (its z-buffer, kept) and any dithered or blended one in front of them write
+        their flags, the dithered and blended last, nothing blended."""
         import gpu
 
         stats = sample.stats
