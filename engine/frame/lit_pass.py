@@ -82,8 +82,9 @@ class LitPass:
         # A technique's targets of its own beside the pass's (its part adds outputs, the film
         # holds them: ``film.FilmPart``). Blender's gpu module binds six colour
         # targets: with them the Emission pass is drawn apart, over the z-buffer the lit pass leaves.
-        own = film.lit_part if any(part.outputs for part in data.parts) else None
-        if own is None and any(part.outputs for part in data.parts):
+        writes = any(part.outputs for part in data.parts)
+        own = film.lit_part if writes else None
+        if writes and own is None:
             raise RuntimeError("a technique's lit part writes targets the film does not hold")
         emission_apart = own is not None and emission
         fb = film.lit_framebuffer(aux, emission and not emission_apart, counted, own)
