@@ -155,6 +155,10 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "ao_jitter": (0.0, 0.0),
         "sample_index": 0,
         "lens_coc": (0.0, 0.0, 0.0, 0.0),
+        "env_rotation_x": (1.0, 0.0, 0.0, 0.0),
+        "env_rotation_y": (0.0, 1.0, 0.0, 0.0),
+        "env_rotation_z": (0.0, 0.0, 1.0, 0.0),
+        "env_params": (0.0, 0.0, 0.0, 0.0),
     }
 
 

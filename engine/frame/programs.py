@@ -140,6 +140,13 @@ FRAME_STRUCT = Struct(
         # The settle test's depth of field (``lens.coc_row``): x the aperture's radius times the
         # pixels per unit, y 1 / focus, z 1 with a lens (0: a pinhole).
         ("VEC4", "lens_coc"),
+        # WORLD_ENV (features/world_env.py): the columns of the rotation from world directions
+        # to the Environment Texture's, and (Background strength, the sun's clamp of the image
+        # or 0, 1 where the image's texture is premultiplied, 0).
+        ("VEC4", "env_rotation_x"),
+        ("VEC4", "env_rotation_y"),
+        ("VEC4", "env_rotation_z"),
+        ("VEC4", "env_params"),
     ),
 )
 

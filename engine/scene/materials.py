@@ -668,6 +668,9 @@ class World:
     # None for none.
     rotation: np.ndarray | None = None
     sun: WorldSun | None = None  # World > Settings > Sun (EEVEE's): its light above a threshold
+    # Where the sun took the image's light above its threshold: that threshold (radiance, with
+    # the strength), what the rest of the world's light is clamped to; None where it took none.
+    sun_clamp: float | None = None
 
     @property
     def mean(self):

@@ -44,6 +44,7 @@ class TextureCache:
         self._textures = {}  # image name -> (GPUTexture, premultiplied)
         self._sh = {}  # image name -> its equirectangular SH (9, 3), strength 1
         self._env = {}  # image name -> the image box-filtered as the SH saw it (h, w, 3), strength 1
+        self._prefiltered = {}  # (image name, clamp) -> (its prefiltered atlas, bytes) (``world_prefiltered``)
         self.uploads = 0  # images taken from Blender since creation (tests and the benchmark read it)
         self.bytes = 0
         self._messages = {}  # image name -> what the user must be told of it (``messages``)
@@ -53,6 +54,8 @@ class TextureCache:
             entry = self._textures.pop(name, None)
             self._sh.pop(name, None)
             self._env.pop(name, None)
+            for key in [k for k in self._prefiltered if k[0] == name]:
+                self.bytes -= self._prefiltered.pop(key)[1]
             self._messages.pop(name, None)
             if entry is not None:
                 self.bytes -= _texture_bytes(entry[0])
@@ -61,6 +64,7 @@ class TextureCache:
         self._textures.clear()
         self._sh.clear()
         self._env.clear()
+        self._prefiltered.clear()
         self._messages.clear()
         self.bytes = 0
 
@@ -119,6 +123,20 @@ class TextureCache:
             env = self._env[name] = np.clip(rgba[..., :3], 0.0, None)
             sh = self._sh[name] = equirect_sh(env)
         return sh
+
+    def world_prefiltered(self, name, clamp, build, size):
+        """The prefiltered environment of image ``name`` (``world/prefilter.py``), its source
+        clamped to ``clamp``: ``build(texture, premultiplied)`` makes it, ``size`` its bytes;
+        kept until the image changes. At most two clamps an image are kept."""
+        key = (name, float(clamp))
+        entry = self._prefiltered.get(key)
+        if entry is None:
+            for old in [k for k in self._prefiltered if k[0] == name][1:]:
+                self.bytes -= self._prefiltered.pop(old)[1]
+            texture, premultiplied = self._entry(name)
+            entry = self._prefiltered[key] = (build(texture, premultiplied), int(size))
+            self.bytes += entry[1]
+        return entry[0]
 
     def world_env(self, name):
         """The image ``name`` box-filtered as ``world_sh`` projected it (h, w, 3), row 0 at the

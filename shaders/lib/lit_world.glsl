@@ -1,11 +1,12 @@
-// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl
+// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl
 #ifndef PENUMBRA_LIB_LIT_WORLD
 #define PENUMBRA_LIB_LIT_WORLD
 
 /* The world's light on the surface (engine/frame/world/sh_light.py, world/directions.py, world/occlusion.py):
  * diffuse from its spherical-harmonic irradiance, specular (what makes metals look like metal)
  * from its radiance around the reflected direction, blurred by roughness and weighted by the
- * environment BRDF.
+ * environment BRDF. WORLD_ENV (features/world_env.py): an Environment Texture's specular from
+ * the image itself, prefiltered by roughness (lib/world_env.glsl), not from its SH.
  *
  * WORLD_AO (lib/gtao.glsl): the world's diffuse light is scaled by its visibility from
  * screen-space ground-truth ambient occlusion over the camera depth prepass, its specular by the
@@ -30,6 +31,22 @@
 #ifndef WORLD_RATIO_OUT
 #  define WORLD_RATIO_OUT 0
 #endif
+#ifndef WORLD_ENV
+#  define WORLD_ENV 0
+#endif
+
+/* The share of a lobe's specular world light that the world ratio's directions shadow: from 1
+ * for a lobe of roughness WORLD_RATIO_ROUGH and more to 0 below WORLD_RATIO_SHARP. A few
+ * directions a sample say nothing of a sharp lobe: each one's f cos L / p is 0 or huge, so the
+ * ratio came out 0 or 1 from pixel to pixel, speckles that did not converge (a polished floor
+ * by the feet of what stands on it, a mirror's black spots). The ratio leaves the sharp share
+ * unshadowed: what hides the world from it is the scene a reflection would show. */
+#define WORLD_RATIO_SHARP 0.2
+#define WORLD_RATIO_ROUGH 0.5
+float world_ratio_share(float rough)
+{
+  return smoothstep(WORLD_RATIO_SHARP, WORLD_RATIO_ROUGH, rough);
+}
 
 #if WORLD_RATIO
 vec4 world_sums = vec4(0.0); /* (N_d, D_d, N_s, D_s) of this sample's directions */
@@ -44,11 +61,12 @@ vec4 world_ao_sums()
   return vec4(world_part_vis.x * d, d, world_part_vis.y * sp, sp);
 }
 
-/* A direction's (diffuse, specular) f cos L / p for one lobe, in luminance. */
-vec2 world_direction_weights(vec3 E, vec3 albedo, vec3 f, float cosine, LightData L)
+/* A direction's (diffuse, specular) f cos L / p for one lobe, in luminance; the specular's of
+ * the share of it the ratio shadows (world_ratio_share of ``rough``). */
+vec2 world_direction_weights(vec3 E, vec3 albedo, vec3 f, float cosine, LightData L, float rough)
 {
   vec3 fd = albedo / M_PI * L.diffuse_factor;
-  return cosine * vec2(world_luminance(E * fd), world_luminance(E * max(f - fd, vec3(0.0))));
+  return cosine * vec2(world_luminance(E * fd), world_ratio_share(rough) * world_luminance(E * max(f - fd, vec3(0.0))));
 }
 #endif
 
@@ -66,6 +84,47 @@ vec3 world_sh(vec3 d, vec2 g)
   return max(r, vec3(0.0));
 }
 
+#if WORLD_ENV
+/* The image's radiance about direction ``R`` (world space) as a GGX lobe of Principled roughness
+ * ``rough`` reflects it: between the image itself (roughness 0, read with the footprint of
+ * ``R`` from pixel to pixel, as the background reads it) and the prefiltered levels, one each
+ * WORLD_ENV_STEP of roughness (WORLD_ENV_LEVELS in world_env_atlas), linearly; times the
+ * Background strength and clamped where the world's sun took the light above its threshold
+ * (frame.env_params: strength, clamp or 0, premultiplied). */
+const ivec3 world_env_levels[WORLD_ENV_COUNT] = ivec3[](WORLD_ENV_LEVELS);
+
+vec3 world_env_radiance(vec3 R, float rough)
+{
+  vec3 d = mat3(frame.env_rotation_x.xyz, frame.env_rotation_y.xyz, frame.env_rotation_z.xyz) * R;
+  vec2 uv = equirect_uv(d);
+  float t = clamp(rough, 0.0, 1.0) / WORLD_ENV_STEP;
+  int k = min(int(floor(t)), WORLD_ENV_COUNT);
+  float f = t - float(k);
+  vec3 lo;
+  if (k == 0) {
+    vec2 dx = dFdx(uv), dy = dFdy(uv);
+    dx.x -= round(dx.x);
+    dy.x -= round(dy.x);
+    float width = length(d.xy);
+    dx.x *= width;
+    dy.x *= width;
+    lo = sample_image_grad(world_env_image, uv, dx, dy, ivec4(1, 0, 0, 0), frame.env_params.z > 0.5).rgb;
+    lo = max(lo, vec3(0.0));
+    if (frame.env_params.y > 0.0) {
+      lo = min(lo, vec3(frame.env_params.y));
+    }
+  }
+  else {
+    lo = equirect_bilinear(world_env_atlas, world_env_levels[k - 1], uv).rgb;
+  }
+  vec3 r = lo;
+  if (f > 0.0 && k < WORLD_ENV_COUNT) {
+    r = mix(lo, equirect_bilinear(world_env_atlas, world_env_levels[k], uv).rgb, f);
+  }
+  return frame.env_params.x * max(r, vec3(0.0));
+}
+#endif
+
 #if WORLD_AO
 /* The world's cosine-weighted visibility at the normal of the lobe being lit
  * (surface_world_light). */
@@ -81,7 +140,11 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
   vec3 diffuse = b.albedo * world_sh(b.N, vec2(2.0 / 3.0, 0.25));
   vec3 R = reflect(-V, b.N);
   float t = b.rough * b.rough;
+#if WORLD_ENV
+  vec3 radiance = world_env_radiance(R, b.rough);
+#else
   vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
+#endif
   vec3 specular = radiance * (b.f0.rgb * ab.x + ab.y);
 #if WORLD_AO && WORLD_RATIO
   /* The occlusion goes into the ratio's sums (surface_world_light), the colour keeps U whole. */
@@ -92,7 +155,7 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
 #endif
 #if WORLD_RATIO
   world_part_d = diffuse;
-  world_part_s = specular;
+  world_part_s = specular * world_ratio_share(b.rough);
 #endif
   return diffuse + specular;
 }
@@ -150,7 +213,7 @@ void world_direction(Surface s, LightData L, vec3 to_light, float irradiance, fl
   for (int k = 0; k < NODE_LOBES; k++) {
     if (NdotL[k] > 0.0) {
       vec3 f = lobe_brdf(s.lobe[k], s.V, to_light, NdotL[k], L);
-      w += s.lobe[k].weight * world_direction_weights(E, s.lobe[k].albedo, f, cosines[k], L);
+      w += s.lobe[k].weight * world_direction_weights(E, s.lobe[k].albedo, f, cosines[k], L, s.lobe[k].rough);
     }
   }
   w = max(w, vec2(0.0));

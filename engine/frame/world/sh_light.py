@@ -47,10 +47,16 @@ def with_sh_light(world, textures, shaders):
 def reduce_environment(shaders, texture, premultiplied, width, height):
     """``texture`` box-filtered to ``width`` x ``height`` texels on the GPU, read back as an
     array (height, width, 4), row 0 at the bottom."""
+    from ..film import texture_array
+
+    return texture_array(reduced_texture(shaders, texture, premultiplied, width, height), 4)
+
+
+def reduced_texture(shaders, texture, premultiplied, width, height):
+    """``texture`` box-filtered to ``width`` x ``height`` texels on the GPU (RGBA32F, straight
+    colour, finite)."""
     import gpu
     from gpu_extras.batch import batch_for_shader
-
-    from ..film import texture_array
 
     target = gpu.types.GPUTexture((width, height), format="RGBA32F")
     framebuffer = gpu.types.GPUFrameBuffer(color_slots=(target,))
@@ -65,4 +71,4 @@ def reduce_environment(shaders, texture, premultiplied, width, height):
         shader.uniform_float("target_size", (float(width), float(height)))
         shader.uniform_float("env_premultiplied", float(premultiplied))
         batch.draw(shader)
-    return texture_array(target, 4)
+    return target

@@ -68,7 +68,7 @@ def with_sun(world):
     if kept is None:
         return world, None
     sh, left, light = kept
-    out = dataclasses.replace(world, sh=sh, background=world_background(sh), env=left)
+    out = dataclasses.replace(world, sh=sh, background=world_background(sh), env=left, sun_clamp=sun.threshold)
     return out, dataclasses.replace(light, matrix=light.matrix.copy(), color=light.color.copy())
 
 
