@@ -8,6 +8,9 @@
               -> <out>/benchmark.csv
     perf      frame cost and scaling as ratios to Workbench: resolution, viewport redraw,
               lights, objects, instances, triangles, extraction -> <out>/perf.csv
+    reflections  glossy surfaces under a real HDRI and a polished floor: error against time,
+              Penumbra (image or SH reflections) vs Cycles one glossy bounce and EEVEE
+              -> <out>/reflections.csv
     samples   render samples: error against time vs Cycles spp and EEVEE, cost per sample,
               an edge close-up -> <out>/samples.csv, samples.png, samples_closeup.png
     post      cost of each post layer; separable against direct 2-D blur -> <out>/post_costs.csv
@@ -33,7 +36,7 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import assets, camera, frame, perf, post, samples, shadows, soak, terminator, world
+from tools.benchmarks import assets, camera, frame, perf, post, reflections, samples, shadows, soak, terminator, world
 
 COMMANDS = {
     "assets": assets,
@@ -41,6 +44,7 @@ COMMANDS = {
     "frame": frame,
     "perf": perf,
     "post": post,
+    "reflections": reflections,
     "samples": samples,
     "shadows": shadows,
     "soak": soak,
