@@ -261,6 +261,18 @@ DEBUG_VIEW = Enum(
             },
         ),
         (
+            "REFLECTIONS",
+            "Reflections",
+            "Where the glossy surfaces' screen-space rays met the scene (Light Paths > Screen Space Reflections), "
+            "averaged over the frame's samples: every sample traces in this view, the first too",
+            10,
+            {
+                "lit": True,
+                "legend": "share of the samples whose reflection ray met the scene: black none (the world is "
+                "reflected there, or nothing is traced), white every one",
+            },
+        ),
+        (
             "WORLD_LIGHT",
             "World Light",
             "The light the world alone gives each pixel, with its visibility (its sampled shadow maps, the "

@@ -513,6 +513,18 @@ SCENE_PARAMS = (
         section=LIGHT_PATHS,
     ),
     Param(
+        "screen_space_reflections",
+        "BOOL",
+        True,
+        "Glossy surfaces sharper than roughness 0.5 reflect the scene the camera sees: every sample after a "
+        "frame's first traces one ray per pixel in screen space and reads the image the samples so far made "
+        "where it meets a surface. Where the ray meets nothing on the screen, and in one-sample frames (the "
+        "viewport while the view moves), the surface reflects the world. Off: glossy surfaces reflect the "
+        "world alone",
+        label="Screen Space Reflections",
+        section=LIGHT_PATHS,
+    ),
+    Param(
         "navigation_scale",
         "FLOAT",
         0.5,

@@ -3,6 +3,7 @@
  *   DEBUG_LIT            lights evaluated, sun cascade + 1, texel density of the worst-sampled
  *                        light (LIGHT_COST, CASCADES, TEXEL_DENSITY)
  *   DEBUG_LIT, WORLD_AO  the world's visibility (WORLD_AO)
+ *   DEBUG_LIT, DEBUG_REFLECTIONS  where the traced rays met the scene (REFLECTIONS)
  *   DEBUG_TERM 1         the world's light with its visibility (WORLD_LIGHT)
  *   DEBUG_TERM 2         the diffuse bounce (INDIRECT) */
 
@@ -29,7 +30,9 @@ void main()
   debug_term = world_ratio_apply(vec4(debug_term, 1.0), world_d, world_s, world_sums).rgb;
 #endif
 
-#if DEBUG_LIT && WORLD_AO
+#if DEBUG_LIT && DEBUG_REFLECTIONS
+  vec4 shown = vec4(debug_reflected, 0.0, 0.0, 1.0);
+#elif DEBUG_LIT && WORLD_AO
   vec4 shown = vec4(debug_world_ao, 0.0, 0.0, 1.0);
 #elif DEBUG_LIT
   vec4 shown = vec4(debug_lights, debug_cascade, debug_density, 1.0);

@@ -19,5 +19,9 @@ void main()
     discard;
   }
 #endif
+#if SSR_SETTLE
+  /* A lobe later samples trace (features/reflections.py) changes with every sample. */
+  settle_unstable = settle_unstable || world_traced;
+#endif
   out_color = settle_flags(world_term, m.coverage);
 }

@@ -9,8 +9,8 @@
     perf      frame cost and scaling as ratios to Workbench: resolution, viewport redraw,
               lights, objects, instances, triangles, extraction -> <out>/perf.csv
     reflections  glossy surfaces under a real HDRI and a polished floor: error against time,
-              Penumbra (image or SH reflections) vs Cycles one glossy bounce and EEVEE
-              -> <out>/reflections.csv
+              Penumbra (scene reflections, world image, SH) vs Cycles one glossy bounce, EEVEE
+              -> <out>/reflections.csv, reflections.png; --cost: on against off, 160x90 and 960x540
     samples   render samples: error against time vs Cycles spp and EEVEE, cost per sample,
               an edge close-up -> <out>/samples.csv, samples.png, samples_closeup.png
     post      cost of each post layer; separable against direct 2-D blur -> <out>/post_costs.csv

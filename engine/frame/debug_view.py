@@ -17,6 +17,9 @@ Each view shows numbers the engine itself used for the frame, not a second compu
   alone, in colour: the lit pass's ``DEBUG_TERM`` variant writes that term of its colour.
 * WORLD_AO: the world's visibility from the ambient occlusion (``world/occlusion.py``), written by the
   lit pass's ``DEBUG_LIT`` variant with ``WORLD_AO`` (every sample occluded), in grey.
+* REFLECTIONS: where the reflections' rays met the scene (``features/reflections.py``: the
+  weight of the pixel's surest hit, 0 where none), written by the ``DEBUG_LIT`` variant with
+  ``DEBUG_REFLECTIONS`` (every sample traces), in grey.
 
 ``DebugImage.values`` holds those numbers per pixel (tests read them); ``image`` is what is
 shown: the values through a colour scale with a legend strip along the bottom, ``legend`` says
@@ -117,8 +120,10 @@ def lit_view(view, raw, occluded=True):
         image = np.concatenate([rgb, np.ones(covered.shape + (1,), np.float32)], axis=-1)
         values = (rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32)).astype(np.float32)  # luminance
         return DebugImage(view, values, image, f"{item.label}: {item.legend}", covered)
-    if view == "WORLD_AO":
-        values = np.clip(raw[..., 0], 0.0, 1.0).astype(np.float32) if occluded else np.ones(covered.shape, np.float32)
+    if view in ("WORLD_AO", "REFLECTIONS"):
+        values = np.clip(raw[..., 0], 0.0, 1.0).astype(np.float32)
+        if view == "WORLD_AO" and not occluded:
+            values = np.ones(covered.shape, np.float32)
         image = _compose(
             values, covered, lambda v: np.repeat(v[..., None], 3, -1), lambda t: np.repeat(t[..., None], 3, -1)
         )

@@ -73,7 +73,8 @@ class FilmPart:
     The film calls, for the parts of the frame (``Film.begin``): ``framebuffer`` (the lit
     pass's targets with its own), ``clear`` (before a sample's lit pass), ``begin`` (a fresh
     frame), ``accumulate`` (each sample), ``accumulated`` (what a sample's value kept copies), ``convergence``
-    (its share of the convergence check), ``resolve`` (after the last sample),
+    (its share of the convergence check), ``resolve`` (after the last sample, into the colour
+    target; or into ``framebuffer``, ``Film.mean_into``: the mean so far, over the film's),
     ``bytes_per_pixel``, and ``release`` whenever the film's targets go (a new size, the end
     of a render)."""
 
@@ -101,7 +102,7 @@ class FilmPart:
         """(``ProgramPart`` of the convergence check, {sampler: texture}), or None."""
         return None
 
-    def resolve(self, film):
+    def resolve(self, film, framebuffer=None):
         pass
 
     def bytes_per_pixel(self, film):
@@ -408,6 +409,19 @@ class Film:
                 self.fullscreen(SCALED_COPY, resolve_fb, {"src_color": accum}, {"scale": inverse})
         for part in self.parts:
             part.resolve(self)
+
+    def mean_into(self, framebuffer):
+        """The colour's mean over the samples accumulated so far (what ``resolve`` would write,
+        the techniques' parts' included) into ``framebuffer`` (one RGBA32F target at the
+        film's size), leaving the film's own targets as they are: what a later sample reads of
+        the frame's image (``features/reflections.py``)."""
+        if self._weight is not None:
+            self.fullscreen(WEIGHTED_RESOLVE, framebuffer, {"src_color": self._accum_color, "weight": self._weight}, {})
+        else:
+            inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
+            self.fullscreen(SCALED_COPY, framebuffer, {"src_color": self._accum_color}, {"scale": inverse})
+        for part in self.parts:
+            part.resolve(self, framebuffer)
 
     @property
     def accum_color(self):

@@ -159,6 +159,9 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "env_rotation_y": (0.0, 1.0, 0.0, 0.0),
         "env_rotation_z": (0.0, 0.0, 1.0, 0.0),
         "env_params": (0.0, 0.0, 0.0, 0.0),
+        "ssr_params": (0.0, 0.0, 0.0, 0.0),
+        "ssr_view": view,
+        "ssr_view_proj": camera.projection @ view,
     }
 
 

@@ -147,6 +147,12 @@ FRAME_STRUCT = Struct(
         ("VEC4", "env_rotation_y"),
         ("VEC4", "env_rotation_z"),
         ("VEC4", "env_params"),
+        # SSR (features/reflections.py, lib/ssr.glsl): (the longest ray in world units, a
+        # surface's thickness as a fraction of its depth, 0, 0), and the view and projection
+        # of the camera its depth prepass was drawn through (positions relative to the origin).
+        ("VEC4", "ssr_params"),
+        ("MAT4", "ssr_view"),
+        ("MAT4", "ssr_view_proj"),
     ),
 )
 

@@ -44,7 +44,8 @@ class Sample:
     world occlusion ((distance, jitter) or None), its lights, its unjittered ``camera`` (maps
     are planned from it), its ``view_camera`` (pixel offset, point of the lens), its ``draws``
     and its ``stats``. Outputs: its lights in view, shadow ``plan`` and ``atlas`` (None
-    without maps), ``cameras`` (raster camera, view camera, light rectangles), frame ``data``,
+    without maps), ``cameras`` (raster camera, view camera, light rectangles), the view depth
+    range the raster camera's depth buffer is fitted to (``depth_range``), frame ``data``,
     the draws the camera sees (``seen``) and the light-linking ``masks``. The settle test
     draws as the pilot did; the SHADOW_MAPS view shows the last sample's."""
 
@@ -65,6 +66,7 @@ class Sample:
     plan: object = None
     atlas: object = None
     cameras: tuple = None
+    depth_range: tuple | None = None
     data: object = None
     seen: list = None
     masks: dict = None
@@ -518,6 +520,7 @@ class Renderer:
             draws = sample.draws
             depth_range = lightspace.box_depth_range(camera.projection, camera.view, corners_of(draws), camera.is_ortho)
         # The lit pass rasterises with the depth buffer spread over what the camera sees.
+        sample.depth_range = depth_range
         fitted = lightspace.depth_fitted(view_camera.projection, view_camera.is_ortho, depth_range)
         raster_camera = (
             view_camera if fitted is view_camera.projection else dataclasses.replace(view_camera, projection=fitted)

@@ -112,6 +112,10 @@ class FrameStats:
     # draw calls; counted apart, not in ``passes`` and ``draws``.
     ao_prepasses: int = 0
     ao_draws: int = 0
+    # Reflections (``features/reflections.py``): camera depth prepasses drawn for the traced
+    # rays (counted apart, as the occlusion's), and samples that traced.
+    reflection_prepasses: int = 0
+    reflection_samples: int = 0
     probe_draws: int = 0  # draw calls of the world's probe (``world/probe.py``), counted apart
     world_guided: bool = False  # the probe found an interior: the world's directions come through its openings
     ao_texels: int = 0  # texels whose horizons were marched (half resolution: a quarter of the film)

@@ -9,7 +9,8 @@
  * DEBUG_LIT (programs.LitVariant ``debug``): lights evaluated (lit_lights.glsl), 1 + the cascade
  * of the first cascaded sun looked up and the map texels per screen pixel of the worst-sampled
  * light (0: no map looked up; lib/shadow_filters.glsl), the lobes' mean visibility of the world
- * with WORLD_AO (lit_world.glsl). The pixel's footprint (world-space derivatives of P) is set by
+ * with WORLD_AO (lit_world.glsl), with DEBUG_REFLECTIONS the weight of the surest hit of its
+ * lobes' traced rays (SSR, lit_world.glsl: 0 none met the scene). The pixel's footprint (world-space derivatives of P) is set by
  * the entry shader, where derivatives are defined.
  * DEBUG_TERM (``debug_term``): the one term of the colour the WORLD_LIGHT (1) or INDIRECT (2)
  * view shows. */
@@ -20,6 +21,10 @@ float debug_cascade = 0.0;
 float debug_density = 0.0;
 vec3 debug_dPdx = vec3(0.0), debug_dPdy = vec3(0.0);
 float debug_world_ao = 0.0;
+float debug_reflected = 0.0;
+#endif
+#ifndef DEBUG_REFLECTIONS
+#  define DEBUG_REFLECTIONS 0
 #endif
 
 #if DEBUG_TERM

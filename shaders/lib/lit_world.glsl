@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl
+// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl
 #ifndef PENUMBRA_LIB_LIT_WORLD
 #define PENUMBRA_LIB_LIT_WORLD
 
@@ -6,7 +6,9 @@
  * diffuse from its spherical-harmonic irradiance, specular (what makes metals look like metal)
  * from its radiance around the reflected direction, blurred by roughness and weighted by the
  * environment BRDF. WORLD_ENV (features/world_env.py): an Environment Texture's specular from
- * the image itself, prefiltered by roughness (lib/world_env.glsl), not from its SH.
+ * the image itself, prefiltered by roughness (lib/world_env.glsl), not from its SH. SSR
+ * (lib/ssr.glsl, features/reflections.py): a lobe of roughness under WORLD_RATIO_ROUGH reflects
+ * the scene where a traced ray meets it, the world's light where it meets nothing.
  *
  * WORLD_AO (lib/gtao.glsl): the world's diffuse light is scaled by its visibility from
  * screen-space ground-truth ambient occlusion over the camera depth prepass, its specular by the
@@ -40,13 +42,22 @@
  * directions a sample say nothing of a sharp lobe: each one's f cos L / p is 0 or huge, so the
  * ratio came out 0 or 1 from pixel to pixel, speckles that did not converge (a polished floor
  * by the feet of what stands on it, a mirror's black spots). The ratio leaves the sharp share
- * unshadowed: what hides the world from it is the scene a reflection would show. */
+ * unshadowed: what hides the world from it is the scene a reflection would show, which the
+ * traced rays (SSR) take. */
 #define WORLD_RATIO_SHARP 0.2
 #define WORLD_RATIO_ROUGH 0.5
+#define SSR_FADE 0.4 /* lobes rougher than this fade out their traced rays (SSR) */
 float world_ratio_share(float rough)
 {
   return smoothstep(WORLD_RATIO_SHARP, WORLD_RATIO_ROUGH, rough);
 }
+
+#ifndef SSR_SETTLE
+#  define SSR_SETTLE 0
+#endif
+vec3 world_point = vec3(0.0); /* the surface's point (surface_world_light), for the traced rays */
+bool world_traced = false;    /* some lobe of this surface was (SSR) or would be (SSR_SETTLE) traced */
+int world_lobe = 0;           /* the lobe world_light lights (its rays' random numbers) */
 
 #if WORLD_RATIO
 vec4 world_sums = vec4(0.0); /* (N_d, D_d, N_s, D_s) of this sample's directions */
@@ -100,14 +111,16 @@ vec3 world_env_radiance(vec3 R, float rough)
   float t = clamp(rough, 0.0, 1.0) / WORLD_ENV_STEP;
   int k = min(int(floor(t)), WORLD_ENV_COUNT);
   float f = t - float(k);
+  /* The footprint's derivatives outside the branch: it depends on the lobe's roughness, and
+   * derivatives in non-uniform control flow are undefined. */
+  vec2 dx = dFdx(uv), dy = dFdy(uv);
+  dx.x -= round(dx.x);
+  dy.x -= round(dy.x);
+  float width = length(d.xy);
+  dx.x *= width;
+  dy.x *= width;
   vec3 lo;
   if (k == 0) {
-    vec2 dx = dFdx(uv), dy = dFdy(uv);
-    dx.x -= round(dx.x);
-    dy.x -= round(dy.x);
-    float width = length(d.xy);
-    dx.x *= width;
-    dy.x *= width;
     lo = sample_image_grad(world_env_image, uv, dx, dy, ivec4(1, 0, 0, 0), frame.env_params.z > 0.5).rgb;
     lo = max(lo, vec3(0.0));
     if (frame.env_params.y > 0.0) {
@@ -145,7 +158,8 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
 #else
   vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
 #endif
-  vec3 specular = radiance * (b.f0.rgb * ab.x + ab.y);
+  vec3 dfg = b.f0.rgb * ab.x + ab.y;
+  vec3 specular = radiance * dfg;
 #if WORLD_AO && WORLD_RATIO
   /* The occlusion goes into the ratio's sums (surface_world_light), the colour keeps U whole. */
   world_part_vis = vec2(world_visibility, gtao_specular(world_visibility, max(dot(b.N, V), 0.0), t));
@@ -157,6 +171,28 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
   world_part_d = diffuse;
   world_part_s = specular * world_ratio_share(b.rough);
 #endif
+#if SSR || SSR_SETTLE
+  /* Where a traced ray meets the scene (weight h), the lobe reflects it, and the world's light
+   * it hid goes: specular = radiance dfg (1 - h (1 - share)) + hit dfg h. The share the ratio
+   * shadows keeps its own visibility (its U_s is never more than what is left of the world's
+   * light, so the resolve stays >= 0); the rest, which the ratio leaves alone, takes the
+   * ray's. Lobes from SSR_FADE to WORLD_RATIO_ROUGH fade their rays out; rougher lobes are
+   * not traced. */
+  float reach = 1.0 - smoothstep(SSR_FADE, WORLD_RATIO_ROUGH, b.rough);
+  if (reach > 0.0 && b.weight > 0.0) {
+    world_traced = true;
+#  if SSR
+    vec3 xi = ssr_random(world_lobe);
+    vec3 L = ssr_direction(b.N, V, b.rough, xi.xy);
+    vec3 hit_radiance;
+    float h = reach * ssr_trace(world_point, b.N, L, xi.z, hit_radiance);
+    specular = specular * (1.0 - h * (1.0 - world_ratio_share(b.rough))) + hit_radiance * dfg * h;
+#    if DEBUG_LIT
+    debug_reflected = max(debug_reflected, h);
+#    endif
+#  endif
+  }
+#endif
   return diffuse + specular;
 }
 
@@ -166,6 +202,7 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
  * with ambient occlusion adds its visibility to the sums as one sample's worth. */
 vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
 {
+  world_point = s.P;
 #if WORLD_AO
   mat3 ao_rotation = mat3(frame.view);
   vec3 ao_P = (frame.view * vec4(s.P, 1.0)).xyz;
@@ -189,6 +226,7 @@ vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
     debug_world_ao += w * world_visibility;
 #  endif
 #endif
+    world_lobe = k;
     color += w * world_light(s.lobe[k], s.V, ab[k]);
 #if WORLD_RATIO
     world_d += w * world_part_d;

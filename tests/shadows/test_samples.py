@@ -369,10 +369,12 @@ def test_filter_size_zero_and_ten_and_hard_lights_at_many_samples(penumbra, gpu_
 
     scene = scenes.demo_scene(48, 27)
     scene.penumbra.layers.clear()
-    # The world's ambient occlusion occludes a frame's first sample only and the world's
-    # sampled directions the others: both off, so every sample is the same.
+    # The world's ambient occlusion occludes a frame's first sample only, the world's sampled
+    # directions the others, and the reflections' rays are drawn anew each sample after the
+    # first: all off, so every sample is the same.
     scene.penumbra.world_ao = False
     scene.penumbra.world_shadows = False
+    scene.penumbra.screen_space_reflections = False
     for ob in scene.objects:
         if ob.type == "LIGHT":
             ob.data.shadow_soft_size = 0.0

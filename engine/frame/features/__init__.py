@@ -1,8 +1,8 @@
 """The frame's techniques, one module each, over the same small set of hooks (``Feature``).
 
 A technique that a frame may or may not need (the world's ratio estimator, the world's image
-in glossy lobes, settling, the diffuse bounce, the world's occlusion, depth of field, motion
-blur) lives in one module here and is registered in ``REGISTRY``. The renderer asks each
+in glossy lobes, the scene's reflections, settling, the diffuse bounce, the world's occlusion,
+depth of field, motion blur) lives in one module here and is registered in ``REGISTRY``. The renderer asks each
 registered technique whether the frame needs it (``wanted``) and then calls the hooks of those
 that answered yes, in registry order, at fixed points of the frame; it does not name them. The
 lit pass, the frame data and the film take what the hooks return (``LitPart``: fields of the lit
@@ -15,6 +15,7 @@ from .base import NO_PART, Feature, LitPart
 from .bounce import Bounce
 from .depth_of_field import DepthOfField
 from .motion_blur import MotionBlur
+from .reflections import Reflections
 from .settling import Settling
 from .world_env import WorldEnvironment
 from .world_occlusion import WorldOcclusion
@@ -22,8 +23,8 @@ from .world_ratio import WorldRatio
 
 # The order their hooks run in: motion blur first (it moves a sample's scene and camera), then
 # depth of field (the sample's point of the lens), the world's ratio (its directions), its
-# image in glossy lobes, the world's occlusion (which keeps the first sample from the
+# image in glossy lobes, the scene's reflections in them, the world's occlusion (which keeps the first sample from the
 # directions), the bounce, and settling last (it decides over what the others planned).
-REGISTRY = (MotionBlur, DepthOfField, WorldRatio, WorldEnvironment, WorldOcclusion, Bounce, Settling)
+REGISTRY = (MotionBlur, DepthOfField, WorldRatio, WorldEnvironment, Reflections, WorldOcclusion, Bounce, Settling)
 
 __all__ = ["NO_PART", "REGISTRY", "Feature", "LitPart"]

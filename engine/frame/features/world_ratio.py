@@ -145,9 +145,10 @@ class RatioTargets(FilmPart):
     def convergence(self, film):
         return CONVERGENCE, {**self._accumulations(), "half_world_sums": self.half[0]}
 
-    def resolve(self, film):
+    def resolve(self, film, framebuffer=None):
         """The colour resolved anew with the world's light through its ratio (over the shadow
-        and Emission passes the plain resolve wrote)."""
+        and Emission passes the plain resolve wrote), into the film's colour or
+        ``framebuffer``."""
         per_pixel = film.weight is not None
         total = film.weight_sum
         samplers = {
@@ -156,7 +157,8 @@ class RatioTargets(FilmPart):
             **self._accumulations(),
         }
         uniforms = {"scale": 1.0 / total if total > 0.0 else 0.0, "per_pixel": 1.0 if per_pixel else 0.0}
-        film.fullscreen(RESOLVE, gpu_framebuffer(film.color), samplers, uniforms)
+        target = gpu_framebuffer(film.color) if framebuffer is None else framebuffer
+        film.fullscreen(RESOLVE, target, samplers, uniforms)
 
     def bytes_per_pixel(self, film):
         return 6 * 16 + (16 if film.tracking else 0)

@@ -160,7 +160,16 @@ class WorldAO:
     def draw(self, draws, camera, size, origin, caches, stats, alpha_offset=0.5):
         """The view depth of ``draws`` (those the camera sees) through the raster ``camera``
         into ``texture`` at the film's ``size``; ``caches``: the renderer's ``GpuCaches``;
-        ``alpha_offset``: the sample's, as the lit pass hashes dithered surfaces with it."""
+        ``alpha_offset``: the sample's, as the lit pass hashes dithered surfaces with it.
+        Counted in ``stats`` as the occlusion's prepass; returns its draw calls."""
+        drawn = self.draw_depth(draws, camera, size, origin, caches, alpha_offset)
+        stats.ao_draws += drawn  # counted apart from the lit pass's ``draws`` and ``passes``
+        stats.ao_prepasses += 1
+        return drawn
+
+    def draw_depth(self, draws, camera, size, origin, caches, alpha_offset=0.5):
+        """``draw`` without counting it (another technique's prepass counts its own); returns
+        its draw calls."""
         import gpu
 
         shaders, materials, textures = caches.shaders, caches.materials, caches.textures
@@ -240,8 +249,7 @@ class WorldAO:
             gpu.state.front_facing_set(False)
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
-        stats.ao_draws += bound["draws"]  # counted apart from the lit pass's ``draws`` and ``passes``
-        stats.ao_prepasses += 1
+        return bound["draws"]
 
     def release(self):
         """Give the targets back to the pool (final renders; inside the GPU context) or drop
