@@ -15,11 +15,16 @@ hdri_spheres    three spheres on a grey ground under a real outdoor HDRI (Blende
 polished_floor  a dark polished dielectric floor (roughness 0.05) under a sun 35 deg up and a
                 dim uniform sky, with a cube, Suzanne and a sphere on it: where the floor's
                 sharp lobe met the world's ratio it carried a salt-and-pepper pattern
+glass_checker   a Glass BSDF sphere (IOR 1.45) and a Principled cube of Transmission 1
+                (roughness 0.05, Thickness Mode Slab) on a checker ground under a sun and a
+                pale sky
 ==============  ==========================================================================
 
 References are Cycles with one glossy bounce (max_bounces 1, diffuse 0: a mirror shows the
-world and what is around it, a diffuse surface its direct light), through Penumbra's pixel
-filter, cached like ``world_scenes``' (out/reference_cache, keyed by this file's digest)."""
+world and what is around it, a diffuse surface its direct light), and for a scene with glass
+(``scene["transmission_bounces"]``) as many transmission bounces with caustics off, through
+Penumbra's pixel filter, cached like ``world_scenes``' (out/reference_cache, keyed by this
+file's digest)."""
 
 import hashlib
 import math
@@ -120,7 +125,49 @@ def polished_floor(scene):
     scenes.look_at(scene, (0.0, -7.0, 2.4), (0.0, 0.0, 0.4), lens=35.0)
 
 
-SCENES = {"hdri_spheres": hdri_spheres, "polished_floor": polished_floor}
+def glass_checker(scene):
+    ws.uniform_sky(scene, (0.6, 0.7, 0.9), 0.5)
+    ground, bsdf, _out = _node_material("Checker")
+    checker = ground.node_tree.nodes.new("ShaderNodeTexChecker")
+    checker.inputs["Scale"].default_value = 12.0
+    checker.inputs["Color1"].default_value = (0.8, 0.8, 0.8, 1.0)
+    checker.inputs["Color2"].default_value = (0.05, 0.05, 0.05, 1.0)
+    ground.node_tree.links.new(checker.outputs["Color"], bsdf.inputs["Base Color"])
+    bsdf.inputs["Roughness"].default_value = 0.6
+    scenes.plane(scene, "Ground", size=20.0, mat=ground)
+    glass, _bsdf, out = _node_material("Glass")
+    node = glass.node_tree.nodes.new("ShaderNodeBsdfGlass")
+    node.inputs["IOR"].default_value = 1.45
+    node.inputs["Roughness"].default_value = 0.0
+    node.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    glass.node_tree.nodes.remove(_bsdf)
+    glass.node_tree.links.new(node.outputs[0], out.inputs["Surface"])
+    scenes.uv_sphere(scene, "GlassBall", center=(-1.2, 0.0, 1.0), radius=1.0, segments=64, rings=32, mat=glass)
+    for poly in scene.objects["GlassBall"].data.polygons:
+        poly.use_smooth = True
+    clear = scenes.material("Clear", (0.9, 0.95, 1.0), roughness=0.05)
+    next(n for n in clear.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled").inputs[
+        "Transmission Weight"
+    ].default_value = 1.0
+    clear.thickness_mode = "SLAB"  # Settings > Thickness Mode, as an EEVEE user sets it for a box
+    scenes.box(scene, "ClearCube", center=(1.4, 0.3, 0.7), size=(1.4, 1.4, 1.4), mat=clear)
+    sun = scenes.light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(40.0), 0.0, math.radians(-30.0)))
+    sun.data.angle = math.radians(1.0)
+    scenes.look_at(scene, (0.0, -7.5, 3.2), (0.0, 0.0, 0.6), lens=40.0)
+    scene["transmission_bounces"] = 8
+
+
+def _node_material(name):
+    mat = bpy.data.materials.new(name)
+    if mat.node_tree is None:  # Blender 4.5
+        mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    out = next(n for n in nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+    return mat, bsdf, out
+
+
+SCENES = {"hdri_spheres": hdri_spheres, "polished_floor": polished_floor, "glass_checker": glass_checker}
 
 
 def build(name, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):
@@ -136,6 +183,16 @@ def use_engine(scene, engine, **settings):
     key = engine.upper()
     if key == "CYCLES":
         bounces = {"max_bounces": 1, "glossy_bounces": 1}
+        through = int(scene.get("transmission_bounces", 0))
+        if through:  # glass: through it (each interface a bounce), caustics off
+            bounces = {
+                "max_bounces": through + 1,
+                "glossy_bounces": 1,
+                "transmission_bounces": through,
+                "diffuse_bounces": 0,
+                "caustics_refractive": False,
+                "caustics_reflective": False,
+            }
         engines.configure(scene, "CYCLES", **bounces, **settings, **kit.matched_filter(scene))
     else:
         engines.configure(scene, key, **settings)

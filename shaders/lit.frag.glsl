@@ -6,6 +6,7 @@
  *   lib/lit_terminator.glsl  Shadow Terminator: where a light's shadow is looked up, the cosine
  *   lib/lit_bsdf.glsl        the Principled layering: lobe_setup, lobe_brdf, env_brdf
  *   lib/lit_world.glsl       the world's SH light, its occlusion (WORLD_AO) and ratio (WORLD_RATIO)
+ *   lib/refraction.glsl      what a transmissive surface shows through it (TRANSMISSION)
  *   lib/lit_settle.glsl      the settle test's flags (SETTLE_TEST)
  *   lib/lit_lights.glsl      add_light (one shadow lookup, every lobe) and lights_on (the loops)
  *   lib/lit_outputs.glsl     surface_color and write_passes: what a variant writes
@@ -38,11 +39,19 @@ void main()
 
   vec2 ab[NODE_LOBES];
   Surface s = surface_setup(m, ab);
+#if TRANSMISSION
+  /* The share of the dielectric's diffuse that is light from behind instead. */
+  float transmitted = transmission_share(m.transmission, m.metal);
+  s.lobe[0].albedo *= 1.0 - transmitted;
+#endif
 
   /* The world's light, the lights', the bounce. */
   vec3 color = surface_world_light(s, ab);
   float arriving = 0.0, unshadowed = 0.0;
   lights_on(s, color, arriving, unshadowed);
+#if TRANSMISSION
+  color += transmitted * surface_refraction(s, m.base.rgb, ab[0]);
+#endif
 #if INDIRECT_RSM
   /* One diffuse bounce from the lights' reflective shadow maps (lib/indirect_rsm.glsl). */
   color += surface_bounce(s);

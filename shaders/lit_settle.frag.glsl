@@ -23,5 +23,10 @@ void main()
   /* A lobe later samples trace (features/reflections.py) changes with every sample. */
   settle_unstable = settle_unstable || world_traced;
 #endif
+#if TRANSMISSION
+  /* What a transmissive surface shows through it (features/refraction.py) is traced anew
+   * every sample. */
+  settle_unstable = settle_unstable || material.transmission > 0.0;
+#endif
   out_color = settle_flags(world_term, m.coverage);
 }

@@ -39,6 +39,7 @@ class FrameData:
     bins: np.ndarray = None  # (rows, columns, LIGHT_WORDS) light masks of the screen bins, or None
     samplers: dict = field(default_factory=dict)  # {name: texture} the techniques' parts bind
     begins: tuple = ()  # the techniques' GPU work over the frame block before the draws (``LitPart.begin``)
+    betweens: tuple = ()  # their work after the opaque surfaces, before the transmissive (``LitPart.between``)
     # The techniques' ``ProgramPart`` values of the lit program (``LitPart.program``), in order,
     # and those blended surfaces take: what a ``programs.LitKey`` lists after the pass's own.
     parts: tuple = ()
@@ -162,6 +163,7 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "ssr_params": (0.0, 0.0, 0.0, 0.0),
         "ssr_view": view,
         "ssr_view_proj": camera.projection @ view,
+        "refr_params": (0.0, 0.0, 0.0, 0.0),
     }
 
 
@@ -301,6 +303,7 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
         bins=bins,
         samplers=samplers,
         begins=tuple(part.begin for part in inputs.parts if part.begin is not None),
+        betweens=tuple(part.between for part in inputs.parts if part.between is not None),
         parts=parts,
         blended_parts=tuple(p.blended_program for p in inputs.parts if p.blended_program is not None),
     )

@@ -22,6 +22,9 @@ from .programs import (
     terminator_uniforms,
 )
 
+# The material feature of surfaces that transmit light (``materials.Material.transmission``).
+TRANSMISSION = "TRANSMISSION"
+
 # The world's Environment Texture behind everything (materials.World.image).
 BACKGROUND = Program(
     name="background",
@@ -97,6 +100,11 @@ class LitPass:
         if world_data is not None and world_data.image is not None and not transparent:
             self._background(film, world_data, camera, frame.origin, "LESS_EQUAL" if converged else "NONE")
         opaque, blended, parts = self._entries(sample.seen, camera, sample.atlas, stats, hashed_last=False)
+        # Transmissive surfaces after the others, over what they see through (``LitPart.between``:
+        # the refraction's copy of the colour so far); without it they draw as the others.
+        transmissive = [e for e in opaque if TRANSMISSION in e[0]] if data.betweens else []
+        if transmissive:
+            opaque = [e for e in opaque if TRANSMISSION not in e[0]]
         if data.begins:
             block = self._ubo("frame", data.frame)
             for begin in data.begins:
@@ -112,6 +120,16 @@ class LitPass:
             gpu.state.depth_test_set("LESS_EQUAL")
             gpu.state.depth_mask_set(True)
             submit.draw(opaque, aux)
+        if transmissive:
+            for between in data.betweens:
+                between(film, stats)
+            submit.rebind()
+            with fb.bind():
+                gpu.state.viewport_set(0, 0, width, height)
+                gpu.state.depth_test_set("LESS_EQUAL")
+                gpu.state.depth_mask_set(True)
+                submit.draw(transmissive, aux)
+            opaque = opaque + transmissive
         if emission_apart and opaque:
             submit.rebind(counted=False)
             with film.emission_framebuffer().bind():
@@ -280,6 +298,16 @@ def set_image_flags(shader, mat, textures):
     )
 
 
+def object_thickness(corners):
+    """The smallest dimension of an instance's bounds from their world ``corners`` (8, 3; corner
+    i at bits x, y, z of i): what a transmissive surface takes for its thickness (EEVEE's
+    default); 0 for a flat one (a pane: light crosses one interface)."""
+    c = np.asarray(corners, np.float64)
+    dims = [np.linalg.norm(c[k] - c[0]) for k in (1, 2, 4)]
+    thickness = float(min(dims))
+    return thickness if np.isfinite(thickness) and thickness > 0.0 else 0.0
+
+
 @dataclass
 class _Parts:
     """What ``LitPass._entries`` found of the draws: closed instances whose back faces never
@@ -368,13 +396,15 @@ class _Submission:
         self.shader = shader
         return shader
 
-    def _has_solid(self, shader):
-        if shader not in self.solid:
+    def _has(self, shader, name):
+        """Whether ``shader`` kept the push constant ``name`` (the compiler removes unread ones)."""
+        key = (shader, name)
+        if key not in self.solid:
             try:
-                self.solid[shader] = shader.uniform_from_name("solid") != -1
+                self.solid[key] = shader.uniform_from_name(name) != -1
             except ValueError:  # Blender raises where GL reports -1
-                self.solid[shader] = False
-        return self.solid[shader]
+                self.solid[key] = False
+        return self.solid[key]
 
     def draw(self, entries, with_aux, blended=False, emission_only=False):
         import gpu
@@ -393,12 +423,14 @@ class _Submission:
             shader = self.bind(features, with_aux, mat.tree, blended, emission_only)
             if last is not d or self.model_shader is not shader:
                 shader.uniform_float("model", d.model)
-                if self._has_solid(shader):  # compiled out where no light reads it
+                if self._has(shader, "solid"):  # compiled out where no light reads it
                     shader.uniform_int("solid", int(id(d) in outside))
                 if self.masks is not None:
                     shader.uniform_int("light_mask", self.masks[id(d)])
                 if id(d) in terminators:  # skipping any the compiler removed (a holdout's)
                     set_uniforms(shader, terminators[id(d)])
+                if TRANSMISSION in features and self._has(shader, "object_thickness"):
+                    shader.uniform_float("object_thickness", object_thickness(d.corners))
                 if d.instance.hair is not None:
                     shader.uniform_float("hair_pixel", self.hair_pixel if d.instance.hair == "STRAND" else 0.0)
                 last, self.model_shader = d, shader

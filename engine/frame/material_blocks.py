@@ -33,6 +33,8 @@ class MaterialBlocks:
             "specular": tuple(mat.f0),
             "alpha": float(mat.alpha),
             "normal_strength": float(mat.normal_strength),
+            "transmission": float(mat.transmission) if mat.transmits else 0.0,
+            "ior": float(mat.ior),
         }
         for channel in CHANNELS:
             ref = mat.textures.get(channel)

@@ -153,6 +153,9 @@ FRAME_STRUCT = Struct(
         ("VEC4", "ssr_params"),
         ("MAT4", "ssr_view"),
         ("MAT4", "ssr_view_proj"),
+        # REFRACTION (features/refraction.py, lib/refraction.glsl): (the longest ray in world
+        # units, a surface's thickness as a fraction of its depth, 0, 0).
+        ("VEC4", "refr_params"),
     ),
 )
 
@@ -179,6 +182,8 @@ MATERIAL_STRUCT = Struct(
         ("FLOAT", "metallic"),
         ("FLOAT", "alpha"),
         ("FLOAT", "normal_strength"),
+        ("FLOAT", "transmission"),  # Principled Transmission Weight (features/refraction.py)
+        ("FLOAT", "ior"),  # its IOR, for what it refracts
         *(f for c in CHANNELS for f in (("VEC4", f"{c}_uv_u"), ("VEC4", f"{c}_uv_v"), ("IVEC4", f"{c}_mode"))),
     ),
 )
@@ -217,6 +222,8 @@ def material_defines(features):
     for name in TERMINATOR_FEATURES:
         out[name] = name in features
     out["HAIR_STRIP"] = "HAIR" in features  # hair strips widened in the vertex shader
+    out["TRANSMISSION"] = "TRANSMISSION" in features  # light from behind (lib/refraction.glsl)
+    out["THICKNESS_SLAB"] = "THICKNESS_SLAB" in features  # leaving it through a parallel face
     return out
 
 
@@ -246,6 +253,7 @@ LIT = Program(
         "lib/world_ratio.glsl",
         "lib/lit_surface.glsl",
         "lib/lit_world.glsl",
+        "lib/refraction.glsl",
         "lib/lit_settle.glsl",
         "lib/lit_lights.glsl",
         "lib/lit_outputs.glsl",
@@ -254,7 +262,8 @@ LIT = Program(
     entry_libs=("lib/lit_inputs.glsl",),
     # light_mask: with LIGHT_LINKING, the lights (bits in shading order) that reach this object.
     # solid: 1 for a closed surface seen from outside (its facets turned from a light are in its shadow).
-    push_constants=(("MAT4", "model"), ("IVEC4", "light_mask"), ("INT", "solid")),
+    # object_thickness: with TRANSMISSION, the object's smallest dimension (lib/refraction.glsl).
+    push_constants=(("MAT4", "model"), ("IVEC4", "light_mask"), ("INT", "solid"), ("FLOAT", "object_thickness")),
     # The techniques' samplers come with their parts (``features.LitPart.program``).
     samplers=(
         ("FLOAT_2D", SHADOW_SAMPLER),

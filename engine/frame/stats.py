@@ -116,6 +116,10 @@ class FrameStats:
     # rays (counted apart, as the occlusion's), and samples that traced.
     reflection_prepasses: int = 0
     reflection_samples: int = 0
+    # Refraction (``features/refraction.py``): camera depth prepasses of what is not
+    # transmissive, and samples that copied the colour transmissive surfaces see through.
+    refraction_prepasses: int = 0
+    refraction_samples: int = 0
     probe_draws: int = 0  # draw calls of the world's probe (``world/probe.py``), counted apart
     world_guided: bool = False  # the probe found an interior: the world's directions come through its openings
     ao_texels: int = 0  # texels whose horizons were marched (half resolution: a quarter of the film)

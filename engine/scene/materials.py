@@ -52,6 +52,10 @@ class Material:
     specular_tint: tuple = (1.0, 1.0, 1.0)
     metallic: float = 0.0
     alpha: float = 1.0
+    # Principled Transmission Weight (a Glass BSDF: 1): the share of the dielectric's diffuse
+    # that is light refracted from behind instead (features/refraction.py).
+    transmission: float = 0.0
+    thickness_mode: str = "SPHERE"  # Settings > Thickness Mode (EEVEE's): how light leaves it again
     emission: tuple = (0.0, 0.0, 0.0)  # colour * strength
     normal_strength: float = 0.0  # 0: no normal map
     textures: dict = field(default_factory=dict)  # channel -> TextureRef
@@ -78,6 +82,11 @@ class Material:
         return tuple(sorted(maps))
 
     @property
+    def transmits(self):
+        """Whether light from behind shows through it (its transmission, on a dielectric)."""
+        return self.tree is None and not self.holdout and self.transmission > 0.0 and self.metallic < 1.0
+
+    @property
     def uses_alpha(self):
         transparent = self.tree is not None and self.tree.transparent
         return self.blend != "OPAQUE" and (self.alpha < 1.0 or "alpha" in self.textures or transparent)
@@ -92,6 +101,10 @@ class Material:
             out.add(f"ALPHA_{self.blend}")
         if self.holdout:
             out.add("HOLDOUT")
+        if self.transmits:
+            out.add("TRANSMISSION")
+            if self.thickness_mode == "SLAB":
+                out.add("THICKNESS_SLAB")
         if self.tree is not None:
             out.add(f"NODES_{self.tree.key}")
             if "UV" in self.tree.needs:
@@ -280,6 +293,7 @@ def material_from_blender(mat):
         out.cull_camera = bool(getattr(mat, "use_backface_culling", False))
         out.cull_shadow = bool(getattr(mat, "use_backface_culling_shadow", False))
         out.transparent_shadow = bool(getattr(mat, "use_transparent_shadow", True))
+        out.thickness_mode = str(getattr(mat, "thickness_mode", "SPHERE"))
     return out
 
 
@@ -306,6 +320,8 @@ def _material_surface(mat):
     for socket in ("Volume", "Displacement"):
         if _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", socket, {"ALL", "EEVEE"}):
             notes.append(f"its {socket} output is not drawn")
+    if out.transmits and _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", "Thickness", {"ALL", "EEVEE"}):
+        notes.append("its Thickness output is not read (the object's smallest dimension is its thickness)")
     out.messages = tuple(f"material '{mat.name}': {n}" for n in dict.fromkeys(notes))
     return out
 
@@ -356,6 +372,8 @@ def _shader(mat, node, notes, depth=0):
         return _emission_shader(node, notes)
     if idname == "ShaderNodeBsdfDiffuse":
         return _diffuse_shader(node, notes)
+    if idname == "ShaderNodeBsdfGlass":
+        return _glass_shader(node, notes)
     if idname in {"ShaderNodeBsdfHair", "ShaderNodeBsdfHairPrincipled"}:
         return _hair_shader(mat, node, notes)
     if idname in {"ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic"}:
@@ -555,7 +573,13 @@ def _principled(mat, node, notes):
         out.blend = "HASHED"  # the material's render method decides (material_from_blender)
     from .nodetree import principled_unread
 
-    notes += [f"{name} is not drawn" for name in principled_unread(node)]
+    unread = principled_unread(node)
+    for name in ("Transmission Weight", "Transmission"):
+        sock = inputs.get(name)
+        if name in unread and not sock.is_linked:  # a constant: drawn (features/refraction.py)
+            out.transmission = min(max(float(sock.default_value), 0.0), 1.0)
+            unread.remove(name)
+    notes += [f"{name} is not drawn" for name in unread]
     return out
 
 
@@ -589,6 +613,22 @@ def _emission_shader(node, notes):
     if out.color_attribute is not None:
         notes.append("a colour attribute into Emission (not drawn)")
         out.color_attribute = None
+    return out
+
+
+def _glass_shader(node, notes):
+    """A Glass BSDF: a dielectric of its IOR that transmits all it does not reflect, its colour
+    tinting both (as Cycles' glass)."""
+    out = Material(transmission=1.0, specular=0.5)
+    out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (1.0, 1.0, 1.0, 1.0))
+    out.roughness = _value_channel(node.inputs["Roughness"], notes, "Roughness", out, "roughness", 0.0)
+    out.ior = _value_channel(node.inputs["IOR"], notes, "IOR", out, None, 1.45)
+    if "base_color" not in out.textures:
+        out.specular_tint = tuple(float(c) for c in out.base_color[:3])
+    distribution = getattr(node, "distribution", "GGX")
+    if distribution not in {"GGX", "MULTI_GGX", "SHARP"}:
+        notes.append(f"a Glass BSDF's {distribution} distribution (drawn as GGX)")
+    _normal_map(None, node, notes, out)
     return out
 
 

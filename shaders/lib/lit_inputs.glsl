@@ -16,6 +16,7 @@ struct MaterialInputs {
   float rough, metal, coverage;
   vec3 emission;
   vec4 spec_f0;     /* the dielectric's F0 (lobe_setup) */
+  float transmission; /* Principled Transmission Weight (TRANSMISSION, lib/refraction.glsl) */
   vec3 tree_normal; /* the tree's shading normal (NODE_NORMAL) */
 #if NODE_LOBES == 2
   vec4 base_b;
@@ -35,6 +36,7 @@ MaterialInputs material_inputs()
   m.coverage = material.alpha;
   m.emission = material.emission;
   m.spec_f0 = material.specular;
+  m.transmission = material.transmission;
   m.tree_normal = vec3(0.0);
 #if NODE_LOBES == 2
   m.base_b = m.base;

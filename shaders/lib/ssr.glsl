@@ -25,10 +25,18 @@
 #endif
 #define SSR_REFINE 5      /* bisections between the last step in front and the first behind */
 #define SSR_EDGE 0.05     /* hits fade out over this fraction of the screen at its edges */
-#define SSR_START_PX 1.5  /* the ray starts this many pixels from its surface (no self-hit) */
+#define SSR_START_PX 1.5  /* a reflected ray starts this many pixels from its surface (no self-hit) */
 #define SSR_OWN 0.01      /* a hit this close to the start's plane (times its depth) is its own */
 
-#if SSR
+#ifndef REFRACTION
+#  define REFRACTION 0
+#endif
+
+#ifndef TRANSMISSION
+#  define TRANSMISSION 0
+#endif
+
+#if SSR || REFRACTION || TRANSMISSION
 uint ssr_hash(uint x)
 {
   x ^= x >> 16u;
@@ -48,11 +56,11 @@ vec3 ssr_random(int k)
   return vec3(uvec3(a, b, c) >> 8u) * (1.0 / 16777216.0);
 }
 
-/* The prepass's view depth at pixel ``p`` (clamped to the screen: a fetch outside it is
+/* A prepass's view depth at pixel ``p`` (clamped to the screen: a fetch outside it is
  * undefined). */
-float ssr_scene(vec2 p, vec2 size)
+float ssr_scene(sampler2D depth, vec2 p, vec2 size)
 {
-  return texelFetch(ssr_depth, ivec2(clamp(p, vec2(0.0), size - 1.0)), 0).r;
+  return texelFetch(depth, ivec2(clamp(p, vec2(0.0), size - 1.0)), 0).r;
 }
 
 /* The ray's view depth at fraction ``t`` of the screen segment (perspective-correct). */
@@ -68,19 +76,31 @@ float ssr_fraction(vec4 q, float t)
   return t * q.w / mix(q.z, q.w, t);
 }
 
-/* Trace from ``P`` (world space, relative to the frame's origin) on a surface of normal ``N``
- * along the unit ``L``: the hit's weight (0: none; fading to 0 at the screen's edges) and
- * ``radiance`` there. A surface point within SSR_OWN of its depth from the start's tangent
- * plane is the start's own surface (a ray that grazes it reads its depth texels, taken at
- * their centres, as in front of it), not a hit. */
-float ssr_trace(vec3 P, vec3 N, vec3 L, float jitter, out vec3 radiance)
+/* March from ``P`` (world space, relative to the frame's origin) on a surface of normal ``N``
+ * along the unit ``L``, at most ``len`` world units, through the camera (``view``,
+ * ``view_proj``) that drew the view depth ``depth``: the hit's weight (0: none; fading to 0 at
+ * the screen's edges) and its pixel ``hit``. ``thick``: the thickness taken for a surface as a
+ * fraction of its depth. With ``own_check`` (a reflection: its own surface is in ``depth``) the
+ * ray starts SSR_START_PX from it, and a surface point within SSR_OWN of its depth from the
+ * start's tangent plane is the start's own surface (a ray that grazes it reads its depth
+ * texels, taken at their centres, as in front of it), not a hit. */
+float ssr_march(sampler2D depth,
+                mat4 view,
+                mat4 view_proj,
+                float len,
+                float thick,
+                bool own_check,
+                vec3 P,
+                vec3 N,
+                vec3 L,
+                float jitter,
+                out vec2 hit)
 {
-  radiance = vec3(0.0);
-  vec2 size = vec2(textureSize(ssr_depth, 0));
-  vec3 v0 = (frame.ssr_view * vec4(P, 1.0)).xyz;
-  vec3 d = mat3(frame.ssr_view) * L;
-  vec3 nv = mat3(frame.ssr_view) * N;
-  float len = frame.ssr_params.x;
+  hit = vec2(0.0);
+  vec2 size = vec2(textureSize(depth, 0));
+  vec3 v0 = (view * vec4(P, 1.0)).xyz;
+  vec3 d = mat3(view) * L;
+  vec3 nv = mat3(view) * N;
   if (frame.is_ortho == 0 && d.z > 0.0) {
     /* Towards the camera: the end stays in front of it. */
     len = min(len, (0.999 * -v0.z) / d.z);
@@ -88,8 +108,8 @@ float ssr_trace(vec3 P, vec3 N, vec3 L, float jitter, out vec3 radiance)
   if (!(len > 0.0) || !(-v0.z > 0.0)) {
     return 0.0;
   }
-  vec4 h0 = frame.ssr_view_proj * vec4(P, 1.0);
-  vec4 h1 = frame.ssr_view_proj * vec4(P + L * len, 1.0);
+  vec4 h0 = view_proj * vec4(P, 1.0);
+  vec4 h1 = view_proj * vec4(P + L * len, 1.0);
   if (!(h0.w > 0.0) || !(h1.w > 0.0)) {
     return 0.0;
   }
@@ -112,26 +132,36 @@ float ssr_trace(vec3 P, vec3 N, vec3 L, float jitter, out vec3 radiance)
     t_end = min(t_end, -s0.y / ds.y);
   }
   float pixels = length(ds) * t_end;
-  if (!(pixels > SSR_START_PX + 1.0)) {
-    return 0.0;
+  float start_px = own_check ? SSR_START_PX : 0.0;
+  if (!(pixels > start_px + 1.0)) {
+    /* Along the view (within a pixel on the screen): a refracted ray meets what lies behind
+     * its start at its start's pixel; a reflected one would meet its own surface. */
+    float behind = ssr_scene(depth, s0, size);
+    bool inside = all(greaterThanEqual(s0, vec2(0.0))) && all(lessThan(s0, size));
+    if (own_check || !inside || !(behind > 0.0) || behind < -v0.z * (1.0 - thick)) {
+      return 0.0;
+    }
+    hit = s0;
+    vec2 edge = min(s0, size - s0) / (SSR_EDGE * size);
+    return clamp(min(edge.x, edge.y), 0.0, 1.0);
   }
-  float t_start = SSR_START_PX / length(ds);
+  float t_start = start_px / length(ds);
   float dt = (t_end - t_start) / float(SSR_STEPS);
   float t_prev = t_start;
   for (int i = 0; i < SSR_STEPS; i++) {
     float t = t_start + dt * (float(i) + jitter);
     vec2 sp = s0 + ds * t;
-    float scene = ssr_scene(sp, size);
+    float scene = ssr_scene(depth, sp, size);
     float ray = ssr_depth_at(q, t);
     if (scene > 0.0 && ray > scene) {
       float before = ssr_depth_at(q, t_prev);
-      float thickness = max(ray - before, 0.0) + frame.ssr_params.y * scene;
+      float thickness = max(ray - before, 0.0) + thick * scene;
       if (ray - scene <= thickness) {
         /* Between the last point in front of the surface and this one behind it. */
         float lo = t_prev, hi = t;
         for (int j = 0; j < SSR_REFINE; j++) {
           float mid = 0.5 * (lo + hi);
-          float z = ssr_scene(s0 + ds * mid, size);
+          float z = ssr_scene(depth, s0 + ds * mid, size);
           if (z > 0.0 && ssr_depth_at(q, mid) > z) {
             hi = mid;
           }
@@ -142,19 +172,15 @@ float ssr_trace(vec3 P, vec3 N, vec3 L, float jitter, out vec3 radiance)
         /* The crossing found, the ray must be at the surface there, not far behind it (a ray
          * that passed under a thin object and shows behind it on the screen), and the
          * surface not the start's own. */
-        vec2 hit = s0 + ds * hi;
-        float surface = ssr_scene(hit, size);
+        vec2 at_hit = s0 + ds * hi;
+        float surface = ssr_scene(depth, at_hit, size);
         float at = ssr_depth_at(q, hi);
         vec3 vr = v0 + d * (len * ssr_fraction(q, hi));
         vec3 vs = (frame.is_ortho != 0) ? vec3(vr.xy, -surface) : vr * (surface / max(at, 1e-30));
-        bool own = abs(dot(vs - v0, nv)) <= SSR_OWN * surface;
-        if (surface > 0.0 && at - surface <= frame.ssr_params.y * surface && !own) {
-          vec3 c = texelFetch(ssr_radiance, ivec2(clamp(hit, vec2(0.0), size - 1.0)), 0).rgb;
-          if (!all(lessThan(abs(c), vec3(1e30)))) {
-            return 0.0; /* never carry a broken value into a reflection */
-          }
-          radiance = max(c, vec3(0.0));
-          vec2 edge = min(hit, size - hit) / (SSR_EDGE * size);
+        bool own = own_check && abs(dot(vs - v0, nv)) <= SSR_OWN * surface;
+        if (surface > 0.0 && at - surface <= thick * surface && !own) {
+          hit = clamp(at_hit, vec2(0.0), size - 1.0);
+          vec2 edge = min(at_hit, size - at_hit) / (SSR_EDGE * size);
           return clamp(min(edge.x, edge.y), 0.0, 1.0);
         }
       }
@@ -162,6 +188,15 @@ float ssr_trace(vec3 P, vec3 N, vec3 L, float jitter, out vec3 radiance)
     t_prev = t;
   }
   return 0.0;
+}
+
+/* The image ``image`` at pixel ``hit``, >= 0; ``ok`` false where it is not finite (never carry
+ * a broken value into a reflection or a refraction). */
+vec3 ssr_fetch(sampler2D image, vec2 hit, out bool ok)
+{
+  vec3 c = texelFetch(image, ivec2(hit), 0).rgb;
+  ok = all(lessThan(abs(c), vec3(1e30)));
+  return ok ? max(c, vec3(0.0)) : vec3(0.0);
 }
 
 /* The direction a traced lobe of normal ``N`` and Principled roughness ``rough`` reflects
@@ -176,6 +211,20 @@ vec3 ssr_direction(vec3 N, vec3 V, float rough, vec2 xi)
   vec3 H = ggx_half_vector(xi, rough * rough, N);
   vec3 L = reflect(-V, H);
   return (dot(L, N) > 0.0) ? L : R;
+}
+#endif
+
+#if SSR
+/* A reflection (ssr_march through the prepass's camera, frame.ssr_*): the hit's weight and
+ * ``radiance`` there, the frame's image so far. */
+float ssr_trace(vec3 P, vec3 N, vec3 L, float jitter, out vec3 radiance)
+{
+  vec2 hit;
+  float w = ssr_march(
+      ssr_depth, frame.ssr_view, frame.ssr_view_proj, frame.ssr_params.x, frame.ssr_params.y, true, P, N, L, jitter, hit);
+  bool ok = false;
+  radiance = (w > 0.0) ? ssr_fetch(ssr_radiance, hit, ok) : vec3(0.0);
+  return ok ? w : 0.0;
 }
 #endif
 

@@ -12,13 +12,16 @@ class LitPart:
     fields of the frame block (``programs.FRAME_STRUCT``) this technique sets; ``samplers``,
     {sampler name: texture} the lit program reads (bound with the frame's blocks); ``begin``:
     GPU work over the sample's frame block before the lit pass's draws
-    (``begin(frame_block, stats)``), or None."""
+    (``begin(frame_block, stats)``), or None; ``between``: GPU work after the opaque surfaces
+    are drawn and before the transmissive ones (``between(film, stats)``: what they see
+    through), or None."""
 
     program: object = None
     blended: object = None
     rows: dict = dataclasses.field(default_factory=dict)
     samplers: dict = dataclasses.field(default_factory=dict)
     begin: object = None
+    between: object = None
 
     @property
     def blended_program(self):
