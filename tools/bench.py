@@ -8,7 +8,7 @@
               -> <out>/benchmark.csv
     perf      frame cost and scaling as ratios to Workbench: resolution, viewport redraw,
               lights, objects, instances, triangles, extraction -> <out>/perf.csv
-    reflections  glossy surfaces under a real HDRI and a polished floor: error against time,
+    reflections  glossy surfaces under a real HDRI, a polished floor, glass: error against time,
               Penumbra (scene reflections, world image, SH) vs Cycles one glossy bounce, EEVEE
               -> <out>/reflections.csv, reflections.png; --cost: on against off, 160x90 and 960x540
     samples   render samples: error against time vs Cycles spp and EEVEE, cost per sample,

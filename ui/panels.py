@@ -279,6 +279,8 @@ class PENUMBRA_PT_material(PenumbraPanel, bpy.types.Panel):
         col.prop(context.material, "use_backface_culling", text="Camera")
         if hasattr(context.material, "use_backface_culling_shadow"):
             col.prop(context.material, "use_backface_culling_shadow", text="Shadow")
+        if hasattr(context.material, "thickness_mode"):  # how light leaves a transmissive surface
+            self.layout.prop(context.material, "thickness_mode", text="Thickness")
 
 
 class PENUMBRA_UL_layers(bpy.types.UIList):

@@ -666,6 +666,9 @@ def summary(read):
     if read.holdout:
         alpha = "holdout (a hole in the film)"
     lines.append(("IMAGE_ALPHA", f"Alpha: {alpha}"))
+    if read.transmits:
+        mode = "a slab" if read.thickness_mode == "SLAB" else "a sphere"
+        lines.append(("MATERIAL", f"Transmission: {read.transmission:.2f}, through {mode} (Thickness Mode)"))
     lines += [("ERROR", m.split(": ", 1)[-1]) for m in read.messages]
     return lines
 

@@ -26,9 +26,6 @@
  * 0, 0). */
 
 #if TRANSMISSION
-#  ifndef REFRACTION
-#    define REFRACTION 0
-#  endif
 
 /* The share of the surface that transmits: its Transmission Weight, of the dielectric part. */
 float transmission_share(float transmission, float metal)

@@ -146,7 +146,10 @@ def test_glass_and_transmission_are_read(penumbra):
     read = material_from_blender(glass(ior=1.33, color=(0.9, 0.5, 0.2, 1.0)))
     assert read.transmits and read.transmission == 1.0 and read.ior == pytest.approx(1.33)
     assert read.specular_tint == pytest.approx((0.9, 0.5, 0.2)) and not read.messages
-    assert "TRANSMISSION" in read.features
+    assert "TRANSMISSION" in read.features and "THICKNESS_SLAB" in read.features  # glass(): Slab
+    from penumbra.engine.scene.materials import summary
+
+    assert any("Transmission: 1.00, through a slab" in text for _icon, text in summary(read))
     mat, bsdf, _out = material_scenes.node_material("Clear")
     bsdf.inputs["Transmission Weight"].default_value = 0.7
     read = material_from_blender(mat)

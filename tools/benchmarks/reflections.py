@@ -1,21 +1,25 @@
 """What glossy surfaces see: error against time on ``devkit.reflection_scenes``.
 
 ``hdri_spheres`` (a mirror, a brushed metal and a polished red ball on a ground under
-Blender's own forest.exr, turned 40 deg) and ``polished_floor`` (a dark polished floor under a
-sun and a dim sky, objects on it), in this one process:
+Blender's own forest.exr, turned 40 deg), ``polished_floor`` (a dark polished floor under a
+sun and a dim sky, objects on it) and ``glass_checker`` (a Glass BSDF ball and a Principled
+cube of Transmission 1 on a checker), in this one process:
 
 - Penumbra at 4, 16, 64 render samples: glossy lobes reflect the scene where a screen-space
   ray meets it (``features/reflections.py``) and the Environment Texture prefiltered by
-  roughness elsewhere (``features/world_env.py``).
-- Penumbra without the scene's reflections (the world's image alone), and without both (the
-  world's SH light: what the frame did before issue 50), each technique left out of the
-  registry, at 16 and 64. The world ratio's sharp-lobe share (``lit_world.glsl``
-  ``world_ratio_share``) is in all: it is not a technique of its own.
-- Cycles with one glossy bounce (max_bounces 1) at 16 and 64 spp, EEVEE once
+  roughness elsewhere (``features/world_env.py``); transmissive surfaces refract what is
+  behind them (``features/refraction.py``).
+- Penumbra without the screen-space techniques (the scene's reflections and the refraction:
+  the world's image alone), and without the image too (the world's SH light: what the frame
+  did before issue 50), each technique left out of the registry, at 16 and 64. The world
+  ratio's sharp-lobe share (``lit_world.glsl`` ``world_ratio_share``) is in all: it is not a
+  technique of its own.
+- Cycles with one glossy bounce (max_bounces 1; through glass, 8 transmission bounces with
+  caustics off) at 16 and 64 spp, EEVEE once
   (``devkit.engines``: 16 TAA samples, no probe baked).
 
-Error: the mean absolute difference of display RGB against Cycles at 256 spp (one glossy
-bounce, the same pixel filter; cached in out/reference_cache) over the objects' pixels
+Error: the mean absolute difference of display RGB against Cycles at 256 spp (the bounces
+above, the same pixel filter; cached in out/reference_cache) over the objects' pixels
 (Workbench's flat object mask), over every pixel, and over the mirror sphere's upper half
 (the sky it reflects; its lower half shows the ground and its neighbours). Time: the median
 of ``--runs`` F12 renders after the measured one.
@@ -48,7 +52,7 @@ FIELDS = ["scene", "config", "samples", "time_s", "mae_objects", "mae_all", "mae
 IMAGE = "Penumbra"
 WORLD_ONLY = "Penumbra, world image only"
 SH = "Penumbra, SH world light"
-LEFT_OUT = {WORLD_ONLY: ("reflections",), SH: ("reflections", "world_env")}
+LEFT_OUT = {WORLD_ONLY: ("reflections", "refraction"), SH: ("reflections", "refraction", "world_env")}
 CYCLES = "Cycles, 1 glossy bounce"
 EEVEE = f"EEVEE ({EEVEE_SAMPLES} TAA)"
 
