@@ -264,3 +264,14 @@ def front_to_back(draws, camera):
         key = np.linalg.norm(np.maximum(0.0, np.maximum(lo - position, position - hi)), axis=1)
     key = np.where(np.isfinite(key), key, np.inf)
     return [draws[i] for i in np.lexsort((key, lightspace.flat_boxes(corners)))]
+
+
+def longest_ray(draws):
+    """The longest ray a screen-space trace follows (reflections, refraction): the diagonal of
+    the box around what the frame draws (0 where nothing finite is drawn)."""
+    corners = corners_of(draws).reshape(-1, 3)
+    corners = corners[np.all(np.isfinite(corners), axis=1)]
+    if len(corners) == 0:
+        return 0.0
+    diagonal = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0)))
+    return diagonal if np.isfinite(diagonal) else 0.0

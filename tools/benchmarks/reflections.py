@@ -324,7 +324,8 @@ def run(args):
         rows, shown = sweep(args, w, h)
     report.write_csv(args.out / "reflections.csv", rows, FIELDS)
     title = (
-        f"Glossy surfaces, {w}x{h}: display MAE against Cycles 256 spp (one glossy bounce); Blender "
+        f"What surfaces see, {w}x{h}: display MAE against Cycles 256 spp (one glossy bounce; through glass "
+        f"8 transmission bounces, caustics off); Blender "
         f"{bpy.app.version_string}, {session.gpu_renderer() or 'n/a'}"
     )
     plot(rows, shown, args.out / "reflections.png", title)

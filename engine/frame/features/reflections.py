@@ -33,7 +33,7 @@ import numpy as np
 from ....shaders.loader import ProgramPart
 from ...gpu_pool import new_texture
 from ...shadows import lightspace
-from ..draw_list import corners_of
+from ..draw_list import longest_ray
 from ..world.occlusion import WorldAO
 from .base import NO_PART, Feature, LitPart
 
@@ -80,16 +80,6 @@ def reflective_material(mat):
 def reflective_materials(draws):
     """Whether any draw the camera sees has a reflective material (``reflective_material``)."""
     return any(reflective_material(m) for d in draws if d.instance.camera for m in (d.instance.materials or (None,)))
-
-
-def longest_ray(draws):
-    """The longest ray traced: the diagonal of the box around what the frame draws."""
-    corners = corners_of(draws).reshape(-1, 3)
-    corners = corners[np.all(np.isfinite(corners), axis=1)]
-    if len(corners) == 0:
-        return 0.0
-    diagonal = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0)))
-    return diagonal if np.isfinite(diagonal) else 0.0
 
 
 class Reflections(Feature):

@@ -19,10 +19,10 @@ import dataclasses
 from ....shaders.loader import ProgramPart
 from ...gpu_pool import new_texture
 from ...shadows import lightspace
+from ..draw_list import longest_ray
 from ..film_programs import SCALED_COPY
 from ..world.occlusion import WorldAO
 from .base import Feature, LitPart
-from .reflections import longest_ray
 
 THICKNESS = 0.02  # a surface's thickness, as a fraction of its depth, that a ray behind it still meets
 DEPTH_SAMPLER = "refr_depth"
