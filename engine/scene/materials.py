@@ -372,8 +372,8 @@ def _shader(mat, node, notes, depth=0):
         return _emission_shader(node, notes)
     if idname == "ShaderNodeBsdfDiffuse":
         return _diffuse_shader(node, notes)
-    if idname == "ShaderNodeBsdfGlass":
-        return _glass_shader(node, notes)
+    if idname in {"ShaderNodeBsdfGlass", "ShaderNodeBsdfRefraction"}:
+        return _glass_shader(node, notes, reflects=idname == "ShaderNodeBsdfGlass")
     if idname in {"ShaderNodeBsdfHair", "ShaderNodeBsdfHairPrincipled"}:
         return _hair_shader(mat, node, notes)
     if idname in {"ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic"}:
@@ -616,18 +616,20 @@ def _emission_shader(node, notes):
     return out
 
 
-def _glass_shader(node, notes):
+def _glass_shader(node, notes, reflects=True):
     """A Glass BSDF: a dielectric of its IOR that transmits all it does not reflect, its colour
-    tinting both (as Cycles' glass)."""
-    out = Material(transmission=1.0, specular=0.5)
+    tinting both (as Cycles' glass); a Refraction BSDF (``reflects`` False) the same without
+    the reflection (Specular IOR Level 0: all of it transmits)."""
+    out = Material(transmission=1.0, specular=0.5 if reflects else 0.0)
     out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (1.0, 1.0, 1.0, 1.0))
     out.roughness = _value_channel(node.inputs["Roughness"], notes, "Roughness", out, "roughness", 0.0)
     out.ior = _value_channel(node.inputs["IOR"], notes, "IOR", out, None, 1.45)
     if "base_color" not in out.textures:
         out.specular_tint = tuple(float(c) for c in out.base_color[:3])
     distribution = getattr(node, "distribution", "GGX")
-    if distribution not in {"GGX", "MULTI_GGX", "SHARP"}:
-        notes.append(f"a Glass BSDF's {distribution} distribution (drawn as GGX)")
+    rough = out.roughness > 0.0 or "roughness" in out.textures
+    if rough and distribution not in {"GGX", "MULTI_GGX", "SHARP"}:  # (all alike at roughness 0)
+        notes.append(f"a {node.bl_label}'s {distribution.title()} distribution (drawn as GGX)")
     _normal_map(None, node, notes, out)
     return out
 

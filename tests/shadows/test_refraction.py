@@ -47,34 +47,23 @@ def glass(name="Glass", ior=IOR, roughness=0.0, color=(1.0, 1.0, 1.0, 1.0), thic
     return mat
 
 
-def _edge_scene(slab=True, roughness=0.0):
+def _edge_scene(slab=True, roughness=0.0, ior=IOR, scale=1.0):
     """A black world, no lamp: the ground emits for y < 0 and is black for y > 0; with ``slab``
     a glass slab THICK deep rests on it; an orthographic camera looks down along +y, TILT from
-    the vertical."""
+    the vertical. ``scale``: every length times it (the picture stays the same)."""
     scene = scenes.empty_scene(*SIZE)
     scenes.set_world(scene, (0.0, 0.0, 0.0))
-    s = 20.0
-    scenes.mesh_object(
-        scene,
-        "Lit",
-        [(-s, -s, 0), (s, -s, 0), (s, 0, 0), (-s, 0, 0)],
-        [(0, 1, 2, 3)],
-        mat=scenes.emissive("Glow", EMISSION),
-    )
-    scenes.mesh_object(
-        scene,
-        "Dark",
-        [(-s, 0, 0), (s, 0, 0), (s, s, 0), (-s, s, 0)],
-        [(0, 1, 2, 3)],
-        mat=scenes.material("Black", (0, 0, 0), specular=0.0),
-    )
+    s = 20.0 * scale
+    lit, dark = scenes.emissive("Glow", EMISSION), scenes.material("Black", (0, 0, 0), specular=0.0)
+    scenes.mesh_object(scene, "Lit", [(-s, -s, 0), (s, -s, 0), (s, 0, 0), (-s, 0, 0)], [(0, 1, 2, 3)], mat=lit)
+    scenes.mesh_object(scene, "Dark", [(-s, 0, 0), (s, 0, 0), (s, s, 0), (-s, s, 0)], [(0, 1, 2, 3)], mat=dark)
     if slab:
-        scenes.box(
-            scene, "Slab", center=(0.0, 0.0, THICK / 2), size=(30.0, 30.0, THICK), mat=glass(roughness=roughness)
-        )
-    distance = 10.0
-    location = (0.0, -distance * math.sin(TILT), THICK + distance * math.cos(TILT))
-    scenes.camera(scene, location, (TILT, 0.0, 0.0), ortho_scale=ORTHO, clip=(0.1, 40.0))
+        size = (30.0 * scale, 30.0 * scale, THICK * scale)
+        mat = glass(ior=ior, roughness=roughness)
+        scenes.box(scene, "Slab", center=(0.0, 0.0, THICK * scale / 2), size=size, mat=mat)
+    distance = 10.0 * scale
+    location = (0.0, -distance * math.sin(TILT), THICK * scale + distance * math.cos(TILT))
+    scenes.camera(scene, location, (TILT, 0.0, 0.0), ortho_scale=ORTHO * scale, clip=(0.1 * scale, 40.0 * scale))
     return scene
 
 
@@ -107,6 +96,11 @@ def test_a_slab_shifts_the_edge_by_snells_law(penumbra, gpu_call):
     expected = THICK * math.cos(TILT) * (math.tan(TILT) - math.tan(inside)) * SIZE[0] / ORTHO
     shift = _edge_row(through) - _edge_row(bare)
     assert shift == pytest.approx(expected, abs=0.5), (shift, expected)
+    # A one-sample frame (the viewport while the view moves) refracts the same: it reads its
+    # own sample's colour, not the frame's so far.
+    one, stats = _render(gpu_call, _edge_scene(), samples=1)
+    assert stats.refraction_samples == 1
+    assert _edge_row(one) - _edge_row(bare) == pytest.approx(expected, abs=0.5)
     # The lit ground through the glass: the rows from 3 under the edge down to 14 under it
     # (the bottom rows' rays meet the ground under the screen's edge: the world, black here).
     row = int(_edge_row(through))
@@ -115,6 +109,36 @@ def test_a_slab_shifts_the_edge_by_snells_law(penumbra, gpu_call):
     schlick = f0 + (1 - f0) * (1 - math.cos(TILT)) ** 5
     assert 0.96 * (1 - schlick) <= lit / EMISSION <= 1.01 * (1 - schlick), (lit, 1 - schlick)
     assert np.isfinite(through).all() and (through >= 0).all()
+
+
+@pytest.mark.parametrize("scale", (1e-3, 1e3))
+def test_the_slab_refracts_alike_at_a_millimetre_and_a_kilometre(penumbra, gpu_call, scale):
+    """The same slab a thousand times smaller or larger (camera, clip range and all): the edge
+    moves by the same pixels (within half a pixel of Snell's 11.18)."""
+    bare, _s = _render(gpu_call, _edge_scene(slab=False, scale=scale))
+    through, _s = _render(gpu_call, _edge_scene(scale=scale))
+    inside = math.asin(math.sin(TILT) / IOR)
+    expected = THICK * math.cos(TILT) * (math.tan(TILT) - math.tan(inside)) * SIZE[0] / ORTHO
+    assert _edge_row(through) - _edge_row(bare) == pytest.approx(expected, abs=0.5)
+
+
+def test_extreme_iors_and_roughness_stay_finite(penumbra, gpu_call):
+    """IOR 1 bends nothing (the edge where it is without the slab, within half a pixel, and the
+    ground's full radiance through it: no Fresnel at all); IOR 0.5 (light from a denser medium:
+    total internal reflection past 30 deg), IOR 1000 and roughness 1 render finite and
+    non-negative; IOR 0.5 and roughness 1 still show the lit ground through the slab, and IOR
+    1000, whose f0 is 0.996, mirrors the black world and lets at most 1 % through (measured
+    0.4 %)."""
+    bare, _s = _render(gpu_call, _edge_scene(slab=False))
+    clear, _s = _render(gpu_call, _edge_scene(ior=1.0))
+    assert _edge_row(clear) == pytest.approx(_edge_row(bare), abs=0.5)
+    row = int(_edge_row(clear))
+    assert float(_profile(clear)[row - 14 : row - 3].mean()) == pytest.approx(EMISSION, rel=0.01)
+    for ior, rough in ((0.5, 0.0), (1000.0, 0.0), (IOR, 1.0)):
+        image, _s = _render(gpu_call, _edge_scene(ior=ior, roughness=rough))
+        assert np.isfinite(image).all() and (image >= 0).all(), (ior, rough)
+        brightest = float(image[..., :3].max())
+        assert brightest <= 0.01 * EMISSION if ior > 100.0 else brightest > 0.2 * EMISSION, (ior, rough, brightest)
 
 
 def test_a_rough_slab_blurs_the_edge(penumbra, gpu_call):
@@ -150,6 +174,10 @@ def test_glass_and_transmission_are_read(penumbra):
     from penumbra.engine.scene.materials import summary
 
     assert any("Transmission: 1.00, through a slab" in text for _icon, text in summary(read))
+    refraction, _bsdf, _out = material_scenes.node_material("Refraction")
+    material_scenes.replace_shader(refraction, "ShaderNodeBsdfRefraction")
+    read = material_from_blender(refraction)
+    assert read.transmits and read.f0[3] == 0.0 and not read.messages  # no reflection
     mat, bsdf, _out = material_scenes.node_material("Clear")
     bsdf.inputs["Transmission Weight"].default_value = 0.7
     read = material_from_blender(mat)
