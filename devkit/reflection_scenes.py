@@ -58,28 +58,9 @@ def hdri_path(name=HDRI):
 
 def hdri_world(scene, name=HDRI, strength=1.0, rotation_z=0.0):
     """The world: Environment Texture of ``name`` (a Mapping node turning it ``rotation_z``
-    about Z where not 0) -> Background of ``strength``."""
+    about Z where not 0) -> Background of ``strength`` (``world_scenes.environment_world``)."""
     image = bpy.data.images.load(str(hdri_path(name)), check_existing=True)
-    world = scene.world
-    world.use_nodes = True
-    tree = world.node_tree
-    bg = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBackground")
-    bg.inputs["Strength"].default_value = strength
-    env = tree.nodes.new("ShaderNodeTexEnvironment")
-    env.image = image
-    if rotation_z:
-        mapping = tree.nodes.new("ShaderNodeMapping")
-        mapping.inputs["Rotation"].default_value = (0.0, 0.0, rotation_z)
-        coords = tree.nodes.new("ShaderNodeTexCoord")
-        tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
-        tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
-    tree.links.new(env.outputs["Color"], bg.inputs["Color"])
-    return world
-
-
-def _principled(name, color, metallic, roughness):
-    mat = scenes.material(name, color, roughness=roughness, metallic=metallic)
-    return mat
+    return ws.environment_world(scene, image, strength, rotation_z or None)
 
 
 def hdri_spheres(scene):
@@ -93,7 +74,7 @@ def hdri_spheres(scene):
             radius=1.0,
             segments=64,
             rings=32,
-            mat=_principled(name, color, metallic, rough),
+            mat=scenes.material(name, color, roughness=rough, metallic=metallic),
         )
     for ob in scene.objects:
         if ob.type == "MESH" and ob.name != "Ground":

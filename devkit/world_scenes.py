@@ -135,6 +135,15 @@ def hdri_sky(scene, strength=1.0):
     image.file_format = "OPEN_EXR"
     image.pixels.foreach_set(hdri_pixels(w, h).ravel())
     image.pack()
+    world = environment_world(scene, image, strength, HDRI_ROTATION_Z)
+    world.color = tuple(float(c) for c in hdri_pixels(w, h)[..., :3].reshape(-1, 3).mean(0))
+    return world
+
+
+def environment_world(scene, image, strength=1.0, rotation_z=None):
+    """``scene``'s world lit by ``image``: Environment Texture (equirectangular) -> Background
+    of ``strength``; with ``rotation_z``, Texture Coordinate (Generated) -> Mapping (Point, that
+    Z rotation) -> the texture's Vector."""
     world = scene.world
     world.use_nodes = True
     tree = world.node_tree
@@ -143,14 +152,14 @@ def hdri_sky(scene, strength=1.0):
     env = tree.nodes.new("ShaderNodeTexEnvironment")
     env.image = image
     env.projection = "EQUIRECTANGULAR"
-    mapping = tree.nodes.new("ShaderNodeMapping")
-    mapping.vector_type = "POINT"
-    mapping.inputs["Rotation"].default_value = (0.0, 0.0, HDRI_ROTATION_Z)
-    coords = tree.nodes.new("ShaderNodeTexCoord")
-    tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
-    tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+    if rotation_z is not None:
+        mapping = tree.nodes.new("ShaderNodeMapping")
+        mapping.vector_type = "POINT"
+        mapping.inputs["Rotation"].default_value = (0.0, 0.0, rotation_z)
+        coords = tree.nodes.new("ShaderNodeTexCoord")
+        tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+        tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
     tree.links.new(env.outputs["Color"], bg.inputs["Color"])
-    world.color = tuple(float(c) for c in hdri_pixels(w, h)[..., :3].reshape(-1, 3).mean(0))
     return world
 
 
