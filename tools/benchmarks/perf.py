@@ -267,8 +267,9 @@ def bare_copy(mesh):
 # --- sections ------------------------------------------------------------------------------
 
 
-def _fenced_stats(scene):
-    """FrameStats of an F12 render of ``scene`` with every stage fenced (``StageClock``)."""
+def fenced_stats():
+    """FrameStats of an F12 render of the current scene, as it is set up, with every stage
+    fenced (``StageClock``)."""
     from penumbra.engine.frame.renderer import Renderer
 
     seen = []
@@ -281,11 +282,16 @@ def _fenced_stats(scene):
 
     Renderer.fence_stages, Renderer.render = True, recorded
     try:
-        _penumbra(scene)
         _render()
     finally:
         Renderer.fence_stages, Renderer.render = False, render
     return seen[-1]
+
+
+def _fenced_stats(scene):
+    """``fenced_stats`` of ``scene`` drawn by Penumbra."""
+    _penumbra(scene)
+    return fenced_stats()
 
 
 def cpu_note(stats):

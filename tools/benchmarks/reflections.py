@@ -46,6 +46,7 @@ import numpy as np
 from devkit import reflection_scenes as rs
 from devkit import report, session, timing
 from devkit.engines import EEVEE_SAMPLES
+from tools.benchmarks import perf
 
 HELP = "glossy surfaces: error against time, Penumbra (scene reflections, world image, SH) vs Cycles and EEVEE"
 FIELDS = ["scene", "config", "samples", "time_s", "mae_objects", "mae_all", "mae_mirror_upper"]
@@ -189,26 +190,6 @@ COST_SIZES = ((160, 90), (960, 540))
 COST_SAMPLES = 16
 
 
-def fenced_stats(scene):
-    """FrameStats of one F12 render of ``scene`` with every stage fenced."""
-    from penumbra.engine.frame.renderer import Renderer
-
-    seen = []
-    render = Renderer.render
-
-    def recorded(self, *args, **kwargs):
-        out = render(self, *args, **kwargs)
-        seen.append(out.stats)
-        return out
-
-    Renderer.fence_stages, Renderer.render = True, recorded
-    try:
-        timing.render(1, warmup=0)
-    finally:
-        Renderer.fence_stages, Renderer.render = False, render
-    return seen[-1]
-
-
 def further_sample_ms(stats):
     later = sorted(stats.sample_cpu_seconds[1:]) or stats.sample_cpu_seconds
     return 1e3 * later[len(later) // 2] if later else 0.0
@@ -228,9 +209,9 @@ def cost(args):
                     scene.penumbra.screen_space_reflections = on
                     times[on].append(timing.render(1, warmup=0).median)
             scene.penumbra.screen_space_reflections = False
-            off = fenced_stats(scene)
+            off = perf.fenced_stats()
             scene.penumbra.screen_space_reflections = True
-            on = fenced_stats(scene)
+            on = perf.fenced_stats()
             traced = max(on.reflection_samples, 1)
             t_on, t_off = statistics.median(times[True]), statistics.median(times[False])
             rows.append(
