@@ -15,6 +15,9 @@ hdri_spheres    three spheres on a grey ground under a real outdoor HDRI (Blende
 polished_floor  a dark polished dielectric floor (roughness 0.05) under a sun 35 deg up and a
                 dim uniform sky, with a cube, Suzanne and a sphere on it: where the floor's
                 sharp lobe met the world's ratio it carried a salt-and-pepper pattern
+probe_floor     polished_floor with a Plane Light Probe over the floor (a planar reflection:
+                what the screen does not hold of the objects, their undersides and backs, is
+                reflected too)
 glass_checker   a Glass BSDF sphere (IOR 1.45) and a Principled cube of Transmission 1
                 (roughness 0.05, Thickness Mode Slab) on a checker ground under a sun and a
                 pale sky
@@ -106,6 +109,11 @@ def polished_floor(scene):
     scenes.look_at(scene, (0.0, -7.0, 2.4), (0.0, 0.0, 0.4), lens=35.0)
 
 
+def probe_floor(scene):
+    polished_floor(scene)
+    scenes.plane_probe(scene, "Floor Probe", size=(60.0, 60.0))
+
+
 def glass_checker(scene):
     ws.uniform_sky(scene, (0.6, 0.7, 0.9), 0.5)
     ground, bsdf, _out = _node_material("Checker")
@@ -148,7 +156,12 @@ def _node_material(name):
     return mat, bsdf, out
 
 
-SCENES = {"hdri_spheres": hdri_spheres, "polished_floor": polished_floor, "glass_checker": glass_checker}
+SCENES = {
+    "hdri_spheres": hdri_spheres,
+    "polished_floor": polished_floor,
+    "probe_floor": probe_floor,
+    "glass_checker": glass_checker,
+}
 
 
 def build(name, width=DEFAULT_WIDTH, height=DEFAULT_HEIGHT):

@@ -117,6 +117,18 @@ def box(scene, name="Box", center=(0, 0, 0), size=(1, 1, 1), mat=None):
     return mesh_object(scene, name, verts, faces, location=center, mat=mat)
 
 
+def plane_probe(scene, name="Mirror Probe", location=(0, 0, 0), size=(1.0, 1.0), distance=0.1, clip=0.001):
+    """A Plane Light Probe (a planar reflection) at ``location``, its square ``size`` (X, Y)
+    across, Influence Distance ``distance`` and Clipping Offset ``clip``."""
+    data = bpy.data.lightprobes.new(name, "PLANE")
+    data.influence_distance = distance
+    data.clip_start = clip
+    ob = bpy.data.objects.new(name, data)
+    ob.location = location
+    ob.scale = (size[0] / 2.0, size[1] / 2.0, 1.0)
+    return link(scene, ob)
+
+
 def box_over_plane(scene, plane_size=10.0, box_center=(0, 0, 1.5), box_size=1.0, mat=None):
     """A square plane of side ``plane_size`` at z = 0 (object "Plane") and a cube of side
     ``box_size`` centred at ``box_center`` (object "Box"), both with ``mat`` (default: a new

@@ -22,8 +22,18 @@
  *                  EMISSION_OUTPUT; the ratio's targets with WORLD_RATIO_OUT)
  *   EMISSION_ONLY  the Emission pass alone, over the z-buffer the lit pass left */
 
+#ifndef CLIP_PLANE
+#  define CLIP_PLANE 0
+#endif
+
 void main()
 {
+#if CLIP_PLANE
+  /* A Plane probe's capture (engine/frame/features/planar.py): nothing under the mirror. */
+  if (dot(vec4(v_world, 1.0), frame.clip_plane) < 0.0) {
+    discard;
+  }
+#endif
   MaterialInputs m = material_inputs();
   /* Decided here, discarded at the end (lib/lit_inputs.glsl coverage_discards). */
   bool dropped = coverage_discards(m.coverage);

@@ -11,8 +11,7 @@ ENGINE = "PENUMBRA"
 
 # Generic panels of features Penumbra does not render (by name prefix or full name).
 EXCLUDE_PREFIXES = (
-    "DATA_PT_lightprobe",  # light probes: no baked lighting
-    "DATA_PT_context_lightprobe",
+    "DATA_PT_lightprobe",  # light probes: Penumbra's own panel shows what a Plane probe sets
     "RENDER_PT_freestyle",  # Freestyle lines
     "VIEWLAYER_PT_freestyle",
     "MATERIAL_PT_freestyle",
@@ -28,6 +27,7 @@ EXCLUDE = {
 # EEVEE panels whose settings Penumbra reads.
 INCLUDE = {
     "DATA_PT_EEVEE_light",  # type, colour, power, radius, spot size and blend
+    "DATA_PT_context_lightprobe",  # the probe's datablock (its settings: PENUMBRA_PT_lightprobe)
     "EEVEE_MATERIAL_PT_context_material",
     "EEVEE_MATERIAL_PT_surface",  # the Principled BSDF Penumbra reads
     "EEVEE_WORLD_PT_surface",  # the world colour (ambient)

@@ -257,6 +257,28 @@ class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
         draw_params(col, context.light.penumbra, settings.LIGHT_PARAMS)
 
 
+class PENUMBRA_PT_lightprobe(PenumbraPanel, bpy.types.Panel):
+    """A Light Probe's settings Penumbra reads: a Plane probe's influence and clipping offset
+    (``engine/frame/features/planar.py``); the other types say they are not used."""
+
+    bl_label = "Probe"
+    bl_context = "data"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and getattr(context, "lightprobe", None) is not None
+
+    def draw(self, context):
+        layout = self.split_layout()
+        probe = context.lightprobe
+        if probe.type != "PLANE":
+            layout.label(text="Penumbra uses Plane probes only (planar reflections)", icon="INFO")
+            return
+        col = layout.column()
+        col.prop(probe, "influence_distance", text="Distance")
+        col.prop(probe, "clip_start", text="Clipping Offset")
+
+
 class PENUMBRA_PT_material(PenumbraPanel, bpy.types.Panel):
     """What Penumbra draws of the active material, and each part of its node tree it does not
     read (the same messages the render report gives)."""
@@ -356,6 +378,7 @@ classes = (
     PENUMBRA_PT_passes,
     PENUMBRA_PT_shadows,
     PENUMBRA_PT_light,
+    PENUMBRA_PT_lightprobe,
     PENUMBRA_PT_lighting,
     PENUMBRA_PT_light_paths,
     PENUMBRA_PT_world,

@@ -164,6 +164,12 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "ssr_view": view,
         "ssr_view_proj": camera.projection @ view,
         "refr_params": (0.0, 0.0, 0.0, 0.0),
+        "planar_view": view,
+        "planar_view_proj": camera.projection @ view,
+        "planar_influence": np.zeros((4, 4)),
+        "planar_plane": (0.0, 0.0, 1.0, 0.0),
+        "planar_params": (0.0, 0.0, 0.0, 0.0),
+        "clip_plane": (0.0, 0.0, 0.0, 1.0),
     }
 
 

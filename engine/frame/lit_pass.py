@@ -338,6 +338,7 @@ class _Submission:
         atlas, data = sample.atlas, sample.data
         self.lit, self.data, self.atlas, self.origin = lit, data, atlas, sample.origin
         self.masks, self.parts, self.stats = sample.masks, parts, sample.stats
+        self.mirrored = bool(sample.mirrored)  # a mirrored view turns every winding (``features/planar.py``)
         self.shadow_tex = atlas.texture if atlas is not None else lit._shadow_dummy()
         self.emission = self.counted = False
         # A debug view's entry shader, unless a technique's part brings its own (the settle test's).
@@ -413,9 +414,9 @@ class _Submission:
         last = None
         for features, _rank, d, batch, mat in entries:
             # Material › Backface Culling › Camera: faces turned away are not drawn (the
-            # winding flips under a mirroring model matrix).
+            # winding flips under a mirroring model matrix, and again through a mirrored view).
             cull = (mat.cull_camera or id(d) in outside) and d.instance.hair is None  # strips have no back
-            culling = (cull, cull and d.det < 0.0)
+            culling = (cull, cull and (d.det < 0.0) != self.mirrored)
             if self.culling != culling:
                 gpu.state.face_culling_set("BACK" if culling[0] else "NONE")
                 gpu.state.front_facing_set(culling[1])

@@ -156,6 +156,17 @@ FRAME_STRUCT = Struct(
         # REFRACTION (features/refraction.py, lib/refraction.glsl): (the longest ray in world
         # units, a surface's thickness as a fraction of its depth, 0, 0).
         ("VEC4", "refr_params"),
+        # PLANAR (features/planar.py, lib/planar.glsl): the mirrored camera its capture was
+        # drawn through, the map into the probe's influence box (-1..1 inside), the mirror's
+        # plane (normal, d: dot((P, 1), it) is the height over it) and (the
+        # longest ray, a surface's thickness as a fraction of its depth, 0, 0); CLIP_PLANE (a
+        # capture's lit pass): the plane under which nothing is drawn (dot((P, 1), it) < 0).
+        ("MAT4", "planar_view"),
+        ("MAT4", "planar_view_proj"),
+        ("MAT4", "planar_influence"),
+        ("VEC4", "planar_plane"),
+        ("VEC4", "planar_params"),
+        ("VEC4", "clip_plane"),
     ),
 )
 

@@ -46,7 +46,8 @@ class Sample:
     and its ``stats``. Outputs: its lights in view, shadow ``plan`` and ``atlas`` (None
     without maps), ``cameras`` (raster camera, view camera, light rectangles), the view depth
     range the raster camera's depth buffer is fitted to (``depth_range``), frame ``data``,
-    the draws the camera sees (``seen``) and the light-linking ``masks``. The settle test
+    the draws the camera sees (``seen``) and the light-linking ``masks``; ``mirrored``: a
+    capture's view reflects the scene (``features/planar.py``). The settle test
     draws as the pilot did; the SHADOW_MAPS view shows the last sample's."""
 
     index: int = 0
@@ -70,6 +71,7 @@ class Sample:
     data: object = None
     seen: list = None
     masks: dict = None
+    mirrored: bool = False  # its view camera mirrors the scene (a Plane probe's capture): windings turn
 
 
 @dataclasses.dataclass
@@ -538,12 +540,39 @@ class Renderer:
         rectangles), with the frame's techniques' parts (``Feature.lit``); ``target``: the
         settle test's framebuffer (``sample.settle_test``, ``features/settling.py``). Fills in
         ``sample.data`` (the frame data it drew with)."""
-        snapshot, settings = frame.snapshot, frame.settings
+        parts = tuple(feature.lit(frame, sample) for feature in frame.features)
+        self._frame_data(frame, sample, parts, frame.aux and target is None, sample.cameras[2])
+        if target is not None:
+            self.lit_pass.draw_settle_test(sample, target)
+        else:
+            self.lit_pass.draw(frame, sample)
+        return sample.data
+
+    def capture(self, frame, sample, lit_pass, parts):
+        """A lit pass of ``sample`` seen from elsewhere (``sample.cameras``: a Plane probe's
+        mirrored camera) into ``lit_pass``'s film, with ``parts`` for the techniques' (what a
+        capture takes: ``Feature.in_captures``): colour, normal and view depth, the world's
+        image behind it whatever the film's transparency, no light bins (the camera's
+        rectangles), no debug view. The world's directions light nothing there where the
+        frame's ratio estimator shadows its SH light (its sums are the camera's)."""
+        settings = dataclasses.replace(frame.settings, film_transparent=False, debug_view="NONE")
+        request = dataclasses.replace(frame.request, aux=True, emission=False, settings=settings)
+        seen_from = dataclasses.replace(frame, request=request)
+        world_sh = frame.world_sh or not any(lt.world for lt in sample.lights)
+        if world_sh and any(lt.world for lt in sample.lights):
+            sample.lights = [dataclasses.replace(lt, color=np.zeros(3)) if lt.world else lt for lt in sample.lights]
+        self._frame_data(seen_from, sample, parts, True, None)
+        lit_pass.draw(seen_from, sample)
+        return sample.data
+
+    def _frame_data(self, frame, sample, parts, aux_outputs, rects):
+        """``sample.data`` (the frame data its lit pass binds, with the techniques' ``parts``),
+        the draws its camera sees and the light-linking masks."""
+        snapshot = frame.snapshot
         lights, plan, atlas = sample.lights, sample.plan, sample.atlas
-        raster_camera, view_camera, rects = sample.cameras
         inputs = LitInputs(
             atlas=AtlasShape(atlas.size, atlas.columns, atlas.depth_format) if atlas else AtlasShape(),
-            aux_outputs=frame.aux and target is None,
+            aux_outputs=aux_outputs,
             rects=rects,
             size=self.film.size,
             alpha_offset=sample.alpha_offset,
@@ -552,19 +581,14 @@ class Renderer:
             sample_index=sample.index,
             world_sampled=frame.world_sampled,
             world_sh=frame.world_sh or not any(lt.world for lt in lights),
-            parts=tuple(feature.lit(frame, sample) for feature in frame.features),
+            parts=parts,
         )
         world = snapshot.world if snapshot.world is not None else snapshot.world_color
-        sample.data = build_frame_data(lights, raster_camera, world, settings, plan, inputs)
+        sample.data = build_frame_data(lights, sample.cameras[0], world, frame.settings, plan, inputs)
         sample.seen = [d for d in sample.draws if d.instance.camera]
         sample.masks = (
             light_masks(sample.seen, lights, sample.data.order) if sample.data.variant.light_linking else None
         )
-        if target is not None:
-            self.lit_pass.draw_settle_test(sample, target)
-        else:
-            self.lit_pass.draw(frame, sample)
-        return sample.data
 
     def _resolve(self, frame, drawn):
         """The resolve stage: the film's accumulation divided by its weights, the techniques'

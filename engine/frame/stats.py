@@ -116,6 +116,7 @@ class FrameStats:
     # rays (counted apart, as the occlusion's), and samples that traced.
     reflection_prepasses: int = 0
     reflection_samples: int = 0
+    planar_captures: int = 0  # lit passes drawn mirrored about a Plane Light Probe
     # Refraction (``features/refraction.py``): camera depth prepasses of what is not
     # transmissive, and samples that copied the colour transmissive surfaces see through.
     refraction_prepasses: int = 0

@@ -286,6 +286,70 @@ class Snapshot:
     # Cycles' light portals (area lights flagged Portal): where the world's light comes in,
     # as (matrix, size x, size y); they guide the world's directions and emit nothing.
     portals: tuple = ()
+    # Plane Light Probes (``PlaneProbe``): planar reflections (``frame/features/planar.py``).
+    planes: tuple = ()
+
+
+@dataclass(frozen=True)
+class PlaneProbe:
+    """A Plane Light Probe as EEVEE reads it: the object's ``matrix`` (its local XY square,
+    -1..1, is the mirror; its local Z the plane's normal), ``influence_distance`` (how far from
+    the plane a surface takes its reflection, world units), ``clip_start`` (Clipping Offset:
+    what lies less than this above the plane, the mirror's own surface, is not reflected) and its object's ``name``."""
+
+    matrix: np.ndarray
+    influence_distance: float
+    clip_start: float
+    name: str = ""
+
+    @property
+    def normal(self):
+        """The plane's unit normal (its local Z in world space); None where degenerate."""
+        m = np.asarray(self.matrix, np.float64)
+        z = m[:3, 2]
+        n = np.linalg.norm(z)
+        if not (np.isfinite(n) and n > 0.0) or not np.all(np.isfinite(m)):
+            return None
+        return z / n
+
+    @property
+    def point(self):
+        return np.asarray(self.matrix, np.float64)[:3, 3].copy()
+
+    @property
+    def corners(self):
+        """The mirror's four corners (4, 3) in world space."""
+        m = np.asarray(self.matrix, np.float64)
+        local = np.array([[-1, -1, 0, 1], [1, -1, 0, 1], [1, 1, 0, 1], [-1, 1, 0, 1]], np.float64)
+        return (local @ m.T)[:, :3]
+
+
+# Light Probes Penumbra does not use, by type: what the report says once.
+_PROBES_NOT_USED = {
+    "SPHERE": "Sphere Light Probe '{}' is not used: glossy lobes read the world and the screen",
+    "CUBEMAP": "Sphere Light Probe '{}' is not used: glossy lobes read the world and the screen",
+    "VOLUME": "Volume Light Probe '{}' is not used: Penumbra bakes no indirect light",
+    "GRID": "Volume Light Probe '{}' is not used: Penumbra bakes no indirect light",
+}
+
+
+def plane_probe(ob, matrix):
+    """The ``PlaneProbe`` of Light Probe object ``ob`` (evaluated) at ``matrix`` (4x4 numpy),
+    or the message saying why it is not used (a Sphere or Volume probe)."""
+    data = ob.data
+    kind = str(getattr(data, "type", ""))
+    if kind not in ("PLANE", "PLANAR"):
+        return _PROBES_NOT_USED.get(kind, "Light Probe '{}' is not used").format(ob.name)
+    if not np.all(np.isfinite(matrix)):
+        return f"Plane Light Probe '{ob.name}' has a non-finite matrix: not used"
+    distance = float(getattr(data, "influence_distance", 0.1))
+    clip = float(getattr(data, "clip_start", 0.0))
+    if getattr(data, "visibility_collection", None) is not None:
+        return (
+            f"Plane Light Probe '{ob.name}': its Visibility Collection is not honoured (it reflects every object)",
+            PlaneProbe(matrix, max(distance, 0.0), max(clip, 0.0), ob.name),
+        )
+    return PlaneProbe(matrix, max(distance, 0.0), max(clip, 0.0), ob.name)
 
 
 def matrix_np(m):
@@ -701,8 +765,20 @@ class _Reading:
         hair_type = getattr(depsgraph.scene.render, "hair_type", "STRIP")
         self.strip_mode = "STRAND" if hair_type == "STRAND" else "STRIP"
         self.instances, self.lights, self.portals, self.messages = [], [], [], []
+        self.planes = []
         self.used = set()
         self._own, self._held, self._sets, self._terminators = {}, {}, {}, {}
+
+    def probe(self, inst):
+        """A Light Probe: a Plane probe's ``PlaneProbe``; the others named once."""
+        read = plane_probe(inst.object, matrix_np(inst.matrix_world))
+        if isinstance(read, tuple):
+            self.messages.append(read[0])
+            read = read[1]
+        if isinstance(read, str):
+            self.messages.append(read)
+        else:
+            self.planes.append(read)
 
     def own_data(self, orig):
         """Pointer of ``orig``'s own evaluated geometry (cached for this snapshot)."""
@@ -892,6 +968,8 @@ class SceneCache:
         for inst in depsgraph.object_instances:
             if inst.object.type == "LIGHT":
                 reading.light(inst)
+            elif inst.object.type == "LIGHT_PROBE":
+                reading.probe(inst)
             else:
                 self._read_object(reading, inst)
         messages = reading.messages
@@ -911,6 +989,7 @@ class SceneCache:
             messages=tuple(f"Penumbra: {m}" for m in dict.fromkeys(messages)),
             images_changed=frozenset(self._take_images_changed()),
             portals=tuple(reading.portals),
+            planes=tuple(reading.planes),
         )
 
     def _read_object(self, reading, inst):

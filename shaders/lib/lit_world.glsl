@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl
+// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl
 #ifndef PENUMBRA_LIB_LIT_WORLD
 #define PENUMBRA_LIB_LIT_WORLD
 
@@ -8,7 +8,9 @@
  * environment BRDF. WORLD_ENV (features/world_env.py): an Environment Texture's specular from
  * the image itself, prefiltered by roughness (lib/world_env.glsl), not from its SH. SSR
  * (lib/ssr.glsl, features/reflections.py): a lobe of roughness under WORLD_RATIO_ROUGH reflects
- * the scene where a traced ray meets it, the world's light where it meets nothing.
+ * the scene where a traced ray meets it, the world's light where it meets nothing. PLANAR
+ * (lib/planar.glsl, features/planar.py): in a Plane probe's influence the ray is traced through
+ * the probe's mirrored capture first, and on the screen where that meets nothing.
  *
  * WORLD_AO (lib/gtao.glsl): the world's diffuse light is scaled by its visibility from
  * screen-space ground-truth ambient occlusion over the camera depth prepass, its specular by the
@@ -171,22 +173,35 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
   world_part_d = diffuse;
   world_part_s = specular * world_ratio_share(b.rough);
 #endif
-#if SSR || SSR_SETTLE
+#if SSR || SSR_SETTLE || PLANAR
   /* Where a traced ray meets the scene (weight h), the lobe reflects it, and the world's light
    * it hid goes: specular = radiance dfg (1 - h (1 - share)) + hit dfg h. The share the ratio
    * shadows keeps its own visibility (its U_s is never more than what is left of the world's
    * light, so the resolve stays >= 0); the rest, which the ratio leaves alone, takes the
    * ray's. Lobes from SSR_FADE to WORLD_RATIO_ROUGH fade their rays out; rougher lobes are
-   * not traced. */
+   * not traced. A Plane probe's capture (PLANAR) is asked first; the screen (SSR) takes what
+   * it leaves: h = h_p + (1 - h_p) h_s, the hits weighted alike. */
   float reach = 1.0 - smoothstep(SSR_FADE, WORLD_RATIO_ROUGH, b.rough);
   if (reach > 0.0 && b.weight > 0.0) {
     world_traced = true;
-#  if SSR
+#  if SSR || PLANAR
     vec3 xi = ssr_random(world_lobe);
     vec3 L = ssr_direction(b.N, V, b.rough, xi.xy);
-    vec3 hit_radiance;
-    float h = reach * ssr_trace(world_point, b.N, L, xi.z, hit_radiance);
-    specular = specular * (1.0 - h * (1.0 - world_ratio_share(b.rough))) + hit_radiance * dfg * h;
+    vec3 seen;
+    float h = 0.0;
+    vec3 hits = vec3(0.0);
+#    if PLANAR
+    h = reach * planar_trace(world_point, b.N, L, xi.z, seen);
+    hits = h * seen;
+#    endif
+#    if SSR
+    if (h < 1.0) {
+      float hs = (1.0 - h) * reach * ssr_trace(world_point, b.N, L, xi.z, seen);
+      hits += hs * seen;
+      h += hs;
+    }
+#    endif
+    specular = specular * (1.0 - h * (1.0 - world_ratio_share(b.rough))) + hits * dfg;
 #    if DEBUG_LIT
     debug_reflected = max(debug_reflected, h);
 #    endif

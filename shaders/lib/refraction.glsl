@@ -89,7 +89,7 @@ vec3 surface_refraction(Surface s, vec3 base, vec2 ab)
 #  if REFRACTION
   vec2 hit;
   float w = ssr_march(
-      refr_depth, frame.view, frame.view_proj, frame.refr_params.x, frame.refr_params.y, false, P, N, T, xi.z, hit);
+      refr_depth, 0, frame.view, frame.view_proj, frame.refr_params.x, frame.refr_params.y, false, P, N, T, xi.z, hit);
   bool ok = false;
   vec3 behind = (w > 0.0) ? ssr_fetch(refr_behind, hit, ok) : vec3(0.0);
   if (ok) {

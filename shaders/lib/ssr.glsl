@@ -36,7 +36,11 @@
 #  define TRANSMISSION 0
 #endif
 
-#if SSR || REFRACTION || TRANSMISSION
+#ifndef PLANAR
+#  define PLANAR 0
+#endif
+
+#if SSR || REFRACTION || TRANSMISSION || PLANAR
 uint ssr_hash(uint x)
 {
   x ^= x >> 16u;
@@ -56,11 +60,11 @@ vec3 ssr_random(int k)
   return vec3(uvec3(a, b, c) >> 8u) * (1.0 / 16777216.0);
 }
 
-/* A prepass's view depth at pixel ``p`` (clamped to the screen: a fetch outside it is
- * undefined). */
-float ssr_scene(sampler2D depth, vec2 p, vec2 size)
+/* A prepass's view depth at pixel ``p``, in channel ``channel`` of ``depth`` (clamped to the
+ * screen: a fetch outside it is undefined). */
+float ssr_scene(sampler2D depth, int channel, vec2 p, vec2 size)
 {
-  return texelFetch(depth, ivec2(clamp(p, vec2(0.0), size - 1.0)), 0).r;
+  return texelFetch(depth, ivec2(clamp(p, vec2(0.0), size - 1.0)), 0)[channel];
 }
 
 /* The ray's view depth at fraction ``t`` of the screen segment (perspective-correct). */
@@ -78,13 +82,15 @@ float ssr_fraction(vec4 q, float t)
 
 /* March from ``P`` (world space, relative to the frame's origin) on a surface of normal ``N``
  * along the unit ``L``, at most ``len`` world units, through the camera (``view``,
- * ``view_proj``) that drew the view depth ``depth``: the hit's weight (0: none; fading to 0 at
+ * ``view_proj``) that drew the view depth ``depth`` (in its channel ``channel``; at most
+ * "infinitely" far, 1e10, or 0 where nothing was drawn): the hit's weight (0: none; fading to 0 at
  * the screen's edges) and its pixel ``hit``. ``thick``: the thickness taken for a surface as a
  * fraction of its depth. With ``own_check`` (a reflection: its own surface is in ``depth``) the
  * ray starts SSR_START_PX from it, and a surface point within SSR_OWN of its depth from the
  * start's tangent plane is the start's own surface (a ray that grazes it reads its depth
  * texels, taken at their centres, as in front of it), not a hit. */
 float ssr_march(sampler2D depth,
+                int channel,
                 mat4 view,
                 mat4 view_proj,
                 float len,
@@ -136,7 +142,7 @@ float ssr_march(sampler2D depth,
   if (!(pixels > start_px + 1.0)) {
     /* Along the view (within a pixel on the screen): a refracted ray meets what lies behind
      * its start at its start's pixel; a reflected one would meet its own surface. */
-    float behind = ssr_scene(depth, s0, size);
+    float behind = ssr_scene(depth, channel, s0, size);
     bool inside = all(greaterThanEqual(s0, vec2(0.0))) && all(lessThan(s0, size));
     if (own_check || !inside || !(behind > 0.0) || behind < -v0.z * (1.0 - thick)) {
       return 0.0;
@@ -151,7 +157,7 @@ float ssr_march(sampler2D depth,
   for (int i = 0; i < SSR_STEPS; i++) {
     float t = t_start + dt * (float(i) + jitter);
     vec2 sp = s0 + ds * t;
-    float scene = ssr_scene(depth, sp, size);
+    float scene = ssr_scene(depth, channel, sp, size);
     float ray = ssr_depth_at(q, t);
     if (scene > 0.0 && ray > scene) {
       float before = ssr_depth_at(q, t_prev);
@@ -161,7 +167,7 @@ float ssr_march(sampler2D depth,
         float lo = t_prev, hi = t;
         for (int j = 0; j < SSR_REFINE; j++) {
           float mid = 0.5 * (lo + hi);
-          float z = ssr_scene(depth, s0 + ds * mid, size);
+          float z = ssr_scene(depth, channel, s0 + ds * mid, size);
           if (z > 0.0 && ssr_depth_at(q, mid) > z) {
             hi = mid;
           }
@@ -173,7 +179,7 @@ float ssr_march(sampler2D depth,
          * that passed under a thin object and shows behind it on the screen), and the
          * surface not the start's own. */
         vec2 at_hit = s0 + ds * hi;
-        float surface = ssr_scene(depth, at_hit, size);
+        float surface = ssr_scene(depth, channel, at_hit, size);
         float at = ssr_depth_at(q, hi);
         vec3 vr = v0 + d * (len * ssr_fraction(q, hi));
         vec3 vs = (frame.is_ortho != 0) ? vec3(vr.xy, -surface) : vr * (surface / max(at, 1e-30));
@@ -220,8 +226,9 @@ vec3 ssr_direction(vec3 N, vec3 V, float rough, vec2 xi)
 float ssr_trace(vec3 P, vec3 N, vec3 L, float jitter, out vec3 radiance)
 {
   vec2 hit;
-  float w = ssr_march(
-      ssr_depth, frame.ssr_view, frame.ssr_view_proj, frame.ssr_params.x, frame.ssr_params.y, true, P, N, L, jitter, hit);
+  float w = ssr_march(ssr_depth,
+                      0,
+                      frame.ssr_view, frame.ssr_view_proj, frame.ssr_params.x, frame.ssr_params.y, true, P, N, L, jitter, hit);
   bool ok = false;
   radiance = (w > 0.0) ? ssr_fetch(ssr_radiance, hit, ok) : vec3(0.0);
   return ok ? w : 0.0;

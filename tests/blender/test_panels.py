@@ -19,6 +19,7 @@ SHOWN = [
     "DATA_PT_camera_dof", "DATA_PT_camera_dof_aperture",  # depth of field by lens sampling
     "PENUMBRA_PT_motion_blur", "PENUMBRA_PT_motion_blur_curve",  # Blender's motion blur settings
     "PENUMBRA_PT_world_sun",  # EEVEE's World > Sun: threshold, angle, shadow
+    "DATA_PT_context_lightprobe", "PENUMBRA_PT_lightprobe",  # Plane probes: planar reflections
 ]  # fmt: skip
 HIDDEN = [
     "DATA_PT_light",  # would repeat the light type switch

@@ -2,8 +2,10 @@
 
 ``hdri_spheres`` (a mirror, a brushed metal and a polished red ball on a ground under
 Blender's own forest.exr, turned 40 deg), ``polished_floor`` (a dark polished floor under a
-sun and a dim sky, objects on it) and ``glass_checker`` (a Glass BSDF ball and a Principled
-cube of Transmission 1 on a checker), in this one process:
+sun and a dim sky, objects on it), ``probe_floor`` (the same with a Plane Light Probe on the
+floor, also measured without the probe's capture: the screen's reflections alone) and
+``glass_checker`` (a Glass BSDF ball and a Principled cube of Transmission 1 on a checker),
+in this one process:
 
 - Penumbra at 4, 16, 64 render samples: glossy lobes reflect the scene where a screen-space
   ray meets it (``features/reflections.py``) and the Environment Texture prefiltered by
@@ -27,11 +29,13 @@ of ``--runs`` F12 renders after the measured one.
 -> ``<out>/reflections.csv``, ``<out>/reflections.png`` (error against time per scene, over
 the reference, Penumbra's most samples and EEVEE), a Markdown table to stdout.
 
-``--cost``: instead, what the scene's reflections cost, on both scenes at 160x90 (where the
+``--cost``: instead, what the scene's reflections cost, on every scene at 160x90 (where the
 pixels cost next to nothing: the CPU's share) and at 960x540, 16 samples: the median of
 ``--runs`` interleaved F12 renders with Screen Space Reflections on and off (their ratio), and
 from one fenced frame each (``Renderer.fence_stages``) a further sample's CPU time and the
-reflections' stage CPU and GPU time per traced sample. -> ``<out>/reflections_cost.csv``.
+reflections' stage CPU and GPU time per traced sample; on a scene with Plane probes, also
+their captures on and off (the ``planar`` stage per capture: a lit pass each sample).
+-> ``<out>/reflections_cost.csv``.
 """
 
 import contextlib
@@ -53,7 +57,12 @@ FIELDS = ["scene", "config", "samples", "time_s", "mae_objects", "mae_all", "mae
 IMAGE = "Penumbra"
 WORLD_ONLY = "Penumbra, world image only"
 SH = "Penumbra, SH world light"
-LEFT_OUT = {WORLD_ONLY: ("reflections", "refraction"), SH: ("reflections", "refraction", "world_env")}
+SCREEN_ONLY = "Penumbra, screen only (no probe)"
+LEFT_OUT = {
+    WORLD_ONLY: ("reflections", "refraction", "planar"),
+    SH: ("reflections", "refraction", "world_env", "planar"),
+    SCREEN_ONLY: ("planar",),
+}
 CYCLES = "Cycles, 1 glossy bounce"
 EEVEE = f"EEVEE ({EEVEE_SAMPLES} TAA)"
 
@@ -62,10 +71,13 @@ def log(message):
     print(f"bench reflections: {message}", file=sys.stderr, flush=True)
 
 
-def configs(quick):
+def configs(quick, probes=False):
+    """The configurations of a scene (``probes``: it has Plane probes, also without them)."""
     samples = (4, 16) if quick else (4, 16, 64)
     out = [(IMAGE, "PENUMBRA", n, {"render_samples": n}) for n in samples]
     out += [(label, "PENUMBRA", n, {"render_samples": n}) for label in (WORLD_ONLY, SH) for n in samples[1:]]
+    if probes:
+        out += [(SCREEN_ONLY, "PENUMBRA", n, {"render_samples": n}) for n in samples]
     out += [(CYCLES, "CYCLES", n, {"samples": n}) for n in (16, 64)]
     out.append((EEVEE, "EEVEE", EEVEE_SAMPLES, {}))
     return out
@@ -100,9 +112,10 @@ def sweep(args, w, h):
         objects = rs.object_mask(name, w, h)
         mirror = upper_half(rs.object_mask(name, w, h, ("Mirror",))) if name == "hdri_spheres" else None
         scene = rs.build(name, w, h)
+        probes = any(ob.type == "LIGHT_PROBE" for ob in scene.objects)
         shown[name] = [("Cycles 256 spp", reference)]
         most = max(n for label, _e, n, _s in configs(args.quick) if label == IMAGE)
-        for label, engine, n, settings in configs(args.quick):
+        for label, engine, n, settings in configs(args.quick, probes):
             log(f"{name}: {label}, {n}")
             rs.use_engine(scene, engine, **settings)
             with without(LEFT_OUT.get(label, ())):
@@ -128,6 +141,7 @@ def sweep(args, w, h):
 STYLES = {
     IMAGE: ("tab:blue", "-o"),
     WORLD_ONLY: ("tab:cyan", "--s"),
+    SCREEN_ONLY: ("tab:green", "-.d"),
     SH: ("tab:gray", ":^"),
     CYCLES: ("tab:red", "-P"),
     EEVEE: ("tab:purple", "*"),
@@ -195,40 +209,68 @@ def further_sample_ms(stats):
     return 1e3 * later[len(later) // 2] if later else 0.0
 
 
+def screen_switch(scene):
+    """Screen Space Reflections on or off (the setting): a context manager per state."""
+
+    @contextlib.contextmanager
+    def switch(on):
+        scene.penumbra.screen_space_reflections = on
+        yield
+
+    return switch
+
+
+def probe_switch(on):
+    """The Plane probes' captures on or off (the planar technique left out of the registry)."""
+    return without(() if on else ("planar",))
+
+
+def on_off(args, switch):
+    """(median F12 time on, off; fenced stats on, off) of the scene, ``switch(on)`` around each."""
+    times = {True: [], False: []}
+    for on in (True, False):  # warm-up: shader compilation, first allocations
+        with switch(on):
+            timing.render(1, warmup=0)
+    for _ in range(args.runs):
+        for on in (True, False):
+            with switch(on):
+                times[on].append(timing.render(1, warmup=0).median)
+    stats = {}
+    for on in (False, True):
+        with switch(on):
+            stats[on] = perf.fenced_stats()
+    return statistics.median(times[True]), statistics.median(times[False]), stats[True], stats[False]
+
+
 def cost(args):
+    """Per scene and size, Screen Space Reflections on against off; where the scene has Plane
+    probes, also their captures on against off (stage ``planar``, per capture)."""
     rows = []
     for w, h in COST_SIZES:
         for name in rs.SCENES:
             scene = rs.use_engine(rs.build(name, w, h), "PENUMBRA", render_samples=COST_SAMPLES)
-            times = {True: [], False: []}
-            for on in (True, False):  # warm-up: shader compilation, first allocations
-                scene.penumbra.screen_space_reflections = on
-                timing.render(1, warmup=0)
-            for _ in range(args.runs):
-                for on in (True, False):
-                    scene.penumbra.screen_space_reflections = on
-                    times[on].append(timing.render(1, warmup=0).median)
-            scene.penumbra.screen_space_reflections = False
-            off = perf.fenced_stats()
-            scene.penumbra.screen_space_reflections = True
-            on = perf.fenced_stats()
-            traced = max(on.reflection_samples, 1)
-            t_on, t_off = statistics.median(times[True]), statistics.median(times[False])
-            rows.append(
-                {
-                    "scene": name,
-                    "size": f"{w}x{h}",
-                    "on_s": t_on,
-                    "off_s": t_off,
-                    "ratio": t_on / t_off,
-                    "sample_cpu_on_ms": further_sample_ms(on),
-                    "sample_cpu_off_ms": further_sample_ms(off),
-                    "ssr_cpu_ms": 1e3 * on.cpu_seconds.get("reflections", 0.0) / traced,
-                    "ssr_gpu_ms": 1e3 * on.gpu_seconds.get("reflections", 0.0) / traced,
-                    "traced": on.reflection_samples,
-                }
-            )
-            log(f"  {rows[-1]}")
+            probes = any(ob.type == "LIGHT_PROBE" for ob in scene.objects)
+            toggles = [(name, screen_switch(scene), "reflections", "reflection_samples")]
+            if probes:
+                toggles.append((f"{name} (probe)", probe_switch, "planar", "planar_captures"))
+            for label, switch, stage, counter in toggles:
+                t_on, t_off, on, off = on_off(args, switch)
+                traced = max(getattr(on, counter), 1)
+                rows.append(
+                    {
+                        "scene": label,
+                        "size": f"{w}x{h}",
+                        "on_s": t_on,
+                        "off_s": t_off,
+                        "ratio": t_on / t_off,
+                        "sample_cpu_on_ms": further_sample_ms(on),
+                        "sample_cpu_off_ms": further_sample_ms(off),
+                        "ssr_cpu_ms": 1e3 * on.cpu_seconds.get(stage, 0.0) / traced,
+                        "ssr_gpu_ms": 1e3 * on.gpu_seconds.get(stage, 0.0) / traced,
+                        "traced": getattr(on, counter),
+                    }
+                )
+                log(f"  {rows[-1]}")
     return rows
 
 
@@ -254,7 +296,7 @@ def cost_markdown(rows):
         "On / off",
         "Sample CPU on (ms)",
         "Sample CPU off (ms)",
-        "Reflections CPU / GPU per traced sample (ms)",
+        "Stage CPU / GPU per traced sample or capture (ms)",
     ]
     return report.markdown_table(header, cells, align="llrrrrrr")
 

@@ -1,8 +1,8 @@
 """The frame's techniques, one module each, over the same small set of hooks (``Feature``).
 
 A technique that a frame may or may not need (the world's ratio estimator, the world's image in
-glossy lobes, the scene's reflections, refraction, settling, the diffuse bounce, the world's
-occlusion, depth of field, motion blur) lives in one module here and is registered in
+glossy lobes, a Plane probe's reflection, the scene's reflections, refraction, settling, the
+diffuse bounce, the world's occlusion, depth of field, motion blur) lives in one module here and is registered in
 ``REGISTRY``. The renderer asks each registered technique whether the frame needs it
 (``wanted``) and then calls the hooks of those that answered yes, in registry order, at fixed
 points of the frame; it does not name them. The lit pass, the frame data and the film take what
@@ -15,6 +15,7 @@ from .base import NO_PART, Feature, LitPart
 from .bounce import Bounce
 from .depth_of_field import DepthOfField
 from .motion_blur import MotionBlur
+from .planar import PlanarReflections
 from .reflections import Reflections
 from .refraction import Refraction
 from .settling import Settling
@@ -24,14 +25,16 @@ from .world_ratio import WorldRatio
 
 # The order their hooks run in: motion blur first (it moves a sample's scene and camera), then
 # depth of field (the sample's point of the lens), the world's ratio (its directions), its
-# image in glossy lobes, the scene's reflections in them, what transmissive surfaces refract,
-# the world's occlusion (which keeps the first sample from the directions), the bounce, and
-# settling last (it decides over what the others planned).
+# image in glossy lobes (a Plane probe's capture takes it), a Plane probe's mirrored capture,
+# the scene's reflections in them, what transmissive surfaces refract, the world's occlusion
+# (which keeps the first sample from the directions), the bounce, and settling last (it
+# decides over what the others planned).
 REGISTRY = (
     MotionBlur,
     DepthOfField,
     WorldRatio,
     WorldEnvironment,
+    PlanarReflections,
     Reflections,
     Refraction,
     WorldOcclusion,

@@ -49,6 +49,10 @@ class Feature:
     Every hook does nothing by default, so a technique implements only those it needs."""
 
     name = ""
+    # Its lit part goes into the lit passes that capture the scene from elsewhere too (a
+    # Plane probe's mirrored view, ``planar.py``): it changes what a surface shows, not the
+    # film's targets, and reads nothing of the camera's own image.
+    in_captures = False
 
     def __init__(self, renderer):
         self.renderer = renderer

@@ -50,6 +50,7 @@ def rotation_rows(world):
 
 class WorldEnvironment(Feature):
     name = "world_env"
+    in_captures = True
 
     def __init__(self, renderer):
         super().__init__(renderer)

@@ -1,0 +1,164 @@
+"""Planar reflections from Plane Light Probes (issue 50; ``engine/frame/features/planar.py``,
+``shaders/lib/planar.glsl``): each sample draws the scene mirrored about the probe's plane,
+and traced lobes in the probe's influence read that capture.
+
+Checked against geometry: a mirror floor with a Plane probe, in a black world with no lamp,
+shows an emissive panel that hangs above the camera's view (off the screen, where no
+screen-space ray can find it) where the panel mirrored about the floor's plane projects (the
+mirrored camera's picture, rendered as that mirrored panel alone), at the panel's radiance
+in every sample, the first and a one-sample frame's too. What the probe's square does not
+cover and what it costs where nothing needs it are checked beside.
+"""
+
+import numpy as np
+import pytest
+
+from devkit import scenes
+
+SIZE = (160, 90)
+SAMPLES = 8
+EMISSION = 2.0
+# A panel above the top of the camera's view: seen only in the mirror.
+PANEL = dict(center=(0.0, 1.0, 2.6), size=(2.4, 0.08, 1.0))
+CAMERA = ((0.0, -7.0, 1.1), (0.0, 0.0, -0.6))
+
+
+def _render(gpu_call, scene, samples=SAMPLES, without=None):
+    """(linear RGBA, stats) of a frame of ``scene`` (one sample: the single-sample frame)."""
+    from penumbra.engine.frame.features import REGISTRY
+    from penumbra.engine.frame.renderer import Renderer
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    def job(engine, depsgraph):
+        engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name != without))
+        cam = camera_from_scene(depsgraph, scene, *SIZE)
+        out = engine.render_frame(depsgraph, cam, *SIZE, samples=(0, samples), sample_count=samples)
+        return out.color_array().copy(), out.stats
+
+    return gpu_call(job)
+
+
+def _scene(mirror=True, probe=True, panel_z=None, roughness=0.0, probe_size=(60.0, 60.0), probe_x=0.0):
+    """A black world, no lamp; an emissive panel facing down the camera's axis above its view
+    (``panel_z``: its centre's height, mirrored below the floor where negative), and with
+    ``mirror`` a white metal floor of ``roughness`` at z = 0, with ``probe`` a Plane probe on it
+    (its square ``probe_size`` across, centred at x = ``probe_x``)."""
+    scene = scenes.empty_scene(*SIZE)
+    scenes.set_world(scene, (0.0, 0.0, 0.0))
+    if mirror:
+        scenes.plane(scene, "Floor", size=60.0, mat=scenes.material("Mirror", (1.0, 1.0, 1.0), roughness, metallic=1.0))
+    if probe:
+        scenes.plane_probe(scene, location=(probe_x, 0.0, 0.0), size=probe_size)
+    center = PANEL["center"] if panel_z is None else (*PANEL["center"][:2], panel_z)
+    scenes.box(scene, "Panel", center=center, size=PANEL["size"], mat=scenes.emissive("Glow", EMISSION))
+    scenes.look_at(scene, *CAMERA, lens=40.0)
+    return scene
+
+
+def _erode(mask, n=1):
+    out = mask.copy()
+    for _ in range(n):
+        inner = out.copy()
+        inner[1:] &= out[:-1]
+        inner[:-1] &= out[1:]
+        inner[:, 1:] &= out[:, :-1]
+        inner[:, :-1] &= out[:, 1:]
+        out = inner
+    return out
+
+
+@pytest.fixture(scope="module")
+def mirrored_panel(penumbra, gpu_call):
+    """Where the panel mirrored about z = 0 projects: the mirrored camera's picture of it."""
+    image, _stats = _render(gpu_call, _scene(mirror=False, probe=False, panel_z=-PANEL["center"][2]))
+    return image[..., :3].mean(axis=2) > 0.5 * EMISSION
+
+
+@pytest.mark.parametrize("samples", [1, SAMPLES])
+def test_a_mirror_probe_shows_what_the_screen_does_not_hold(penumbra, gpu_call, mirrored_panel, samples):
+    """The panel is off the screen (the camera alone sees none of it); with a Plane probe on
+    the mirror floor the floor holds the panel's radiance where the mirrored panel projects
+    (its median within -3 % and +2 %: a white metal's Fresnel is 1; every sample, the first
+    too), black elsewhere (99th percentile under 2 % of it), and the reflection's outline is
+    the mirrored panel's (intersection over union at least 0.85). Without the probe the
+    screen's reflections cannot find the panel: the floor stays black."""
+    panel, _s = _render(gpu_call, _scene(mirror=False, probe=False), samples=1)
+    assert float(panel[..., :3].max()) <= 1e-6, "the panel must be off the screen"
+    where = mirrored_panel
+    inside = _erode(where, 1)
+    assert inside.sum() > 100, inside.sum()
+    image, stats = _render(gpu_call, _scene(), samples=samples)
+    assert "planar" in stats.techniques and stats.planar_captures == samples
+    lum = image[..., :3].mean(axis=2)
+    ratio = float(np.median(lum[inside])) / EMISSION
+    assert 0.97 <= ratio <= 1.02, ratio
+    dark = _erode(~where, 2)
+    assert float(np.percentile(lum[dark], 99)) <= 0.02 * EMISSION
+    reflected = lum > 0.5 * EMISSION
+    iou = (reflected & where).sum() / (reflected | where).sum()
+    assert iou >= 0.85, iou
+    without, stats = _render(gpu_call, _scene(probe=False), samples=samples)
+    assert "planar" not in stats.techniques and stats.planar_captures == 0
+    assert float(without[..., :3].mean(axis=2)[inside].max()) <= 0.02 * EMISSION
+
+
+def test_the_probe_square_bounds_its_influence(penumbra, gpu_call, mirrored_panel):
+    """A probe whose square covers only the floor left of x = 0 reflects the panel there and
+    nowhere right of it (beyond a pixel's filter)."""
+    image, stats = _render(gpu_call, _scene(probe_size=(30.0, 60.0), probe_x=-15.0), samples=1)
+    lum = image[..., :3].mean(axis=2)
+    inside = _erode(mirrored_panel, 1)
+    middle = SIZE[0] // 2
+    left, right = inside.copy(), inside.copy()
+    left[:, middle - 2 :] = False
+    right[:, : middle + 2] = False
+    assert left.sum() > 30 and right.sum() > 30
+    assert float(np.median(lum[left])) >= 0.97 * EMISSION
+    assert float(lum[right].max()) <= 0.02 * EMISSION
+
+
+def test_a_rough_probe_floor_blurs_the_reflection(penumbra, gpu_call, mirrored_panel):
+    """A floor of roughness 0.3 under the probe spreads the panel's reflection: a lower peak
+    than the mirror's over more of the floor, finite and non-negative."""
+    mirror, _s = _render(gpu_call, _scene())
+    rough, stats = _render(gpu_call, _scene(roughness=0.3))
+    assert "planar" in stats.techniques
+    a, b = mirror[..., :3].mean(axis=2), rough[..., :3].mean(axis=2)
+    assert np.isfinite(b).all() and (b >= 0).all()
+    spread = ((b > 0.05 * EMISSION).sum(), (a > 0.05 * EMISSION).sum())
+    assert b.max() < 0.95 * a.max() and spread[0] > 1.1 * spread[1], (b.max(), a.max(), spread)
+
+
+def test_a_probe_costs_nothing_where_nothing_needs_it(penumbra, gpu_call):
+    """No capture where the floor is rough (0.6: no traced lobe), nor where the probe's mirror
+    is out of view (under the camera, facing away), nor without the technique; the draw
+    calls are then those of the scene without a probe."""
+    _image, bare = _render(gpu_call, _scene(probe=False, roughness=0.6), samples=2)
+    _image, stats = _render(gpu_call, _scene(roughness=0.6), samples=2)
+    assert "planar" not in stats.techniques and stats.planar_captures == 0
+    assert (stats.draws, stats.passes) == (bare.draws, bare.passes)
+    scene = _scene()
+    probe = scene.objects["Mirror Probe"]
+    probe.rotation_euler = (np.pi, 0.0, 0.0)  # its mirror faces down, away from the camera
+    _image, stats = _render(gpu_call, scene, samples=2)
+    assert stats.planar_captures == 0
+    _image, stats = _render(gpu_call, _scene(), samples=2, without="planar")
+    assert stats.planar_captures == 0
+
+
+def test_probes_penumbra_does_not_use_are_named(penumbra, gpu_call):
+    """A Sphere and a Volume probe are named in the report, once each; of two Plane probes in
+    view the frame reflects one and names the other."""
+    import bpy
+
+    scene = _scene()
+    for kind in ("SPHERE", "VOLUME"):
+        ob = bpy.data.objects.new(f"{kind.title()} Probe", bpy.data.lightprobes.new(kind, kind))
+        scenes.link(scene, ob)
+    scenes.plane_probe(scene, "Second Mirror", location=(0.0, 0.0, 0.0), size=(4.0, 4.0))
+    _image, stats = _render(gpu_call, scene, samples=1)
+    text = "\n".join(stats.messages)
+    assert text.count("Sphere Light Probe 'Sphere Probe' is not used") == 1, text
+    assert text.count("Volume Light Probe 'Volume Probe' is not used") == 1, text
+    assert text.count("Plane Light Probe 'Second Mirror' is not drawn") == 1, text
+    assert stats.planar_captures == 1
