@@ -38,20 +38,29 @@ def _render(gpu_call, scene, samples=SAMPLES, without=None):
     return gpu_call(job)
 
 
-def _scene(mirror=True, probe=True, panel_z=None, roughness=0.0, probe_size=(60.0, 60.0), probe_x=0.0):
+def _scene(mirror=True, probe=True, panel_z=None, roughness=0.0, probe_size=(60.0, 60.0), probe_x=0.0, scale=1.0):
     """A black world, no lamp; an emissive panel facing down the camera's axis above its view
     (``panel_z``: its centre's height, mirrored below the floor where negative), and with
     ``mirror`` a white metal floor of ``roughness`` at z = 0, with ``probe`` a Plane probe on it
-    (its square ``probe_size`` across, centred at x = ``probe_x``)."""
+    (its square ``probe_size`` across, centred at x = ``probe_x``); every length (the camera's
+    clip range too) times ``scale``."""
+    s = float(scale)
     scene = scenes.empty_scene(*SIZE)
     scenes.set_world(scene, (0.0, 0.0, 0.0))
     if mirror:
-        scenes.plane(scene, "Floor", size=60.0, mat=scenes.material("Mirror", (1.0, 1.0, 1.0), roughness, metallic=1.0))
+        mat = scenes.material("Mirror", (1.0, 1.0, 1.0), roughness, metallic=1.0)
+        scenes.plane(scene, "Floor", size=60.0 * s, mat=mat)
     if probe:
-        scenes.plane_probe(scene, location=(probe_x, 0.0, 0.0), size=probe_size)
+        scenes.plane_probe(
+            scene, location=(probe_x * s, 0.0, 0.0), size=(probe_size[0] * s, probe_size[1] * s), distance=0.1 * s
+        )
     center = PANEL["center"] if panel_z is None else (*PANEL["center"][:2], panel_z)
-    scenes.box(scene, "Panel", center=center, size=PANEL["size"], mat=scenes.emissive("Glow", EMISSION))
-    scenes.look_at(scene, *CAMERA, lens=40.0)
+    size = PANEL["size"]
+    glow = scenes.emissive("Glow", EMISSION)
+    scenes.box(scene, "Panel", center=tuple(c * s for c in center), size=tuple(c * s for c in size), mat=glow)
+    location, target = CAMERA
+    cam = scenes.look_at(scene, tuple(c * s for c in location), tuple(c * s for c in target), lens=40.0)
+    cam.data.clip_start, cam.data.clip_end = 0.1 * s, 100.0 * s
     return scene
 
 
@@ -144,6 +153,36 @@ def test_a_probe_costs_nothing_where_nothing_needs_it(penumbra, gpu_call):
     assert stats.planar_captures == 0
     _image, stats = _render(gpu_call, _scene(), samples=2, without="planar")
     assert stats.planar_captures == 0
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+def test_a_mirror_probe_at_millimetre_and_kilometre_scales(penumbra, gpu_call, mirrored_panel, scale):
+    """The same mirror, panel and camera a thousand times smaller and larger: the reflection
+    lies where it does at 1 (outline IoU at least 0.85 against the mirrored panel at scale 1)
+    at the panel's radiance (median within -3 % and +2 %)."""
+    image, stats = _render(gpu_call, _scene(scale=scale), samples=1)
+    assert stats.planar_captures == 1
+    lum = image[..., :3].mean(axis=2)
+    inside = _erode(mirrored_panel, 1)
+    ratio = float(np.median(lum[inside])) / EMISSION
+    assert 0.97 <= ratio <= 1.02, ratio
+    reflected = lum > 0.5 * EMISSION
+    iou = (reflected & mirrored_panel).sum() / (reflected | mirrored_panel).sum()
+    assert iou >= 0.85, iou
+
+
+def test_degenerate_probes_and_a_grazing_camera(penumbra, gpu_call):
+    """A probe of zero size draws no capture; a camera a millimetre over the mirror, looking
+    along it, renders a finite, non-negative frame with its capture."""
+    scene = _scene()
+    scene.objects["Mirror Probe"].scale = (0.0, 0.0, 1.0)
+    image, stats = _render(gpu_call, scene, samples=1)
+    assert stats.planar_captures == 0 and np.isfinite(image).all()
+    scene = _scene()
+    scenes.look_at(scene, (0.0, -7.0, 1e-3), (0.0, 10.0, 1e-3), lens=40.0)
+    image, stats = _render(gpu_call, scene, samples=2)
+    assert stats.planar_captures == 2
+    assert np.isfinite(image).all() and (image[..., :3] >= 0.0).all()
 
 
 def test_probes_penumbra_does_not_use_are_named(penumbra, gpu_call):
