@@ -28,15 +28,14 @@
 
 void main()
 {
-#if CLIP_PLANE
-  /* A Plane probe's capture (engine/frame/features/planar.py): nothing under the mirror. */
-  if (dot(vec4(v_world, 1.0), frame.clip_plane) < 0.0) {
-    discard;
-  }
-#endif
   MaterialInputs m = material_inputs();
   /* Decided here, discarded at the end (lib/lit_inputs.glsl coverage_discards). */
   bool dropped = coverage_discards(m.coverage);
+#if CLIP_PLANE
+  /* A Plane probe's capture (engine/frame/features/planar.py): nothing under the mirror
+   * (discarded at the end, as the coverage: never ahead of the lights' loops). */
+  dropped = dropped || dot(vec4(v_world, 1.0), frame.clip_plane) < 0.0;
+#endif
 #if EMISSION_ONLY
   /* The Emission pass drawn apart, over the z-buffer the lit pass left (a frame whose other
    * targets leave its own no room: lit_pass.py). */

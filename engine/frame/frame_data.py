@@ -170,6 +170,11 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "planar_plane": (0.0, 0.0, 1.0, 0.0),
         "planar_params": (0.0, 0.0, 0.0, 0.0),
         "clip_plane": (0.0, 0.0, 0.0, 1.0),
+        "cube_params": (0.0, 0.0, 0.0, 0.0),
+        "cube_probe": (0.0, 0.0, 0.0, -1.0),
+        "cube_probe_influence": np.zeros((4, 4)),
+        "cube_probe_shape": (0.0, 0.0, 0.0, 0.0),
+        "cube_camera": (0.0, 0.0, 0.0, -1.0),
     }
 
 

@@ -167,6 +167,15 @@ FRAME_STRUCT = Struct(
         ("VEC4", "planar_plane"),
         ("VEC4", "planar_params"),
         ("VEC4", "clip_plane"),
+        # CUBES (features/cubes.py, lib/cubes.glsl): (a face's side in texels, the longest ray,
+        # a surface's thickness as a fraction of its depth, 0); a Sphere probe's cube (its
+        # centre, its row in the atlas or -1), the map into its influence and (1 for a box, its
+        # falloff, 0, 0); the camera's cube (its centre, its row or -1).
+        ("VEC4", "cube_params"),
+        ("VEC4", "cube_probe"),
+        ("MAT4", "cube_probe_influence"),
+        ("VEC4", "cube_probe_shape"),
+        ("VEC4", "cube_camera"),
     ),
 )
 

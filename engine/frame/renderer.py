@@ -551,15 +551,16 @@ class Renderer:
     def capture(self, frame, sample, lit_pass, parts):
         """A lit pass of ``sample`` seen from elsewhere (``sample.cameras``: a Plane probe's
         mirrored camera) into ``lit_pass``'s film, with ``parts`` for the techniques' (what a
-        capture takes: ``Feature.in_captures``): colour, normal and view depth, the world's
-        image behind it whatever the film's transparency, no light bins (the camera's
-        rectangles), no debug view. The world's directions light nothing there where the
-        frame's ratio estimator shadows its SH light (its sums are the camera's)."""
+        capture takes: ``Feature.capture``): colour, normal and view depth, the world's image
+        behind it whatever the film's transparency, no light bins (the camera's rectangles),
+        no debug view. Where the surfaces take the world's SH light, its directions light
+        nothing there unless a part takes their ratio (``WORLD_RATIO``)."""
         settings = dataclasses.replace(frame.settings, film_transparent=False, debug_view="NONE")
         request = dataclasses.replace(frame.request, aux=True, emission=False, settings=settings)
         seen_from = dataclasses.replace(frame, request=request)
         world_sh = frame.world_sh or not any(lt.world for lt in sample.lights)
-        if world_sh and any(lt.world for lt in sample.lights):
+        ratio = any(dict(p.program.defines).get("WORLD_RATIO") for p in parts if p.program is not None)
+        if world_sh and not ratio and any(lt.world for lt in sample.lights):
             sample.lights = [dataclasses.replace(lt, color=np.zeros(3)) if lt.world else lt for lt in sample.lights]
         self._frame_data(seen_from, sample, parts, True, None)
         lit_pass.draw(seen_from, sample)

@@ -117,6 +117,7 @@ class FrameStats:
     reflection_prepasses: int = 0
     reflection_samples: int = 0
     planar_captures: int = 0  # lit passes drawn mirrored about a Plane Light Probe
+    cube_faces: int = 0  # lit passes drawn into cube maps (``features/cubes.py``: six a cube)
     # Refraction (``features/refraction.py``): camera depth prepasses of what is not
     # transmissive, and samples that copied the colour transmissive surfaces see through.
     refraction_prepasses: int = 0

@@ -288,6 +288,8 @@ class Snapshot:
     portals: tuple = ()
     # Plane Light Probes (``PlaneProbe``): planar reflections (``frame/features/planar.py``).
     planes: tuple = ()
+    # Sphere Light Probes (``SphereProbe``): cube maps by the lit pass (``frame/features/cubes.py``).
+    spheres: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -324,20 +326,66 @@ class PlaneProbe:
         return (local @ m.T)[:, :3]
 
 
+@dataclass(frozen=True)
+class SphereProbe:
+    """A Sphere Light Probe as EEVEE reads it: the object's ``matrix`` (its origin is where the
+    cube map is captured), its influence (``box``: a box, else a sphere, of ``influence_distance``
+    in the object's local units, fading over ``falloff`` of it), ``clip_start`` and
+    ``clip_end`` (the capture's clip range) and its object's ``name``."""
+
+    matrix: np.ndarray
+    influence_distance: float
+    falloff: float
+    clip_start: float
+    clip_end: float
+    box: bool = False
+    name: str = ""
+
+    @property
+    def position(self):
+        return np.asarray(self.matrix, np.float64)[:3, 3].copy()
+
+    @property
+    def radius(self):
+        """The influence's largest reach from its centre in world units."""
+        scale = np.linalg.norm(np.asarray(self.matrix, np.float64)[:3, :3], axis=0)
+        r = float(self.influence_distance * scale.max() * (np.sqrt(3.0) if self.box else 1.0))
+        return r if np.isfinite(r) else 0.0
+
+
 # Light Probes Penumbra does not use, by type: what the report says once.
 _PROBES_NOT_USED = {
-    "SPHERE": "Sphere Light Probe '{}' is not used: glossy lobes read the world and the screen",
-    "CUBEMAP": "Sphere Light Probe '{}' is not used: glossy lobes read the world and the screen",
     "VOLUME": "Volume Light Probe '{}' is not used: Penumbra bakes no indirect light",
     "GRID": "Volume Light Probe '{}' is not used: Penumbra bakes no indirect light",
 }
 
 
+def sphere_probe(ob, matrix):
+    """The ``SphereProbe`` of Sphere Light Probe object ``ob`` at ``matrix``, or a message."""
+    data = ob.data
+    if not np.all(np.isfinite(matrix)):
+        return f"Sphere Light Probe '{ob.name}' has a non-finite matrix: not used"
+    near = max(float(getattr(data, "clip_start", 0.1)), 1e-6)
+    far = max(float(getattr(data, "clip_end", 40.0)), near * 2.0)
+    return SphereProbe(
+        matrix,
+        max(float(getattr(data, "influence_distance", 2.5)), 0.0),
+        min(max(float(getattr(data, "falloff", 0.2)), 0.0), 1.0),
+        near,
+        far,
+        str(getattr(data, "influence_type", "ELIPSOID")) == "BOX",
+        ob.name,
+    )
+
+
 def plane_probe(ob, matrix):
     """The ``PlaneProbe`` of Light Probe object ``ob`` (evaluated) at ``matrix`` (4x4 numpy),
-    or the message saying why it is not used (a Sphere or Volume probe)."""
+    a Sphere probe's ``SphereProbe``, or the message saying why it is not used (a Volume
+    probe)."""
     data = ob.data
     kind = str(getattr(data, "type", ""))
+    if kind in ("SPHERE", "CUBEMAP"):
+        return sphere_probe(ob, matrix)
     if kind not in ("PLANE", "PLANAR"):
         return _PROBES_NOT_USED.get(kind, "Light Probe '{}' is not used").format(ob.name)
     if not np.all(np.isfinite(matrix)):
@@ -765,18 +813,21 @@ class _Reading:
         hair_type = getattr(depsgraph.scene.render, "hair_type", "STRIP")
         self.strip_mode = "STRAND" if hair_type == "STRAND" else "STRIP"
         self.instances, self.lights, self.portals, self.messages = [], [], [], []
-        self.planes = []
+        self.planes, self.spheres = [], []
         self.used = set()
         self._own, self._held, self._sets, self._terminators = {}, {}, {}, {}
 
     def probe(self, inst):
-        """A Light Probe: a Plane probe's ``PlaneProbe``; the others named once."""
+        """A Light Probe: a Plane probe's ``PlaneProbe``, a Sphere probe's ``SphereProbe``;
+        the others named once."""
         read = plane_probe(inst.object, matrix_np(inst.matrix_world))
         if isinstance(read, tuple):
             self.messages.append(read[0])
             read = read[1]
         if isinstance(read, str):
             self.messages.append(read)
+        elif isinstance(read, SphereProbe):
+            self.spheres.append(read)
         else:
             self.planes.append(read)
 
@@ -990,6 +1041,7 @@ class SceneCache:
             images_changed=frozenset(self._take_images_changed()),
             portals=tuple(reading.portals),
             planes=tuple(reading.planes),
+            spheres=tuple(reading.spheres),
         )
 
     def _read_object(self, reading, inst):

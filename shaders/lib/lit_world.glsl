@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl
+// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl lib/cubes.glsl
 #ifndef PENUMBRA_LIB_LIT_WORLD
 #define PENUMBRA_LIB_LIT_WORLD
 
@@ -10,7 +10,9 @@
  * (lib/ssr.glsl, features/reflections.py): a lobe of roughness under WORLD_RATIO_ROUGH reflects
  * the scene where a traced ray meets it, the world's light where it meets nothing. PLANAR
  * (lib/planar.glsl, features/planar.py): in a Plane probe's influence the ray is traced through
- * the probe's mirrored capture first, and on the screen where that meets nothing.
+ * the probe's mirrored capture first, and on the screen where that meets nothing; CUBES
+ * (lib/cubes.glsl, features/cubes.py): what both leave, through a Sphere probe's cube map and
+ * the camera's.
  *
  * WORLD_AO (lib/gtao.glsl): the world's diffuse light is scaled by its visibility from
  * screen-space ground-truth ambient occlusion over the camera depth prepass, its specular by the
@@ -173,18 +175,19 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
   world_part_d = diffuse;
   world_part_s = specular * world_ratio_share(b.rough);
 #endif
-#if SSR || SSR_SETTLE || PLANAR
+#if SSR || SSR_SETTLE || PLANAR || CUBES
   /* Where a traced ray meets the scene (weight h), the lobe reflects it, and the world's light
    * it hid goes: specular = radiance dfg (1 - h (1 - share)) + hit dfg h. The share the ratio
    * shadows keeps its own visibility (its U_s is never more than what is left of the world's
    * light, so the resolve stays >= 0); the rest, which the ratio leaves alone, takes the
    * ray's. Lobes from SSR_FADE to WORLD_RATIO_ROUGH fade their rays out; rougher lobes are
    * not traced. A Plane probe's capture (PLANAR) is asked first; the screen (SSR) takes what
-   * it leaves: h = h_p + (1 - h_p) h_s, the hits weighted alike. */
+   * it leaves: h = h_p + (1 - h_p) h_s, the hits weighted alike; the cube maps (CUBES) what
+   * both leave. */
   float reach = 1.0 - smoothstep(SSR_FADE, WORLD_RATIO_ROUGH, b.rough);
   if (reach > 0.0 && b.weight > 0.0) {
     world_traced = true;
-#  if SSR || PLANAR
+#  if SSR || PLANAR || CUBES
     vec3 xi = ssr_random(world_lobe);
     vec3 L = ssr_direction(b.N, V, b.rough, xi.xy);
     vec3 seen;
@@ -199,6 +202,13 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
       float hs = (1.0 - h) * reach * ssr_trace(world_point, b.N, L, xi.z, seen);
       hits += hs * seen;
       h += hs;
+    }
+#    endif
+#    if CUBES
+    if (h < 1.0) {
+      float hc = (1.0 - h) * reach * cube_trace(world_point, b.N, L, xi.z, seen);
+      hits += hc * seen;
+      h += hc;
     }
 #    endif
     specular = specular * (1.0 - h * (1.0 - world_ratio_share(b.rough))) + hits * dfg;

@@ -40,7 +40,11 @@
 #  define PLANAR 0
 #endif
 
-#if SSR || REFRACTION || TRANSMISSION || PLANAR
+#ifndef CUBES
+#  define CUBES 0
+#endif
+
+#if SSR || REFRACTION || TRANSMISSION || PLANAR || CUBES
 uint ssr_hash(uint x)
 {
   x ^= x >> 16u;

@@ -19,14 +19,20 @@ EMISSION = 2.0
 PANEL = dict(size=(2.4, 0.08, 1.0))
 
 
-def _render(gpu_call, scene, samples=SAMPLES, without=None):
-    """(linear RGBA, stats, the samples' filter weights) of a frame of ``scene``."""
+# The screen's rays alone: the cube maps (``features/cubes.py``) also find what the screen
+# misses, from the frame's first sample on (``tests/shadows/test_cubes.py``).
+SCREEN_ONLY = ("cubes",)
+
+
+def _render(gpu_call, scene, samples=SAMPLES, without=()):
+    """(linear RGBA, stats, the samples' filter weights) of a frame of ``scene``, the
+    techniques named in ``without`` left out."""
     from penumbra.engine.frame.features import REGISTRY
     from penumbra.engine.frame.renderer import Renderer
     from penumbra.engine.scene.extract import camera_from_scene
 
     def job(engine, depsgraph):
-        engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name != without))
+        engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name not in without))
         cam = camera_from_scene(depsgraph, scene, *SIZE)
         out = engine.render_frame(depsgraph, cam, *SIZE, samples=(0, samples), sample_count=samples)
         return out.color_array().copy(), out.stats, list(engine.renderer.film.sample_weights)
@@ -67,7 +73,7 @@ def test_a_mirror_floor_shows_the_panel_where_the_mirrored_camera_sees_it(penumb
     of it; measured 0, 0.85 before rays that graze their own floor were told from hits), and
     the reflection's outline is the mirrored panel's (intersection over union at least 0.85;
     measured 0.91, the edge pixels)."""
-    image, stats, weights = _render(gpu_call, _panel_scene())
+    image, stats, weights = _render(gpu_call, _panel_scene(), without=SCREEN_ONLY)
     mirrored, _s, _w = _render(gpu_call, _panel_scene(mirror=False, panel_z=-1.0))
     panel, _s, _w = _render(gpu_call, _panel_scene(mirror=False))
     assert "reflections" in stats.techniques and stats.reflection_prepasses == 1
@@ -162,6 +168,7 @@ def test_the_reflections_view_shows_where_the_rays_met_the_scene(penumbra, gpu_c
     projects (the outline's IoU with it at least 0.85; measured 0.91) and 0 where the floor
     reflects the world (away from the panel: a ray that leaves the screen); a rough floor
     traces nothing, 0 everywhere."""
+    from penumbra.engine.frame.features import REGISTRY
     from penumbra.engine.frame.renderer import Renderer
     from penumbra.engine.scene.extract import camera_from_scene
 
@@ -169,7 +176,7 @@ def test_the_reflections_view_shows_where_the_rays_met_the_scene(penumbra, gpu_c
         scene.penumbra.debug_view = "REFLECTIONS"
 
         def job(engine, depsgraph):
-            engine.renderer = Renderer()
+            engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name not in SCREEN_ONLY))
             cam = camera_from_scene(depsgraph, scene, *SIZE)
             out = engine.render_frame(depsgraph, cam, *SIZE, samples=(0, 8), sample_count=8)
             return out.debug.values.copy(), out.stats

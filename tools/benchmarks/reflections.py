@@ -3,19 +3,20 @@
 ``hdri_spheres`` (a mirror, a brushed metal and a polished red ball on a ground under
 Blender's own forest.exr, turned 40 deg), ``polished_floor`` (a dark polished floor under a
 sun and a dim sky, objects on it), ``probe_floor`` (the same with a Plane Light Probe on the
-floor, also measured without the probe's capture: the screen's reflections alone) and
-``glass_checker`` (a Glass BSDF ball and a Principled cube of Transmission 1 on a checker),
-in this one process:
+floor) and ``glass_checker`` (a Glass BSDF ball and a Principled cube of Transmission 1 on a
+checker), in this one process:
 
-- Penumbra at 4, 16, 64 render samples: glossy lobes reflect the scene where a screen-space
-  ray meets it (``features/reflections.py``) and the Environment Texture prefiltered by
-  roughness elsewhere (``features/world_env.py``); transmissive surfaces refract what is
-  behind them (``features/refraction.py``).
-- Penumbra without the screen-space techniques (the scene's reflections and the refraction:
-  the world's image alone), and without the image too (the world's SH light: what the frame
-  did before issue 50), each technique left out of the registry, at 16 and 64. The world
-  ratio's sharp-lobe share (``lit_world.glsl`` ``world_ratio_share``) is in all: it is not a
-  technique of its own.
+- Penumbra at 4, 16, 64 render samples: glossy lobes reflect the scene where a Plane probe's
+  mirrored capture (``features/planar.py``), a screen-space ray (``features/reflections.py``)
+  or a ray marched through the cube maps (``features/cubes.py``) meets it, and the
+  Environment Texture prefiltered by roughness elsewhere (``features/world_env.py``);
+  transmissive surfaces refract what is behind them (``features/refraction.py``).
+- Penumbra without the Plane probes' captures and the cube maps (``features/planar.py``,
+  ``features/cubes.py``: the screen's rays alone), without the screen-space techniques too
+  (the scene's reflections and the refraction: the world's image alone), and without the
+  image too (the world's SH light: what the frame did before issue 50), each technique left
+  out of the registry, at 16 and 64. The world ratio's sharp-lobe share (``lit_world.glsl``
+  ``world_ratio_share``) is in all: it is not a technique of its own.
 - Cycles with one glossy bounce (max_bounces 1; through glass, 8 transmission bounces with
   caustics off) at 16 and 64 spp, EEVEE once
   (``devkit.engines``: 16 TAA samples, no probe baked).
@@ -31,10 +32,12 @@ the reference, Penumbra's most samples and EEVEE), a Markdown table to stdout.
 
 ``--cost``: instead, what the scene's reflections cost, on every scene at 160x90 (where the
 pixels cost next to nothing: the CPU's share) and at 960x540, 16 samples: the median of
-``--runs`` interleaved F12 renders with Screen Space Reflections on and off (their ratio), and
-from one fenced frame each (``Renderer.fence_stages``) a further sample's CPU time and the
-reflections' stage CPU and GPU time per traced sample; on a scene with Plane probes, also
-their captures on and off (the ``planar`` stage per capture: a lit pass each sample).
+``--runs`` interleaved F12 renders with Screen Space Reflections on and off (their ratio:
+the screen's rays and the camera's cube), and from one fenced frame each
+(``Renderer.fence_stages``) a further sample's CPU time and the reflections' stage CPU and GPU
+time per traced sample; the cube maps on and off (the ``cubes`` stage per face drawn: six lit
+passes once a frame a cube); on a scene with Plane probes, also their captures on and off (the
+``planar`` stage per capture: a lit pass each sample).
 -> ``<out>/reflections_cost.csv``.
 """
 
@@ -57,11 +60,11 @@ FIELDS = ["scene", "config", "samples", "time_s", "mae_objects", "mae_all", "mae
 IMAGE = "Penumbra"
 WORLD_ONLY = "Penumbra, world image only"
 SH = "Penumbra, SH world light"
-SCREEN_ONLY = "Penumbra, screen only (no probe)"
+SCREEN_ONLY = "Penumbra, screen only (no probe, no cube)"
 LEFT_OUT = {
-    WORLD_ONLY: ("reflections", "refraction", "planar"),
-    SH: ("reflections", "refraction", "world_env", "planar"),
-    SCREEN_ONLY: ("planar",),
+    WORLD_ONLY: ("reflections", "refraction", "planar", "cubes"),
+    SH: ("reflections", "refraction", "world_env", "planar", "cubes"),
+    SCREEN_ONLY: ("planar", "cubes"),
 }
 CYCLES = "Cycles, 1 glossy bounce"
 EEVEE = f"EEVEE ({EEVEE_SAMPLES} TAA)"
@@ -71,13 +74,12 @@ def log(message):
     print(f"bench reflections: {message}", file=sys.stderr, flush=True)
 
 
-def configs(quick, probes=False):
-    """The configurations of a scene (``probes``: it has Plane probes, also without them)."""
+def configs(quick):
+    """The configurations of every scene."""
     samples = (4, 16) if quick else (4, 16, 64)
     out = [(IMAGE, "PENUMBRA", n, {"render_samples": n}) for n in samples]
-    out += [(label, "PENUMBRA", n, {"render_samples": n}) for label in (WORLD_ONLY, SH) for n in samples[1:]]
-    if probes:
-        out += [(SCREEN_ONLY, "PENUMBRA", n, {"render_samples": n}) for n in samples]
+    labels = (SCREEN_ONLY, WORLD_ONLY, SH)
+    out += [(label, "PENUMBRA", n, {"render_samples": n}) for label in labels for n in samples[1:]]
     out += [(CYCLES, "CYCLES", n, {"samples": n}) for n in (16, 64)]
     out.append((EEVEE, "EEVEE", EEVEE_SAMPLES, {}))
     return out
@@ -112,10 +114,9 @@ def sweep(args, w, h):
         objects = rs.object_mask(name, w, h)
         mirror = upper_half(rs.object_mask(name, w, h, ("Mirror",))) if name == "hdri_spheres" else None
         scene = rs.build(name, w, h)
-        probes = any(ob.type == "LIGHT_PROBE" for ob in scene.objects)
         shown[name] = [("Cycles 256 spp", reference)]
         most = max(n for label, _e, n, _s in configs(args.quick) if label == IMAGE)
-        for label, engine, n, settings in configs(args.quick, probes):
+        for label, engine, n, settings in configs(args.quick):
             log(f"{name}: {label}, {n}")
             rs.use_engine(scene, engine, **settings)
             with without(LEFT_OUT.get(label, ())):
@@ -225,6 +226,11 @@ def probe_switch(on):
     return without(() if on else ("planar",))
 
 
+def cube_switch(on):
+    """The cube maps on or off (the cubes technique left out of the registry)."""
+    return without(() if on else ("cubes",))
+
+
 def on_off(args, switch):
     """(median F12 time on, off; fenced stats on, off) of the scene, ``switch(on)`` around each."""
     times = {True: [], False: []}
@@ -243,14 +249,18 @@ def on_off(args, switch):
 
 
 def cost(args):
-    """Per scene and size, Screen Space Reflections on against off; where the scene has Plane
-    probes, also their captures on against off (stage ``planar``, per capture)."""
+    """Per scene and size, Screen Space Reflections on against off (the screen's rays and the
+    camera's cube), the cube maps on against off (stage ``cubes``, per face drawn); where the
+    scene has Plane probes, also their captures on against off (stage ``planar``, per capture)."""
     rows = []
     for w, h in COST_SIZES:
         for name in rs.SCENES:
             scene = rs.use_engine(rs.build(name, w, h), "PENUMBRA", render_samples=COST_SAMPLES)
             probes = any(ob.type == "LIGHT_PROBE" for ob in scene.objects)
-            toggles = [(name, screen_switch(scene), "reflections", "reflection_samples")]
+            toggles = [
+                (name, screen_switch(scene), "reflections", "reflection_samples"),
+                (f"{name} (cubes)", cube_switch, "cubes", "cube_faces"),
+            ]
             if probes:
                 toggles.append((f"{name} (probe)", probe_switch, "planar", "planar_captures"))
             for label, switch, stage, counter in toggles:

@@ -13,6 +13,7 @@ renders without it. ``docs/design.md`` says how a new technique joins.
 
 from .base import NO_PART, Feature, LitPart
 from .bounce import Bounce
+from .cubes import CubeReflections
 from .depth_of_field import DepthOfField
 from .motion_blur import MotionBlur
 from .planar import PlanarReflections
@@ -26,7 +27,8 @@ from .world_ratio import WorldRatio
 # The order their hooks run in: motion blur first (it moves a sample's scene and camera), then
 # depth of field (the sample's point of the lens), the world's ratio (its directions), its
 # image in glossy lobes (a Plane probe's capture takes it), a Plane probe's mirrored capture,
-# the scene's reflections in them, what transmissive surfaces refract, the world's occlusion
+# the scene's reflections in them, the cube maps of what the screen does not hold, what
+# transmissive surfaces refract, the world's occlusion
 # (which keeps the first sample from the directions), the bounce, and settling last (it
 # decides over what the others planned).
 REGISTRY = (
@@ -36,6 +38,7 @@ REGISTRY = (
     WorldEnvironment,
     PlanarReflections,
     Reflections,
+    CubeReflections,
     Refraction,
     WorldOcclusion,
     Bounce,

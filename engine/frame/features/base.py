@@ -43,16 +43,13 @@ class Feature:
     * ``before_sample(frame, s)``: a stage of its own before sample ``s`` (settling's test);
     * ``prepare(frame, sample)``: its change to the sample's view, scene or lights (``Sample``);
     * ``before_lit(frame, sample)``: GPU work the sample's lit pass reads (a depth prepass);
-    * ``lit(frame, sample)``: its ``LitPart`` of the sample's lit pass;
+    * ``lit(frame, sample)``: its ``LitPart`` of the sample's lit pass, and ``capture(frame,
+      sample)`` of a lit pass that captures the scene from elsewhere (``planar``, ``cubes``);
     * ``resolve(frame)``: after the last sample; ``memory_bytes(frame)``: what it holds.
 
     Every hook does nothing by default, so a technique implements only those it needs."""
 
     name = ""
-    # Its lit part goes into the lit passes that capture the scene from elsewhere too (a
-    # Plane probe's mirrored view, ``planar.py``): it changes what a surface shows, not the
-    # film's targets, and reads nothing of the camera's own image.
-    in_captures = False
 
     def __init__(self, renderer):
         self.renderer = renderer
@@ -83,6 +80,13 @@ class Feature:
     def lit(self, frame, sample):
         return NO_PART
 
+    def capture(self, frame, sample):
+        """Its ``LitPart`` of a lit pass that captures the scene from elsewhere (a Plane
+        probe's mirrored view, a cube map's face: ``Renderer.capture``), or None: it takes no
+        part there. Such a part changes what a surface shows and writes no target of the
+        film's, nor reads the camera's own image."""
+        return None
+
     def resolve(self, frame):
         pass
 
@@ -91,6 +95,11 @@ class Feature:
 
     def release(self):
         pass
+
+
+def captured_parts(frame, sample):
+    """The ``LitPart``s the frame's techniques give a capture of ``sample`` (``Feature.capture``)."""
+    return tuple(p for p in (f.capture(frame, sample) for f in frame.features) if p is not None)
 
 
 def across_samples(frame, what, instead):

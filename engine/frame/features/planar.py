@@ -31,7 +31,7 @@ from ....shaders.loader import ProgramPart
 from ...shadows import lightspace
 from ..draw_list import longest_ray
 from ..film import Film
-from .base import Feature, LitPart
+from .base import Feature, LitPart, captured_parts
 from .reflections import THICKNESS, reflective_materials
 
 COLOR_SAMPLER = "planar_color"
@@ -176,7 +176,7 @@ class PlanarReflections(Feature):
                 masks=None,
             )
             part = LitPart(program=CAPTURE_PART, rows={"clip_plane": plane_row(probe, frame.origin, offset)})
-            self.renderer.capture(frame, capture, self.lit_pass, (part, *self._world_parts(frame, sample)))
+            self.renderer.capture(frame, capture, self.lit_pass, (part, *captured_parts(frame, sample)))
             view = np.asarray(view_camera.view, np.float64) @ lightspace.from_origin(frame.origin)
             self._rows = {
                 "planar_view": view,
@@ -186,11 +186,6 @@ class PlanarReflections(Feature):
                 "planar_params": (self._distance, THICKNESS, 0.0, 0.0),
             }
             frame.stats.planar_captures += 1
-
-    def _world_parts(self, frame, sample):
-        """The parts of the frame's techniques a capture takes too (``Feature.in_captures``:
-        the world's image in glossy lobes)."""
-        return tuple(f.lit(frame, sample) for f in frame.features if f.in_captures)
 
     def lit(self, frame, sample):
         if sample.settle_test:

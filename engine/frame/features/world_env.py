@@ -50,7 +50,6 @@ def rotation_rows(world):
 
 class WorldEnvironment(Feature):
     name = "world_env"
-    in_captures = True
 
     def __init__(self, renderer):
         super().__init__(renderer)
@@ -80,6 +79,9 @@ class WorldEnvironment(Feature):
 
     def lit(self, frame, sample):
         return self._part
+
+    def capture(self, frame, sample):
+        return self._part  # a capture's glossy lobes read the world's image too
 
     def resolve(self, frame):
         self._part = None  # the atlas stays in the texture cache (counted in its bytes)

@@ -22,6 +22,9 @@ OUTPUTS = (("VEC4", "out_world_diffuse"), ("VEC4", "out_world_specular"), ("VEC4
 OPAQUE = ProgramPart("ratio1", outputs=OUTPUTS, defines=(("WORLD_RATIO", True), ("WORLD_RATIO_OUT", 1)))
 BLENDED = ProgramPart("ratio2", outputs=OUTPUTS[:2], defines=(("WORLD_RATIO", True), ("WORLD_RATIO_OUT", 2)))
 _RATIO = LitPart(program=OPAQUE, blended=BLENDED)
+# A capture's (a Plane probe's mirror, a cube's face: ``Feature.capture``): its surfaces take
+# the ratio of this sample's directions within the sample (lit.frag.glsl), no film targets.
+_CAPTURE = LitPart(program=ProgramPart("ratio0", defines=(("WORLD_RATIO", True), ("WORLD_RATIO_OUT", 0))))
 
 NAMES = ("world_diffuse", "world_specular", "world_sums")  # the targets' samplers, in order
 _SAMPLERS = tuple(("FLOAT_2D", name) for name in NAMES)
@@ -201,3 +204,6 @@ class WorldRatio(Feature):
     def lit(self, frame, sample):
         # The settle test's variant weighs the world's light but accumulates nothing.
         return super().lit(frame, sample) if sample.settle_test else _RATIO
+
+    def capture(self, frame, sample):
+        return _CAPTURE

@@ -1,13 +1,16 @@
-"""Planar reflections from Plane Light Probes (issue 50; ``engine/frame/features/planar.py``,
-``shaders/lib/planar.glsl``): each sample draws the scene mirrored about the probe's plane,
-and traced lobes in the probe's influence read that capture.
+"""What the screen does not hold (issue 50): planar reflections from Plane Light Probes
+(``engine/frame/features/planar.py``, ``shaders/lib/planar.glsl``: each sample draws the
+scene mirrored about the probe's plane, and traced lobes in the probe's influence read that
+capture), and cube maps (``features/cubes.py``, ``shaders/lib/cubes.glsl``: a Sphere Light
+Probe's and the camera's, drawn once a frame, marched by the rays the rest leave).
 
 Checked against geometry: a mirror floor with a Plane probe, in a black world with no lamp,
 shows an emissive panel that hangs above the camera's view (off the screen, where no
 screen-space ray can find it) where the panel mirrored about the floor's plane projects (the
 mirrored camera's picture, rendered as that mirrored panel alone), at the panel's radiance
 in every sample, the first and a one-sample frame's too. What the probe's square does not
-cover and what it costs where nothing needs it are checked beside.
+cover and what it costs where nothing needs it are checked beside. The same panel is found
+by the camera's cube map, and by a Sphere probe's in its influence.
 """
 
 import numpy as np
@@ -23,14 +26,19 @@ PANEL = dict(center=(0.0, 1.0, 2.6), size=(2.4, 0.08, 1.0))
 CAMERA = ((0.0, -7.0, 1.1), (0.0, 0.0, -0.6))
 
 
-def _render(gpu_call, scene, samples=SAMPLES, without=None):
-    """(linear RGBA, stats) of a frame of ``scene`` (one sample: the single-sample frame)."""
+# What the screen holds alone: the camera's cube map (``features/cubes.py``) finds the panel too.
+SCREEN_ONLY = ("cubes",)
+
+
+def _render(gpu_call, scene, samples=SAMPLES, without=()):
+    """(linear RGBA, stats) of a frame of ``scene`` (one sample: the single-sample frame), the
+    techniques named in ``without`` left out."""
     from penumbra.engine.frame.features import REGISTRY
     from penumbra.engine.frame.renderer import Renderer
     from penumbra.engine.scene.extract import camera_from_scene
 
     def job(engine, depsgraph):
-        engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name != without))
+        engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name not in without))
         cam = camera_from_scene(depsgraph, scene, *SIZE)
         out = engine.render_frame(depsgraph, cam, *SIZE, samples=(0, samples), sample_count=samples)
         return out.color_array().copy(), out.stats
@@ -90,7 +98,8 @@ def test_a_mirror_probe_shows_what_the_screen_does_not_hold(penumbra, gpu_call, 
     (its median within -3 % and +2 %: a white metal's Fresnel is 1; every sample, the first
     too), black elsewhere (99th percentile under 2 % of it), and the reflection's outline is
     the mirrored panel's (intersection over union at least 0.85). Without the probe the
-    screen's reflections cannot find the panel: the floor stays black."""
+    screen's reflections cannot find the panel (the camera's cube map left out too): the
+    floor stays black."""
     panel, _s = _render(gpu_call, _scene(mirror=False, probe=False), samples=1)
     assert float(panel[..., :3].max()) <= 1e-6, "the panel must be off the screen"
     where = mirrored_panel
@@ -106,7 +115,7 @@ def test_a_mirror_probe_shows_what_the_screen_does_not_hold(penumbra, gpu_call, 
     reflected = lum > 0.5 * EMISSION
     iou = (reflected & where).sum() / (reflected | where).sum()
     assert iou >= 0.85, iou
-    without, stats = _render(gpu_call, _scene(probe=False), samples=samples)
+    without, stats = _render(gpu_call, _scene(probe=False), samples=samples, without=SCREEN_ONLY)
     assert "planar" not in stats.techniques and stats.planar_captures == 0
     assert float(without[..., :3].mean(axis=2)[inside].max()) <= 0.02 * EMISSION
 
@@ -151,7 +160,7 @@ def test_a_probe_costs_nothing_where_nothing_needs_it(penumbra, gpu_call):
     probe.rotation_euler = (np.pi, 0.0, 0.0)  # its mirror faces down, away from the camera
     _image, stats = _render(gpu_call, scene, samples=2)
     assert stats.planar_captures == 0
-    _image, stats = _render(gpu_call, _scene(), samples=2, without="planar")
+    _image, stats = _render(gpu_call, _scene(), samples=2, without=("planar",))
     assert stats.planar_captures == 0
 
 
@@ -186,18 +195,83 @@ def test_degenerate_probes_and_a_grazing_camera(penumbra, gpu_call):
 
 
 def test_probes_penumbra_does_not_use_are_named(penumbra, gpu_call):
-    """A Sphere and a Volume probe are named in the report, once each; of two Plane probes in
-    view the frame reflects one and names the other."""
+    """A Volume probe is named in the report, once; of two Plane probes in view the frame
+    reflects one and names the other."""
     import bpy
 
     scene = _scene()
-    for kind in ("SPHERE", "VOLUME"):
+    for kind in ("VOLUME",):
         ob = bpy.data.objects.new(f"{kind.title()} Probe", bpy.data.lightprobes.new(kind, kind))
         scenes.link(scene, ob)
     scenes.plane_probe(scene, "Second Mirror", location=(0.0, 0.0, 0.0), size=(4.0, 4.0))
     _image, stats = _render(gpu_call, scene, samples=1)
     text = "\n".join(stats.messages)
-    assert text.count("Sphere Light Probe 'Sphere Probe' is not used") == 1, text
     assert text.count("Volume Light Probe 'Volume Probe' is not used") == 1, text
     assert text.count("Plane Light Probe 'Second Mirror' is not drawn") == 1, text
     assert stats.planar_captures == 1
+
+
+def _hit_share(image, where):
+    """The median share of the panel's radiance over the eroded ``where``."""
+    lum = image[..., :3].mean(axis=2)
+    return float(np.median(lum[_erode(where, 1)])) / EMISSION
+
+
+def test_the_cameras_cube_finds_what_the_screen_does_not_hold(penumbra, gpu_call, mirrored_panel):
+    """No probe: the camera's cube map (drawn once a frame at the camera, all around it) holds
+    the panel above the view, and the rays that leave the screen find it there: the floor
+    shows the panel where the mirrored panel projects (median at least 90 % of its radiance:
+    the march's steps miss some samples' rays at its edges), black away from it (99th
+    percentile under 2 %), six faces drawn once for the frame."""
+    image, stats = _render(gpu_call, _scene(probe=False))
+    assert "cubes" in stats.techniques and stats.cube_faces == 6 and stats.planar_captures == 0
+    share = _hit_share(image, mirrored_panel)
+    assert 0.9 <= share <= 1.02, share
+    lum = image[..., :3].mean(axis=2)
+    assert float(np.percentile(lum[_erode(~mirrored_panel, 2)], 99)) <= 0.02 * EMISSION
+
+
+def _sphere_probe(scene, location, radius, name="Room Probe"):
+    import bpy
+
+    data = bpy.data.lightprobes.new(name, "SPHERE")
+    data.influence_distance = radius
+    data.clip_start, data.clip_end = 0.01, 200.0
+    ob = bpy.data.objects.new(name, data)
+    ob.location = location
+    return scenes.link(scene, ob)
+
+
+def test_a_sphere_probes_cube_reflects_in_its_influence(penumbra, gpu_call, mirrored_panel):
+    """Screen Space Reflections off (no screen rays, no camera cube): a Sphere probe over the
+    floor whose influence holds it shows the panel where the mirrored panel projects (median
+    at least 90 %), through its own cube's depth (the parallax from the probe's point to the
+    floor's); a probe whose influence lies away from the floor shows nothing; a second probe
+    the camera sees is named."""
+    scene = _scene(probe=False)
+    scene.penumbra.screen_space_reflections = False
+    _sphere_probe(scene, (0.0, -6.0, 0.5), 40.0)
+    image, stats = _render(gpu_call, scene)
+    assert stats.cube_faces == 6, stats.cube_faces
+    assert _hit_share(image, mirrored_panel) >= 0.9
+    scene = _scene(probe=False)
+    scene.penumbra.screen_space_reflections = False
+    _sphere_probe(scene, (2.6, 0.0, 0.3), 0.6)
+    _sphere_probe(scene, (-2.6, 0.0, 0.3), 0.6, "Other Probe")
+    image, stats = _render(gpu_call, scene)
+    assert stats.cube_faces == 6
+    assert float(image[..., :3].mean(axis=2)[_erode(mirrored_panel, 1)].max()) <= 0.02 * EMISSION
+    assert sum("Sphere Light Probe" in m and "is not drawn" in m for m in stats.messages) == 1
+
+
+def test_cube_maps_cost_nothing_where_nothing_needs_them(penumbra, gpu_call):
+    """No cube is drawn for a one-sample frame, a rough floor, or with Screen Space Reflections
+    off and no Sphere probe."""
+    _image, stats = _render(gpu_call, _scene(probe=False), samples=1)
+    assert stats.cube_faces == 0 and "cubes" not in stats.techniques
+    _image, stats = _render(gpu_call, _scene(probe=False, roughness=0.6))
+    assert stats.cube_faces == 0
+    scene = _scene(probe=False)
+    scene.penumbra.screen_space_reflections = False
+    _image, stats = _render(gpu_call, scene)
+    assert stats.cube_faces == 0
