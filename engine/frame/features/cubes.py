@@ -74,6 +74,7 @@ CUBE_COPY = Program(
     outputs=(("VEC4", "out_color"), ("FLOAT", "out_depth")),
 )
 
+
 def face_size(width, height):
     """A cube face's side in texels: the power of two at or above two thirds of the frame's
     larger side, from 64 to 512 (a face spans 90 deg, a frame's side about 40 to 60: a face
