@@ -259,7 +259,8 @@ class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
 
 class PENUMBRA_PT_lightprobe(PenumbraPanel, bpy.types.Panel):
     """A Light Probe's settings Penumbra reads: a Plane probe's influence and clipping offset
-    (``engine/frame/features/planar.py``); the other types say they are not used."""
+    (``engine/frame/features/planar.py``), a Sphere probe's influence and clip range
+    (``features/cubes.py``); a Volume probe says it is not used."""
 
     bl_label = "Probe"
     bl_context = "data"
@@ -271,12 +272,19 @@ class PENUMBRA_PT_lightprobe(PenumbraPanel, bpy.types.Panel):
     def draw(self, context):
         layout = self.split_layout()
         probe = context.lightprobe
-        if probe.type != "PLANE":
-            layout.label(text="Penumbra uses Plane probes only (planar reflections)", icon="INFO")
-            return
         col = layout.column()
-        col.prop(probe, "influence_distance", text="Distance")
-        col.prop(probe, "clip_start", text="Clipping Offset")
+        if probe.type == "PLANE":
+            col.prop(probe, "influence_distance", text="Distance")
+            col.prop(probe, "clip_start", text="Clipping Offset")
+        elif probe.type == "SPHERE":
+            col.prop(probe, "influence_type")
+            col.prop(probe, "influence_distance", text="Radius" if probe.influence_type == "ELIPSOID" else "Size")
+            col.prop(probe, "falloff")
+            sub = col.column(align=True)
+            sub.prop(probe, "clip_start", text="Clipping Start")
+            sub.prop(probe, "clip_end", text="End")
+        else:
+            layout.label(text="Penumbra bakes no indirect light: Volume probes are not used", icon="INFO")
 
 
 class PENUMBRA_PT_material(PenumbraPanel, bpy.types.Panel):

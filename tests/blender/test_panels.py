@@ -169,3 +169,47 @@ def test_normal_pass_matches_cycles(penumbra):
     assert inside.mean() > 0.15  # ground, box faces and sphere in view
     np.testing.assert_allclose(ours[inside], ref[inside], atol=5e-3)
     assert np.all(ours[background & ~edges] == 0.0)
+
+
+class _Layout:
+    """Records what a panel's ``draw`` asks of its layout (properties, labels)."""
+
+    def __init__(self):
+        self.props, self.labels = [], []
+        self.use_property_split = self.use_property_decorate = False
+
+    def prop(self, data, name, **_kw):
+        assert hasattr(data, name), name  # a property the datablock has, in this Blender
+        self.props.append(name)
+
+    def label(self, text="", **_kw):
+        self.labels.append(text)
+
+    def column(self, **_kw):
+        return self
+
+    row = column
+
+
+@pytest.mark.parametrize(
+    "kind, shown",
+    [
+        ("PLANE", ["influence_distance", "clip_start"]),
+        ("SPHERE", ["influence_type", "influence_distance", "falloff", "clip_start", "clip_end"]),
+        ("VOLUME", []),
+    ],
+)
+def test_the_probe_panel_shows_what_penumbra_reads(penumbra, kind, shown):
+    """Penumbra's Probe panel draws a Plane probe's influence and clipping offset (planar
+    reflections), a Sphere probe's influence and clip range (its cube map), and says a Volume
+    probe is not used."""
+    import types
+
+    panel = _panel("PENUMBRA_PT_lightprobe")
+    probe = bpy.data.lightprobes.new(kind, kind)
+    layout = _Layout()
+    panel.draw(
+        types.SimpleNamespace(layout=layout, split_layout=lambda: layout), types.SimpleNamespace(lightprobe=probe)
+    )
+    assert layout.props == shown
+    assert bool(layout.labels) == (not shown)
