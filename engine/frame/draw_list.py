@@ -275,3 +275,26 @@ def longest_ray(draws):
         return 0.0
     diagonal = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0)))
     return diagonal if np.isfinite(diagonal) else 0.0
+
+
+# Principled roughness from which lobes are not traced (lit_world.glsl WORLD_RATIO_ROUGH; from
+# SSR_FADE, 0.4, their rays fade out): what the reflections, a Plane probe's capture and the
+# cube maps serve.
+TRACED_BELOW = 0.5
+
+
+def reflective_material(mat):
+    """Whether a surface of material ``mat`` (``materials.Material``; None: the default, of
+    roughness 0.5) may have a lobe sharp enough to be traced."""
+    if mat is None or mat.holdout:
+        return False
+    if mat.tree is not None or "roughness" in mat.textures:
+        return True  # its roughness is known per pixel only
+    if not (mat.specular > 0.0 or mat.metallic > 0.0):
+        return False
+    return float(mat.roughness) < TRACED_BELOW
+
+
+def reflective_materials(draws):
+    """Whether any draw the camera sees has a reflective material (``reflective_material``)."""
+    return any(reflective_material(m) for d in draws if d.instance.camera for m in (d.instance.materials or (None,)))

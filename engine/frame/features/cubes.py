@@ -30,14 +30,14 @@ import numpy as np
 from ....shaders.loader import Program, ProgramPart
 from ...gpu_pool import new_texture
 from ...scene.extract import Camera
-from ..draw_list import longest_ray
+from ..draw_list import longest_ray, reflective_materials
 from ..film import Film
 from .base import Feature, LitPart, captured_parts
-from .reflections import THICKNESS, reflective_materials
 
 COLOR_SAMPLER = "cube_color"
 DEPTH_SAMPLER = "cube_depth"
 STEPS = 24
+THICKNESS = 0.02  # a surface's thickness, as a fraction of its depth, that a ray behind it still meets
 
 # The six faces: (right, up, forward) of each, +X, -X, +Y, -Y, +Z, -Z; face k's slot in a
 # cube's 3 x 2 block of the atlas is (k % 3, k // 3).

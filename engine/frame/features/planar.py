@@ -29,13 +29,13 @@ import numpy as np
 
 from ....shaders.loader import ProgramPart
 from ...shadows import lightspace
-from ..draw_list import longest_ray
+from ..draw_list import longest_ray, reflective_materials
 from ..film import Film
 from .base import Feature, LitPart, captured_parts
-from .reflections import THICKNESS, reflective_materials
 
 COLOR_SAMPLER = "planar_color"
 DEPTH_SAMPLER = "planar_depth"  # the capture's normal target: its view depth in w
+THICKNESS = 0.02  # a surface's thickness, as a fraction of its depth, that a ray behind it still meets
 
 PART = ProgramPart(
     "planar",

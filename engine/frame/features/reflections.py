@@ -33,13 +33,10 @@ import numpy as np
 from ....shaders.loader import ProgramPart
 from ...gpu_pool import new_texture
 from ...shadows import lightspace
-from ..draw_list import longest_ray
+from ..draw_list import longest_ray, reflective_materials
 from ..world.occlusion import WorldAO
 from .base import NO_PART, Feature, LitPart
 
-# Principled roughness from which lobes are not traced (lit_world.glsl WORLD_RATIO_ROUGH; from
-# SSR_FADE, 0.4, their rays fade out).
-TRACED_BELOW = 0.5
 # A surface's thickness, as a fraction of its depth, that a ray behind it still meets.
 THICKNESS = 0.02
 STEPS = 32
@@ -63,23 +60,6 @@ DEBUG_TRACE_PART = ProgramPart(
     samplers=PART.samplers,
     defines=PART.defines + (("DEBUG_REFLECTIONS", True),),
 )
-
-
-def reflective_material(mat):
-    """Whether a surface of material ``mat`` (``materials.Material``; None: the default, of
-    roughness 0.5) may have a lobe sharp enough to be traced."""
-    if mat is None or mat.holdout:
-        return False
-    if mat.tree is not None or "roughness" in mat.textures:
-        return True  # its roughness is known per pixel only
-    if not (mat.specular > 0.0 or mat.metallic > 0.0):
-        return False
-    return float(mat.roughness) < TRACED_BELOW
-
-
-def reflective_materials(draws):
-    """Whether any draw the camera sees has a reflective material (``reflective_material``)."""
-    return any(reflective_material(m) for d in draws if d.instance.camera for m in (d.instance.materials or (None,)))
 
 
 class Reflections(Feature):
