@@ -17,9 +17,9 @@ the view moves) show the mirror too.
 
 What stays approximate, said once in the report: a frame draws one probe's capture (the one
 whose mirror covers most of the image; the others are named); the capture takes the sample's
-lights as the camera's view culled them and their maps as fitted to it, and the world's
-light on what it shows is unshadowed (the world ratio's targets are the camera's); surfaces
-in the capture reflect the world, not the scene. Wanted where a Plane probe's mirror is in
+lights as the camera's view culled them and their maps as fitted to it, and the world's ratio
+of the sample's own directions (``Feature.capture``); surfaces in the capture reflect the
+world, not the scene. Wanted where a Plane probe's mirror is in
 view and a surface may have a traced lobe (``reflective_materials``); a scene without either
 pays nothing."""
 
@@ -48,8 +48,8 @@ CAPTURE_PART = ProgramPart("planar_capture", defines=(("CLIP_PLANE", True),))
 SETTLE_PART = ProgramPart("planar_settle", defines=(("SSR_SETTLE", True),))
 
 APPROXIMATE = (
-    "Penumbra: a Plane Light Probe's reflection takes the lights as the camera sees them and the "
-    "world's light unshadowed"
+    "Penumbra: a Plane Light Probe's reflection takes the lights as the camera's view culls them, "
+    "their shadow maps as fitted to it"
 )
 
 
