@@ -146,3 +146,17 @@ def _multiple_scattering(rough, mu_v, ior):
     f_ss = 2.0 * np.mean(fresnel_dielectric(mus, ior) * mus)
     f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg))
     return 1.0 + f_ms * (1.0 - e) / e
+
+
+def erode(mask, n=1):
+    """``mask`` (a boolean image) shrunk by ``n`` pixels: a pixel stays where it and its four
+    neighbours do (the inside of an outline, away from its edge pixels)."""
+    out = mask.copy()
+    for _ in range(n):
+        inner = out.copy()
+        inner[1:] &= out[:-1]
+        inner[:-1] &= out[1:]
+        inner[:, 1:] &= out[:, :-1]
+        inner[:, :-1] &= out[:, 1:]
+        out = inner
+    return out

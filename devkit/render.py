@@ -44,3 +44,21 @@ def engine_frame(runner, scene, width, height):
         return out.stats, out.color_array().copy()
 
     return runner(job)
+
+
+def technique_frame(runner, scene, width, height, samples, without=()):
+    """A frame of ``samples`` samples of ``scene``'s camera through the engine core, with the
+    frame's techniques named in ``without`` left out of its renderer's registry
+    (``engine/frame/features``): (scene-linear RGBA array, row 0 at the bottom, FrameStats, the
+    samples' filter weights)."""
+    from penumbra.engine.frame.features import REGISTRY
+    from penumbra.engine.frame.renderer import Renderer
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    def job(engine, depsgraph):
+        engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name not in without))
+        cam = camera_from_scene(depsgraph, scene, width, height)
+        out = engine.render_frame(depsgraph, cam, width, height, samples=(0, samples), sample_count=samples)
+        return out.color_array().copy(), out.stats, list(engine.renderer.film.sample_weights)
+
+    return runner(job)

@@ -732,3 +732,12 @@ def boxes_in_frustum(view_proj, corners):
         out |= np.all(h[..., axis] > w, axis=1)
         out |= np.all(h[..., axis] < -w, axis=1)
     return ~out
+
+
+def finite_inverse(m):
+    """The inverse of the 4x4 ``m`` (float64), or None where it is singular or not finite."""
+    try:
+        inv = np.linalg.inv(np.asarray(m, np.float64))
+    except np.linalg.LinAlgError:
+        return None
+    return inv if np.all(np.isfinite(inv)) else None

@@ -142,6 +142,18 @@ vec3 world_env_radiance(vec3 R, float rough)
 }
 #endif
 
+#if SSR || PLANAR || CUBES
+/* A traced ray's further way of meeting the scene (a Plane probe's capture, the screen, the
+ * cube maps, in that order) takes the share ``w`` of what the earlier ones left: the hits'
+ * weight ``h`` and their weighted radiance ``hits`` grow by (1 - h) w and (1 - h) w ``seen``. */
+void world_hit(float w, vec3 seen, inout float h, inout vec3 hits)
+{
+  float add = (1.0 - h) * w;
+  hits += add * seen;
+  h += add;
+}
+#endif
+
 #if WORLD_AO
 /* The world's cosine-weighted visibility at the normal of the lobe being lit
  * (surface_world_light). */
@@ -193,22 +205,21 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
     vec3 seen;
     float h = 0.0;
     vec3 hits = vec3(0.0);
+    float w;
 #    if PLANAR
-    h = reach * planar_trace(world_point, b.N, L, xi.z, seen);
-    hits = h * seen;
+    w = planar_trace(world_point, b.N, L, xi.z, seen);
+    world_hit(reach * w, seen, h, hits);
 #    endif
 #    if SSR
     if (h < 1.0) {
-      float hs = (1.0 - h) * reach * ssr_trace(world_point, b.N, L, xi.z, seen);
-      hits += hs * seen;
-      h += hs;
+      w = ssr_trace(world_point, b.N, L, xi.z, seen);
+      world_hit(reach * w, seen, h, hits);
     }
 #    endif
 #    if CUBES
     if (h < 1.0) {
-      float hc = (1.0 - h) * reach * cube_trace(world_point, b.N, L, xi.z, seen);
-      hits += hc * seen;
-      h += hc;
+      w = cube_trace(world_point, b.N, L, xi.z, seen);
+      world_hit(reach * w, seen, h, hits);
     }
 #    endif
     specular = specular * (1.0 - h * (1.0 - world_ratio_share(b.rough))) + hits * dfg;

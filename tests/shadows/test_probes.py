@@ -17,6 +17,8 @@ import numpy as np
 import pytest
 
 from devkit import scenes
+from devkit.analytic import erode as _erode
+from devkit.render import technique_frame
 
 SIZE = (160, 90)
 SAMPLES = 8
@@ -33,17 +35,8 @@ SCREEN_ONLY = ("cubes",)
 def _render(gpu_call, scene, samples=SAMPLES, without=()):
     """(linear RGBA, stats) of a frame of ``scene`` (one sample: the single-sample frame), the
     techniques named in ``without`` left out."""
-    from penumbra.engine.frame.features import REGISTRY
-    from penumbra.engine.frame.renderer import Renderer
-    from penumbra.engine.scene.extract import camera_from_scene
-
-    def job(engine, depsgraph):
-        engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name not in without))
-        cam = camera_from_scene(depsgraph, scene, *SIZE)
-        out = engine.render_frame(depsgraph, cam, *SIZE, samples=(0, samples), sample_count=samples)
-        return out.color_array().copy(), out.stats
-
-    return gpu_call(job)
+    image, stats, _weights = technique_frame(gpu_call, scene, *SIZE, samples, without)
+    return image, stats
 
 
 def _scene(mirror=True, probe=True, panel_z=None, roughness=0.0, probe_size=(60.0, 60.0), probe_x=0.0, scale=1.0):
@@ -70,18 +63,6 @@ def _scene(mirror=True, probe=True, panel_z=None, roughness=0.0, probe_size=(60.
     cam = scenes.look_at(scene, tuple(c * s for c in location), tuple(c * s for c in target), lens=40.0)
     cam.data.clip_start, cam.data.clip_end = 0.1 * s, 100.0 * s
     return scene
-
-
-def _erode(mask, n=1):
-    out = mask.copy()
-    for _ in range(n):
-        inner = out.copy()
-        inner[1:] &= out[:-1]
-        inner[:-1] &= out[1:]
-        inner[:, 1:] &= out[:, :-1]
-        inner[:, :-1] &= out[:, 1:]
-        out = inner
-    return out
 
 
 @pytest.fixture(scope="module")

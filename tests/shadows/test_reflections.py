@@ -12,6 +12,8 @@ radiance times the samples that traced (the first has no image yet). Against Cyc
 import numpy as np
 
 from devkit import scenes
+from devkit.analytic import erode as _erode
+from devkit.render import technique_frame
 
 SIZE = (160, 90)
 SAMPLES = 16
@@ -27,17 +29,7 @@ SCREEN_ONLY = ("cubes",)
 def _render(gpu_call, scene, samples=SAMPLES, without=()):
     """(linear RGBA, stats, the samples' filter weights) of a frame of ``scene``, the
     techniques named in ``without`` left out."""
-    from penumbra.engine.frame.features import REGISTRY
-    from penumbra.engine.frame.renderer import Renderer
-    from penumbra.engine.scene.extract import camera_from_scene
-
-    def job(engine, depsgraph):
-        engine.renderer = Renderer(features=tuple(f for f in REGISTRY if f.name not in without))
-        cam = camera_from_scene(depsgraph, scene, *SIZE)
-        out = engine.render_frame(depsgraph, cam, *SIZE, samples=(0, samples), sample_count=samples)
-        return out.color_array().copy(), out.stats, list(engine.renderer.film.sample_weights)
-
-    return gpu_call(job)
+    return technique_frame(gpu_call, scene, *SIZE, samples, without)
 
 
 def _panel_scene(mirror=True, panel_z=1.0, roughness=0.0):
@@ -51,18 +43,6 @@ def _panel_scene(mirror=True, panel_z=1.0, roughness=0.0):
     scenes.box(scene, "Panel", center=(0.0, 0.0, panel_z), mat=scenes.emissive("Glow", EMISSION), **PANEL)
     scenes.look_at(scene, (0.0, -7.0, 1.1), (0.0, 0.0, 0.1), lens=40.0)
     return scene
-
-
-def _erode(mask, n=1):
-    out = mask.copy()
-    for _ in range(n):
-        inner = out.copy()
-        inner[1:] &= out[:-1]
-        inner[:-1] &= out[1:]
-        inner[:, 1:] &= out[:, :-1]
-        inner[:, :-1] &= out[:, 1:]
-        out = inner
-    return out
 
 
 def test_a_mirror_floor_shows_the_panel_where_the_mirrored_camera_sees_it(penumbra, gpu_call):

@@ -30,6 +30,7 @@ import numpy as np
 from ....shaders.loader import Program, ProgramPart
 from ...gpu_pool import new_texture
 from ...scene.extract import Camera
+from ...shadows import lightspace
 from ..draw_list import longest_ray, reflective_materials
 from ..film import Film
 from .base import Feature, LitPart, captured_parts
@@ -104,11 +105,7 @@ def influence_matrix(probe, origin):
     m = np.asarray(probe.matrix, np.float64).copy()
     m[:3, :3] *= max(probe.influence_distance, 1e-9)
     m[:3, 3] -= np.asarray(origin, np.float64)
-    try:
-        inv = np.linalg.inv(m)
-    except np.linalg.LinAlgError:
-        return None
-    return inv if np.all(np.isfinite(inv)) else None
+    return lightspace.finite_inverse(m)
 
 
 def sees_influence(probe, camera):

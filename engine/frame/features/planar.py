@@ -84,11 +84,7 @@ def influence_matrix(probe, origin):
     m = np.asarray(probe.matrix, np.float64).copy()
     m[:3, 2] = probe.normal * max(probe.influence_distance, 1e-9)
     m[:3, 3] -= np.asarray(origin, np.float64)
-    try:
-        inv = np.linalg.inv(m)
-    except np.linalg.LinAlgError:
-        return None
-    return inv if np.all(np.isfinite(inv)) else None
+    return lightspace.finite_inverse(m)
 
 
 def coverage(probe, camera, size):
