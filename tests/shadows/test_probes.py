@@ -256,3 +256,33 @@ def test_cube_maps_cost_nothing_where_nothing_needs_them(penumbra, gpu_call):
     scene.penumbra.screen_space_reflections = False
     _image, stats = _render(gpu_call, scene)
     assert stats.cube_faces == 0
+
+
+def test_the_viewport_drawing_a_sample_a_call_shows_the_final_render(penumbra, gpu_call):
+    """The viewport draws a frame's samples one call at a time: the Plane probe's capture is
+    drawn every sample (settling's pilot too), the cube maps once for the frame (its first call) and kept
+    over the later calls, so after n calls the frame is the n-sample final render's, exactly."""
+    from devkit.render import render
+
+    scene = _scene()
+    _sphere_probe(scene, (0.0, -6.0, 0.5), 40.0)
+    scene.penumbra.render_samples = scene.penumbra.viewport_samples = 6
+    scene.penumbra.preview_adaptive_threshold = scene.penumbra.adaptive_threshold
+    final = render(scene)["Combined"]
+
+    def job(engine, depsgraph):
+        cam = scene.camera.evaluated_get(depsgraph)
+        view = cam.matrix_world.inverted()
+        window = cam.calc_matrix_camera(depsgraph, x=SIZE[0], y=SIZE[1], scale_x=1.0, scale_y=1.0)
+        captures = faces = 0
+        for _ in range(6):
+            out, _rendered = engine.viewport_frame(depsgraph, view, window, *SIZE)
+            captures += out.stats.planar_captures
+            faces += out.stats.cube_faces
+        return out.color_array().copy(), captures, faces
+
+    image, captures, faces = gpu_call(job)
+    # A capture each sample (and for settling's pilot sample), the two cubes once.
+    assert captures in (6, 7) and faces == 12, (captures, faces)
+    assert float(final[..., :3].max()) > EMISSION * 0.5  # the reflection is there
+    np.testing.assert_array_equal(image, final)
