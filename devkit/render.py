@@ -62,3 +62,21 @@ def technique_frame(runner, scene, width, height, samples, without=()):
         return out.color_array().copy(), out.stats, list(engine.renderer.film.sample_weights)
 
     return runner(job)
+
+
+def viewport_calls(runner, scene, width, height, calls):
+    """``calls`` redraws of the viewport through ``scene``'s camera (the engine's
+    ``viewport_frame``, one more sample a call while it refines): (the last call's
+    scene-linear RGBA array, row 0 at the bottom, each call's FrameStats)."""
+
+    def job(engine, depsgraph):
+        cam = scene.camera.evaluated_get(depsgraph)
+        view = cam.matrix_world.inverted()
+        window = cam.calc_matrix_camera(depsgraph, x=width, y=height, scale_x=1.0, scale_y=1.0)
+        stats = []
+        for _ in range(calls):
+            out, _rendered = engine.viewport_frame(depsgraph, view, window, width, height)
+            stats.append(out.stats)
+        return out.color_array().copy(), stats
+
+    return runner(job)

@@ -262,7 +262,7 @@ def test_the_viewport_drawing_a_sample_a_call_shows_the_final_render(penumbra, g
     """The viewport draws a frame's samples one call at a time: the Plane probe's capture is
     drawn every sample (settling's pilot too), the cube maps once for the frame (its first call) and kept
     over the later calls, so after n calls the frame is the n-sample final render's, exactly."""
-    from devkit.render import render
+    from devkit.render import render, viewport_calls
 
     scene = _scene()
     _sphere_probe(scene, (0.0, -6.0, 0.5), 40.0)
@@ -270,18 +270,8 @@ def test_the_viewport_drawing_a_sample_a_call_shows_the_final_render(penumbra, g
     scene.penumbra.preview_adaptive_threshold = scene.penumbra.adaptive_threshold
     final = render(scene)["Combined"]
 
-    def job(engine, depsgraph):
-        cam = scene.camera.evaluated_get(depsgraph)
-        view = cam.matrix_world.inverted()
-        window = cam.calc_matrix_camera(depsgraph, x=SIZE[0], y=SIZE[1], scale_x=1.0, scale_y=1.0)
-        captures = faces = 0
-        for _ in range(6):
-            out, _rendered = engine.viewport_frame(depsgraph, view, window, *SIZE)
-            captures += out.stats.planar_captures
-            faces += out.stats.cube_faces
-        return out.color_array().copy(), captures, faces
-
-    image, captures, faces = gpu_call(job)
+    image, calls = viewport_calls(gpu_call, scene, *SIZE, 6)
+    captures, faces = sum(s.planar_captures for s in calls), sum(s.cube_faces for s in calls)
     # A capture each sample (and for settling's pilot sample), the two cubes once.
     assert captures in (6, 7) and faces == 12, (captures, faces)
     assert float(final[..., :3].max()) > EMISSION * 0.5  # the reflection is there

@@ -118,25 +118,15 @@ def test_the_viewport_drawing_a_sample_a_call_shows_the_final_render(penumbra, g
     drawn once for the frame (at the pixels' centres, not at the pixel offset of the call
     that first traces), so after n calls the mirror floor is the n-sample final render's,
     exactly (the same pixels: the rays and their hits are the same)."""
-    from devkit.render import render
+    from devkit.render import render, viewport_calls
 
     scene = _panel_scene()
     scene.penumbra.render_samples = scene.penumbra.viewport_samples = 6
     scene.penumbra.preview_adaptive_threshold = scene.penumbra.adaptive_threshold
     final = render(scene)["Combined"]
 
-    def job(engine, depsgraph):
-        cam = scene.camera.evaluated_get(depsgraph)
-        view = cam.matrix_world.inverted()
-        window = cam.calc_matrix_camera(depsgraph, x=SIZE[0], y=SIZE[1], scale_x=1.0, scale_y=1.0)
-        prepasses = traced = 0
-        for _ in range(6):
-            out, _rendered = engine.viewport_frame(depsgraph, view, window, *SIZE)
-            prepasses += out.stats.reflection_prepasses
-            traced += out.stats.reflection_samples
-        return out.color_array().copy(), prepasses, traced
-
-    image, prepasses, traced = gpu_call(job)
+    image, calls = viewport_calls(gpu_call, scene, *SIZE, 6)
+    prepasses, traced = sum(s.reflection_prepasses for s in calls), sum(s.reflection_samples for s in calls)
     assert prepasses == 1 and traced == 5
     assert float(final[..., :3].max()) > EMISSION * 0.5  # the reflection is there
     np.testing.assert_array_equal(image, final)
