@@ -26,7 +26,7 @@ def read_exr(path):
                 groups.setdefault(parts[-2] if len(parts) >= 2 else "Combined", []).append(i)
             for key, idx in groups.items():
                 # Files may store channels alphabetically (A, B, G, R): put them in RGBA order.
-                idx.sort(key=lambda i: _CHANNEL_ORDER.find(spec.channelnames[i].split(".")[-1]))
+                idx.sort(key=lambda i: _CHANNEL_ORDER.find(spec.channelnames[i].split(".")[-1].upper()))
                 passes[key] = pixels[:, :, idx]
             sub += 1
     finally:
@@ -102,7 +102,7 @@ def read_exr_layers(path):
                 view = parts[2] if len(parts) == 4 else part_view
                 groups.setdefault((layer, view, pass_name), []).append(i)
             for (layer, view, pass_name), idx in groups.items():
-                idx.sort(key=lambda i: _CHANNEL_ORDER.find(spec.channelnames[i].split(".")[-1]))
+                idx.sort(key=lambda i: _CHANNEL_ORDER.find(spec.channelnames[i].split(".")[-1].upper()))
                 out.setdefault((layer, view), {})[pass_name] = pixels[:, :, idx]
             sub += 1
     finally:

@@ -9,12 +9,18 @@ import bpy
 import numpy as np
 
 from . import gpu_pool
-from .frame import sampling
+from .frame import cryptomatte, sampling
 from .frame.output import (
+    CRYPTOMATTE_SWITCHES,
+    DENOISING_PASSES,
+    FURTHER_PASSES,
+    cryptomatte_levels,
     frame_in_region,
     mist_pass,
+    pass_name,
     render_views,
     render_window,
+    requested_passes,
     unsupported_in_use,
     view_distance_scale,
     viewport_window,
@@ -73,6 +79,7 @@ class PenumbraEngineCore:
         deadline=None,
         navigating=False,
         motion=None,
+        passes=(),
     ):
         """Extract, then render samples ``samples`` of a frame of ``sample_count`` samples
         (``Renderer.render``); returns the renderer's FrameOutput. ``pixel_scale`` scales the
@@ -105,6 +112,7 @@ class PenumbraEngineCore:
             deadline=deadline,
             navigating=navigating,
             motion=motion,
+            passes=tuple(passes),
         )
         out = self.renderer.render(snapshot, request, on_sample=on_sample)
         self.last_stats = out.stats
@@ -347,6 +355,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.register_pass(scene, renderlayer, "Lit", 4, "RGBA", "COLOR")
         if renderlayer.use_pass_emit:
             self.register_pass(scene, renderlayer, EMISSION_PASS, 3, "RGB", "COLOR")
+        for name, channels, chan_id, kind in further_passes(renderlayer):
+            self.register_pass(scene, renderlayer, name, channels, chan_id, kind)
 
     def render(self, depsgraph):
         """Render the pixels Blender asks for: the render region of the frame at Blender's
@@ -426,12 +436,13 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     emission=vl.use_pass_emit,
                     adaptive=adaptive,
                     motion=motion,
+                    passes=requested_passes(vl),
                 )
                 if out.stats.cancelled and out.stats.samples == 0:
                     return  # cancelled before a sample was drawn: nothing to write
                 self._report_frame(out.stats, label, count, reported)
                 passes = self._passes(depsgraph, camera, out, window)
-                self._write_result(window, layer, view, passes)
+                self._write_result(window, layer, view, passes, cryptomatte_metadata(vl, out))
                 self.update_progress((index + 1) / len(views))
                 if out.stats.cancelled:
                     return  # the later views are not started
@@ -495,6 +506,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             passes["Mist"] = window.cut(self._mist(depsgraph.scene, camera, out, width, height))
         if vl.use_pass_emit:
             passes[EMISSION_PASS] = window.cut(out.emission_array())
+        passes.update({name: window.cut(data) for name, data in further_pass_data(vl, out).items()})
         return passes
 
     @staticmethod
@@ -508,11 +520,14 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             return np.where(np.isfinite(depth), 0.0, 1.0).astype(np.float32)
         return mist_pass(depth, scale, mist.start, mist.depth, mist.falloff)
 
-    def _write_result(self, window, layer, view, passes):
+    def _write_result(self, window, layer, view, passes, metadata=None):
         """Fill one result (``window``-sized, of ``layer`` and ``view``) with every pass the
-        view layer has; on any error the result is cancelled, not left half-written."""
+        view layer has, and ``metadata`` ({key: value}: Cryptomatte's manifest) in its stamp
+        data; on any error the result is cancelled, not left half-written."""
         result = self.begin_result(0, 0, window.width, window.height, layer=layer, view=view)
         try:
+            for key, value in (metadata or {}).items():
+                result.stamp_data_add_field(key, value)
             render_layer = result.layers[0]
             for name, data in passes.items():
                 render_pass = render_layer.passes.find_by_name(name, view)
@@ -560,6 +575,65 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.draw_display(depsgraph.scene, out.color, width, height, window)
         if self.refining():
             self.tag_redraw()  # the next redraw refines: full resolution, or one more sample
+
+
+def further_passes(view_layer):
+    """(name, channels, chan_id, type) of each further pass ``view_layer`` asks for, as
+    Blender's engines register them (``output.FURTHER_PASSES``, Denoising Data, Shader AOVs,
+    Cryptomatte's layers)."""
+    new = bpy.app.version >= (5, 0, 0)
+    keys = requested_passes(view_layer)
+    out = [(pass_name(p, new), *p[4:]) for p in FURTHER_PASSES if p[1] in keys]
+    out += [p[1:] for p in DENOISING_PASSES if p[0] in keys]
+    for key in keys:
+        if key.startswith("AOV_"):
+            kind, name = key[4:].split(":", 1)
+            out.append((name, 1, "X", "VALUE") if kind == "VALUE" else (name, 4, "RGBA", "COLOR"))
+    levels = cryptomatte_levels(view_layer)
+    for kind, switch in zip(cryptomatte.KINDS, CRYPTOMATTE_SWITCHES, strict=True):
+        if getattr(view_layer, switch, False):
+            out += [(f"Crypto{kind}{i:02d}", 4, "rgba", "COLOR") for i in range((levels + 1) // 2)]
+    return out
+
+
+def further_pass_data(view_layer, out):
+    """{pass name: full-frame pixels} of the further passes of frame ``out``."""
+    if not out.passes:
+        return {}
+    new = bpy.app.version >= (5, 0, 0)
+    data = {}
+    for p in FURTHER_PASSES:
+        if p[1] in out.passes:
+            data[pass_name(p, new)] = out.pass_array(p[1], p[4])
+    for key, name, channels, *_rest in DENOISING_PASSES:
+        if key in out.passes:
+            data[name] = out.pass_array(key, channels)
+    for key in out.passes:
+        if key.startswith("AOV_"):
+            kind, name = key[4:].split(":", 1)
+            data[name] = out.pass_array(key, 1 if kind == "VALUE" else 4)
+            if kind == "COLOR":
+                data[name][..., 3] = 1.0
+    crypto = out.passes.get("CRYPTOMATTE")
+    if crypto is not None:
+        levels = cryptomatte_levels(view_layer)
+        for index, (kind, switch) in enumerate(zip(cryptomatte.KINDS, CRYPTOMATTE_SWITCHES, strict=True)):
+            if getattr(view_layer, switch, False):
+                for i, layer in enumerate(crypto.layers(index, levels)):
+                    data[f"Crypto{kind}{i:02d}"] = layer
+    return data
+
+
+def cryptomatte_metadata(view_layer, out):
+    """The render result's Cryptomatte metadata of frame ``out`` (its manifests), or {}."""
+    crypto = (out.passes or {}).get("CRYPTOMATTE")
+    if crypto is None:
+        return {}
+    meta = {}
+    for index, (kind, switch) in enumerate(zip(cryptomatte.KINDS, CRYPTOMATTE_SWITCHES, strict=True)):
+        if getattr(view_layer, switch, False):
+            meta.update(cryptomatte.metadata(view_layer.name, kind, crypto.names[index]))
+    return meta
 
 
 def _camera_view(cam_ob):

@@ -600,6 +600,15 @@ VIEW_LAYER_PARAMS = (
         label="Lit (Before Post)",
         section=PASSES,
     ),
+    Param(
+        "use_pass_denoising",
+        "BOOL",
+        False,
+        "Denoising Albedo and Denoising Normal passes, averaged over the samples: the Albedo and Normal inputs "
+        "of the compositor's Denoise node",
+        label="Denoising Data",
+        section=PASSES,
+    ),
 )
 
 # --- what the renderer reads --------------------------------------------------------------

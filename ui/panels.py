@@ -1,6 +1,7 @@
 """Render-properties panels and the sidebar (N-panel) tab with the post-layer stack."""
 
 import bpy
+from bl_ui.properties_view_layer import ViewLayerAOVPanelHelper, ViewLayerCryptomattePanelHelper
 
 from ..engine import settings
 from ..engine.enums import DEBUG_VIEW
@@ -234,8 +235,31 @@ class PENUMBRA_PT_passes(PenumbraPanel, bpy.types.Panel):
         col.prop(view_layer, "use_pass_z")
         col.prop(view_layer, "use_pass_mist")
         col.prop(view_layer, "use_pass_normal")
+        col.prop(view_layer, "use_pass_position")
+        col.prop(view_layer, "use_pass_object_index")
+        col.prop(view_layer, "use_pass_material_index")
+        col = layout.column(heading="Light", align=True)
         col.prop(view_layer, "use_pass_emit")
+        col.prop(view_layer, "use_pass_environment")
+        col.prop(view_layer, "use_pass_diffuse_color")
+        col.prop(view_layer, "use_pass_glossy_color")
+        col.prop(view_layer, "use_pass_transmission_color")
+        col = layout.column(heading="Penumbra", align=True)
         draw_params(col, view_layer.penumbra, settings.VIEW_LAYER_PARAMS)
+
+
+class PENUMBRA_PT_passes_aov(ViewLayerAOVPanelHelper, bpy.types.Panel):
+    """The view layer's Shader AOVs (Blender's list), under Penumbra's passes."""
+
+    bl_parent_id = "PENUMBRA_PT_passes"
+    COMPAT_ENGINES = {"PENUMBRA"}
+
+
+class PENUMBRA_PT_passes_cryptomatte(ViewLayerCryptomattePanelHelper, bpy.types.Panel):
+    """Cryptomatte's kinds and levels (Blender's panel), under Penumbra's passes."""
+
+    bl_parent_id = "PENUMBRA_PT_passes"
+    COMPAT_ENGINES = {"PENUMBRA"}
 
 
 class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
@@ -384,6 +408,8 @@ classes = (
     PENUMBRA_PT_motion_blur,
     PENUMBRA_PT_motion_blur_curve,
     PENUMBRA_PT_passes,
+    PENUMBRA_PT_passes_aov,
+    PENUMBRA_PT_passes_cryptomatte,
     PENUMBRA_PT_shadows,
     PENUMBRA_PT_light,
     PENUMBRA_PT_lightprobe,

@@ -40,6 +40,19 @@ class FrameOutput:
     normal_data: object = None
     emission: object = None  # GPUTexture, the Emission pass (when asked for)
     debug: object = None  # debug_view.DebugImage when a debug view replaced the image
+    # Blender's further passes (``features/passes.py``): {key: GPUTexture, or the Cryptomatte
+    # ``cryptomatte.Accumulator``}
+    passes: dict = None
+
+    def pass_array(self, key, channels):
+        """A further pass's pixels (height, width, ``channels``); Position in the world's
+        frame (drawn relative to the frame origin; 0 where no surface is)."""
+        data = texture_array(self.passes[key], 4)
+        if key == "POSITION":
+            hit = data[..., 3:4] > 0.0
+            origin = np.asarray(self.passes.get("ORIGIN", (0.0, 0.0, 0.0)), np.float64)
+            return np.where(hit, data[..., :3] + origin, 0.0).astype(np.float32)
+        return data[..., :channels]
 
     def emission_array(self):
         return texture_array(self.emission, 4)[..., :3]

@@ -148,6 +148,43 @@ class LitPass:
                 gpu.state.blend_set("NONE")
         _reset_state(stats)
 
+    def draw_apart(self, sample, framebuffer, entry, part_of, per_draw):
+        """The sample's surfaces drawn again over the z-buffer its lit pass left, into
+        ``framebuffer`` (whose depth is the film's z-buffer), with ``entry`` (a
+        ``ProgramPart`` with the entry shader) and ``part_of(tree)`` (the draw's outputs and
+        defines for a material's compiled tree, or None): the passes' draws
+        (``features/passes.py``). Opaque and alpha-hashed surfaces nearest first, then blended
+        ones farthest first, none blended, none writing depth; ``per_draw(shader, draw,
+        material)`` sets a draw's own push constants."""
+        import gpu
+
+        stats = sample.stats
+        opaque, blended, parts = self._entries(sample.seen, sample.view_camera, sample.atlas, stats, hashed_last=False)
+        submit = _Submission(self, sample, parts)
+        submit.masks = None  # the lights are not read
+        submit.apart = (entry, part_of)
+        submit.per_draw = per_draw
+        width, height = self.film.size
+        with framebuffer.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(False)
+            gpu.state.blend_set("NONE")
+            submit.draw(opaque, False)
+            submit.draw(blended, False, blended=True)
+        _reset_state(stats)
+
+    def background_into(self, target, frame, sample):
+        """What the camera sees of the world where no surface is, into ``target`` (RGBA32F at
+        the film's size): the Environment pass's background, whatever the film's transparency."""
+        world = frame.snapshot.world
+        if world is not None and world.image is not None:
+            fb = gpu_framebuffer_with_depth(target, self.film.zbuffer)
+            self._background(self.film, world, sample.view_camera, frame.origin, "LESS_EQUAL", fb)
+        else:
+            color = frame.snapshot.world_color
+            target.clear(format="FLOAT", value=(*map(float, color[:3]), 1.0))
+
     def draw_settle_test(self, sample, target):
         """The settle test's variant of the lit pass (``sample.data`` built for the test) into
         ``target`` (``features.settling.SettleTargets.test_framebuffer``): the surfaces the
@@ -204,8 +241,9 @@ class LitPass:
         blended.sort(key=lambda e: -e[1])
         return opaque, blended, _Parts(outside, terminators)
 
-    def _background(self, film, world, camera, origin, depth_test="NONE"):
-        """The world's Environment Texture behind the scene (``BACKGROUND``)."""
+    def _background(self, film, world, camera, origin, depth_test="NONE", framebuffer=None):
+        """The world's Environment Texture behind the scene (``BACKGROUND``), into the film's
+        colour or ``framebuffer``."""
         from mathutils import Matrix
 
         width, height = film.size
@@ -221,7 +259,7 @@ class LitPass:
             inverse = turn @ inverse
         film.fullscreen(
             BACKGROUND,
-            film.fb_color,
+            film.fb_color if framebuffer is None else framebuffer,
             {"env": self.textures.get(world.image)},
             {
                 "env_premultiplied": float(self.textures.premultiplied(world.image)),
@@ -288,6 +326,13 @@ class LitPass:
         return self._dummy_shadow
 
 
+def gpu_framebuffer_with_depth(target, zbuffer):
+    """A framebuffer drawing into ``target`` over ``zbuffer``."""
+    import gpu
+
+    return gpu.types.GPUFrameBuffer(depth_slot=zbuffer, color_slots=(target,))
+
+
 def set_image_flags(shader, mat, textures):
     """The ``image_premultiplied`` push constant of a draw of ``mat``: which of its images
     Blender stores premultiplied (``programs.image_premultiplied_bits``)."""
@@ -341,6 +386,8 @@ class _Submission:
         self.mirrored = bool(sample.mirrored)  # a mirrored view turns every winding (``features/planar.py``)
         self.shadow_tex = atlas.texture if atlas is not None else lit._shadow_dummy()
         self.emission = self.counted = False
+        self.apart = None  # (entry part, part of a tree): a draw apart (``LitPass.draw_apart``)
+        self.per_draw = None
         # A debug view's entry shader, unless a technique's part brings its own (the settle test's).
         variant = data.variant
         debug = (variant.debug or variant.debug_term) and not any(p.fragment for p in data.parts)
@@ -365,6 +412,9 @@ class _Submission:
         """The ``programs.LitKey`` of a draw: the pass's targets, the frame's techniques' parts
         (``blended``: those blended surfaces take), the material's, and the entry shader."""
         data = self.data
+        if self.apart is not None:  # a draw of its own: its part and entry, nothing of the techniques'
+            entry, part_of = self.apart
+            return lit_key(False, data.variant, (part_of(tree),), features, tree, entry)
         if emission_only:  # what the surface emits, nothing of the techniques'
             return lit_key(False, data.variant, (EMISSION_ONLY,), features, tree)
         own = (EMISSION_PART,) if self.emission and with_aux else ()
@@ -435,6 +485,8 @@ class _Submission:
                 if d.instance.hair is not None:
                     shader.uniform_float("hair_pixel", self.hair_pixel if d.instance.hair == "STRAND" else 0.0)
                 last, self.model_shader = d, shader
+            if self.per_draw is not None:
+                self.per_draw(shader, d, mat)
             if mat.tree is not None and mat.tree.needs & {"GENERATED", "OBJECT_INFO"}:
                 set_uniforms(shader, d.tree_uniforms(mat.tree))
             shader.uniform_block("material", lit.materials.get(mat))

@@ -103,8 +103,60 @@ def _lookup(owner, path):
     return owner
 
 
+# Blender's further passes Penumbra writes (``features/passes.py``): the view layer's switch,
+# the pass's key, its name from Blender 5.0 and before it, channels, chan_id, type.
+FURTHER_PASSES = (
+    ("use_pass_position", "POSITION", "Position", "Position", 3, "XYZ", "VECTOR"),
+    ("use_pass_object_index", "OBJECT_INDEX", "Object Index", "IndexOB", 1, "X", "VALUE"),
+    ("use_pass_material_index", "MATERIAL_INDEX", "Material Index", "IndexMA", 1, "X", "VALUE"),
+    ("use_pass_diffuse_color", "DIFFUSE_COLOR", "Diffuse Color", "DiffCol", 3, "RGB", "COLOR"),
+    ("use_pass_glossy_color", "GLOSSY_COLOR", "Glossy Color", "GlossCol", 3, "RGB", "COLOR"),
+    ("use_pass_transmission_color", "TRANSMISSION_COLOR", "Transmission Color", "TransCol", 3, "RGB", "COLOR"),
+    ("use_pass_environment", "ENVIRONMENT", "Environment", "Env", 3, "RGB", "COLOR"),
+)
+# Penumbra's Denoising Data switch (``penumbra.use_pass_denoising``): Cycles' names.
+DENOISING_PASSES = (
+    ("DENOISING_ALBEDO", "Denoising Albedo", 3, "RGB", "COLOR"),
+    ("DENOISING_NORMAL", "Denoising Normal", 3, "XYZ", "VECTOR"),
+)
+CRYPTOMATTE_SWITCHES = ("use_pass_cryptomatte_object", "use_pass_cryptomatte_material", "use_pass_cryptomatte_asset")
+
 # The view layer passes Penumbra writes (its own Shadow and Lit passes live in ``penumbra``).
-WRITTEN_PASSES = {"use_pass_combined", "use_pass_z", "use_pass_normal", "use_pass_mist", "use_pass_emit"}
+WRITTEN_PASSES = {
+    "use_pass_combined",
+    "use_pass_z",
+    "use_pass_normal",
+    "use_pass_mist",
+    "use_pass_emit",
+    *(p[0] for p in FURTHER_PASSES),
+    *CRYPTOMATTE_SWITCHES,
+}
+
+
+def pass_name(further, new_names):
+    """A ``FURTHER_PASSES`` row's pass name on this Blender line (``new_names``: 5.0 and later)."""
+    return further[2] if new_names else further[3]
+
+
+def cryptomatte_levels(view_layer):
+    """The view layer's Cryptomatte levels, at most 16 (Blender's and Cycles' bound)."""
+    return min(16, max(1, int(getattr(view_layer, "pass_cryptomatte_depth", 6))))
+
+
+def requested_passes(view_layer):
+    """The ``FrameRequest.passes`` keys of what ``view_layer`` asks for beyond Combined, Depth,
+    Mist, Normal, Emission and Penumbra's own: its switched-on ``FURTHER_PASSES``, Penumbra's
+    Denoising Data, its valid Shader AOVs and Cryptomatte."""
+    keys = [p[1] for p in FURTHER_PASSES if getattr(view_layer, p[0], False) is True]
+    own = getattr(view_layer, "penumbra", None)
+    if own is not None and getattr(own, "use_pass_denoising", False):
+        keys += [p[0] for p in DENOISING_PASSES]
+    for aov in getattr(view_layer, "aovs", ()):
+        if aov.is_valid and aov.name:
+            keys.append(f"AOV_{'VALUE' if aov.type == 'VALUE' else 'COLOR'}:{aov.name}")
+    if any(getattr(view_layer, s, False) is True for s in CRYPTOMATTE_SWITCHES):
+        keys.append("CRYPTOMATTE")
+    return tuple(dict.fromkeys(keys))
 
 
 def unsupported_in_use(camera_data, render, view_layer):
@@ -123,8 +175,6 @@ def unsupported_in_use(camera_data, render, view_layer):
                 if getattr(view_layer, name, False) is True:
                     own = " (switch on Penumbra's own in View Layer > Passes)" if name == "use_pass_shadow" else ""
                     out.append(f"Penumbra: Blender's {prop.name} pass is not written{own}")
-        if len(getattr(view_layer, "aovs", ())):
-            out.append("Penumbra: shader AOV passes are not written")
         if len(getattr(view_layer, "lightgroups", ())):
             out.append("Penumbra: light group passes are not written")
     return list(dict.fromkeys(out))

@@ -449,13 +449,15 @@ def tree_part(tree):
     """The ``ProgramPart`` of compiled node tree ``tree``: its GLSL families, its generated
     code, its constants block and image samplers, and the per-draw values it reads. Made once
     per tree (trees equal in what they compile share it)."""
-    key = (tree.key, tree.families, tree.needs, len(tree.constants), len(tree.images), tree.code)
+    key = (tree.key, tree.families, tree.needs, len(tree.constants), len(tree.images), tree.code, tree.aovs)
     part = _TREE_PARTS.get(key)
     if part is None:
         pushes = tuple(p for need in sorted(tree.needs) for p in TREE_UNIFORMS.get(need, ()))
         part = _TREE_PARTS[key] = ProgramPart(
             name="",  # the material's features name the tree (NODES_<key>)
-            defines=(("NODE_PROCEDURAL", any(f.startswith("texture_") for f in tree.families)),),
+            defines=(("NODE_PROCEDURAL", any(f.startswith("texture_") for f in tree.families)),)
+            # Its AOV Output nodes (``nodetree.Compiler.compile_aovs``): the passes' draw calls them.
+            + ((("NODE_AOVS", len(tree.aovs)), ("NODE_AOV_SLOTS", len(tree.aovs))) if tree.aovs else ()),
             # The generated code calls the families' functions (which bring what they need by
             # their ``// requires:`` lines) and, for its image textures, lib/material.glsl's sample_image.
             libs=(("lib/material.glsl",) if tree.images else ()) + tuple(f"nodes/{f}.glsl" for f in tree.families),

@@ -119,6 +119,7 @@ class FramePlan:
     motion: object = None
     reflective: bool = False
     ao_distance: float | None = None
+    pass_outputs: dict = dataclasses.field(default_factory=dict)  # the passes' (``features/passes.py``)
 
     @property
     def camera(self):
@@ -532,6 +533,8 @@ class Renderer:
             feature.before_lit(frame, sample)
         with clock.stage("lit pass"):
             self.lit(frame, sample)
+        for feature in frame.features:
+            feature.after_lit(frame, sample)
         sample.stats.binned = sample.data.bins is not None
         return sample
 
@@ -638,10 +641,12 @@ class Renderer:
         if not frame.aux:
             out = FrameOutput(color, None, None, stats, width, height, lit=film.color)
             out.debug = debug_image
+            out.passes = dict(frame.pass_outputs)
             return out
         out = FrameOutput(color, film.depth, film.shadow, stats, width, height, lit=film.color, normal=film.normal)
         out.debug = debug_image
         out.emission = film.emission if frame.emission else None
+        out.passes = dict(frame.pass_outputs)
         if frame.accumulate and film.centre is not None:
             out.depth_data, out.normal_data = film.centre
         return out

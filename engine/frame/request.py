@@ -23,7 +23,8 @@ class FrameRequest:
     ``adaptive`` (``sampling.Adaptive``): what may end the frame early; ``deadline`` (a
     ``sampling.clock()`` value): when its time limit ends it, if not counted from this call's
     first sample; ``navigating``: a one-sample frame while the view moves; ``motion``
-    (``motion.Motion``): what moves during the shutter."""
+    (``motion.Motion``): what moves during the shutter; ``passes``: Blender's further passes
+    the view layer asks for (``features/passes.py`` keys: data, colour, AOV, Cryptomatte)."""
 
     camera: object
     settings: object
@@ -37,6 +38,7 @@ class FrameRequest:
     deadline: float | None = None
     navigating: bool = False
     motion: object = None
+    passes: tuple = ()
 
     @property
     def size(self):

@@ -90,6 +90,8 @@ class MeshInstance:
     random: float = 0.0  # the Object Info node's Random: Blender's per-object (or per-instance) hash
     hair: str | None = None  # hair strips (``Geometry.strands``): Render > Curves > Shape (STRAND, STRIP)
     motion_key: tuple = ()  # which instance it is at another time of the shutter (``motion_key``)
+    pass_index: int = 0  # Object > Relations > Pass Index (the Object Index pass)
+    crypto_names: tuple = ("", "")  # its Cryptomatte object and asset (topmost parent) names
 
 
 @dataclass(frozen=True)
@@ -784,6 +786,14 @@ def _geometry_key(inst, ob, own_data):
     return ("OB", name), frozenset({name, data_name})
 
 
+def _topmost(ob):
+    """An object's topmost parent (itself without one): its Cryptomatte asset."""
+    seen = 0
+    while ob.parent is not None and seen < 1000:
+        ob, seen = ob.parent, seen + 1
+    return ob
+
+
 def _has_shape_keys(ob):
     data = ob.data
     return getattr(data, "shape_keys", None) is not None
@@ -914,6 +924,8 @@ class _Reading:
                 else (orig.name_full,),
                 hair=strip,
                 motion_key=motion_key(inst),
+                pass_index=int(getattr(orig, "pass_index", 0)),
+                crypto_names=(orig.name, _topmost(orig).name),
             )
         )
 

@@ -67,6 +67,8 @@ class Material:
     transparent_shadow: bool = True  # Settings > Transparent Shadows: off, alpha casts as opaque
     messages: tuple = ()  # what could not be read, for the render report and the panel
     tree: object = None  # nodetree.CompiledTree: the node tree drawn as generated GLSL
+    name: str = ""  # the material's name (its Cryptomatte id)
+    pass_index: int = 0  # Material > Settings > Pass Index (the Material Index pass)
 
     @property
     def f0(self):
@@ -294,6 +296,8 @@ def material_from_blender(mat):
         out.cull_shadow = bool(getattr(mat, "use_backface_culling_shadow", False))
         out.transparent_shadow = bool(getattr(mat, "use_transparent_shadow", True))
         out.thickness_mode = str(getattr(mat, "thickness_mode", "SPHERE"))
+        out.name = str(mat.name)
+        out.pass_index = int(getattr(mat, "pass_index", 0))
     return out
 
 
@@ -315,8 +319,8 @@ def _material_surface(mat):
         out = _display(mat, notes, "its surface shader is drawn with the viewport display colour")
     elif "alpha" in out.textures or out.alpha < 1.0:
         out.blend = _blend_mode(mat)
-    if notes:
-        out, notes = _compiled(mat, out, notes, whole)
+    if notes or _writes_aovs(mat):
+        out, notes = _compiled(mat, out, notes, whole or _writes_aovs(mat))
     for socket in ("Volume", "Displacement"):
         if _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", socket, {"ALL", "EEVEE"}):
             notes.append(f"its {socket} output is not drawn")
@@ -324,6 +328,11 @@ def _material_surface(mat):
         notes.append("its Thickness output is not read (the object's smallest dimension is its thickness)")
     out.messages = tuple(f"material '{mat.name}': {n}" for n in dict.fromkeys(notes))
     return out
+
+
+def _writes_aovs(mat):
+    """Whether ``mat``'s tree has an AOV Output node (only its compiled tree writes them)."""
+    return any(n.bl_idname == "ShaderNodeOutputAOV" and not n.mute for n in mat.node_tree.nodes)
 
 
 def _compiled(mat, read, notes, whole):

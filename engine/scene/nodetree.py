@@ -150,6 +150,7 @@ class CompiledTree:
     surface_fallback: bool = False  # the whole surface fell back (nothing compiled)
     normal: bool = False  # it computes the shading normal (a Bump, ...): NODE_NORMAL
     lobes: int = 1  # 2: a Mix / Add Shader of two surfaces, shaded as two lobes (NODE_LOBES == 2)
+    aovs: tuple = ()  # the AOV names its AOV Output nodes write, in node_aovs' order (NODE_AOVS)
 
 
 # --- the registry -------------------------------------------------------------------------
@@ -460,9 +461,10 @@ class Compiler:
 
     # -- the whole tree --
 
-    def compile(self, surface_socket):
+    def compile(self, surface_socket, aov_nodes=()):
         v = self.shader_input_root(surface_socket)
         body = "\n".join(self.lines)
+        aov_code, aovs = self.compile_aovs(aov_nodes)
         signature = (
             "void node_tree(vec3 N, vec3 V, bool front, inout vec4 base, inout float roughness,\n"
             "               inout float metallic, inout vec4 specular, inout float alpha, inout vec3 emission,\n"
@@ -484,6 +486,7 @@ class Compiler:
                 "                       emission, normal);\n"
                 "}\n"
             )
+        code += aov_code
         families = tuple(sorted(self.families))
         needs = frozenset(self.needs)
         images = tuple(self.images)
@@ -505,7 +508,28 @@ class Compiler:
             surface_fallback=self.surface_fallback,
             normal=self.normal,
             lobes=max(1, v.lobes),
+            aovs=aovs,
         )
+
+    def compile_aovs(self, nodes):
+        """The AOV Output nodes ``nodes`` as ``node_aovs(N, V, front, aov)``: per node, in
+        order, its Color (rgb) and Value (a) into ``aov[k]`` (the Shader AOV passes, drawn
+        apart: ``features/passes.py``). Returns (code, their AOV names); a node whose input
+        cannot compile writes 0 there and is named."""
+        if not nodes:
+            return "", ()
+        self.lines, self.cache = [], {}  # its own function: the surface's temporaries are not in scope
+        writes = []
+        for k, node in enumerate(nodes):
+            try:
+                color = self.input(node, "Color", Context(), "vec4")
+                value = self.input(node, "Value", Context(), "float")
+                writes.append(f"  aov[{k}] = vec4(({color.expr}).rgb, {value.expr});")
+            except Fallback as exc:
+                self.messages.append(f"AOV '{_aov_name(node)}' from {exc} (written as 0)")
+        body = "\n".join(self.lines + writes)
+        code = f"void node_aovs(vec3 N, vec3 V, bool front, inout vec4 aov[NODE_AOV_SLOTS])\n{{\n{body}\n}}\n"
+        return code, tuple(_aov_name(n) for n in nodes)
 
     def shader_input_root(self, socket):
         ctx = Context()
@@ -537,6 +561,11 @@ def _prelude(needs):
     return "".join(out)
 
 
+def _aov_name(node):
+    """The AOV an AOV Output node writes (``aov_name``; ``name`` before Blender 4.0)."""
+    return str(getattr(node, "aov_name", "") or "")
+
+
 def compile_material(mat):
     """``CompiledTree`` of ``mat``'s surface, or (None, message) when the tree is beyond the
     compiler's bounds or has no surface: returns (tree, message)."""
@@ -549,8 +578,9 @@ def compile_material(mat):
     if surface is None:
         return None, None
     compiler = Compiler(mat)
+    aov_nodes = [n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputAOV" and not n.mute and _aov_name(n)]
     try:
-        return compiler.compile(surface), None
+        return compiler.compile(surface, aov_nodes), None
     except TreeTooLarge as exc:
         return None, f"its node tree is too large to compile ({exc})"
     except RecursionError:

@@ -261,7 +261,8 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         scene.camera.data.type = "PANO"
         scene.render.use_motion_blur = True
         layer = scene.view_layers[0]
-        layer.use_pass_diffuse_color = layer.use_pass_vector = layer.use_pass_cryptomatte_object = True
+        layer.use_pass_diffuse_direct = layer.use_pass_vector = layer.use_pass_ambient_occlusion = True
+        layer.use_pass_diffuse_color = layer.use_pass_cryptomatte_object = True  # written
         layer.use_pass_shadow = layer.use_pass_z = layer.use_pass_normal = True  # Depth and Normal are written
         layer.aovs.add()
         for kind in ("pointclouds", "volumes"):  # object types Penumbra does not draw
@@ -282,10 +283,9 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
     assert result["done"]
     for message in (
         "panoramic cameras are not rendered (drawn as a perspective camera)",
-        "Blender's Diffuse Color pass is not written",
+        "Blender's Diffuse Direct pass is not written",
         "Blender's Vector pass is not written",
-        "Blender's Cryptomatte Object pass is not written",
-        "shader AOV passes are not written",
+        "Blender's Ambient Occlusion pass is not written",
         "area light 'Panel': Spread is not rendered (it emits over the whole half-space)",
         "point cloud object 'Pointclouds' is not drawn",
         "volume object 'Volumes' is not drawn",
@@ -297,6 +297,7 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
     # Drawn (a panoramic camera's depth of field is not: the camera is named as a whole).
     assert "depth of field" not in output and "motion blur" not in output
     assert "Depth pass is not" not in output and "Normal pass is not" not in output and "Z pass" not in output
+    assert "Diffuse Color pass" not in output and "Cryptomatte" not in output and "AOV" not in output
 
 
 def test_final_renders_take_their_textures_from_the_pool_and_draw_every_map_again():

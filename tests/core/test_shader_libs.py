@@ -16,7 +16,7 @@ load_penumbra()
 import penumbra  # noqa: E402
 from penumbra.engine.enums import DEPTH_FORMAT  # noqa: E402
 from penumbra.engine.frame import film_programs, programs, shadow_programs  # noqa: E402
-from penumbra.engine.frame.features import bounce, settling, world_occlusion, world_ratio  # noqa: E402
+from penumbra.engine.frame.features import bounce, passes, settling, world_occlusion, world_ratio  # noqa: E402
 from penumbra.engine.post.base import PointEffect, point_program  # noqa: E402
 from penumbra.shaders import loader  # noqa: E402
 from penumbra.shaders.loader import Program, lib_requires, program_sources, resolve_libs  # noqa: E402
@@ -180,6 +180,7 @@ def _fake_tree(families, images=0):
         constants=np.zeros((1, 4), np.float32),
         images=tuple(range(images)),
         needs=frozenset({"GENERATED"}),
+        aovs=(),
     )
 
 
@@ -210,11 +211,12 @@ def _engine_programs():
         (False, (programs.COUNTED_PART,)),
         (True, (programs.EMISSION_PART,)),
         (False, (programs.EMISSION_ONLY,)),
+        (False, (passes.group_part(("POSITION", "DIFFUSE_COLOR", "AOV_VALUE:x"), None),)),
     ):
         for tree in (None,) + trees:
             features = frozenset({"TEX_BASE_COLOR", "TERMINATOR_OFFSET"} if tree is None else {"NODES_x"})
             combos = [(t, None) for t in ((part,) for part in parts)]
-            combos += [((), entry) for entry in (None, *programs.ENTRY_PARTS.values())]
+            combos += [((), entry) for entry in (None, *programs.ENTRY_PARTS.values(), passes.ENTRY)]
             combos += [(parts[:2] + parts[3:5], None)]
             for technique, entry in combos:
                 p = programs.lit_key(aux, variant, own + technique, features, tree, entry).program()

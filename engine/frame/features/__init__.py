@@ -16,6 +16,7 @@ from .bounce import Bounce
 from .cubes import CubeReflections
 from .depth_of_field import DepthOfField
 from .motion_blur import MotionBlur
+from .passes import Passes
 from .planar import PlanarReflections
 from .reflections import Reflections
 from .refraction import Refraction
@@ -30,7 +31,8 @@ from .world_ratio import WorldRatio
 # the scene's reflections in them, the cube maps of what the screen does not hold, what
 # transmissive surfaces refract, the world's occlusion
 # (which keeps the first sample from the directions), the bounce, and settling last (it
-# decides over what the others planned).
+# decides over what the others planned); the passes' draws after all of them (they draw over what
+# the lit pass left).
 REGISTRY = (
     MotionBlur,
     DepthOfField,
@@ -43,6 +45,7 @@ REGISTRY = (
     WorldOcclusion,
     Bounce,
     Settling,
+    Passes,
 )
 
 __all__ = ["NO_PART", "REGISTRY", "Feature", "LitPart"]

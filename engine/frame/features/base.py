@@ -43,6 +43,8 @@ class Feature:
     * ``before_sample(frame, s)``: a stage of its own before sample ``s`` (settling's test);
     * ``prepare(frame, sample)``: its change to the sample's view, scene or lights (``Sample``);
     * ``before_lit(frame, sample)``: GPU work the sample's lit pass reads (a depth prepass);
+    * ``after_lit(frame, sample)``: GPU work over what the sample's lit pass left (its
+      z-buffer), before the sample is accumulated: the passes' draws;
     * ``lit(frame, sample)``: its ``LitPart`` of the sample's lit pass, and ``capture(frame,
       sample)`` of a lit pass that captures the scene from elsewhere (``planar``, ``cubes``);
     * ``resolve(frame)``: after the last sample; ``memory_bytes(frame)``: what it holds.
@@ -75,6 +77,9 @@ class Feature:
         pass
 
     def before_lit(self, frame, sample):
+        pass
+
+    def after_lit(self, frame, sample):
         pass
 
     def lit(self, frame, sample):

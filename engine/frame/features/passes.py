@@ -1,0 +1,227 @@
+"""Blender's data and colour passes, Shader AOVs and Cryptomatte (``FrameRequest.passes``): the
+surfaces drawn apart after each sample's lit pass, over the z-buffer it left
+(``shaders/lit_passes.frag.glsl``), up to six passes a draw. A pass is averaged over the
+samples like Combined (its film accumulation, filter and adaptive mask), or taken from the
+centred sample as Cycles takes it (Position, Object and Material Index); Cryptomatte's ids are
+read back each sample and ranked on the CPU (``frame/cryptomatte.py``).
+
+A frame that asks for no such pass does not register this technique: no draw, no target."""
+
+from ....shaders.loader import ProgramPart, set_uniforms
+from ...gpu_pool import new_texture
+from .. import cryptomatte, sampling
+from ..film import FilmPart, clear_zero
+from ..film_programs import SCALED_COPY, WEIGHTED_RESOLVE
+from .base import Feature
+
+# Each pass a frame can ask for: its id in lit_passes.frag.glsl, and how the samples give it
+# (MEAN: averaged as Combined; CENTRE: the centred sample's; IDS: read back every sample).
+MEAN, CENTRE, IDS = "MEAN", "CENTRE", "IDS"
+PASSES = {
+    "POSITION": (1, CENTRE),
+    "OBJECT_INDEX": (2, CENTRE),
+    "MATERIAL_INDEX": (3, CENTRE),
+    "DIFFUSE_COLOR": (4, MEAN),
+    "GLOSSY_COLOR": (5, MEAN),
+    "TRANSMISSION_COLOR": (6, MEAN),
+    "ENVIRONMENT": (7, MEAN),
+    "DENOISING_ALBEDO": (8, MEAN),
+    "DENOISING_NORMAL": (9, MEAN),
+    "CRYPTOMATTE": (10, IDS),
+    "UV": (11, MEAN),
+}
+AOV_COLOR, AOV_VALUE = 32, 64  # + the AOV Output node's index in its tree (lit_passes.frag.glsl)
+MAX_TARGETS = 6  # colour targets Blender's gpu module binds
+
+# The entry shader of the passes' draws and the per-draw values it reads.
+ENTRY = ProgramPart(
+    "passes",
+    fragment="lit_passes.frag.glsl",
+    # (Object Index, Material Index, Cryptomatte's object and material ids), its asset id.
+    push_constants=(("VEC4", "pass_ids"), ("FLOAT", "pass_asset")),
+)
+
+
+def _mode(key):
+    return PASSES[key][1] if key in PASSES else MEAN
+
+
+def groups(keys):
+    """The draws of a frame's passes: (mode, keys) with at most MAX_TARGETS keys each; the
+    centred sample's apart from those of every sample."""
+    every = [k for k in keys if _mode(k) != CENTRE]
+    centre = [k for k in keys if _mode(k) == CENTRE]
+    out = []
+    for mode, ks in ((MEAN, every), (CENTRE, centre)):
+        out += [(mode, tuple(ks[i : i + MAX_TARGETS])) for i in range(0, len(ks), MAX_TARGETS)]
+    return out
+
+
+def group_part(keys, tree):
+    """The ``ProgramPart`` of one draw of ``keys``: its outputs and which pass each writes;
+    an AOV the material's ``tree`` does not write is 0 there."""
+    defines = [("PASS_COUNT", len(keys))]
+    for slot, key in enumerate(keys):
+        if key.startswith("AOV_"):
+            kind, name = key[4:].split(":", 1)
+            aovs = tree.aovs if tree is not None else ()
+            which = (AOV_VALUE if kind == "VALUE" else AOV_COLOR) + aovs.index(name) if name in aovs else 0
+        else:
+            which = PASSES[key][0]
+        defines.append((f"PASS_{slot}", which))
+    name = "pass" + "_".join(str(v) for _k, v in defines[1:])
+    outputs = tuple(("VEC4", f"out_pass{i}") for i in range(1, len(keys)))
+    return ProgramPart(name, outputs=outputs, defines=tuple(defines))
+
+
+class PassTargets(FilmPart):
+    """The passes' targets: one RGBA32F a pass (what a sample's draw writes; after the frame's
+    resolve, a mean pass's average) and, in a frame of several samples, each mean pass's
+    accumulation with the colour's weights (``Film.copy``: its filter and adaptive mask)."""
+
+    name = "passes"
+
+    def __init__(self):
+        self.size = None
+        self.keys = ()
+        self.sample = {}  # key -> texture
+        self.accum = {}  # key -> (accumulation, its framebuffer)
+        self.fbs = {}
+
+    def ensure(self, film, keys):
+        import gpu
+
+        if self.size != film.size or self.keys != tuple(keys):
+            self.release(film)
+            self.size, self.keys = film.size, tuple(keys)
+        for key in keys:
+            if key not in self.sample:
+                self.sample[key] = new_texture(film.pool, film.size, "RGBA32F")
+        for mode, ks in groups(keys):
+            if ks not in self.fbs:
+                slots = tuple(self.sample[k] for k in ks)
+                self.fbs[ks] = gpu.types.GPUFrameBuffer(depth_slot=film.zbuffer, color_slots=slots)
+        return self.sample
+
+    def framebuffer_of(self, keys):
+        return self.fbs[keys]
+
+    def begin(self, film):
+        import gpu
+
+        for key in self.keys:
+            if _mode(key) != MEAN:
+                continue
+            if key not in self.accum:
+                target = new_texture(film.pool, film.size, "RGBA32F")
+                self.accum[key] = (target, gpu.types.GPUFrameBuffer(color_slots=(target,)))
+            clear_zero(self.accum[key][0])
+
+    def accumulate(self, film, weight, sample, mask, gather):
+        for key, (_target, fb) in self.accum.items():
+            film.copy(fb, self.sample[key], weight, mask, gather)
+
+    def resolve(self, film, framebuffer=None):
+        """Each mean pass's average into its target (not into ``framebuffer``: that is the
+        colour's mean alone, ``Film.mean_into``)."""
+        if framebuffer is not None:
+            return
+        import gpu
+
+        for key, (accum, _fb) in self.accum.items():
+            out = gpu.types.GPUFrameBuffer(color_slots=(self.sample[key],))
+            if film.weight is not None:
+                film.fullscreen(WEIGHTED_RESOLVE, out, {"src_color": accum, "weight": film.weight}, {})
+            else:
+                total = film.weight_sum
+                film.fullscreen(SCALED_COPY, out, {"src_color": accum}, {"scale": 1.0 / total if total > 0 else 0.0})
+
+    def bytes_per_pixel(self, film):
+        return 16 * (len(self.sample) + len(self.accum))
+
+    def release(self, film):
+        film.give([*self.sample.values(), *(t for t, _fb in self.accum.values())])
+        self.sample, self.accum, self.fbs = {}, {}, {}
+        self.size, self.keys = None, ()
+
+
+class Passes(Feature):
+    """The passes a final render's view layer asks for (``FrameRequest.passes``)."""
+
+    name = "passes"
+
+    def __init__(self, renderer):
+        super().__init__(renderer)
+        self.targets = PassTargets()
+        self.crypto = None  # cryptomatte.Accumulator of the frame
+
+    def wanted(self, frame):
+        return bool(frame.request.passes)
+
+    def plan(self, frame):
+        keys = frame.request.passes
+        self.targets.ensure(self.renderer.film, keys)
+        if "CRYPTOMATTE" in keys and frame.request.samples[0] == 0:
+            self.crypto = cryptomatte.Accumulator(frame.size)
+            seen = [d.instance for d in frame.draws if d.instance.camera]
+            self.crypto.names = (
+                sorted({i.crypto_names[0] for i in seen}),
+                sorted({m.name for i in seen for m in i.materials if m is not None}),
+                sorted({i.crypto_names[1] for i in seen}),
+            )
+
+    def film_part(self, frame):
+        return self.targets
+
+    def after_lit(self, frame, sample):
+        """The sample's pass draws: those of every sample, and at the centred sample (the
+        first) those it alone gives; Cryptomatte's ids read back and added."""
+        if sample.pilot or sample.settle_test:
+            return
+        renderer = self.renderer
+        targets = self.targets
+        keys = frame.request.passes
+        for mode, ks in groups(keys):
+            if mode == CENTRE and sample.index != 0:
+                continue
+            fb = targets.framebuffer_of(ks)
+            with fb.bind():
+                fb.clear(color=(0.0, 0.0, 0.0, 0.0))
+            if "ENVIRONMENT" in ks:
+                renderer.lit_pass.background_into(targets.sample["ENVIRONMENT"], frame, sample)
+            renderer.lit_pass.draw_apart(sample, fb, ENTRY, lambda tree, ks=ks: group_part(ks, tree), _per_draw)
+        if self.crypto is not None:
+            from ..film import texture_array
+
+            with frame.clock.waiting():
+                ids = texture_array(targets.sample["CRYPTOMATTE"], 4)
+            taps = sampling.sample_taps(sample.index, frame.settings.filter_size) if frame.accumulate else [(0, 0, 1.0)]
+            self.crypto.add(ids[..., :3], taps, sampling.gathers(frame.settings.filter_size) and frame.accumulate)
+
+    def resolve(self, frame):
+        """What the frame's passes are (``frame.pass_outputs``): their targets, and
+        Cryptomatte's ranked (id, coverage) layers."""
+        outputs = {k: self.targets.sample[k] for k in frame.request.passes if k != "CRYPTOMATTE"}
+        if self.crypto is not None:
+            outputs["CRYPTOMATTE"] = self.crypto
+        outputs["ORIGIN"] = tuple(float(x) for x in frame.origin)  # what Position is relative to
+        frame.pass_outputs = outputs
+
+    def memory_bytes(self, frame):
+        return self.targets.bytes_per_pixel(self.renderer.film) * frame.size[0] * frame.size[1]
+
+    def release(self):
+        self.targets.release(self.renderer.film)
+        self.crypto = None
+
+
+def _per_draw(shader, draw, mat):
+    """A draw's own values: its object's and material's Pass Index, its Cryptomatte ids."""
+    obj, material, asset = cryptomatte.draw_ids(draw.instance, mat)
+    index = float(draw.instance.pass_index), float(getattr(mat, "pass_index", 0))
+    set_uniforms(shader, {"pass_ids": (*index, obj, material), "pass_asset": asset})
+
+
+def passes_of(frame):
+    """{key: texture or cryptomatte.Accumulator} of a rendered frame (empty without passes)."""
+    return dict(getattr(frame, "pass_outputs", None) or {})
