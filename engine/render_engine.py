@@ -95,7 +95,8 @@ class PenumbraEngineCore:
         snapshot = self.cache.snapshot(depsgraph)
         settings = scene.penumbra.render_settings(
             frame=scene.frame_current,
-            film_transparent=scene.render.film_transparent,
+            # View Layer > Filter > Environment off: the world lights, the camera does not see it.
+            film_transparent=scene.render.film_transparent or not getattr(depsgraph.view_layer, "use_sky", True),
             pixel_scale=pixel_scale,
             use_simplify=scene.render.use_simplify,
         )
@@ -260,6 +261,8 @@ class PenumbraEngineCore:
         shutter = float(r.motion_blur_shutter)
         if not r.use_motion_blur or not (math.isfinite(shutter) and shutter > 0.0):
             return None, []
+        if not getattr(depsgraph.view_layer, "use_motion_blur", True):  # View Layer > Filter > Motion Blur
+            return None, []
         start = {"START": 0.0, "CENTER": -0.5, "END": -1.0}.get(r.motion_blur_position, -0.5) * shutter
         frame, subframe = scene.frame_current, float(scene.frame_subframe)
         count = motion_steps(scene.objects)
@@ -408,7 +411,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                 self.update_stats("", f"Penumbra | {layer}{' | ' + view if view else ''} | rendering")
                 camera = self._view_camera(depsgraph, view, width, height)
                 options = scene.penumbra
-                count = int(options.render_samples)
+                # View Layer > Override > Samples (0: the scene's).
+                count = int(getattr(vl, "samples", 0) or 0) or int(options.render_samples)
                 adaptive = adaptive_settings(
                     options.use_adaptive_sampling,
                     options.adaptive_threshold,

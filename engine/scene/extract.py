@@ -825,6 +825,11 @@ class _Reading:
         self.instances, self.lights, self.portals, self.messages = [], [], [], []
         self.planes, self.spheres = [], []
         self.used = set()
+        # The view layer's Override > Material and Filter > Surfaces and Curves.
+        layer = depsgraph.view_layer
+        self.material_override = getattr(layer, "material_override", None)
+        self.surfaces = bool(getattr(layer, "use_solid", True))
+        self.curves = bool(getattr(layer, "use_strand", True))
         self._own, self._held, self._sets, self._terminators = {}, {}, {}, {}
 
     def probe(self, inst):
@@ -985,10 +990,12 @@ class SceneCache:
         self.materials.clear()
         self.world = None
 
-    def _world(self, scene):
-        name = scene.world.name_full if scene.world is not None else ""
+    def _world(self, scene, override=None):
+        """The world's light: the scene's, or the view layer's World Override."""
+        world = override if override is not None else scene.world
+        name = world.name_full if world is not None else ""
         if self.world is None or self.world[0] != name:
-            self.world = (name, world_from_blender(scene))
+            self.world = (name, world_from_blender(scene, world))
         return self.world[1]
 
     def _geometry_for(self, inst, ob, key, deps, needs):
@@ -1041,7 +1048,7 @@ class SceneCache:
         # Forget geometry no longer in the scene so its GPU buffers are freed.
         for key in [k for k in self.geometry if k not in reading.used]:
             del self.geometry[key]
-        world = self._world(scene)
+        world = self._world(scene, getattr(depsgraph.view_layer, "world_override", None))
         messages += world.messages
         return Snapshot(
             instances=reading.instances,
@@ -1076,8 +1083,17 @@ class SceneCache:
         camera, shadow = bool(orig.visible_camera), bool(orig.visible_shadow)
         if not (camera or shadow):
             return
+        if getattr(orig, "is_shadow_catcher", False):
+            reading.messages.append(f"object '{ob.name}': Shadow Catcher is Cycles-only (drawn as an ordinary object)")
         obj = _Object(inst, ob, orig, matrix, camera, shadow)
         slots = [self._material(slot.material) for slot in ob.material_slots]
+        if reading.material_override is not None:  # View Layer > Override > Material: every slot's
+            slots = [self._material(reading.material_override)] * max(1, len(slots))
+        if ob.type == "CURVES" or systems:
+            if not reading.curves:  # View Layer > Filter > Curves off
+                systems = []
+                if ob.type == "CURVES":
+                    return
         if ob.type == "CURVES":
             key, deps = _geometry_key(inst, ob, reading.own_data)
             geo = self._strips_for(key, deps, lambda ob=ob: hair.geometry_from_curves(ob.data))
@@ -1087,7 +1103,8 @@ class SceneCache:
         self._read_particle_hair(reading, obj, systems, slots)
         if not inst.is_instance and not inst.show_self:
             return  # a particle emitter with Show Emitter off for this render
-        self._read_surface(reading, obj, slots)
+        if reading.surfaces:  # View Layer > Filter > Surfaces
+            self._read_surface(reading, obj, slots)
 
     def _read_particle_hair(self, reading, obj, systems, slots):
         """The strips of the hair particle ``systems`` of ``obj``, each with its settings'

@@ -829,11 +829,11 @@ def _environment_rotation(world, env, messages):
     return m.T if kind == "TEXTURE" else m
 
 
-def world_from_blender(scene):
-    """The scene world's light (``World``, see ``_world_surface``); a Volume shader on the
-    world's output is named (not drawn)."""
-    out = _world_surface(scene)
-    world = scene.world
+def world_from_blender(scene, world=None):
+    """The scene world's light (``World``, see ``_world_surface``), or ``world``'s (a view
+    layer's World Override); a Volume shader on the world's output is named (not drawn)."""
+    world = scene.world if world is None else world
+    out = _world_surface(world)
     tree = getattr(world, "node_tree", None) if world is not None else None
     if (
         tree is not None
@@ -844,10 +844,9 @@ def world_from_blender(scene):
     return out
 
 
-def _world_surface(scene):
+def _world_surface(world):
     """The scene world's light (``World``): a Background shader's colour x strength, or an
     Environment Texture image's radiance as SH; anything else its colour with a message."""
-    world = scene.world
     if world is None:
         return World.constant((0.0, 0.0, 0.0))
     tree = getattr(world, "node_tree", None)

@@ -264,7 +264,7 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         layer.use_pass_diffuse_direct = layer.use_pass_vector = layer.use_pass_ambient_occlusion = True
         layer.use_pass_diffuse_color = layer.use_pass_cryptomatte_object = True  # written
         layer.use_pass_shadow = layer.use_pass_z = layer.use_pass_normal = True  # Depth and Normal are written
-        layer.aovs.add()
+        bpy.data.objects["Ball"].is_shadow_catcher = True
         for kind in ("pointclouds", "volumes"):  # object types Penumbra does not draw
             data = getattr(bpy.data, kind).new(kind)
             scene.collection.objects.link(bpy.data.objects.new(kind.title(), data))
@@ -286,6 +286,7 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         "Blender's Diffuse Direct pass is not written",
         "Blender's Vector pass is not written",
         "Blender's Ambient Occlusion pass is not written",
+        "object 'Ball': Shadow Catcher is Cycles-only (drawn as an ordinary object)",
         "area light 'Panel': Spread is not rendered (it emits over the whole half-space)",
         "point cloud object 'Pointclouds' is not drawn",
         "volume object 'Volumes' is not drawn",
