@@ -14,7 +14,9 @@ from .frame.output import (
     CRYPTOMATTE_SWITCHES,
     DENOISING_PASSES,
     FURTHER_PASSES,
+    LIGHT_COLOR,
     cryptomatte_levels,
+    divided,
     frame_in_region,
     mist_pass,
     pass_name,
@@ -605,10 +607,14 @@ def further_pass_data(view_layer, out):
     if not out.passes:
         return {}
     new = bpy.app.version >= (5, 0, 0)
+    asked = requested_passes(view_layer)
     data = {}
     for p in FURTHER_PASSES:
-        if p[1] in out.passes:
-            data[pass_name(p, new)] = out.pass_array(p[1], p[4])
+        if p[1] in out.passes and p[1] in asked:
+            pixels = out.pass_array(p[1], p[4])
+            if p[1] in LIGHT_COLOR:
+                pixels = divided(pixels, out.pass_array(LIGHT_COLOR[p[1]], 3))
+            data[pass_name(p, new)] = pixels
     for key, name, channels, *_rest in DENOISING_PASSES:
         if key in out.passes:
             data[name] = out.pass_array(key, channels)

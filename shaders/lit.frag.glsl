@@ -57,20 +57,33 @@ void main()
   /* The world's light, the lights', the bounce. */
   vec3 color = surface_world_light(s, ab);
   float arriving = 0.0, unshadowed = 0.0;
+#if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_GLOSSY
   lights_on(s, color, arriving, unshadowed);
-#if TRANSMISSION
+#endif
+#if TRANSMISSION && (LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_TRANSMISSION)
   color += transmitted * surface_refraction(s, m.base.rgb, ab[0]);
 #endif
-#if INDIRECT_RSM
+#if INDIRECT_RSM && (LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE_INDIRECT)
   /* One diffuse bounce from the lights' reflective shadow maps (lib/indirect_rsm.glsl). */
   color += surface_bounce(s);
 #endif
 #if WORLD_RATIO && WORLD_RATIO_OUT != 1
-  /* No film sums for this surface (a blended one): its own ratio within this sample. */
+  /* No film sums for this surface (a blended one): its own ratio within this sample (of the
+   * world's light the variant carries: a light pass's lobe alone). */
+#  if LIGHT_PASS == LIGHT_PASS_DIFFUSE
+  world_s = vec3(0.0);
+#  elif LIGHT_PASS == LIGHT_PASS_GLOSSY
+  world_d = vec3(0.0);
+#  elif LIGHT_PASS != 0
+  world_d = world_s = vec3(0.0);
+#  endif
   color = world_ratio_apply(vec4(color, 1.0), world_d, world_s, world_sums).rgb;
 #endif
   if (dropped) {
     discard;
   }
+#if LIGHT_PASS != 0
+  m.emission = vec3(0.0); /* the Emission pass's */
+#endif
   write_passes(surface_color(color + m.emission, m.coverage), s, arriving, unshadowed, m.emission, HOLDOUT == 0);
 }

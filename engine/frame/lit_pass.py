@@ -174,6 +174,35 @@ class LitPass:
             submit.draw(blended, False, blended=True)
         _reset_state(stats)
 
+    def draw_light(self, sample, framebuffers, part):
+        """The sample's lit pass again over the z-buffer it left, with the frame's techniques'
+        parts and ``part`` (a ``ProgramPart`` switching the lit variant to one of Blender's
+        light passes, LIGHT_PASS): opaque surfaces (their framebuffer ``framebuffers[0]``) and
+        then blended ones blended over them (``framebuffers[1]``), none writing depth."""
+        import gpu
+
+        stats = sample.stats
+        opaque, blended, parts = self._entries(sample.seen, sample.view_camera, sample.atlas, stats, hashed_last=False)
+        submit = _Submission(self, sample, parts)
+        submit.light = part
+        width, height = self.film.size
+        with framebuffers[0].bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(False)
+            gpu.state.blend_set("NONE")
+            submit.draw(opaque, False)
+        if blended:
+            submit.rebind()
+            with framebuffers[1].bind():
+                gpu.state.viewport_set(0, 0, width, height)
+                gpu.state.depth_test_set("LESS_EQUAL")
+                gpu.state.depth_mask_set(False)
+                gpu.state.blend_set("ALPHA_PREMULT")
+                submit.draw(blended, False, blended=True)
+                gpu.state.blend_set("NONE")
+        _reset_state(stats)
+
     def background_into(self, target, frame, sample):
         """What the camera sees of the world where no surface is, into ``target`` (RGBA32F at
         the film's size): the Environment pass's background, whatever the film's transparency."""
@@ -387,6 +416,7 @@ class _Submission:
         self.shadow_tex = atlas.texture if atlas is not None else lit._shadow_dummy()
         self.emission = self.counted = False
         self.apart = None  # (entry part, part of a tree): a draw apart (``LitPass.draw_apart``)
+        self.light = None  # a light pass's part after the techniques' (``LitPass.draw_light``)
         self.per_draw = None
         # A debug view's entry shader, unless a technique's part brings its own (the settle test's).
         variant = data.variant
@@ -420,6 +450,8 @@ class _Submission:
         own = (EMISSION_PART,) if self.emission and with_aux else ()
         own += (COUNTED_PART,) if self.counted and not with_aux else ()
         techniques = data.blended_parts if blended else data.parts
+        if self.light is not None:
+            techniques = (*techniques, self.light)
         return lit_key(with_aux, data.variant, own + techniques, features, tree, self.entry)
 
     def bind(self, features, with_aux, tree, blended=False, emission_only=False):

@@ -113,7 +113,30 @@ FURTHER_PASSES = (
     ("use_pass_glossy_color", "GLOSSY_COLOR", "Glossy Color", "GlossCol", 3, "RGB", "COLOR"),
     ("use_pass_transmission_color", "TRANSMISSION_COLOR", "Transmission Color", "TransCol", 3, "RGB", "COLOR"),
     ("use_pass_environment", "ENVIRONMENT", "Environment", "Env", 3, "RGB", "COLOR"),
+    ("use_pass_diffuse_direct", "DIFFUSE_DIRECT", "Diffuse Direct", "DiffDir", 3, "RGB", "COLOR"),
+    ("use_pass_diffuse_indirect", "DIFFUSE_INDIRECT", "Diffuse Indirect", "DiffInd", 3, "RGB", "COLOR"),
+    ("use_pass_glossy_direct", "GLOSSY_DIRECT", "Glossy Direct", "GlossDir", 3, "RGB", "COLOR"),
+    ("use_pass_glossy_indirect", "GLOSSY_INDIRECT", "Glossy Indirect", "GlossInd", 3, "RGB", "COLOR"),
+    ("use_pass_transmission_direct", "TRANSMISSION_DIRECT", "Transmission Direct", "TransDir", 3, "RGB", "COLOR"),
 )
+# The Color pass each light pass is divided by (Cycles: Direct = light / Color where Color is
+# not 0, else 0), so that Direct x Color is the light the surface reflects.
+LIGHT_COLOR = {
+    "DIFFUSE_DIRECT": "DIFFUSE_COLOR",
+    "DIFFUSE_INDIRECT": "DIFFUSE_COLOR",
+    "GLOSSY_DIRECT": "GLOSSY_COLOR",
+    "GLOSSY_INDIRECT": "GLOSSY_COLOR",
+    "TRANSMISSION_DIRECT": "TRANSMISSION_COLOR",
+}
+
+
+def divided(light, color):
+    """A light pass over its Color pass, channel by channel; 0 where the colour is 0."""
+    light, color = np.asarray(light, np.float64), np.asarray(color, np.float64)
+    out = np.divide(light, color, out=np.zeros_like(light), where=color > 0.0)
+    return out.astype(np.float32)
+
+
 # Penumbra's Denoising Data switch (``penumbra.use_pass_denoising``): Cycles' names.
 DENOISING_PASSES = (
     ("DENOISING_ALBEDO", "Denoising Albedo", 3, "RGB", "COLOR"),

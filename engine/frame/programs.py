@@ -309,6 +309,8 @@ LIT = Program(
             "EMISSION_OUTPUT": False,
             "EMISSION_ONLY": False,
             "COUNT_SHADED": False,
+            # One light pass of Blender's alone (features/passes.py LIGHT_PASSES; 0: all of it).
+            "LIGHT_PASS": 0,
             # The techniques' switches, off; their parts turn them on (``features.LitPart``).
             "INDIRECT_RSM": False,
             "RSM_SAMPLES": 1,

@@ -72,7 +72,13 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   vec3 reflected = vec3(0.0);
   for (int k = 0; k < NODE_LOBES; k++) {
     if (NdotL[k] > 0.0) {
-      reflected += (s.lobe[k].weight * cosines[k]) * lobe_brdf(s.lobe[k], s.V, to_light, NdotL[k], L);
+      vec3 f = lobe_brdf(s.lobe[k], s.V, to_light, NdotL[k], L);
+#if LIGHT_PASS == LIGHT_PASS_DIFFUSE
+      f = min(f, s.lobe[k].albedo / M_PI * L.diffuse_factor); /* its diffuse term (the specular's >= 0) */
+#elif LIGHT_PASS == LIGHT_PASS_GLOSSY
+      f = max(f - s.lobe[k].albedo / M_PI * L.diffuse_factor, vec3(0.0)); /* the rest: its specular */
+#endif
+      reflected += (s.lobe[k].weight * cosines[k]) * f;
     }
   }
   vec3 added = (L.color * visibility) * irradiance * reflected;

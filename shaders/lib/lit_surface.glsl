@@ -2,6 +2,14 @@
 #ifndef PENUMBRA_LIB_LIT_SURFACE
 #define PENUMBRA_LIB_LIT_SURFACE
 
+/* Blender's light passes, one a lit variant (LIGHT_PASS; 0: the whole colour), each the
+ * light of one kind of lobe without the surface's emission (engine/frame/features/passes.py). */
+#define LIGHT_PASS_DIFFUSE 1          /* lights' and world's light on the diffuse lobes */
+#define LIGHT_PASS_DIFFUSE_INDIRECT 2 /* the diffuse bounce (INDIRECT_RSM) */
+#define LIGHT_PASS_GLOSSY 3           /* lights' and world's light on the specular lobes */
+#define LIGHT_PASS_GLOSSY_INDIRECT 4  /* what the specular lobes' traced rays met of the scene */
+#define LIGHT_PASS_TRANSMISSION 5     /* what a transmissive surface shows through it */
+
 /* The surface the lit pass shades (lit.frag.glsl): its point, the view, its geometric normals,
  * and its lobes. A material is one lobe. A compiled node tree whose Mix / Add Shader joins two
  * surfaces (engine/scene/nodetree.py) is NODE_LOBES == 2: each lobe its own Principled

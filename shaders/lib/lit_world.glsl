@@ -166,6 +166,7 @@ float world_visibility = 1.0;
  * occlusion it implies for this lobe (gtao_specular). */
 vec3 world_light(Lobe b, vec3 V, vec2 ab)
 {
+  vec3 scene_seen = vec3(0.0); /* what traced rays met of the scene (Glossy Indirect) */
   vec3 diffuse = b.albedo * world_sh(b.N, vec2(2.0 / 3.0, 0.25));
   vec3 R = reflect(-V, b.N);
   float t = b.rough * b.rough;
@@ -222,14 +223,25 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
       world_hit(reach * w, seen, h, hits);
     }
 #    endif
-    specular = specular * (1.0 - h * (1.0 - world_ratio_share(b.rough))) + hits * dfg;
+    specular = specular * (1.0 - h * (1.0 - world_ratio_share(b.rough)));
+    scene_seen = hits * dfg;
 #    if DEBUG_LIT
     debug_reflected = max(debug_reflected, h);
 #    endif
 #  endif
   }
 #endif
-  return diffuse + specular;
+#if LIGHT_PASS == LIGHT_PASS_DIFFUSE
+  return diffuse;
+#elif LIGHT_PASS == LIGHT_PASS_GLOSSY
+  return specular;
+#elif LIGHT_PASS == LIGHT_PASS_GLOSSY_INDIRECT
+  return scene_seen;
+#elif LIGHT_PASS != 0
+  return vec3(0.0);
+#else
+  return diffuse + (specular + scene_seen);
+#endif
 }
 
 /* The world's light on every lobe of ``s``, summed by their weights (``ab``: each lobe's

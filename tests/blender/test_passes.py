@@ -4,6 +4,8 @@ Shader AOVs against their nodes, Cryptomatte through Blender's own compositor no
 render runs in a child process: render-result writes (passes, metadata) must fail a test, not
 the run."""
 
+import textwrap
+
 import numpy as np
 import pytest
 
@@ -80,8 +82,6 @@ def save(**arrays):
 
 
 def child(body):
-    import textwrap
-
     result, output = run_result(textwrap.dedent(SCENE) + textwrap.dedent(body), timeout=600)
     with np.load(result["npz"]) as data:
         return {k: data[k] for k in data.files}, output
@@ -269,3 +269,53 @@ def test_blenders_cryptomatte_node_picks_an_objects_filtered_coverage_from_the_r
     # Coverages of a pixel's ranks add up to at most its whole weight.
     crypto = out["crypto"]
     assert np.all(crypto[..., 1] + crypto[..., 3] <= 1.0 + 1e-5) and np.all(crypto[..., 1] >= crypto[..., 3])
+
+
+LIGHT_SCENE = """
+glass = scenes.material("Glass", (0.9, 0.95, 1.0), roughness=0.05)
+glass.node_tree.nodes["Principled BSDF"].inputs["Transmission Weight"].default_value = 1.0
+scenes.uv_sphere(scene, "Glass", center=(-1.2, 0.6, 0.45), radius=0.45, mat=glass)
+scenes.box(scene, "Lamp", center=(0.2, -1.2, 0.15), size=(0.3, 0.3, 0.3), mat=scenes.emissive("Glow", 2.0))
+scenes.light(scene, "Area", "AREA", 200.0, location=(-2.0, -2.0, 3.0), size=1.0)
+blue.node_tree.nodes["Principled BSDF"].inputs["Roughness"].default_value = 0.05  # a mirror: traced rays
+scene.penumbra.indirect_bounces = 1
+for p in ("diffuse_direct", "diffuse_indirect", "diffuse_color", "glossy_direct", "glossy_indirect", "glossy_color",
+          "transmission_direct", "transmission_color", "emit", "environment"):
+    setattr(layer, "use_pass_" + p, True)
+"""
+
+
+def test_light_passes_add_up_to_combined_per_pixel_and_leave_it_as_it_was():
+    """Cycles' algebra: (Diffuse Direct + Indirect) x Diffuse Color + (Glossy Direct +
+    Indirect) x Glossy Color + Transmission Direct x Color + Emission + Environment is Combined
+    before the post stack, per pixel within 1e-3, in a frame with the world's ratio estimator,
+    an area light, a mirror's traced rays, glass and the diffuse bounce; each pass is finite and
+    >= 0; and asking for the passes leaves Combined bit for bit as it is without them."""
+    out, _ = child(
+        LIGHT_SCENE
+        + textwrap.dedent(
+            """
+        (passes,) = render("light", 8).values()
+        for p in ("diffuse_direct", "diffuse_indirect", "diffuse_color", "glossy_direct", "glossy_indirect",
+                  "glossy_color", "transmission_direct", "transmission_color", "emit", "environment"):
+            setattr(layer, "use_pass_" + p, False)
+        for aov in list(layer.aovs):
+            layer.aovs.remove(aov)
+        (bare,) = render("bare", 8).values()
+        save(bare=bare["Combined"], **{k.replace(" ", "_"): v for k, v in passes.items()})
+        """
+        )
+    )
+
+    def g(name):
+        return out[name.replace(" ", "_")][..., :3].astype(np.float64)
+
+    for name in out:
+        assert np.all(np.isfinite(out[name])) and out[name].min() >= 0.0, name
+    total = (g("Diffuse Direct") + g("Diffuse Indirect")) * g("Diffuse Color")
+    total += (g("Glossy Direct") + g("Glossy Indirect")) * g("Glossy Color")
+    total += g("Transmission Direct") * g("Transmission Color") + g("Emission") + g("Environment")
+    np.testing.assert_allclose(total, g("Combined"), atol=1e-3)
+    for name in ("Diffuse Indirect", "Glossy Indirect", "Transmission Direct", "Emission"):
+        assert g(name).max() > 0.05, name  # each carries light here
+    np.testing.assert_array_equal(out["Combined"], out["bare"])

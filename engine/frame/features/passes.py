@@ -30,6 +30,20 @@ PASSES = {
     "CRYPTOMATTE": (10, IDS),
     "UV": (11, MEAN),
 }
+# Blender's light passes: the light of one kind of lobe (a lit variant of its own, LIGHT_PASS in
+# lib/lit_surface.glsl), averaged like Combined, and the Color pass that divides it into the
+# Direct or Indirect pass (Cycles' algebra: Direct x Color is the light).
+LIGHT_PASSES = {
+    "DIFFUSE_DIRECT": (1, "DIFFUSE_COLOR"),
+    "DIFFUSE_INDIRECT": (2, "DIFFUSE_COLOR"),
+    "GLOSSY_DIRECT": (3, "GLOSSY_COLOR"),
+    "GLOSSY_INDIRECT": (4, "GLOSSY_COLOR"),
+    "TRANSMISSION_DIRECT": (5, "TRANSMISSION_COLOR"),
+}
+LIGHT = "LIGHT"
+# The world ratio's unshadowed light each light pass carries (diffuse, specular), shadowed at
+# the resolve as Combined's is (``world_ratio.RESOLVE``).
+_RATIO_LOBES = {"DIFFUSE_DIRECT": (True, False), "GLOSSY_DIRECT": (False, True)}
 AOV_COLOR, AOV_VALUE = 32, 64  # + the AOV Output node's index in its tree (lit_passes.frag.glsl)
 MAX_TARGETS = 6  # colour targets Blender's gpu module binds
 
@@ -43,13 +57,23 @@ ENTRY = ProgramPart(
 
 
 def _mode(key):
+    if key in LIGHT_PASSES:
+        return LIGHT
     return PASSES[key][1] if key in PASSES else MEAN
 
 
+def frame_keys(keys):
+    """What a frame draws for the passes ``keys``: each, and the Color pass a light pass is
+    divided by."""
+    out = list(keys)
+    out += [LIGHT_PASSES[k][1] for k in keys if k in LIGHT_PASSES]
+    return tuple(dict.fromkeys(out))
+
+
 def groups(keys):
-    """The draws of a frame's passes: (mode, keys) with at most MAX_TARGETS keys each; the
-    centred sample's apart from those of every sample."""
-    every = [k for k in keys if _mode(k) != CENTRE]
+    """The draws of a frame's passes but the light passes: (mode, keys) with at most
+    MAX_TARGETS keys each; the centred sample's apart from those of every sample."""
+    every = [k for k in keys if _mode(k) in (MEAN, IDS)]
     centre = [k for k in keys if _mode(k) == CENTRE]
     out = []
     for mode, ks in ((MEAN, every), (CENTRE, centre)):
@@ -87,21 +111,35 @@ class PassTargets(FilmPart):
         self.sample = {}  # key -> texture
         self.accum = {}  # key -> (accumulation, its framebuffer)
         self.fbs = {}
+        self.scratch = []  # what a light pass's draw writes of the techniques' targets (not kept)
 
-    def ensure(self, film, keys):
+    def ensure(self, film, keys, scratch=0):
+        """The targets of ``keys`` at the film's size, and ``scratch`` targets for the
+        techniques' outputs a light pass's draw writes besides its own."""
         import gpu
 
-        if self.size != film.size or self.keys != tuple(keys):
+        if self.size != film.size or self.keys != tuple(keys) or len(self.scratch) < scratch:
             self.release(film)
             self.size, self.keys = film.size, tuple(keys)
+            self.scratch = [new_texture(film.pool, film.size, "RGBA32F") for _ in range(scratch)]
         for key in keys:
             if key not in self.sample:
                 self.sample[key] = new_texture(film.pool, film.size, "RGBA32F")
-        for mode, ks in groups(keys):
+        for _mode_of, ks in groups(keys):
             if ks not in self.fbs:
                 slots = tuple(self.sample[k] for k in ks)
                 self.fbs[ks] = gpu.types.GPUFrameBuffer(depth_slot=film.zbuffer, color_slots=slots)
         return self.sample
+
+    def light_framebuffer(self, film, key, outputs):
+        """A light pass's framebuffer: its target, then ``outputs`` scratch targets."""
+        import gpu
+
+        which = (key, outputs)
+        if which not in self.fbs:
+            slots = (self.sample[key], *self.scratch[:outputs])
+            self.fbs[which] = gpu.types.GPUFrameBuffer(depth_slot=film.zbuffer, color_slots=slots)
+        return self.fbs[which]
 
     def framebuffer_of(self, keys):
         return self.fbs[keys]
@@ -110,7 +148,7 @@ class PassTargets(FilmPart):
         import gpu
 
         for key in self.keys:
-            if _mode(key) != MEAN:
+            if _mode(key) not in (MEAN, LIGHT):
                 continue
             if key not in self.accum:
                 target = new_texture(film.pool, film.size, "RGBA32F")
@@ -128,20 +166,44 @@ class PassTargets(FilmPart):
             return
         import gpu
 
+        ratio = next((p for p in film.parts if p.name == "world_ratio"), None)
         for key, (accum, _fb) in self.accum.items():
             out = gpu.types.GPUFrameBuffer(color_slots=(self.sample[key],))
-            if film.weight is not None:
+            if ratio is not None and key in _RATIO_LOBES:
+                self._resolve_ratio(film, ratio, key, accum, out)
+            elif film.weight is not None:
                 film.fullscreen(WEIGHTED_RESOLVE, out, {"src_color": accum, "weight": film.weight}, {})
             else:
                 total = film.weight_sum
                 film.fullscreen(SCALED_COPY, out, {"src_color": accum}, {"scale": 1.0 / total if total > 0 else 0.0})
 
+    def _resolve_ratio(self, film, ratio, key, accum, out):
+        """A light pass carrying the world's unshadowed light of one lobe: its average shadowed
+        by the frame's world ratio, as Combined's (the other lobe's U taken as 0)."""
+        from .world_ratio import RESOLVE
+
+        sums = ratio.accumulations()
+        zero = self.scratch[0]  # a light pass's scratch: cleared here, written again next sample
+        clear_zero(zero)
+        diffuse, specular = _RATIO_LOBES[key]
+        per_pixel = film.weight is not None
+        total = film.weight_sum
+        samplers = {
+            "src_color": accum,
+            "weight": film.weight if per_pixel else accum,
+            "world_diffuse": sums["world_diffuse"] if diffuse else zero,
+            "world_specular": sums["world_specular"] if specular else zero,
+            "world_sums": sums["world_sums"],
+        }
+        uniforms = {"scale": 1.0 / total if total > 0.0 else 0.0, "per_pixel": 1.0 if per_pixel else 0.0}
+        film.fullscreen(RESOLVE, out, samplers, uniforms)
+
     def bytes_per_pixel(self, film):
-        return 16 * (len(self.sample) + len(self.accum))
+        return 16 * (len(self.sample) + len(self.accum) + len(self.scratch))
 
     def release(self, film):
-        film.give([*self.sample.values(), *(t for t, _fb in self.accum.values())])
-        self.sample, self.accum, self.fbs = {}, {}, {}
+        film.give([*self.sample.values(), *(t for t, _fb in self.accum.values()), *self.scratch])
+        self.sample, self.accum, self.fbs, self.scratch = {}, {}, {}, []
         self.size, self.keys = None, ()
 
 
@@ -159,8 +221,11 @@ class Passes(Feature):
         return bool(frame.request.passes)
 
     def plan(self, frame):
-        keys = frame.request.passes
-        self.targets.ensure(self.renderer.film, keys)
+        keys = frame_keys(frame.request.passes)
+        # A light pass's draw writes the targets the techniques' parts write beside the colour
+        # (the world ratio's): into scratch targets (the lit pass's own are this sample's).
+        scratch = 4 if any(_mode(k) == LIGHT for k in keys) and frame.accumulate else 0
+        self.targets.ensure(self.renderer.film, keys, scratch)
         if "CRYPTOMATTE" in keys and frame.request.samples[0] == 0:
             self.crypto = cryptomatte.Accumulator(frame.size)
             seen = [d.instance for d in frame.draws if d.instance.camera]
@@ -180,7 +245,21 @@ class Passes(Feature):
             return
         renderer = self.renderer
         targets = self.targets
-        keys = frame.request.passes
+        keys = frame_keys(frame.request.passes)
+        data = sample.data
+        outputs = max(_outputs(data.parts), _outputs(data.blended_parts))
+        for key in keys:
+            if _mode(key) != LIGHT:
+                continue
+            part = ProgramPart(f"light{LIGHT_PASSES[key][0]}", defines=(("LIGHT_PASS", LIGHT_PASSES[key][0]),))
+            targets.sample[key].clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+            fbs = (
+                targets.light_framebuffer(renderer.film, key, _outputs(data.parts)),
+                targets.light_framebuffer(renderer.film, key, _outputs(data.blended_parts)),
+            )
+            if outputs > len(targets.scratch):
+                raise RuntimeError("a technique writes more targets than the light passes' scratch holds")
+            renderer.lit_pass.draw_light(sample, fbs, part)
         for mode, ks in groups(keys):
             if mode == CENTRE and sample.index != 0:
                 continue
@@ -201,7 +280,7 @@ class Passes(Feature):
     def resolve(self, frame):
         """What the frame's passes are (``frame.pass_outputs``): their targets, and
         Cryptomatte's ranked (id, coverage) layers."""
-        outputs = {k: self.targets.sample[k] for k in frame.request.passes if k != "CRYPTOMATTE"}
+        outputs = {k: self.targets.sample[k] for k in frame_keys(frame.request.passes) if k != "CRYPTOMATTE"}
         if self.crypto is not None:
             outputs["CRYPTOMATTE"] = self.crypto
         outputs["ORIGIN"] = tuple(float(x) for x in frame.origin)  # what Position is relative to
@@ -213,6 +292,11 @@ class Passes(Feature):
     def release(self):
         self.targets.release(self.renderer.film)
         self.crypto = None
+
+
+def _outputs(parts):
+    """Colour targets ``parts`` (``ProgramPart``) write besides the lit pass's colour."""
+    return sum(len(p.outputs) for p in parts if p is not None)
 
 
 def _per_draw(shader, draw, mat):

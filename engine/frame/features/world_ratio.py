@@ -139,14 +139,15 @@ class RatioTargets(FilmPart):
         if film.tracking and sample % 2 == 1:
             film.copy(self.half[1], targets[2], weight, mask, gather)
 
-    def _accumulations(self):
+    def accumulations(self):
+        """{sampler name: accumulation} of the ratio's targets (what its resolve reads)."""
         return {name: target for name, (target, _fb) in zip(NAMES, self.accum, strict=True)}
 
     def accumulated(self, film):
         return [(target, source) for (target, _fb), source in zip(self.accum, self.sample, strict=True)]
 
     def convergence(self, film):
-        return CONVERGENCE, {**self._accumulations(), "half_world_sums": self.half[0]}
+        return CONVERGENCE, {**self.accumulations(), "half_world_sums": self.half[0]}
 
     def resolve(self, film, framebuffer=None):
         """The colour resolved anew with the world's light through its ratio (over the shadow
@@ -157,7 +158,7 @@ class RatioTargets(FilmPart):
         samplers = {
             "src_color": film.accum_color,
             "weight": film.weight if per_pixel else film.accum_color,
-            **self._accumulations(),
+            **self.accumulations(),
         }
         uniforms = {"scale": 1.0 / total if total > 0.0 else 0.0, "per_pixel": 1.0 if per_pixel else 0.0}
         target = gpu_framebuffer(film.color) if framebuffer is None else framebuffer
