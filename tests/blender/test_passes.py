@@ -60,7 +60,9 @@ for aov_name, kind in (("mask", "VALUE"), ("cover", "VALUE"), ("tint", "COLOR"),
 
 # Blender 4.5's pass names, as its own engines register them, by 5.0's.
 OLD_NAMES = {"IndexOB": "Object Index", "IndexMA": "Material Index", "DiffCol": "Diffuse Color",
-             "GlossCol": "Glossy Color", "TransCol": "Transmission Color", "Env": "Environment"}
+             "GlossCol": "Glossy Color", "TransCol": "Transmission Color", "Env": "Environment",
+             "DiffDir": "Diffuse Direct", "DiffInd": "Diffuse Indirect", "GlossDir": "Glossy Direct",
+             "GlossInd": "Glossy Indirect", "TransDir": "Transmission Direct", "Emit": "Emission"}
 
 def render(name, samples, compositor=False):
     scene.penumbra.render_samples = samples
