@@ -595,6 +595,7 @@ def further_passes(view_layer):
         if key.startswith("AOV_"):
             kind, name = key[4:].split(":", 1)
             out.append((name, 1, "X", "VALUE") if kind == "VALUE" else (name, 4, "RGBA", "COLOR"))
+    out += [(f"Combined_{k[11:]}", 3, "RGB", "COLOR") for k in keys if k.startswith("LIGHTGROUP:")]
     levels = cryptomatte_levels(view_layer)
     for kind, switch in zip(cryptomatte.KINDS, CRYPTOMATTE_SWITCHES, strict=True):
         if getattr(view_layer, switch, False):
@@ -619,6 +620,8 @@ def further_pass_data(view_layer, out):
         if key in out.passes:
             data[name] = out.pass_array(key, channels)
     for key in out.passes:
+        if key.startswith("LIGHTGROUP:") and key in asked:
+            data[f"Combined_{key[11:]}"] = out.pass_array(key, 3)
         if key.startswith("AOV_"):
             kind, name = key[4:].split(":", 1)
             data[name] = out.pass_array(key, 1 if kind == "VALUE" else 4)

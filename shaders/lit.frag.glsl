@@ -57,7 +57,8 @@ void main()
   /* The world's light, the lights', the bounce. */
   vec3 color = surface_world_light(s, ab);
   float arriving = 0.0, unshadowed = 0.0;
-#if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_GLOSSY
+#if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_GLOSSY || \
+    LIGHT_PASS == LIGHT_PASS_GROUP
   lights_on(s, color, arriving, unshadowed);
 #endif
 #if TRANSMISSION && (LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_TRANSMISSION)
@@ -74,6 +75,8 @@ void main()
   world_s = vec3(0.0);
 #  elif LIGHT_PASS == LIGHT_PASS_GLOSSY
   world_d = vec3(0.0);
+#  elif LIGHT_PASS == LIGHT_PASS_GROUP && LIGHT_GROUP_WORLD
+  /* the world's light whole */
 #  elif LIGHT_PASS != 0
   world_d = world_s = vec3(0.0);
 #  endif
@@ -82,7 +85,9 @@ void main()
   if (dropped) {
     discard;
   }
-#if LIGHT_PASS != 0
+#if LIGHT_PASS == LIGHT_PASS_GROUP
+  m.emission *= group_emission; /* 1 where the object is in the group */
+#elif LIGHT_PASS != 0
   m.emission = vec3(0.0); /* the Emission pass's */
 #endif
   write_passes(surface_color(color + m.emission, m.coverage), s, arriving, unshadowed, m.emission, HOLDOUT == 0);

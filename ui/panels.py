@@ -1,7 +1,11 @@
 """Render-properties panels and the sidebar (N-panel) tab with the post-layer stack."""
 
 import bpy
-from bl_ui.properties_view_layer import ViewLayerAOVPanelHelper, ViewLayerCryptomattePanelHelper
+from bl_ui.properties_view_layer import (
+    ViewLayerAOVPanelHelper,
+    ViewLayerCryptomattePanelHelper,
+    ViewLayerLightgroupsPanelHelper,
+)
 
 from ..engine import settings
 from ..engine.enums import DEBUG_VIEW
@@ -262,6 +266,43 @@ class PENUMBRA_PT_passes_cryptomatte(ViewLayerCryptomattePanelHelper, bpy.types.
     COMPAT_ENGINES = {"PENUMBRA"}
 
 
+class PENUMBRA_PT_passes_lightgroups(ViewLayerLightgroupsPanelHelper, bpy.types.Panel):
+    """The view layer's light groups (Blender's list), under Penumbra's passes."""
+
+    bl_parent_id = "PENUMBRA_PT_passes"
+    COMPAT_ENGINES = {"PENUMBRA"}
+
+
+class PENUMBRA_PT_object_lightgroup(PenumbraPanel, bpy.types.Panel):
+    """Object > Shading > Light Group: the light group a light's light, or a surface's
+    emission, is in (its view layer's light group pass)."""
+
+    bl_label = "Light Group"
+    bl_parent_id = "OBJECT_PT_shading"
+    bl_context = "object"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.split_layout()
+        layout.prop_search(context.object, "lightgroup", context.view_layer, "lightgroups", text="Light Group")
+
+
+class PENUMBRA_PT_world_lightgroup(PenumbraPanel, bpy.types.Panel):
+    """World > Light Group: the light group the world's light is in."""
+
+    bl_label = "Light Group"
+    bl_context = "world"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.world is not None
+
+    def draw(self, context):
+        layout = self.split_layout()
+        layout.prop_search(context.world, "lightgroup", context.view_layer, "lightgroups", text="Light Group")
+
+
 class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
     bl_label = "Penumbra"
     bl_context = "data"
@@ -410,6 +451,9 @@ classes = (
     PENUMBRA_PT_passes,
     PENUMBRA_PT_passes_aov,
     PENUMBRA_PT_passes_cryptomatte,
+    PENUMBRA_PT_passes_lightgroups,
+    PENUMBRA_PT_object_lightgroup,
+    PENUMBRA_PT_world_lightgroup,
     PENUMBRA_PT_shadows,
     PENUMBRA_PT_light,
     PENUMBRA_PT_lightprobe,

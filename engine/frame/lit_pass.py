@@ -2,6 +2,7 @@
 with the frame's lights and shadow atlas, into the film's targets; and the world's
 Environment Texture behind it."""
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -174,17 +175,23 @@ class LitPass:
             submit.draw(blended, False, blended=True)
         _reset_state(stats)
 
-    def draw_light(self, sample, framebuffers, part):
+    def draw_light(self, sample, framebuffers, part, per_draw=None, masks=None):
         """The sample's lit pass again over the z-buffer it left, with the frame's techniques'
         parts and ``part`` (a ``ProgramPart`` switching the lit variant to one of Blender's
         light passes, LIGHT_PASS): opaque surfaces (their framebuffer ``framebuffers[0]``) and
-        then blended ones blended over them (``framebuffers[1]``), none writing depth."""
+        then blended ones blended over them (``framebuffers[1]``), none writing depth;
+        ``per_draw(shader, draw, material)`` a draw's own values, ``masks`` {id(draw): light
+        mask} the lights each draw takes (a light group's; ``part`` then switches LIGHT_LINKING on)."""
         import gpu
 
         stats = sample.stats
         opaque, blended, parts = self._entries(sample.seen, sample.view_camera, sample.atlas, stats, hashed_last=False)
         submit = _Submission(self, sample, parts)
         submit.light = part
+        submit.per_draw = per_draw
+        if masks is not None:  # each draw's lights through the light-linking variant
+            submit.masks = masks
+            submit.variant = dataclasses.replace(sample.data.variant, light_linking=True)
         width, height = self.film.size
         with framebuffers[0].bind():
             gpu.state.viewport_set(0, 0, width, height)
@@ -417,6 +424,7 @@ class _Submission:
         self.emission = self.counted = False
         self.apart = None  # (entry part, part of a tree): a draw apart (``LitPass.draw_apart``)
         self.light = None  # a light pass's part after the techniques' (``LitPass.draw_light``)
+        self.variant = data.variant  # the lit variant its draws take
         self.per_draw = None
         # A debug view's entry shader, unless a technique's part brings its own (the settle test's).
         variant = data.variant
@@ -452,7 +460,7 @@ class _Submission:
         techniques = data.blended_parts if blended else data.parts
         if self.light is not None:
             techniques = (*techniques, self.light)
-        return lit_key(with_aux, data.variant, own + techniques, features, tree, self.entry)
+        return lit_key(with_aux, self.variant, own + techniques, features, tree, self.entry)
 
     def bind(self, features, with_aux, tree, blended=False, emission_only=False):
         lit, data = self.lit, self.data

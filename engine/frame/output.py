@@ -169,7 +169,7 @@ def cryptomatte_levels(view_layer):
 def requested_passes(view_layer):
     """The ``FrameRequest.passes`` keys of what ``view_layer`` asks for beyond Combined, Depth,
     Mist, Normal, Emission and Penumbra's own: its switched-on ``FURTHER_PASSES``, Penumbra's
-    Denoising Data, its valid Shader AOVs and Cryptomatte."""
+    Denoising Data, its valid Shader AOVs, its light groups and Cryptomatte."""
     keys = [p[1] for p in FURTHER_PASSES if getattr(view_layer, p[0], False) is True]
     own = getattr(view_layer, "penumbra", None)
     if own is not None and getattr(own, "use_pass_denoising", False):
@@ -177,6 +177,9 @@ def requested_passes(view_layer):
     for aov in getattr(view_layer, "aovs", ()):
         if aov.is_valid and aov.name:
             keys.append(f"AOV_{'VALUE' if aov.type == 'VALUE' else 'COLOR'}:{aov.name}")
+    for group in getattr(view_layer, "lightgroups", ()):
+        if group.name:
+            keys.append(f"LIGHTGROUP:{group.name}")
     if any(getattr(view_layer, s, False) is True for s in CRYPTOMATTE_SWITCHES):
         keys.append("CRYPTOMATTE")
     return tuple(dict.fromkeys(keys))
@@ -198,8 +201,6 @@ def unsupported_in_use(camera_data, render, view_layer):
                 if getattr(view_layer, name, False) is True:
                     own = " (switch on Penumbra's own in View Layer > Passes)" if name == "use_pass_shadow" else ""
                     out.append(f"Penumbra: Blender's {prop.name} pass is not written{own}")
-        if len(getattr(view_layer, "lightgroups", ())):
-            out.append("Penumbra: light group passes are not written")
     return list(dict.fromkeys(out))
 
 

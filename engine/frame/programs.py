@@ -311,6 +311,7 @@ LIT = Program(
             "COUNT_SHADED": False,
             # One light pass of Blender's alone (features/passes.py LIGHT_PASSES; 0: all of it).
             "LIGHT_PASS": 0,
+            "LIGHT_GROUP_WORLD": False,
             # The techniques' switches, off; their parts turn them on (``features.LitPart``).
             "INDIRECT_RSM": False,
             "RSM_SAMPLES": 1,

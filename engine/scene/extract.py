@@ -92,6 +92,7 @@ class MeshInstance:
     motion_key: tuple = ()  # which instance it is at another time of the shutter (``motion_key``)
     pass_index: int = 0  # Object > Relations > Pass Index (the Object Index pass)
     crypto_names: tuple = ("", "")  # its Cryptomatte object and asset (topmost parent) names
+    lightgroup: str = ""  # Object > Shading > Light Group: the light group its emission is in
 
 
 @dataclass(frozen=True)
@@ -196,6 +197,7 @@ class Light:
     receivers: LinkSet | None = None  # light linking: what it lights (None: everything)
     blockers: LinkSet | None = None  # shadow linking: what casts its shadow (None: everything)
     name: str = ""  # the light object's name (what the SHADOW_MAPS debug view labels its maps with)
+    lightgroup: str = ""  # Object > Shading > Light Group (its light group pass)
     motion_key: tuple = ()  # which light it is at another time of the shutter (``motion_key``)
     # A direction of the world's light (``frame/world/directions.py``): a sun whose ``color`` is
     # the world's radiance from it over its probability.
@@ -893,6 +895,7 @@ class _Reading:
         light = light_from_blender(ob.data, matrix_np(inst.matrix_world))
         if light is not None:
             light.name = ob.name
+            light.lightgroup = str(getattr(ob, "lightgroup", "") or "")
             light.motion_key = motion_key(inst)
             linking = getattr(ob, "light_linking", None)
             if linking is not None:
@@ -931,6 +934,7 @@ class _Reading:
                 motion_key=motion_key(inst),
                 pass_index=int(getattr(orig, "pass_index", 0)),
                 crypto_names=(orig.name, _topmost(orig).name),
+                lightgroup=str(getattr(orig, "lightgroup", "") or ""),
             )
         )
 

@@ -722,6 +722,7 @@ class World:
     # None for none.
     rotation: np.ndarray | None = None
     sun: WorldSun | None = None  # World > Settings > Sun (EEVEE's): its light above a threshold
+    lightgroup: str = ""  # World > Settings > Light Group: the light group its light is in
     # Where the sun took the image's light above its threshold: that threshold (radiance, with
     # the strength), what the rest of the world's light is clamped to; None where it took none.
     sun_clamp: float | None = None
@@ -834,6 +835,7 @@ def world_from_blender(scene, world=None):
     layer's World Override); a Volume shader on the world's output is named (not drawn)."""
     world = scene.world if world is None else world
     out = _world_surface(world)
+    out.lightgroup = str(getattr(world, "lightgroup", "") or "") if world is not None else ""
     tree = getattr(world, "node_tree", None) if world is not None else None
     if (
         tree is not None

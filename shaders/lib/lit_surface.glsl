@@ -9,6 +9,9 @@
 #define LIGHT_PASS_GLOSSY 3           /* lights' and world's light on the specular lobes */
 #define LIGHT_PASS_GLOSSY_INDIRECT 4  /* what the specular lobes' traced rays met of the scene */
 #define LIGHT_PASS_TRANSMISSION 5     /* what a transmissive surface shows through it */
+#define LIGHT_PASS_GROUP 6            /* a light group: its lights (light_mask), its objects' emission
+                                       * (group_emission) and the world's light if it is in the group
+                                       * (LIGHT_GROUP_WORLD) */
 
 /* The surface the lit pass shades (lit.frag.glsl): its point, the view, its geometric normals,
  * and its lobes. A material is one lobe. A compiled node tree whose Mix / Add Shader joins two

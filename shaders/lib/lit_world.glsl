@@ -237,6 +237,8 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
   return specular;
 #elif LIGHT_PASS == LIGHT_PASS_GLOSSY_INDIRECT
   return scene_seen;
+#elif LIGHT_PASS == LIGHT_PASS_GROUP && LIGHT_GROUP_WORLD
+  return diffuse + specular;
 #elif LIGHT_PASS != 0
   return vec3(0.0);
 #else

@@ -321,3 +321,40 @@ def test_light_passes_add_up_to_combined_per_pixel_and_leave_it_as_it_was():
     for name in ("Diffuse Indirect", "Glossy Indirect", "Transmission Direct", "Emission"):
         assert g(name).max() > 0.05, name  # each carries light here
     np.testing.assert_array_equal(out["Combined"], out["bare"])
+
+
+def test_light_groups_add_up_to_combined_and_each_holds_its_own_light():
+    """Light groups: the sun in "key", the area light and the world in "fill", the glowing
+    box's emission in "glow". Their passes add up to Combined before the post stack (surfaces
+    rough enough that no traced ray adds the scene's reflection), "glow" is the box's emission
+    alone, and "key" is the frame lit by the sun alone (the others switched off)."""
+    out, _ = child(
+        """
+        for mat in (red, blue, bpy.data.materials["Grey"]):
+            mat.node_tree.nodes["Principled BSDF"].inputs["Roughness"].default_value = 0.8
+        lamp = scenes.emissive("Glow", 2.0)
+        glow = scenes.box(scene, "Glow", center=(0.2, -1.2, 0.15), size=(0.3, 0.3, 0.3), mat=lamp)
+        area = scenes.light(scene, "Area", "AREA", 200.0, location=(-2.0, -2.0, 3.0), size=1.0)
+        for name in ("key", "fill", "glow"):
+            layer.lightgroups.add(name=name)
+        bpy.data.objects["Sun"].lightgroup, area.lightgroup, glow.lightgroup = "key", "fill", "glow"
+        scene.world.lightgroup = "fill"
+        (passes,) = render("groups", 8).values()
+        for aov in list(layer.aovs):
+            layer.aovs.remove(aov)
+        area.hide_render = True
+        glow.data.materials[0] = bpy.data.materials["Grey"]
+        scenes.set_world(scene, (0.0, 0.0, 0.0))
+        (sun,) = render("sun", 8).values()
+        save(sun=sun["Combined"], **{k.replace(" ", "_"): v for k, v in passes.items()})
+        """
+    )
+    key, fill, glow = out["Combined_key"], out["Combined_fill"], out["Combined_glow"]
+    np.testing.assert_allclose(key + fill + glow, out["Combined"][..., :3], atol=1e-4)
+    assert glow.max() == pytest.approx(2.0, abs=1e-5) and np.all(glow[glow > 0.0] <= 2.0 + 1e-5)
+    box = (glow > 0.0).any(-1)
+    assert 0 < box.sum() < 200  # the box's own pixels (and their filtered edge)
+    # The same sun, though its map may be packed at another size beside fewer lights.
+    np.testing.assert_allclose(key[~box], out["sun"][..., :3][~box], atol=5e-3)
+    assert np.abs(key[~box] - out["sun"][..., :3][~box]).mean() < 2e-4
+    assert fill.min() >= 0.0 and fill.mean() > 0.1

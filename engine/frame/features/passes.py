@@ -56,8 +56,12 @@ ENTRY = ProgramPart(
 )
 
 
+GROUP = "LIGHTGROUP:"  # + a light group's name: its Combined before the post stack
+LIGHT_PASS_GROUP = 6
+
+
 def _mode(key):
-    if key in LIGHT_PASSES:
+    if key in LIGHT_PASSES or key.startswith(GROUP):
         return LIGHT
     return PASSES[key][1] if key in PASSES else MEAN
 
@@ -66,7 +70,7 @@ def frame_keys(keys):
     """What a frame draws for the passes ``keys``: each, and the Color pass a light pass is
     divided by."""
     out = list(keys)
-    out += [LIGHT_PASSES[k][1] for k in keys if k in LIGHT_PASSES]
+    out += [LIGHT_PASSES[k][1] for k in keys if k in LIGHT_PASSES and LIGHT_PASSES[k][1]]
     return tuple(dict.fromkeys(out))
 
 
@@ -112,6 +116,7 @@ class PassTargets(FilmPart):
         self.accum = {}  # key -> (accumulation, its framebuffer)
         self.fbs = {}
         self.scratch = []  # what a light pass's draw writes of the techniques' targets (not kept)
+        self.world_groups = set()  # the light group passes the world's light is in
 
     def ensure(self, film, keys, scratch=0):
         """The targets of ``keys`` at the film's size, and ``scratch`` targets for the
@@ -169,15 +174,16 @@ class PassTargets(FilmPart):
         ratio = next((p for p in film.parts if p.name == "world_ratio"), None)
         for key, (accum, _fb) in self.accum.items():
             out = gpu.types.GPUFrameBuffer(color_slots=(self.sample[key],))
-            if ratio is not None and key in _RATIO_LOBES:
-                self._resolve_ratio(film, ratio, key, accum, out)
+            lobes = _RATIO_LOBES.get(key) or ((True, True) if key in self.world_groups else None)
+            if ratio is not None and lobes is not None:
+                self._resolve_ratio(film, ratio, lobes, accum, out)
             elif film.weight is not None:
                 film.fullscreen(WEIGHTED_RESOLVE, out, {"src_color": accum, "weight": film.weight}, {})
             else:
                 total = film.weight_sum
                 film.fullscreen(SCALED_COPY, out, {"src_color": accum}, {"scale": 1.0 / total if total > 0 else 0.0})
 
-    def _resolve_ratio(self, film, ratio, key, accum, out):
+    def _resolve_ratio(self, film, ratio, lobes, accum, out):
         """A light pass carrying the world's unshadowed light of one lobe: its average shadowed
         by the frame's world ratio, as Combined's (the other lobe's U taken as 0)."""
         from .world_ratio import RESOLVE
@@ -185,7 +191,7 @@ class PassTargets(FilmPart):
         sums = ratio.accumulations()
         zero = self.scratch[0]  # a light pass's scratch: cleared here, written again next sample
         clear_zero(zero)
-        diffuse, specular = _RATIO_LOBES[key]
+        diffuse, specular = lobes
         per_pixel = film.weight is not None
         total = film.weight_sum
         samplers = {
@@ -222,6 +228,15 @@ class Passes(Feature):
 
     def plan(self, frame):
         keys = frame_keys(frame.request.passes)
+        world = frame.snapshot.world
+        world_group = getattr(world, "lightgroup", "") if world is not None else ""
+        self.targets.world_groups = {GROUP + world_group} if world_group else set()
+        groups_asked = [k[len(GROUP) :] for k in keys if k.startswith(GROUP)]
+        if groups_asked and (frame.has("reflections") or frame.has("refraction") or frame.has("bounce")):
+            frame.stats.messages.append(
+                "Penumbra: light group passes hold each group's direct light, world and emission; what surfaces "
+                "reflect or refract of the scene and the diffuse bounce are in Combined alone"
+            )
         # A light pass's draw writes the targets the techniques' parts write beside the colour
         # (the world ratio's): into scratch targets (the lit pass's own are this sample's).
         scratch = 4 if any(_mode(k) == LIGHT for k in keys) and frame.accumulate else 0
@@ -251,15 +266,22 @@ class Passes(Feature):
         for key in keys:
             if _mode(key) != LIGHT:
                 continue
-            part = ProgramPart(f"light{LIGHT_PASSES[key][0]}", defines=(("LIGHT_PASS", LIGHT_PASSES[key][0]),))
+            group = _group_draw(frame, sample, key[len(GROUP) :]) if key.startswith(GROUP) else None
+            if group is not None:
+                part, per_draw, masks = group
+            else:
+                part = ProgramPart(f"light{LIGHT_PASSES[key][0]}", defines=(("LIGHT_PASS", LIGHT_PASSES[key][0]),))
+                per_draw = masks = None
             targets.sample[key].clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
+            if key in targets.world_groups and not frame.settings.film_transparent:
+                renderer.lit_pass.background_into(targets.sample[key], frame, sample)  # the world seen
             fbs = (
                 targets.light_framebuffer(renderer.film, key, _outputs(data.parts)),
                 targets.light_framebuffer(renderer.film, key, _outputs(data.blended_parts)),
             )
             if outputs > len(targets.scratch):
                 raise RuntimeError("a technique writes more targets than the light passes' scratch holds")
-            renderer.lit_pass.draw_light(sample, fbs, part)
+            renderer.lit_pass.draw_light(sample, fbs, part, per_draw, masks)
         for mode, ks in groups(keys):
             if mode == CENTRE and sample.index != 0:
                 continue
@@ -292,6 +314,36 @@ class Passes(Feature):
     def release(self):
         self.targets.release(self.renderer.film)
         self.crypto = None
+
+
+def _group_draw(frame, sample, name):
+    """A light group pass's draw: (its ``ProgramPart``, per-draw values, light masks by draw):
+    the group's lights (world directions with the world), its objects' emission, the world's
+    SH light and image when the world is in the group."""
+    world = frame.snapshot.world
+    world_in = bool(world is not None and getattr(world, "lightgroup", "") == name)
+    part = ProgramPart(
+        f"group{int(world_in)}",
+        defines=(("LIGHT_PASS", LIGHT_PASS_GROUP), ("LIGHT_GROUP_WORLD", world_in)),
+        push_constants=(("FLOAT", "group_emission"),),
+    )
+    lights, order = sample.lights, sample.data.order
+    words = [0, 0, 0, 0]
+    for j, i in enumerate(order):
+        light = lights[i]
+        if (light.world and world_in) or (not light.world and getattr(light, "lightgroup", "") == name):
+            words[j >> 5] |= 1 << (j & 31)
+    linked = sample.masks
+    masks = {}
+    for d in sample.seen:
+        own = linked[id(d)] if linked is not None else (-1, -1, -1, -1)
+        both = [(w & (o & 0xFFFFFFFF)) for w, o in zip(words, own, strict=True)]
+        masks[id(d)] = tuple(w - (1 << 32) if w >= 1 << 31 else w for w in both)
+
+    def per_draw(shader, draw, mat):
+        set_uniforms(shader, {"group_emission": 1.0 if draw.instance.lightgroup == name else 0.0})
+
+    return part, per_draw, masks
 
 
 def _outputs(parts):

@@ -101,5 +101,6 @@ def _extract(world, sun, env):
         angle=max(float(sun.angle), 0.0),
         use_shadow=bool(sun.shadow),
         name="World Sun",
+        lightgroup=getattr(world, "lightgroup", ""),
     )
     return sh, left, light
