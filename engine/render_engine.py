@@ -17,6 +17,7 @@ from .frame.output import (
     LIGHT_COLOR,
     cryptomatte_levels,
     divided,
+    drawn_passes,
     frame_in_region,
     mist_pass,
     pass_name,
@@ -250,6 +251,33 @@ class PenumbraEngineCore:
         )
         return viewport_window(width, height, space.use_render_border, border)
 
+    def read_vectors(self, depsgraph, width, height):
+        """The scene at the previous and next frames (``vectors.Neighbours``): what the Vector
+        pass measures the motion against, as Cycles does (``frame_set`` to each, then back)."""
+        from .frame.vectors import Neighbours
+
+        scene = depsgraph.scene
+        frame, subframe = scene.frame_current, float(scene.frame_subframe)
+        read = []
+        try:
+            for step in (-1, 1):
+                self.frame_set(frame + step, subframe)
+                cam = camera_from_scene(depsgraph, scene, width, height)
+                read.append((motion_matrices(depsgraph), cam.projection @ cam.view))
+        finally:
+            self.frame_set(frame, subframe)
+        return Neighbours(read[0][0], read[1][0], read[0][1], read[1][1])
+
+    @staticmethod
+    def _vector_pass(out, camera, neighbours, width, height):
+        """The Vector pass of frame ``out`` (``vectors.vector_pass``), full frame."""
+        from .frame.vectors import vector_pass
+
+        position = out.pass_array("POSITION", 3)
+        numbers = out.pass_array("DRAW", 1)[..., 0]
+        view_proj = camera.projection @ camera.view
+        return vector_pass(position, numbers, out.passes["DRAWS"], view_proj, neighbours, width, height)
+
     def read_motion(self, depsgraph):
         """What moves during this frame's shutter (Render > Motion Blur: its Position, Shutter
         and Shutter Curve), read at the shutter's steps (``motion_steps``; ``frame_set`` to
@@ -393,6 +421,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
             self.report({"WARNING"}, message)
         try:
             motion, messages = self.read_motion(depsgraph)
+            neighbours = self.read_vectors(depsgraph, width, height) if depsgraph.view_layer.use_pass_vector else None
         except Exception as exc:  # a render must end with a message, never a crash
             traceback.print_exc(file=sys.stderr)
             motion, messages = None, [f"Penumbra: motion blur could not be read ({exc}): rendered without it"]
@@ -442,8 +471,10 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     emission=vl.use_pass_emit,
                     adaptive=adaptive,
                     motion=motion,
-                    passes=requested_passes(vl),
+                    passes=drawn_passes(requested_passes(vl)),
                 )
+                if vl.use_pass_vector and out.passes:
+                    out.passes["VECTOR"] = self._vector_pass(out, camera, neighbours, width, height)
                 if out.stats.cancelled and out.stats.samples == 0:
                     return  # cancelled before a sample was drawn: nothing to write
                 self._report_frame(out.stats, label, count, reported)
@@ -612,7 +643,7 @@ def further_pass_data(view_layer, out):
     data = {}
     for p in FURTHER_PASSES:
         if p[1] in out.passes and p[1] in asked:
-            pixels = out.pass_array(p[1], p[4])
+            pixels = out.passes[p[1]] if p[1] == "VECTOR" else out.pass_array(p[1], p[4])
             if p[1] in LIGHT_COLOR:
                 pixels = divided(pixels, out.pass_array(LIGHT_COLOR[p[1]], 3))
             data[pass_name(p, new)] = pixels

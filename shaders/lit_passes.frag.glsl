@@ -22,6 +22,7 @@
 #define PASS_DENOISING_NORMAL 9
 #define PASS_CRYPTOMATTE 10
 #define PASS_UV 11
+#define PASS_DRAW 12 /* which draw of the frame covers the pixel (+ 1): the Vector pass's read-back */
 #define PASS_AOV_COLOR 32 /* + the AOV Output node's index in the compiled tree (NODE_AOVS): its Color */
 #define PASS_AOV_VALUE 64 /* + the index: its Value */
 
@@ -83,7 +84,10 @@ vec4 pass_value(int which, Surface s, PassColors c, vec4 tree_aov[NODE_AOV_SLOTS
     return vec4(s.lobe[heavier_lobe(s)].N, 1.0);
   }
   if (which == PASS_CRYPTOMATTE) {
-    return vec4(pass_ids.zw, pass_asset, 1.0);
+    return vec4(pass_ids.zw, pass_more.x, 1.0);
+  }
+  if (which == PASS_DRAW) {
+    return vec4(pass_more.y, 0.0, 0.0, 1.0);
   }
   if (which == PASS_UV) {
 #if HAS_UV

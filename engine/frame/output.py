@@ -118,7 +118,20 @@ FURTHER_PASSES = (
     ("use_pass_glossy_direct", "GLOSSY_DIRECT", "Glossy Direct", "GlossDir", 3, "RGB", "COLOR"),
     ("use_pass_glossy_indirect", "GLOSSY_INDIRECT", "Glossy Indirect", "GlossInd", 3, "RGB", "COLOR"),
     ("use_pass_transmission_direct", "TRANSMISSION_DIRECT", "Transmission Direct", "TransDir", 3, "RGB", "COLOR"),
+    ("use_pass_vector", "VECTOR", "Vector", "Vector", 4, "XYZW", "VECTOR"),
 )
+# What the GPU draws for a pass computed from others on the CPU (``vectors.py``).
+DRAWN_FOR = {"VECTOR": ("POSITION", "DRAW")}
+
+
+def drawn_passes(keys):
+    """The ``FrameRequest.passes`` of asked ``keys``: each, or what it is computed from."""
+    out = []
+    for key in keys:
+        out += DRAWN_FOR.get(key, (key,))
+    return tuple(dict.fromkeys(out))
+
+
 # The Color pass each light pass is divided by (Cycles: Direct = light / Color where Color is
 # not 0, else 0), so that Direct x Color is the light the surface reflects.
 LIGHT_COLOR = {

@@ -29,6 +29,7 @@ PASSES = {
     "DENOISING_NORMAL": (9, MEAN),
     "CRYPTOMATTE": (10, IDS),
     "UV": (11, MEAN),
+    "DRAW": (12, CENTRE),  # the draw at each pixel (the Vector pass: ``vectors.py``)
 }
 # Blender's light passes: the light of one kind of lobe (a lit variant of its own, LIGHT_PASS in
 # lib/lit_surface.glsl), averaged like Combined, and the Color pass that divides it into the
@@ -51,8 +52,9 @@ MAX_TARGETS = 6  # colour targets Blender's gpu module binds
 ENTRY = ProgramPart(
     "passes",
     fragment="lit_passes.frag.glsl",
-    # (Object Index, Material Index, Cryptomatte's object and material ids), its asset id.
-    push_constants=(("VEC4", "pass_ids"), ("FLOAT", "pass_asset")),
+    # (Object Index, Material Index, Cryptomatte's object and material ids), (its asset id, the
+    # draw's number + 1).
+    push_constants=(("VEC4", "pass_ids"), ("VEC2", "pass_more")),
 )
 
 
@@ -290,7 +292,8 @@ class Passes(Feature):
                 fb.clear(color=(0.0, 0.0, 0.0, 0.0))
             if "ENVIRONMENT" in ks:
                 renderer.lit_pass.background_into(targets.sample["ENVIRONMENT"], frame, sample)
-            renderer.lit_pass.draw_apart(sample, fb, ENTRY, lambda tree, ks=ks: group_part(ks, tree), _per_draw)
+            values = _draw_values({id(d): i for i, d in enumerate(frame.draws)})
+            renderer.lit_pass.draw_apart(sample, fb, ENTRY, lambda tree, ks=ks: group_part(ks, tree), values)
         if self.crypto is not None:
             from ..film import texture_array
 
@@ -306,6 +309,8 @@ class Passes(Feature):
         if self.crypto is not None:
             outputs["CRYPTOMATTE"] = self.crypto
         outputs["ORIGIN"] = tuple(float(x) for x in frame.origin)  # what Position is relative to
+        if "DRAW" in outputs:  # each draw's instance, by number: what moves it (the Vector pass)
+            outputs["DRAWS"] = [(d.instance.motion_key, d.instance.matrix) for d in frame.draws]
         frame.pass_outputs = outputs
 
     def memory_bytes(self, frame):
@@ -351,11 +356,17 @@ def _outputs(parts):
     return sum(len(p.outputs) for p in parts if p is not None)
 
 
-def _per_draw(shader, draw, mat):
-    """A draw's own values: its object's and material's Pass Index, its Cryptomatte ids."""
-    obj, material, asset = cryptomatte.draw_ids(draw.instance, mat)
-    index = float(draw.instance.pass_index), float(getattr(mat, "pass_index", 0))
-    set_uniforms(shader, {"pass_ids": (*index, obj, material), "pass_asset": asset})
+def _draw_values(numbers):
+    """A draw's own values: its object's and material's Pass Index, its Cryptomatte ids, its
+    number in the frame's draw list + 1 (``numbers``: {id(draw): number})."""
+
+    def per_draw(shader, draw, mat):
+        obj, material, asset = cryptomatte.draw_ids(draw.instance, mat)
+        index = float(draw.instance.pass_index), float(getattr(mat, "pass_index", 0))
+        more = (asset, float(numbers.get(id(draw), -1) + 1))
+        set_uniforms(shader, {"pass_ids": (*index, obj, material), "pass_more": more})
+
+    return per_draw
 
 
 def passes_of(frame):
