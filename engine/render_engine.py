@@ -297,7 +297,12 @@ class PenumbraEngineCore:
         frame, subframe = scene.frame_current, float(scene.frame_subframe)
         count = motion_steps(scene.objects)
         times = tuple(k / (count - 1) for k in range(count))
-        steps, cameras = [], []
+        deforming = {
+            ob.name_full
+            for ob in scene.objects
+            if ob.type == "MESH" and ob.visible_get() and _blurs(ob, deform=True) and _deforms(ob, scene)
+        }
+        steps, cameras, shapes = [], [], []
         try:
             for t in times:
                 at = frame + subframe + start + t * shutter
@@ -305,6 +310,7 @@ class PenumbraEngineCore:
                 self.frame_set(int(whole), at - whole)
                 steps.append(motion_matrices(depsgraph))
                 cameras.append(_camera_view(scene.camera.evaluated_get(depsgraph)))
+                shapes.append(motion_shapes(depsgraph, deforming) if deforming else {})
         finally:
             self.frame_set(frame, subframe)
         reference = _camera_view(scene.camera.evaluated_get(depsgraph))
@@ -314,21 +320,23 @@ class PenumbraEngineCore:
         moves = any(not np.array_equal(cameras[0], c) for c in cameras[1:]) and _blurs(scene.camera)
         curve = _shutter_curve(r.motion_blur_shutter_curve, CURVE_POINTS)
         camera = cameras if moves else None
-        motion = Motion(times=times, instances=moving, lights=moving, camera=camera, camera_ref=reference, curve=curve)
-        messages = []
-        deforming = sorted(
-            {
-                ob.name
-                for ob in scene.objects
-                if ob.type in ("MESH", "CURVES")
-                and ob.visible_get()
-                and _blurs(ob, deform=True)
-                and _deforms(ob, scene)
-            }
+        deformed, changing = deforming_shapes(shapes)
+        motion = Motion(
+            times=times,
+            instances=moving,
+            lights=moving,
+            camera=camera,
+            camera_ref=reference,
+            curve=curve,
+            shapes=deformed,
         )
-        if deforming:
-            names = ", ".join(f"'{n}'" for n in deforming[:3]) + (" ..." if len(deforming) > 3 else "")
-            messages.append(f"Penumbra: deformation motion blur is not rendered: {names} keep the frame's shape")
+        messages = []
+        if changing:
+            names = ", ".join(f"'{n}'" for n in changing[:3]) + (" ..." if len(changing) > 3 else "")
+            messages.append(
+                f"Penumbra: {names} change their topology during the shutter: drawn at the frame's shape, "
+                "moving with their object"
+            )
         return (motion if motion.moves else None), messages
 
 
@@ -678,6 +686,55 @@ def cryptomatte_metadata(view_layer, out):
         if getattr(view_layer, switch, False):
             meta.update(cryptomatte.metadata(view_layer.name, kind, crypto.names[index]))
     return meta
+
+
+def motion_shapes(depsgraph, names):
+    """{``motion_key``: (object name, ``motion.Shape``)} of the instances of the meshes
+    ``names`` (full names) at the depsgraph's time."""
+    from .frame.motion import Shape
+    from .scene.extract import motion_key
+
+    out = {}
+    for inst in depsgraph.object_instances:
+        ob = inst.object
+        orig = ob.original if ob.original is not None else ob
+        if ob.type != "MESH" or orig.name_full not in names:
+            continue
+        mesh = ob.data
+        nv, nc = len(mesh.vertices), len(mesh.loops)
+        co = np.empty(nv * 3, np.float32)
+        mesh.vertices.foreach_get("co", co)
+        vn = np.empty(nv * 3, np.float32)
+        mesh.vertex_normals.foreach_get("vector", vn)
+        cv = np.empty(nc, np.int32)
+        mesh.loops.foreach_get("vertex_index", cv)
+        cn = None
+        if mesh.normals_domain != "POINT":
+            cn = np.empty(nc * 3, np.float32)
+            mesh.corner_normals.foreach_get("vector", cn)
+            cn = cn.reshape(-1, 3)
+        out[motion_key(inst)] = (orig.name, Shape(co.reshape(-1, 3), vn.reshape(-1, 3), cn, cv))
+    return out
+
+
+def deforming_shapes(steps):
+    """From ``motion_shapes`` at each step: ({``motion_key``: [``Shape`` per step]} of the
+    meshes that change shape and keep their topology, the names of those whose topology
+    changes)."""
+    from .frame.motion import same_topology
+
+    if not steps or not steps[0]:
+        return {}, []
+    shapes, changing = {}, set()
+    for key in set(steps[0]).intersection(*steps[1:]):
+        name = steps[0][key][0]
+        per_step = [s[key][1] for s in steps]
+        if not same_topology(per_step):
+            changing.add(name)
+        elif any(not np.array_equal(per_step[0].positions, s.positions) for s in per_step[1:]):
+            shapes[key] = per_step
+    changing |= {v[0] for s in steps for k, v in s.items() if any(k not in o for o in steps)}
+    return shapes, sorted(changing)
 
 
 def _camera_view(cam_ob):

@@ -6,6 +6,8 @@
               time, Penumbra against EEVEE -> <out>/assets.csv, assets.png
     frame     render time of Penumbra, EEVEE, Workbench and Cycles on the demo scene
               -> <out>/benchmark.csv
+    passes    Blender's light and colour passes against Cycles' (max bounces 0), the passes'
+              algebra, and what asking for passes costs -> <out>/passes.csv, passes_cost.csv
     perf      frame cost and scaling as ratios to Workbench: resolution, viewport redraw,
               lights, objects, instances, triangles, extraction -> <out>/perf.csv
     reflections  glossy surfaces under a real HDRI, a polished floor, glass: error against time,
@@ -36,12 +38,26 @@ Markdown tables for the README go to stdout, progress and Blender's own output t
 import argparse
 
 from devkit import session
-from tools.benchmarks import assets, camera, frame, perf, post, reflections, samples, shadows, soak, terminator, world
+from tools.benchmarks import (
+    assets,
+    camera,
+    frame,
+    passes,
+    perf,
+    post,
+    reflections,
+    samples,
+    shadows,
+    soak,
+    terminator,
+    world,
+)
 
 COMMANDS = {
     "assets": assets,
     "camera": camera,
     "frame": frame,
+    "passes": passes,
     "perf": perf,
     "post": post,
     "reflections": reflections,

@@ -35,10 +35,75 @@ class Motion:
     camera: list = None
     camera_ref: np.ndarray = None
     curve: tuple = None
+    # Deforming meshes (armatures, shape keys, modifiers): per instance ``motion_key`` its
+    # ``Shape`` at each step, all of one topology.
+    shapes: dict = field(default_factory=dict)
 
     @property
     def moves(self):
-        return bool(self.instances or self.lights or self.camera is not None)
+        return bool(self.instances or self.lights or self.camera is not None or self.shapes)
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A mesh's surface at one step of the shutter: its vertices' positions and normals (nv, 3)
+    and its corners' normals (nc, 3; None where the mesh's normals live on its points), with
+    ``corner_vert`` (nc,), the vertex of each corner (its topology)."""
+
+    positions: np.ndarray
+    vertex_normals: np.ndarray
+    corner_normals: np.ndarray
+    corner_vert: np.ndarray
+
+
+def same_topology(shapes):
+    """Whether ``shapes`` (``Shape``, one per step) share one topology."""
+    first = shapes[0]
+    return all(
+        len(s.positions) == len(first.positions) and np.array_equal(s.corner_vert, first.corner_vert)
+        for s in shapes[1:]
+    )
+
+
+_SERIAL = [1 << 40]  # serials of deformed geometry (``Geometry.serial``), above any extraction's
+
+
+def deformed(geometry, shapes, times, u):
+    """``geometry`` (the frame's ``Geometry`` of a deforming mesh) with its vertices where they
+    are at shutter fraction ``u``, each interpolated linearly between the ``shapes`` at the
+    steps around it; None where its vertices are neither the shapes' vertices nor their
+    corners (a layout the steps cannot give)."""
+    first = shapes[0]
+    nv, nc = len(first.positions), len(first.corner_vert)
+    count = len(geometry.positions)
+    if count not in (nv, nc):
+        return None
+    t = np.asarray(times, np.float64)
+    k = int(np.clip(np.searchsorted(t, u, side="right") - 1, 0, len(t) - 2)) if len(t) > 1 else 0
+    f = float(np.clip((u - t[k]) / (t[k + 1] - t[k]), 0.0, 1.0)) if len(t) > 1 and t[k + 1] > t[k] else 0.0
+    a, b = shapes[k], shapes[min(k + 1, len(shapes) - 1)]
+    by_vertex = count == nv
+    if nv == nc:  # either layout has this many vertices: the one nearer the frame's own
+        middle = shapes[len(shapes) // 2]
+        near_vertex = np.abs(middle.positions - geometry.positions).max()
+        near_corner = np.abs(middle.positions[middle.corner_vert] - geometry.positions).max()
+        by_vertex = near_vertex <= near_corner
+
+    def layout(shape):
+        if by_vertex:
+            return shape.positions, shape.vertex_normals
+        normals = shape.corner_normals if shape.corner_normals is not None else shape.vertex_normals[shape.corner_vert]
+        return shape.positions[shape.corner_vert], normals
+
+    (pa, na), (pb, nb) = layout(a), layout(b)
+    positions = (pa + f * (pb - pa)).astype(np.float32)
+    normals = na + f * (nb - na)
+    length = np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = np.where(length > 1e-20, normals / np.maximum(length, 1e-20), na).astype(np.float32)
+    drawn = positions[np.unique(geometry.indices)] if len(geometry.indices) else positions
+    bounds = np.array([drawn.min(axis=0), drawn.max(axis=0)], np.float64) if len(drawn) else geometry.bounds
+    _SERIAL[0] += 1
+    return replace(geometry, positions=positions, normals=normals, bounds=bounds, serial=_SERIAL[0])
 
 
 def moving_only(matrices):

@@ -122,13 +122,30 @@ def test_extreme_shutters_stay_finite(penumbra, case):
         assert np.array_equal(image, still)
 
 
-def test_the_shutters_steps_are_read_once_and_deformation_is_named(penumbra, gpu_call):
+def test_the_shutters_steps_are_read_once_with_what_deforms(penumbra, gpu_call):
     """Render > Motion Blur is read at the shutter's start, centre and end (the frame set back
     after): only what moves is kept, the camera when it moves, the shutter curve where it is
-    not flat; an object whose shape deforms is named once (it moves, its shape is the frame's)."""
+    not flat; a mesh whose shape changes over the shutter (an animated shape key) is kept with
+    its vertices at each step, one whose modifier deforms it alike at every step is not, and a
+    deformed one whose topology changes (an animated Build modifier) is named once."""
     scene = _scene()
     cube = scenes.box(scene, "Wobbly", center=(0.0, 1.0, -6.0), size=(0.3, 0.3, 0.3))
     cube.modifiers.new("Twist", "SIMPLE_DEFORM")
+    morph = scenes.box(scene, "Morph", center=(0.0, -1.0, -6.0), size=(0.3, 0.3, 0.3))
+    morph.shape_key_add(name="Basis")
+    key = morph.shape_key_add(name="Up")
+    for v in key.data:
+        v.co.z += 0.5
+    for frame, value in ((1, 0.0), (3, 1.0)):
+        key.value = value
+        key.keyframe_insert("value", frame=frame)
+    for fc in _fcurves(morph.data.shape_keys):
+        for point in fc.keyframe_points:
+            point.interpolation = "LINEAR"
+    growing = scenes.uv_sphere(scene, "Growing", center=(1.0, 0.0, -6.0), radius=0.2)
+    build = growing.modifiers.new("Build", "BUILD")
+    build.frame_start, build.frame_duration = 1, 3
+    growing.modifiers.new("Bend", "SIMPLE_DEFORM")  # deformed, and its faces appear over the frames
     curve = scene.render.motion_blur_shutter_curve
     curve.curves[0].points[0].location = (0.0, 0.2)
     curve.update()
@@ -144,9 +161,70 @@ def test_the_shutters_steps_are_read_once_and_deformation_is_named(penumbra, gpu
     xs = [m[0, 3] for m in motion.instances[("Ball",)]]
     np.testing.assert_allclose(xs, [-0.25, 0.0, 0.25], atol=1e-6)
     assert motion.camera is None and motion.curve is not None and motion.curve[0] < motion.curve[-1]
-    assert len(messages) == 1 and "'Wobbly'" in messages[0] and "deformation motion blur" in messages[0]
+    assert set(motion.shapes) == {("Morph",)}
+    zs = [float(shape.positions[:, 2].max()) for shape in motion.shapes[("Morph",)]]
+    np.testing.assert_allclose(np.diff(zs), [0.0625, 0.0625], atol=1e-5)  # 0.5 a unit of value, 0.25 a step
+    assert len(messages) == 1 and "'Growing'" in messages[0] and "topology" in messages[0]
     scene.render.use_motion_blur = False
     assert gpu_call(job)[0] is None
+
+
+@pytest.mark.parametrize("how", ["shape key", "armature"])
+def test_a_deforming_mesh_smears_as_the_same_motion_by_its_transform(penumbra, how):
+    """The sphere moved by its vertices (a shape key's value, an armature's bone) instead of its
+    object: each sample draws its vertices where they are at its time, so the image is the one
+    the same motion by the object's transform gives (the simulated shutter's within half a
+    pixel)."""
+    import bpy
+
+    moved = render(_scene())["Combined"][..., 0].astype(np.float64)
+    scene = _scene()
+    ball = bpy.data.objects["Ball"]
+    ball.animation_data_clear()
+    ball.location.x = 0.0
+    if how == "shape key":
+        ball.shape_key_add(name="Basis")
+        key = ball.shape_key_add(name="Across")
+        key.slider_min = -1.0
+        for v in key.data:
+            v.co.x += 1.0
+        for frame, value in ((1, -1.0), (3, 1.0)):
+            key.value = value
+            key.keyframe_insert("value", frame=frame)
+        owner = ball.data.shape_keys
+    else:
+        arm = bpy.data.objects.new("Rig", bpy.data.armatures.new("Rig"))
+        scene.collection.objects.link(arm)
+        bpy.context.view_layer.objects.active = arm
+        bpy.ops.object.mode_set(mode="EDIT")
+        bone = arm.data.edit_bones.new("Bone")
+        bone.head, bone.tail = (0.0, 0.0, -DEPTH), (0.0, 0.0, -DEPTH + 0.5)
+        bpy.ops.object.mode_set(mode="OBJECT")
+        ball.parent = arm
+        ball.modifiers.new("Armature", "ARMATURE").object = arm
+        group = ball.vertex_groups.new(name="Bone")
+        group.add(list(range(len(ball.data.vertices))), 1.0, "REPLACE")
+        pose = arm.pose.bones["Bone"]
+        for frame, x in ((1, -1.0), (3, 1.0)):
+            pose.matrix = _bone_at(arm, x)
+            pose.keyframe_insert("location", frame=frame)
+        owner = arm
+    for fc in _fcurves(owner):
+        for point in fc.keyframe_points:
+            point.interpolation = "LINEAR"
+    scene.frame_set(2)
+    deformed = render(scene)["Combined"][..., 0].astype(np.float64)
+    assert np.abs(moved - deformed).max() < 1e-3
+    got, want = _moments(deformed), _moments(_simulated(0.5, SAMPLES))
+    assert math.sqrt(12.0 * got[2]) == pytest.approx(math.sqrt(12.0 * want[2]), abs=0.5)
+
+
+def _bone_at(arm, x):
+    """The pose matrix (armature space) that moves the bone ``x`` along world x."""
+    from mathutils import Matrix
+
+    rest = arm.data.bones["Bone"].matrix_local
+    return Matrix.Translation((x, 0.0, 0.0)) @ rest
 
 
 @pytest.mark.parametrize("steps", [1, 2, 64])
