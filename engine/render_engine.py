@@ -95,6 +95,7 @@ class PenumbraEngineCore:
             shaders = gpu_pool.final_shaders() if self.texture_pool is not None else None
             self.renderer = Renderer(self.texture_pool, shaders)
         scene = depsgraph.scene
+        self.cache.uv_pass = "UV" in passes  # every mesh's UV map read (geometry keyed by what it reads)
         snapshot = self.cache.snapshot(depsgraph)
         settings = scene.penumbra.render_settings(
             frame=scene.frame_current,

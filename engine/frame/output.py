@@ -119,6 +119,7 @@ FURTHER_PASSES = (
     ("use_pass_glossy_indirect", "GLOSSY_INDIRECT", "Glossy Indirect", "GlossInd", 3, "RGB", "COLOR"),
     ("use_pass_transmission_direct", "TRANSMISSION_DIRECT", "Transmission Direct", "TransDir", 3, "RGB", "COLOR"),
     ("use_pass_vector", "VECTOR", "Vector", "Vector", 4, "XYZW", "VECTOR"),
+    ("use_pass_uv", "UV", "UV", "UV", 3, "UVA", "VECTOR"),
 )
 # What the GPU draws for a pass computed from others on the CPU (``vectors.py``).
 DRAWN_FOR = {"VECTOR": ("POSITION", "DRAW")}

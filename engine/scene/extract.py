@@ -5,6 +5,7 @@ modifiers make its mesh unique) and rebuilt only when a depsgraph update says th
 changed. Matrices, materials, lights and the camera are cheap and read every frame.
 """
 
+import dataclasses
 import math
 import sys
 from dataclasses import dataclass
@@ -946,6 +947,7 @@ class SceneCache:
         self.geometry = {}
         self.built = 0  # geometries extracted since creation (tests and stats read it)
         self.materials = {}  # material name -> Material, until an update changes it
+        self.uv_pass = False  # every mesh reads its active render UV map (the UV pass)
         self.materials_read = 0
         self.images_changed = set()  # image names updated since the renderer last looked
         self.world = None  # (world name, materials.World) until a world or image update
@@ -1131,6 +1133,8 @@ class SceneCache:
         the vertex data its ``materials`` read."""
         inst, ob = obj.inst, obj.ob
         needs, extra = Needs.of(materials, ob.data if ob.type == "MESH" else None)
+        if self.uv_pass and needs.uv_map is None:  # the UV pass reads the active render map
+            needs = dataclasses.replace(needs, uv_map="")
         if extra[0] or extra[1]:
             reading.messages.append(
                 f"object '{ob.name}': its materials read several UV maps or colour attributes; only "

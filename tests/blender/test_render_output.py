@@ -261,7 +261,7 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         scene.camera.data.type = "PANO"
         scene.render.use_motion_blur = True
         layer = scene.view_layers[0]
-        layer.use_pass_subsurface_direct = layer.use_pass_uv = layer.use_pass_ambient_occlusion = True
+        layer.use_pass_subsurface_direct = layer.use_pass_subsurface_color = layer.use_pass_ambient_occlusion = True
         layer.use_pass_diffuse_color = layer.use_pass_cryptomatte_object = True  # written
         layer.use_pass_shadow = layer.use_pass_z = layer.use_pass_normal = True  # Depth and Normal are written
         bpy.data.objects["Ball"].is_shadow_catcher = True
@@ -284,7 +284,7 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
     for message in (
         "panoramic cameras are not rendered (drawn as a perspective camera)",
         "Blender's Subsurface Direct pass is not written",
-        "Blender's UV pass is not written",
+        "Blender's Subsurface Color pass is not written",
         "Blender's Ambient Occlusion pass is not written",
         "object 'Ball': Shadow Catcher is Cycles-only (drawn as an ordinary object)",
         "area light 'Panel': Spread is not rendered (it emits over the whole half-space)",

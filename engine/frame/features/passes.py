@@ -62,6 +62,18 @@ GROUP = "LIGHTGROUP:"  # + a light group's name: its Combined before the post st
 LIGHT_PASS_GROUP = 6
 
 
+# The entry of a draw that writes the UV pass: the mesh's UV map as vertex data (extraction reads
+# every mesh's active render map when the UV pass is asked: ``SceneCache.uv_pass``).
+ENTRY_UV = ProgramPart(
+    "passes_uv",
+    fragment=ENTRY.fragment,
+    push_constants=ENTRY.push_constants,
+    vertex_in=(("VEC2", "uv"),),
+    varyings=(("smooth", "VEC2", "v_uv"),),
+    defines=(("HAS_UV", True),),
+)
+
+
 def _mode(key):
     if key in LIGHT_PASSES or key.startswith(GROUP):
         return LIGHT
@@ -293,7 +305,8 @@ class Passes(Feature):
             if "ENVIRONMENT" in ks:
                 renderer.lit_pass.background_into(targets.sample["ENVIRONMENT"], frame, sample)
             values = _draw_values({id(d): i for i, d in enumerate(frame.draws)})
-            renderer.lit_pass.draw_apart(sample, fb, ENTRY, lambda tree, ks=ks: group_part(ks, tree), values)
+            entry = ENTRY_UV if "UV" in ks else ENTRY
+            renderer.lit_pass.draw_apart(sample, fb, entry, lambda tree, ks=ks: group_part(ks, tree), values)
         if self.crypto is not None:
             from ..film import texture_array
 
