@@ -222,12 +222,19 @@ def test_a_frame_without_further_passes_has_no_pass_draw_and_one_with_them_draws
 def test_blenders_cryptomatte_node_picks_an_objects_filtered_coverage_from_the_render():
     """Blender's compositor, in background mode, reads Penumbra's Cryptomatte layers and
     manifest: its Cryptomatte node's matte for "Box" is the box's coverage through the film's
-    filter (the "cover" AOV, 1 on the box, averaged like Combined) within 0.02, edges included;
-    the Ball's asset is its parent's (Rig)."""
+    filter and its motion over the shutter (the "cover" AOV, 1 on the box, averaged like
+    Combined) within 0.02, edges and motion blur included; the Ball's asset is its parent's
+    (Rig)."""
     out, _output = child(
         """
         layer.use_pass_cryptomatte_object = layer.use_pass_cryptomatte_asset = True
         layer.use_pass_cryptomatte_material = True
+        box = bpy.data.objects["Box"]  # moving over the shutter: its matte smears
+        for frame, x in ((1, -0.4), (3, 0.4)):
+            box.location.x = x
+            box.keyframe_insert("location", frame=frame)
+        scene.frame_set(2)
+        scene.render.use_motion_blur = True
         if bpy.app.version >= (5, 0, 0):
             comp = bpy.data.node_groups.new("Comp", "CompositorNodeTree")
             scene.compositing_node_group = comp
