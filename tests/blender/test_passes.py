@@ -461,3 +461,36 @@ def test_uv_pass_matches_cycles_and_a_mesh_without_a_map_reads_zero():
     assert np.median(diff) < 1e-3 and diff.mean() < 0.01
     # (u, v) where there is no map: the reader gives the channels in U, A, V order.
     assert ball.sum() > 10 and np.all(out["uv"][ball][:, [0, 2]] == 0.0)
+
+
+def test_light_passes_add_up_where_pixels_settle():
+    """Lamps without a world over rough spheres: settling keeps its pilot's value in the pixels
+    it settles (features/settling.py), and the passes keep the pilot's too, so the algebra
+    still holds per pixel within 1e-3 (without the pilot's passes: 0.03 here)."""
+    from devkit.session import run_result as run
+
+    result, _ = run(
+        textwrap.dedent(
+            """
+            import json
+            import numpy as np
+            from devkit import session
+            session.load_penumbra().register()
+            from tools.benchmarks import passes as bench
+            scene = bench.lamps(96, 54)
+            bench._switch(scene, bench.LIGHT)
+            scene.view_layers[0].penumbra.use_pass_lit = True
+            scene.penumbra.render_samples = 16
+            import tempfile, os
+            d = bench._render(scene, os.path.join(tempfile.mkdtemp(), "lamps.exr"))
+            g = lambda k: bench._pass(d, k)
+            total = sum((g(f"{k} Direct") + g(f"{k} Indirect")) * g(f"{k} Color") for k in ("Diffuse", "Glossy"))
+            total = total + g("Transmission Direct") * g("Transmission Color") + g("Emission") + g("Environment")
+            print("RESULT " + json.dumps({"error": float(np.abs(total - g("Combined")).max()),
+                                          "lit": float(g("Combined").mean())}))
+            session.hard_exit(0)
+            """
+        ),
+        timeout=600,
+    )
+    assert result["lit"] > 0.1 and result["error"] < 1e-3

@@ -178,6 +178,11 @@ class PassTargets(FilmPart):
         for key, (_target, fb) in self.accum.items():
             film.copy(fb, self.sample[key], weight, mask, gather)
 
+    def accumulated(self, film):
+        """Each averaged pass's (accumulation, this sample's target): where settling keeps its
+        pilot's value, the passes keep the pilot's too, as Combined does."""
+        return [(accum, self.sample[key]) for key, (accum, _fb) in self.accum.items()]
+
     def resolve(self, film, framebuffer=None):
         """Each mean pass's average into its target (not into ``framebuffer``: that is the
         colour's mean alone, ``Film.mean_into``)."""
@@ -270,7 +275,7 @@ class Passes(Feature):
     def after_lit(self, frame, sample):
         """The sample's pass draws: those of every sample, and at the centred sample (the
         first) those it alone gives; Cryptomatte's ids read back and added."""
-        if sample.pilot or sample.settle_test:
+        if sample.settle_test:
             return
         renderer = self.renderer
         targets = self.targets
@@ -279,7 +284,7 @@ class Passes(Feature):
         outputs = max(_outputs(data.parts), _outputs(data.blended_parts))
         for key in keys:
             if _mode(key) != LIGHT:
-                continue
+                continue  # (a pilot sample, settling's, draws what a settled pixel keeps of it)
             group = _group_draw(frame, sample, key[len(GROUP) :]) if key.startswith(GROUP) else None
             if group is not None:
                 part, per_draw, masks = group
@@ -297,7 +302,7 @@ class Passes(Feature):
                 raise RuntimeError("a technique writes more targets than the light passes' scratch holds")
             renderer.lit_pass.draw_light(sample, fbs, part, per_draw, masks)
         for mode, ks in groups(keys):
-            if mode == CENTRE and sample.index != 0:
+            if mode == CENTRE and (sample.index != 0 or sample.pilot):
                 continue
             fb = targets.framebuffer_of(ks)
             with fb.bind():
@@ -307,7 +312,7 @@ class Passes(Feature):
             values = _draw_values({id(d): i for i, d in enumerate(frame.draws)})
             entry = ENTRY_UV if "UV" in ks else ENTRY
             renderer.lit_pass.draw_apart(sample, fb, entry, lambda tree, ks=ks: group_part(ks, tree), values)
-        if self.crypto is not None:
+        if self.crypto is not None and not sample.pilot:
             from ..film import texture_array
 
             with frame.clock.waiting():
