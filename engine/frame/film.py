@@ -88,6 +88,7 @@ class FilmPart:
     frame), ``accumulate`` (each sample), ``accumulated`` (what a sample's value kept copies), ``convergence``
     (its share of the convergence check), ``resolve`` (after the last sample, into the colour
     target; or into ``framebuffer``, ``Film.mean_into``: the mean so far, over the film's),
+    ``resolve_light`` (a light pass's resolve, where the part takes light out of the colour's),
     ``bytes_per_pixel``, and ``release`` whenever the film's targets go (a new size, the end
     of a render)."""
 
@@ -117,6 +118,13 @@ class FilmPart:
 
     def resolve(self, film, framebuffer=None):
         pass
+
+    def resolve_light(self, film, source, framebuffer, lobes, scratch):
+        """Resolve ``source`` (a light pass's accumulation carrying the world's light of
+        ``lobes``, (diffuse, specular)) into ``framebuffer`` as the colour's resolve treats that
+        light; ``scratch``: a texture at the film's size it may overwrite. Returns whether it
+        did (False: the plain average is the pass's)."""
+        return False
 
     def bytes_per_pixel(self, film):
         return 0

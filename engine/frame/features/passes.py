@@ -42,9 +42,9 @@ LIGHT_PASSES = {
     "TRANSMISSION_DIRECT": (5, "TRANSMISSION_COLOR"),
 }
 LIGHT = "LIGHT"
-# The world ratio's unshadowed light each light pass carries (diffuse, specular), shadowed at
-# the resolve as Combined's is (``world_ratio.RESOLVE``).
-_RATIO_LOBES = {"DIFFUSE_DIRECT": (True, False), "GLOSSY_DIRECT": (False, True)}
+# The world's light each light pass carries, by lobe (diffuse, specular): a technique that
+# shadows it at the resolve does so for the pass too (``FilmPart.resolve_light``: the ratio's).
+_WORLD_LOBES = {"DIFFUSE_DIRECT": (True, False), "GLOSSY_DIRECT": (False, True)}
 AOV_COLOR, AOV_VALUE = 32, 64  # + the AOV Output node's index in its tree (lit_passes.frag.glsl)
 MAX_TARGETS = 6  # colour targets Blender's gpu module binds
 
@@ -190,38 +190,16 @@ class PassTargets(FilmPart):
             return
         import gpu
 
-        ratio = next((p for p in film.parts if p.name == "world_ratio"), None)
         for key, (accum, _fb) in self.accum.items():
             out = gpu.types.GPUFrameBuffer(color_slots=(self.sample[key],))
-            lobes = _RATIO_LOBES.get(key) or ((True, True) if key in self.world_groups else None)
-            if ratio is not None and lobes is not None:
-                self._resolve_ratio(film, ratio, lobes, accum, out)
-            elif film.weight is not None:
+            lobes = _WORLD_LOBES.get(key) or ((True, True) if key in self.world_groups else (False, False))
+            if any(lobes) and any(part.resolve_light(film, accum, out, lobes, self.scratch[0]) for part in film.parts):
+                continue  # a technique took its share out (the world ratio's)
+            if film.weight is not None:
                 film.fullscreen(WEIGHTED_RESOLVE, out, {"src_color": accum, "weight": film.weight}, {})
             else:
                 total = film.weight_sum
                 film.fullscreen(SCALED_COPY, out, {"src_color": accum}, {"scale": 1.0 / total if total > 0 else 0.0})
-
-    def _resolve_ratio(self, film, ratio, lobes, accum, out):
-        """A light pass carrying the world's unshadowed light of one lobe: its average shadowed
-        by the frame's world ratio, as Combined's (the other lobe's U taken as 0)."""
-        from .world_ratio import RESOLVE
-
-        sums = ratio.accumulations()
-        zero = self.scratch[0]  # a light pass's scratch: cleared here, written again next sample
-        clear_zero(zero)
-        diffuse, specular = lobes
-        per_pixel = film.weight is not None
-        total = film.weight_sum
-        samplers = {
-            "src_color": accum,
-            "weight": film.weight if per_pixel else accum,
-            "world_diffuse": sums["world_diffuse"] if diffuse else zero,
-            "world_specular": sums["world_specular"] if specular else zero,
-            "world_sums": sums["world_sums"],
-        }
-        uniforms = {"scale": 1.0 / total if total > 0.0 else 0.0, "per_pixel": 1.0 if per_pixel else 0.0}
-        film.fullscreen(RESOLVE, out, samplers, uniforms)
 
     def bytes_per_pixel(self, film):
         return 16 * (len(self.sample) + len(self.accum) + len(self.scratch))

@@ -153,16 +153,34 @@ class RatioTargets(FilmPart):
         """The colour resolved anew with the world's light through its ratio (over the shadow
         and Emission passes the plain resolve wrote), into the film's colour or
         ``framebuffer``."""
+        sums = self.accumulations()
+        target = gpu_framebuffer(film.color) if framebuffer is None else framebuffer
+        self._resolve(film, film.accum_color, target, sums["world_diffuse"], sums["world_specular"])
+
+    def _resolve(self, film, source, framebuffer, world_diffuse, world_specular):
+        """``source`` (an accumulation) over its weight, shadowed by the ratio of the
+        accumulated sums (``RESOLVE``), its SH light ``world_diffuse`` and ``world_specular``."""
         per_pixel = film.weight is not None
         total = film.weight_sum
         samplers = {
-            "src_color": film.accum_color,
-            "weight": film.weight if per_pixel else film.accum_color,
-            **self.accumulations(),
+            "src_color": source,
+            "weight": film.weight if per_pixel else source,
+            "world_diffuse": world_diffuse,
+            "world_specular": world_specular,
+            "world_sums": self.accumulations()["world_sums"],
         }
         uniforms = {"scale": 1.0 / total if total > 0.0 else 0.0, "per_pixel": 1.0 if per_pixel else 0.0}
-        target = gpu_framebuffer(film.color) if framebuffer is None else framebuffer
-        film.fullscreen(RESOLVE, target, samplers, uniforms)
+        film.fullscreen(RESOLVE, framebuffer, samplers, uniforms)
+
+    def resolve_light(self, film, source, framebuffer, lobes, scratch):
+        """A light pass carrying the world's SH light of ``lobes``: its average shadowed by the
+        frame's ratio, as the colour's (the other lobe's U taken as 0: ``scratch``, cleared)."""
+        clear_zero(scratch)
+        sums = self.accumulations()
+        diffuse = sums["world_diffuse"] if lobes[0] else scratch
+        specular = sums["world_specular"] if lobes[1] else scratch
+        self._resolve(film, source, framebuffer, diffuse, specular)
+        return True
 
     def bytes_per_pixel(self, film):
         return 6 * 16 + (16 if film.tracking else 0)
