@@ -83,6 +83,7 @@ class PenumbraEngineCore:
         navigating=False,
         motion=None,
         passes=(),
+        cryptomatte=(6, (0, 1, 2)),
     ):
         """Extract, then render samples ``samples`` of a frame of ``sample_count`` samples
         (``Renderer.render``); returns the renderer's FrameOutput. ``pixel_scale`` scales the
@@ -118,6 +119,7 @@ class PenumbraEngineCore:
             navigating=navigating,
             motion=motion,
             passes=tuple(passes),
+            cryptomatte=cryptomatte,
         )
         out = self.renderer.render(snapshot, request, on_sample=on_sample)
         self.last_stats = out.stats
@@ -481,6 +483,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
                     adaptive=adaptive,
                     motion=motion,
                     passes=drawn_passes(requested_passes(vl)),
+                    cryptomatte=cryptomatte_request(vl),
                 )
                 if vl.use_pass_vector and out.passes:
                     out.passes["VECTOR"] = self._vector_pass(out, camera, neighbours, width, height)
@@ -641,6 +644,12 @@ def further_passes(view_layer):
         if getattr(view_layer, switch, False):
             out += [(f"Crypto{kind}{i:02d}", 4, "rgba", "COLOR") for i in range((levels + 1) // 2)]
     return out
+
+
+def cryptomatte_request(view_layer):
+    """``FrameRequest.cryptomatte`` of ``view_layer``: its levels and the kinds it asks for."""
+    kinds = tuple(i for i, switch in enumerate(CRYPTOMATTE_SWITCHES) if getattr(view_layer, switch, False))
+    return cryptomatte_levels(view_layer), kinds
 
 
 def further_pass_data(view_layer, out):

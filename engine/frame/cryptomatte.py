@@ -99,13 +99,15 @@ class Accumulator:
     total weight (its background share included). An id that finds no free slot is dropped
     (the pixel already holds ``capacity`` others)."""
 
-    def __init__(self, size, capacity=16):
+    def __init__(self, size, capacity=16, kinds=(0, 1, 2)):
         width, height = size
         self.size = (width, height)
+        self.kinds = tuple(kinds)  # the kinds accumulated (the others stay empty)
         self.ids = np.zeros((3, height, width, capacity), np.float32)
         self.weights = np.zeros((3, height, width, capacity), np.float64)
         self.total = np.zeros((height, width), np.float64)
         self.samples = 0
+        self._inside = {}  # tap shifts -> each pixel's weight of the taps inside the image
         self.names = ((), (), ())  # each kind's names in the frame (its manifest)
 
     def add(self, ids, taps, gather=False):
@@ -117,30 +119,40 @@ class Accumulator:
         self.samples += 1
         if not gather:
             weight = float(sum(w for _x, _y, w in taps))
-            flat = np.arange(height * width)
-            for kind in range(3):
-                self._add(kind, flat, ids[..., kind].ravel(), weight)
+            every = np.ones((height, width), bool)
+            for kind in self.kinds:
+                self._add_dense(kind, ids[..., kind], np.full((height, width), weight), every)
             self.total += weight
             return
-        shifts = [(int(round(x)), int(round(y)), float(w)) for x, y, w in taps]
-        for kind in range(3):
+        shifts = tuple((int(round(x)), int(round(y)), float(w)) for x, y, w in taps)
+        inside = self._inside.get(shifts)
+        if inside is None:
+            ones = np.ones((height, width))
+            inside = self._inside[shifts] = sum(w * _shifted(ones, tx, ty, 0.0) for tx, ty, w in shifts)
+        for kind in self.kinds:
             channel = ids[..., kind]
             # Where every tap sees the pixel's own id, the whole sample goes to it at once.
             same = np.ones((height, width), bool)
             for tx, ty, _w in shifts:
                 same &= _shifted(channel, tx, ty, np.nan) == channel
-            flat = np.flatnonzero(same)
-            inside = np.zeros((height, width))
-            for tx, ty, w in shifts:
-                inside += w * _shifted(np.ones((height, width)), tx, ty, 0.0)
-            self._add_weights(kind, flat, channel.ravel()[flat], inside.ravel()[flat])
+            self._add_dense(kind, channel, inside, same)
             edge = np.flatnonzero(~same)
             for tx, ty, w in shifts:
                 seen = _shifted(channel, tx, ty, np.nan).ravel()[edge]
                 ok = ~np.isnan(seen)
                 self._add(kind, edge[ok], seen[ok], w)
-        for tx, ty, w in shifts:
-            self.total += w * _shifted(np.ones((height, width)), tx, ty, 0.0)
+        self.total += inside
+
+    def _add_dense(self, kind, channel, weights, mask):
+        """Add ``weights`` (height, width) to the id ``channel`` holds at each pixel of
+        ``mask``: in place where a pixel's first slot holds it already (most pixels, most
+        samples), through ``_add_weights`` elsewhere."""
+        first = self.ids[kind][..., 0]
+        valid = mask & (channel != 0.0)
+        hit = valid & (first == channel)
+        self.weights[kind][..., 0] += np.where(hit, weights, 0.0)
+        flat = np.flatnonzero(valid & ~hit)
+        self._add_weights(kind, flat, channel.ravel()[flat], weights.ravel()[flat])
 
     def _add(self, kind, flat, values, weight):
         self._add_weights(kind, flat, values, np.full(len(flat), weight))
@@ -153,6 +165,12 @@ class Accumulator:
             return
         ids = self.ids[kind].reshape(-1, self.ids.shape[-1])
         acc = self.weights[kind].reshape(-1, self.ids.shape[-1])
+        # Most pixels see the id they saw first: added in place, the rest looked up below.
+        first = ids[flat, 0] == values
+        acc[flat[first], 0] += weights[first]  # (each pixel once a call: no repeated index)
+        flat, values, weights = flat[~first], values[~first], weights[~first]
+        if not len(flat):
+            return
         slots = ids[flat]
         match = slots == values[:, None]
         found = match.any(axis=1)
@@ -167,11 +185,19 @@ class Accumulator:
         """The (levels + 1) // 2 passes of ``kind`` (index into ``KINDS``): (height, width, 4)
         each, (id, coverage) of ranks 2i and 2i + 1, coverage the id's share of the pixel's
         total weight."""
-        order = np.argsort(-self.weights[kind], axis=-1, kind="stable")
-        ids = np.take_along_axis(self.ids[kind], order, -1)
-        cov = np.take_along_axis(self.weights[kind], order, -1)
-        total = np.where(self.total > 0.0, self.total, 1.0)[..., None]
-        cov = (cov / total).astype(np.float32)
+        slots = self.ids.shape[-1]
+        ids = self.ids[kind].reshape(-1, slots).copy()
+        cov = self.weights[kind].reshape(-1, slots).copy()
+        # Only pixels that met several ids need ranking (a pixel's first id sits in slot 0).
+        several = np.flatnonzero(ids[:, 1] != 0.0)
+        if len(several):
+            order = np.argsort(-cov[several], axis=-1, kind="stable")
+            ids[several] = np.take_along_axis(ids[several], order, -1)
+            cov[several] = np.take_along_axis(cov[several], order, -1)
+        total = np.where(self.total > 0.0, self.total, 1.0).reshape(-1, 1)
+        shape = self.total.shape + (slots,)
+        ids = ids.reshape(shape)
+        cov = (cov / total).astype(np.float32).reshape(shape)
         count = (min(int(levels), 16) + 1) // 2
         out = []
         for i in range(count):

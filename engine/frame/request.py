@@ -24,7 +24,9 @@ class FrameRequest:
     ``sampling.clock()`` value): when its time limit ends it, if not counted from this call's
     first sample; ``navigating``: a one-sample frame while the view moves; ``motion``
     (``motion.Motion``): what moves during the shutter; ``passes``: Blender's further passes
-    the view layer asks for (``features/passes.py`` keys: data, colour, AOV, Cryptomatte)."""
+    the view layer asks for (``features/passes.py`` keys: data, colour, AOV, Cryptomatte);
+    ``cryptomatte``: with Cryptomatte, its levels and the kinds asked (indices into
+    ``cryptomatte.KINDS``)."""
 
     camera: object
     settings: object
@@ -39,6 +41,7 @@ class FrameRequest:
     navigating: bool = False
     motion: object = None
     passes: tuple = ()
+    cryptomatte: tuple = (6, (0, 1, 2))
 
     @property
     def size(self):

@@ -239,7 +239,9 @@ class Passes(Feature):
         scratch = 4 if any(_mode(k) == LIGHT for k in keys) and frame.accumulate else 0
         self.targets.ensure(self.renderer.film, keys, scratch)
         if "CRYPTOMATTE" in keys and frame.request.samples[0] == 0:
-            self.crypto = cryptomatte.Accumulator(frame.size)
+            levels, kinds = frame.request.cryptomatte
+            # Room for a few ids beyond those written: an id met late can still outrank one seen early.
+            self.crypto = cryptomatte.Accumulator(frame.size, capacity=min(int(levels), 16) + 2, kinds=kinds)
             seen = [d.instance for d in frame.draws if d.instance.camera]
             self.crypto.names = (
                 sorted({i.crypto_names[0] for i in seen}),
