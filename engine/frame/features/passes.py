@@ -1,9 +1,12 @@
-"""Blender's data and colour passes, Shader AOVs and Cryptomatte (``FrameRequest.passes``): the
-surfaces drawn apart after each sample's lit pass, over the z-buffer it left
-(``shaders/lit_passes.frag.glsl``), up to six passes a draw. A pass is averaged over the
-samples like Combined (its film accumulation, filter and adaptive mask), or taken from the
-centred sample as Cycles takes it (Position, Object and Material Index); Cryptomatte's ids are
-read back each sample and ranked on the CPU (``frame/cryptomatte.py``).
+"""Blender's further passes (``FrameRequest.passes``; docs/passes.md): after each sample's lit
+pass the seen surfaces are drawn again over the z-buffer it left. Data and colour passes and
+Shader AOVs: up to six a draw of their own entry shader (``shaders/lit_passes.frag.glsl``),
+averaged over the samples like Combined (its film accumulation, filter and adaptive mask) or
+taken from the centred sample as Cycles takes them (Position, Object and Material Index). Light
+passes and light groups: the lit program again with the frame's techniques and one
+``LIGHT_PASS`` variant each, averaged, the world's light in them shadowed at the resolve as
+Combined's (``FilmPart.resolve_light``). Cryptomatte's ids are read back each sample and ranked
+on the CPU (``frame/cryptomatte.py``).
 
 A frame that asks for no such pass does not register this technique: no draw, no target."""
 
