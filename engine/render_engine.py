@@ -571,12 +571,17 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
 
     def _write_result(self, window, layer, view, passes, metadata=None):
         """Fill one result (``window``-sized, of ``layer`` and ``view``) with every pass the
-        view layer has, and ``metadata`` ({key: value}: Cryptomatte's manifest) in its stamp
-        data; on any error the result is cancelled, not left half-written."""
+        view layer has, and ``metadata`` ({key: value}: Cryptomatte's manifest) in the render's
+        stamp data (written into the file's header); on any error the result is cancelled, not
+        left half-written."""
+        if metadata:
+            # Into the render's own result (``get_result``), as Cycles stamps it: what a tile's
+            # result holds is not merged into it, nor written to the file.
+            final = self.get_result()
+            for key, value in metadata.items():
+                final.stamp_data_add_field(key, value)
         result = self.begin_result(0, 0, window.width, window.height, layer=layer, view=view)
         try:
-            for key, value in (metadata or {}).items():
-                result.stamp_data_add_field(key, value)
             render_layer = result.layers[0]
             for name, data in passes.items():
                 render_pass = render_layer.passes.find_by_name(name, view)

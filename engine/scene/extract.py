@@ -34,6 +34,7 @@ class Needs:
     uv_map: str | None = None  # "" = the active render UV map
     color_attribute: str | None = None  # "" = the active render colour attribute
     tangents: bool = False  # MikkTSpace tangents of ``uv_map`` (normal maps)
+    uv_pass_only: bool = False  # the UV map is read for the UV pass alone (no texture reads it)
 
     @classmethod
     def of(cls, materials, data=None):
@@ -695,7 +696,8 @@ def _corner_uvs(mesh, needs, nc, messages, positions=None, normals=None):
     layer = layers.get(needs.uv_map) if needs.uv_map else next((u for u in layers if u.active_render), None)
     if layer is None:
         want = f"UV map '{needs.uv_map}'" if needs.uv_map else "UV map"
-        messages.append(f"mesh '{mesh.name}' has no {want}: its textures read UV (0, 0)")
+        if not needs.uv_pass_only:  # (the UV pass holds (0, 0) there, as Cycles')
+            messages.append(f"mesh '{mesh.name}' has no {want}: its textures read UV (0, 0)")
         zeros = np.zeros((nc, 2), np.float32)
         return zeros, (np.zeros((nc, 4), np.float32) if needs.tangents else None)
     uvs = _read(layer.uv, "vector", nc, np.float32, 2)
@@ -1134,7 +1136,7 @@ class SceneCache:
         inst, ob = obj.inst, obj.ob
         needs, extra = Needs.of(materials, ob.data if ob.type == "MESH" else None)
         if self.uv_pass and needs.uv_map is None:  # the UV pass reads the active render map
-            needs = dataclasses.replace(needs, uv_map="")
+            needs = dataclasses.replace(needs, uv_map="", uv_pass_only=True)
         if extra[0] or extra[1]:
             reading.messages.append(
                 f"object '{ob.name}': its materials read several UV maps or colour attributes; only "

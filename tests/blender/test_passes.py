@@ -261,8 +261,12 @@ def test_blenders_cryptomatte_node_picks_an_objects_filtered_coverage_from_the_r
         layers = render("crypto", 16, compositor=True)
         passes = layers[("ViewLayer", "")]
         composite = next(v for k, v in layers.items() if k[0] != "ViewLayer")
+        import OpenImageIO as oiio
+        header = oiio.ImageInput.open(os.path.join(TMP, "crypto.exr"))
+        meta = {a.name: str(a.value) for a in header.spec().extra_attribs if a.name.startswith("cryptomatte/")}
+        header.close()
         save(matte=composite["Combined"], cover=passes["cover"], crypto=passes["CryptoObject00"],
-             index=passes["Object Index"] if "Object Index" in passes else np.zeros(1))
+             meta=np.array(json.dumps(meta)))
         """
     )
     matte, cover = out["matte"], out["cover"][..., 0]
@@ -275,6 +279,17 @@ def test_blenders_cryptomatte_node_picks_an_objects_filtered_coverage_from_the_r
     rig = matte[..., 1]
     assert rig.max() > 0.99 and float((rig > 0.5).sum()) > 30
     assert float((matte[..., 2] > 0.99).sum()) > 500  # the floor's material
+    # The manifest is in the file's header, under Cycles' keys: what Nuke's Cryptomatte reads.
+    import json
+
+    from penumbra.engine.frame import cryptomatte
+
+    meta = json.loads(str(out["meta"]))
+    prefix = f"cryptomatte/{cryptomatte.name_hash('ViewLayer.CryptoObject'):08x}"[:19]
+    assert meta[f"{prefix}/name"] == "ViewLayer.CryptoObject" and meta[f"{prefix}/hash"] == "MurmurHash3_32"
+    manifest = json.loads(meta[f"{prefix}/manifest"])
+    assert manifest["Box"] == f"{cryptomatte.name_hash('Box'):08x}" and {"Ball", "Floor"} <= set(manifest)
+    assert len([k for k in meta if k.endswith("/name")]) == 3  # object, material, asset
     # Coverages of a pixel's ranks add up to at most its whole weight.
     crypto = out["crypto"]
     assert np.all(crypto[..., 1] + crypto[..., 3] <= 1.0 + 1e-5) and np.all(crypto[..., 1] >= crypto[..., 3])
@@ -335,7 +350,7 @@ def test_light_groups_add_up_to_combined_and_each_holds_its_own_light():
     box's emission in "glow". Their passes add up to Combined before the post stack (surfaces
     rough enough that no traced ray adds the scene's reflection), "glow" is the box's emission
     alone, and "key" is the frame lit by the sun alone (the others switched off)."""
-    out, _ = child(
+    out, output = child(
         """
         for mat in (red, blue, bpy.data.materials["Grey"]):
             mat.node_tree.nodes["Principled BSDF"].inputs["Roughness"].default_value = 0.8
@@ -356,6 +371,8 @@ def test_light_groups_add_up_to_combined_and_each_holds_its_own_light():
         save(sun=sun["Combined"], **{k.replace(" ", "_"): v for k, v in passes.items()})
         """
     )
+    # The frame may trace rays (its materials are node trees): the report names what groups leave out.
+    assert "Penumbra: light group passes hold each group's direct light" in output
     key, fill, glow = out["Combined_key"], out["Combined_fill"], out["Combined_glow"]
     np.testing.assert_allclose(key + fill + glow, out["Combined"][..., :3], atol=1e-4)
     assert glow.max() == pytest.approx(2.0, abs=1e-5) and np.all(glow[glow > 0.0] <= 2.0 + 1e-5)

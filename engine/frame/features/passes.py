@@ -62,6 +62,8 @@ ENTRY = ProgramPart(
 
 
 GROUP = "LIGHTGROUP:"  # + a light group's name: its Combined before the post stack
+# Techniques whose light a light group pass leaves out (what they add mixes every group's).
+_MIXED_ACROSS_GROUPS = ("reflections", "planar", "cubes", "refraction", "bounce")
 LIGHT_PASS_GROUP = 6
 
 
@@ -231,12 +233,6 @@ class Passes(Feature):
         world = frame.snapshot.world
         world_group = getattr(world, "lightgroup", "") if world is not None else ""
         self.targets.world_groups = {GROUP + world_group} if world_group else set()
-        groups_asked = [k[len(GROUP) :] for k in keys if k.startswith(GROUP)]
-        if groups_asked and (frame.has("reflections") or frame.has("refraction") or frame.has("bounce")):
-            frame.stats.messages.append(
-                "Penumbra: light group passes hold each group's direct light, world and emission; what surfaces "
-                "reflect or refract of the scene and the diffuse bounce are in Combined alone"
-            )
         # A light pass's draw writes the targets the techniques' parts write beside the colour
         # (the world ratio's): into scratch targets (the lit pass's own are this sample's).
         scratch = 4 if any(_mode(k) == LIGHT for k in keys) and frame.accumulate else 0
@@ -306,7 +302,14 @@ class Passes(Feature):
     def resolve(self, frame):
         """What the frame's passes are (``frame.pass_outputs``): their targets, and
         Cryptomatte's ranked (id, coverage) layers."""
-        outputs = {k: self.targets.sample[k] for k in frame_keys(frame.request.passes) if k != "CRYPTOMATTE"}
+        keys = frame_keys(frame.request.passes)
+        # (Asked here: the frame's techniques are known once every one planned.)
+        if any(k.startswith(GROUP) for k in keys) and any(frame.has(t) for t in _MIXED_ACROSS_GROUPS):
+            frame.stats.messages.append(
+                "Penumbra: light group passes hold each group's direct light, world and emission; what surfaces "
+                "reflect or refract of the scene and the diffuse bounce are in Combined alone"
+            )
+        outputs = {k: self.targets.sample[k] for k in keys if k != "CRYPTOMATTE"}
         if self.crypto is not None:
             outputs["CRYPTOMATTE"] = self.crypto
         outputs["ORIGIN"] = tuple(float(x) for x in frame.origin)  # what Position is relative to
