@@ -224,6 +224,7 @@ class Passes(Feature):
         super().__init__(renderer)
         self.targets = PassTargets()
         self.crypto = None  # cryptomatte.Accumulator of the frame
+        self._centre_draws = []  # (motion key, world matrix) of the centred sample's draws, by number
 
     def wanted(self, frame):
         return bool(frame.request.passes)
@@ -260,6 +261,10 @@ class Passes(Feature):
         targets = self.targets
         keys = frame_keys(frame.request.passes)
         data = sample.data
+        # The sample's own draws (motion blur gives each sample its list), numbered for DRAW.
+        values = _draw_values({id(d): i for i, d in enumerate(sample.draws)})
+        if sample.index == 0 and not sample.pilot:
+            self._centre_draws = [(d.instance.motion_key, d.instance.matrix) for d in sample.draws]
         outputs = max(_outputs(data.parts), _outputs(data.blended_parts))
         for key in keys:
             if _mode(key) != LIGHT:
@@ -288,7 +293,6 @@ class Passes(Feature):
                 fb.clear(color=(0.0, 0.0, 0.0, 0.0))
             if "ENVIRONMENT" in ks:
                 renderer.lit_pass.background_into(targets.sample["ENVIRONMENT"], frame, sample)
-            values = _draw_values({id(d): i for i, d in enumerate(frame.draws)})
             entry = ENTRY_UV if "UV" in ks else ENTRY
             renderer.lit_pass.draw_apart(sample, fb, entry, lambda tree, ks=ks: group_part(ks, tree), values)
         if self.crypto is not None and not sample.pilot:
@@ -313,8 +317,8 @@ class Passes(Feature):
         if self.crypto is not None:
             outputs["CRYPTOMATTE"] = self.crypto
         outputs["ORIGIN"] = tuple(float(x) for x in frame.origin)  # what Position is relative to
-        if "DRAW" in outputs:  # each draw's instance, by number: what moves it (the Vector pass)
-            outputs["DRAWS"] = [(d.instance.motion_key, d.instance.matrix) for d in frame.draws]
+        if "DRAW" in outputs:  # the centred sample's draws' instances, by number (the Vector pass)
+            outputs["DRAWS"] = self._centre_draws
         frame.pass_outputs = outputs
 
     def memory_bytes(self, frame):
