@@ -322,6 +322,9 @@ class Passes(Feature):
         frame.pass_outputs = outputs
 
     def memory_bytes(self, frame):
+        """Its targets in a one-sample frame (a frame of several counts them as the film's part)."""
+        if frame.accumulate:
+            return 0
         return self.targets.bytes_per_pixel(self.renderer.film) * frame.size[0] * frame.size[1]
 
     def release(self):
