@@ -2,6 +2,7 @@
 with the frame's lights and shadow atlas, into the film's targets; and the world's
 Environment Texture behind it."""
 
+import contextlib
 import dataclasses
 from dataclasses import dataclass
 
@@ -157,23 +158,14 @@ class LitPass:
         (``features/passes.py``). Opaque and alpha-hashed surfaces nearest first, then blended
         ones farthest first, none blended, none writing depth; ``per_draw(shader, draw,
         material)`` sets a draw's own push constants."""
-        import gpu
-
-        stats = sample.stats
-        opaque, blended, parts = self._entries(sample.seen, sample.view_camera, sample.atlas, stats, hashed_last=False)
-        submit = _Submission(self, sample, parts)
+        opaque, blended, submit = self._again(sample)
         submit.masks = None  # the lights are not read
         submit.apart = (entry, part_of)
         submit.per_draw = per_draw
-        width, height = self.film.size
-        with framebuffer.bind():
-            gpu.state.viewport_set(0, 0, width, height)
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(False)
-            gpu.state.blend_set("NONE")
+        with self._over_depth(framebuffer):
             submit.draw(opaque, False)
             submit.draw(blended, False, blended=True)
-        _reset_state(stats)
+        _reset_state(sample.stats)
 
     def draw_light(self, sample, framebuffers, part, per_draw=None, masks=None):
         """The sample's lit pass again over the z-buffer it left, with the frame's techniques'
@@ -182,33 +174,42 @@ class LitPass:
         then blended ones blended over them (``framebuffers[1]``), none writing depth;
         ``per_draw(shader, draw, material)`` a draw's own values, ``masks`` {id(draw): light
         mask} the lights each draw takes (a light group's; ``part`` then switches LIGHT_LINKING on)."""
-        import gpu
-
-        stats = sample.stats
-        opaque, blended, parts = self._entries(sample.seen, sample.view_camera, sample.atlas, stats, hashed_last=False)
-        submit = _Submission(self, sample, parts)
+        opaque, blended, submit = self._again(sample)
         submit.light = part
         submit.per_draw = per_draw
         if masks is not None:  # each draw's lights through the light-linking variant
             submit.masks = masks
             submit.variant = dataclasses.replace(sample.data.variant, light_linking=True)
-        width, height = self.film.size
-        with framebuffers[0].bind():
-            gpu.state.viewport_set(0, 0, width, height)
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(False)
-            gpu.state.blend_set("NONE")
+        with self._over_depth(framebuffers[0]):
             submit.draw(opaque, False)
         if blended:
             submit.rebind()
-            with framebuffers[1].bind():
-                gpu.state.viewport_set(0, 0, width, height)
-                gpu.state.depth_test_set("LESS_EQUAL")
-                gpu.state.depth_mask_set(False)
-                gpu.state.blend_set("ALPHA_PREMULT")
+            with self._over_depth(framebuffers[1], "ALPHA_PREMULT"):
                 submit.draw(blended, False, blended=True)
-                gpu.state.blend_set("NONE")
-        _reset_state(stats)
+        _reset_state(sample.stats)
+
+    def _again(self, sample, hashed_last=False):
+        """(opaque entries, blended entries, a ``_Submission``) of the surfaces ``sample``'s lit
+        pass drew, to draw them again (``LitPass._entries``)."""
+        opaque, blended, parts = self._entries(
+            sample.seen, sample.view_camera, sample.atlas, sample.stats, hashed_last=hashed_last
+        )
+        return opaque, blended, _Submission(self, sample, parts)
+
+    @contextlib.contextmanager
+    def _over_depth(self, framebuffer, blend="NONE"):
+        """``framebuffer`` bound at the film's size over the z-buffer the lit pass left: tested
+        (LESS_EQUAL), not written; ``blend`` while it is bound."""
+        import gpu
+
+        width, height = self.film.size
+        with framebuffer.bind():
+            gpu.state.viewport_set(0, 0, width, height)
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(False)
+            gpu.state.blend_set(blend)
+            yield
+            gpu.state.blend_set("NONE")
 
     def background_into(self, target, frame, sample):
         """What the camera sees of the world where no surface is, into ``target`` (RGBA32F at
@@ -226,22 +227,13 @@ class LitPass:
         ``target`` (``features.settling.SettleTargets.test_framebuffer``): the surfaces the
         pilot drew (its z-buffer, kept) and any dithered or blended one in front of them write
         their flags, the dithered and blended last, nothing blended."""
-        import gpu
-
-        stats = sample.stats
-        opaque, blended, parts = self._entries(sample.seen, sample.view_camera, sample.atlas, stats, hashed_last=True)
-        submit = _Submission(self, sample, parts)
-        width, height = self.film.size
-        with target.bind():
-            gpu.state.viewport_set(0, 0, width, height)
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(False)
-            gpu.state.blend_set("NONE")
+        opaque, blended, submit = self._again(sample, hashed_last=True)
+        with self._over_depth(target):
             submit.draw(opaque, False)
             if blended:
                 submit.rebind()
                 submit.draw(blended, False, blended=True)
-        _reset_state(stats)
+        _reset_state(sample.stats)
 
     @staticmethod
     def _entries(draws, camera, atlas, stats, hashed_last):

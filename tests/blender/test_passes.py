@@ -75,6 +75,23 @@ def render(name, samples, compositor=False):
     layers = imageio.read_exr_layers(path)
     return {k: {OLD_NAMES.get(p, p): a[::-1] for p, a in v.items()} for k, v in layers.items()}
 
+def compositor():
+    # The scene's compositor tree, emptied: (tree, its output node, a Render Layers node).
+    # Blender 5.0 made the tree a node group with a Group Output; 4.5 has the scene's own tree.
+    if bpy.app.version >= (5, 0, 0):
+        comp = bpy.data.node_groups.new("Comp", "CompositorNodeTree")
+        scene.compositing_node_group = comp
+        out_node = comp.nodes.new("NodeGroupOutput")
+        comp.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+    else:
+        scene.use_nodes = True
+        comp = scene.node_tree
+        comp.nodes.clear()
+        out_node = comp.nodes.new("CompositorNodeComposite")
+    rl = comp.nodes.new("CompositorNodeRLayers")
+    rl.scene = scene
+    return comp, out_node, rl
+
 def save(**arrays):
     path = os.path.join(TMP, "out.npz")
     np.savez(path, **arrays)
@@ -235,18 +252,7 @@ def test_blenders_cryptomatte_node_picks_an_objects_filtered_coverage_from_the_r
             box.keyframe_insert("location", frame=frame)
         scene.frame_set(2)
         scene.render.use_motion_blur = True
-        if bpy.app.version >= (5, 0, 0):
-            comp = bpy.data.node_groups.new("Comp", "CompositorNodeTree")
-            scene.compositing_node_group = comp
-            out_node = comp.nodes.new("NodeGroupOutput")
-            comp.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
-        else:
-            scene.use_nodes = True
-            comp = scene.node_tree
-            comp.nodes.clear()
-            out_node = comp.nodes.new("CompositorNodeComposite")
-        rl = comp.nodes.new("CompositorNodeRLayers")
-        rl.scene = scene
+        comp, out_node, rl = compositor()
         mattes = []
         for source, name in (("ViewLayer.CryptoObject", "Box"), ("ViewLayer.CryptoAsset", "Rig"),
                              ("ViewLayer.CryptoMaterial", "Grey")):
@@ -404,18 +410,7 @@ def test_vector_pass_matches_cycles_and_blenders_vector_blur_smears_as_with_cycl
         for aov in list(layer.aovs):
             layer.aovs.remove(aov)
         layer.use_pass_vector = layer.use_pass_z = True
-        if bpy.app.version >= (5, 0, 0):
-            comp = bpy.data.node_groups.new("Comp", "CompositorNodeTree")
-            scene.compositing_node_group = comp
-            out_node = comp.nodes.new("NodeGroupOutput")
-            comp.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
-        else:
-            scene.use_nodes = True
-            comp = scene.node_tree
-            comp.nodes.clear()
-            out_node = comp.nodes.new("CompositorNodeComposite")
-        rl = comp.nodes.new("CompositorNodeRLayers")
-        rl.scene = scene
+        comp, out_node, rl = compositor()
         blur = comp.nodes.new("CompositorNodeVecBlur")
         comp.links.new(rl.outputs["Image"], blur.inputs["Image"])
         comp.links.new(rl.outputs["Depth"], blur.inputs[1])
