@@ -128,6 +128,7 @@ SHADOWS = "shadows"
 LIGHTING = "lighting"
 WORLD = "world"  # World Properties › Penumbra (the world's light and its visibility)
 LIGHT_PATHS = "light_paths"  # Render Properties › Light Paths (indirect light)
+VOLUMES = "volumes"  # Render Properties › Volumes (participating media)
 VIEWPORT = "viewport"
 SIMPLIFY = "simplify"
 DEBUG = "debug"
@@ -511,6 +512,17 @@ SCENE_PARAMS = (
         max=256,
         label="Bounce Samples",
         section=LIGHT_PATHS,
+    ),
+    Param(
+        "volume_samples",
+        "INT",
+        64,
+        "Steps of each pixel's march through the media it crosses (EEVEE's Volumes > Samples); each sample "
+        "of a frame places them anew, so the frame's samples converge to the media's single scattering",
+        min=1,
+        max=256,
+        label="Steps",
+        section=VOLUMES,
     ),
     Param(
         "screen_space_reflections",

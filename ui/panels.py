@@ -98,6 +98,11 @@ class PENUMBRA_PT_light_paths(_SettingsPanel, bpy.types.Panel):
     section = settings.LIGHT_PATHS
 
 
+class PENUMBRA_PT_volumes(_SettingsPanel, bpy.types.Panel):
+    bl_label = "Volumes"
+    section = settings.VOLUMES
+
+
 class PENUMBRA_PT_world(_SettingsPanel, bpy.types.Panel):
     """The world's light and its visibility, in World Properties (where EEVEE and Cycles put a
     world's settings); the values are the scene's, saved with it."""
@@ -459,6 +464,7 @@ classes = (
     PENUMBRA_PT_lightprobe,
     PENUMBRA_PT_lighting,
     PENUMBRA_PT_light_paths,
+    PENUMBRA_PT_volumes,
     PENUMBRA_PT_world,
     PENUMBRA_PT_world_sun,
     PENUMBRA_PT_viewport,

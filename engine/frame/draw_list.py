@@ -185,17 +185,16 @@ def corners_of(draws):
     return np.stack([d.corners for d in draws]) if draws else np.zeros((0, 8, 3))
 
 
-def frame_light_rects(lights, draws, camera, width, height, reach=0.0):
+def frame_light_rects(lights, draws, camera, width, height, reach=0.0, receivers=None):
     """The screen rectangles of a frame's lights, once a frame (``light_bins.screen_rects``
     from the unjittered ``camera``): each light's influence padded by how far its samples move
     it (``light_bins.light_reach``), every rectangle by ``reach`` pixels (the camera's offsets
     over the frame's samples). Returns (per light its rectangle or None, the rectangle of a
     light without influence: a sun, a point, a direction of the world), or None without
-    draws or lights."""
+    draws or lights. ``receivers``: boxes beyond the draws that take light (``FramePlan.receivers``)."""
     if not draws:
         return None
-    corners = np.concatenate([d.corners for d in draws])
-    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    lo, hi = _bounds(draws, receivers)
     stand_in = Light(type="SUN", color=np.zeros(3), matrix=np.eye(4), radius=0.0)
     rects = light_bins.screen_rects(
         [*lights, stand_in],
@@ -210,7 +209,15 @@ def frame_light_rects(lights, draws, camera, width, height, reach=0.0):
     return rects[:-1], rects[-1]
 
 
-def lights_in_view(lights, draws, camera, width, height, stats, frame=None):
+def _bounds(draws, receivers=None):
+    """(lo, hi) world corners of the draws' bounds and of ``receivers`` (n, 8, 3) if any."""
+    corners = np.concatenate([d.corners for d in draws])
+    if receivers is not None and len(receivers):
+        corners = np.concatenate([corners, np.asarray(receivers, np.float64).reshape(-1, 3)])
+    return corners.min(axis=0), corners.max(axis=0)
+
+
+def lights_in_view(lights, draws, camera, width, height, stats, frame=None, receivers=None):
     """The lights that can light a visible surface, with the screen rectangle each can reach
     (``light_bins.screen_rects``); a light that reaches nothing the camera sees gets no shadow
     map and no shading. ``frame``: ``frame_light_rects`` of the frame's lights, which the
@@ -222,8 +229,7 @@ def lights_in_view(lights, draws, camera, width, height, stats, frame=None):
         known, anywhere = frame
         rects = [known[i] if i < len(known) else anywhere for i in range(len(lights))]
     else:
-        corners = np.concatenate([d.corners for d in draws])
-        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        lo, hi = _bounds(draws, receivers)
         rects = light_bins.screen_rects(lights, camera.projection @ camera.view, lo, hi, width, height)
     keep = [i for i, r in enumerate(rects) if r is not None]
     stats.lights_out_of_view = len(lights) - len(keep)

@@ -702,12 +702,15 @@ class Film:
             self._fullscreen_batch = batch_for_shader(shader, "TRIS", {"pos": ((-1, -1), (3, -1), (-1, 3))})
         return self._fullscreen_batch
 
-    def fullscreen(self, program, framebuffer, samplers, uniforms, blend="NONE", depth_test="NONE"):
+    def fullscreen(
+        self, program, framebuffer, samplers, uniforms, blend="NONE", depth_test="NONE", blocks=None, defines=None
+    ):
         """One full-frame triangle of ``program`` into ``framebuffer`` (at depth 0.5 when
-        ``depth_test`` tests it against the framebuffer's z-buffer, which it does not write)."""
+        ``depth_test`` tests it against the framebuffer's z-buffer, which it does not write);
+        ``blocks``: {name: uniform buffer} it binds; ``defines``: its variant's."""
         import gpu
 
-        shader = self.shaders.get(program)
+        shader = self.shaders.get(program, defines)
         self._batch(shader)
         width, height = self.size
         with framebuffer.bind():
@@ -719,6 +722,8 @@ class Film:
             shader.bind()
             for name, tex in samplers.items():
                 shader.uniform_sampler(name, tex)
+            for name, block in (blocks or {}).items():
+                shader.uniform_block(name, block)
             if any(pc[1] == "origin" for pc in program.push_constants):
                 shader.uniform_int("origin", (0, 0))
             integer = {pc[1] for pc in program.push_constants if pc[0].startswith(("INT", "IVEC"))}

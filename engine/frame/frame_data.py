@@ -38,6 +38,7 @@ class FrameData:
     order: list  # the light index of each row of ``lights`` (shadowed lights first)
     bins: np.ndarray = None  # (rows, columns, LIGHT_WORDS) light masks of the screen bins, or None
     samplers: dict = field(default_factory=dict)  # {name: texture} the techniques' parts bind
+    blocks: dict = field(default_factory=dict)  # {name: packed bytes} their uniform blocks (``LitPart.blocks``)
     begins: tuple = ()  # the techniques' GPU work over the frame block before the draws (``LitPart.begin``)
     betweens: tuple = ()  # their work after the opaque surfaces, before the transmissive (``LitPart.between``)
     # The techniques' ``ProgramPart`` values of the lit program (``LitPart.program``), in order,
@@ -116,6 +117,7 @@ def light_row(light, shadow=None, origin=_ZERO):
         "bias_scale": light.bias_scale,
         "diffuse_factor": light.diffuse_factor,
         "specular_factor": light.specular_factor,
+        "volume_factor": getattr(light, "volume_factor", 1.0),
         "jittered": int(light.jittered),
         "offset_scale": light.offset_scale,
         "cascade_splits": (list(shadow.splits) + [3.0e38] * 4)[:4] if shadow and shadow.splits else (3.0e38,) * 4,
@@ -175,6 +177,9 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "cube_probe_influence": np.zeros((4, 4)),
         "cube_probe_shape": (0.0, 0.0, 0.0, 0.0),
         "cube_camera": (0.0, 0.0, 0.0, -1.0),
+        "volume_params": (0.0, 0.0, 0.0, 0.0),
+        "volume_inv_view": np.eye(4),
+        "volume_inv_raster": np.eye(4),
     }
 
 
@@ -248,10 +253,11 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
     ``ProgramPart`` values, the frame block their rows."""
     if len(lights) > MAX_LIGHTS:
         raise ValueError(f"{len(lights)} lights; the lit pass takes at most {MAX_LIGHTS}")
-    rows, samplers = {}, {}
+    rows, samplers, blocks = {}, {}, {}
     for part in inputs.parts:
         rows.update(part.rows)
         samplers.update(part.samplers)
+        blocks.update(part.blocks)
     disk = disk_samples(settings, inputs.sample_count)
     order, sampled, shadowed = shading_order(lights, plan)
     sh = getattr(world_color, "sh", None)  # a materials.World, or a constant colour
@@ -313,6 +319,7 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
         order=order,
         bins=bins,
         samplers=samplers,
+        blocks=blocks,
         begins=tuple(part.begin for part in inputs.parts if part.begin is not None),
         betweens=tuple(part.between for part in inputs.parts if part.between is not None),
         parts=parts,

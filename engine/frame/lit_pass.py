@@ -354,6 +354,15 @@ class LitPass:
         return self._dummy_shadow
 
 
+def bind_block(shader, name, block):
+    """Bind uniform block ``name`` of ``shader`` where the compiler kept it (a variant that
+    reads none of it, an entry shader of the passes', has none: Blender raises there)."""
+    try:
+        shader.uniform_block(name, block)
+    except (BufferError, ValueError):
+        pass
+
+
 def gpu_framebuffer_with_depth(target, zbuffer):
     """A framebuffer drawing into ``target`` over ``zbuffer``."""
     import gpu
@@ -476,6 +485,8 @@ class _Submission:
         shader.uniform_sampler("light_bins", lit._bins_texture(data.bins))
         for name, texture in data.samplers.items():  # the techniques' (``LitPart.samplers``)
             shader.uniform_sampler(name, texture)
+        for name, raw in data.blocks.items():  # the techniques' (``LitPart.blocks``)
+            bind_block(shader, name, lit._ubo(name, raw))
         self.shader = shader
         return shader
 

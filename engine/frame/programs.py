@@ -55,6 +55,7 @@ LIGHT_STRUCT = Struct(
         ("FLOAT", "bias_scale"),  # light.penumbra.bias_scale
         ("FLOAT", "diffuse_factor"),  # Light > Influence > Diffuse (EEVEE's), on the diffuse term
         ("FLOAT", "specular_factor"),  # Light > Influence > Specular, on the specular term
+        ("FLOAT", "volume_factor"),  # Light > Influence > Volume: on the light media scatter
         ("INT", "jittered"),  # 1: its maps move by a sub-texel offset in each of the frame's samples
         ("FLOAT", "offset_scale"),  # multiplies the normal offset (besides bias_scale)
         ("VEC4", "cascade_splits"),  # CASCADE: view depth where cascade 0..3 ends (tiles.xyzw)
@@ -176,6 +177,13 @@ FRAME_STRUCT = Struct(
         ("MAT4", "cube_probe_influence"),
         ("VEC4", "cube_probe_shape"),
         ("VEC4", "cube_camera"),
+        # VOLUMES (features/volumes.py, lib/volumes.glsl): (media in the ``media`` block, the
+        # world medium's radius (the clip end), steps of the march, this sample's offset of them).
+        ("VEC4", "volume_params"),
+        # and the march's maps of clip space to positions (relative to the origin): the view
+        # camera's (its clip start and end) and the raster camera's (its z-buffer).
+        ("MAT4", "volume_inv_view"),
+        ("MAT4", "volume_inv_raster"),
     ),
 )
 
@@ -317,6 +325,7 @@ LIT = Program(
             "RSM_SAMPLES": 1,
             "SETTLE_TEST": False,
             "PILOT_SAMPLE": False,
+            "VOLUMES": False,
         }.items()
     ),
 )

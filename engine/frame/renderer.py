@@ -120,6 +120,12 @@ class FramePlan:
     reflective: bool = False
     ao_distance: float | None = None
     pass_outputs: dict = dataclasses.field(default_factory=dict)  # the passes' (``features/passes.py``)
+    # A technique changes every pixel it covers from sample to sample in a way the settle test
+    # does not see (the volumes' march): settling keeps no pilot's value.
+    unsettled: bool = False
+    # Boxes (n, 8, 3 world corners) beyond the draws' that take light: the media's
+    # (``features/volumes.py``). The lights that reach them are lit and their maps cover them.
+    receivers: object = None
 
     @property
     def camera(self):
@@ -306,7 +312,7 @@ class Renderer:
                 features.append(feature)
         frame.features = tuple(features)
         stats.techniques = [f.name for f in features]
-        self.shadow_pass.begin_frame(frame.reach, frame.reflective)
+        self.shadow_pass.begin_frame(frame.reach, frame.reflective, frame.receivers)
         room = MAX_LIGHTS - frame.directions
         frame.lights = select_lights(snapshot.lights, camera.position, room)
         if len(frame.lights) < len(snapshot.lights):
@@ -402,7 +408,9 @@ class Renderer:
         # Which part of the screen each light can reach: once a frame, padded by how far its
         # samples move it and by the camera's pixel offsets (light bins, lights out of view).
         if frame.motion is None:  # with motion blur each sample's own (``lights_in_view``)
-            frame.rects = frame_light_rects(lights, frame.draws, frame.camera, width, height, frame.reach)
+            frame.rects = frame_light_rects(
+                lights, frame.draws, frame.camera, width, height, frame.reach, frame.receivers
+            )
         deadline = request.deadline
         if frame.adaptive is not None and frame.adaptive.time_limit > 0.0 and deadline is None:
             deadline = sampling.clock() + frame.adaptive.time_limit
@@ -511,7 +519,7 @@ class Renderer:
         width, height = film.size
         view_camera, camera = sample.view_camera, sample.camera
         lights, rects = lights_in_view(
-            sample.lights, sample.draws, view_camera, width, height, sample.stats, frame.rects
+            sample.lights, sample.draws, view_camera, width, height, sample.stats, frame.rects, frame.receivers
         )
         sample.lights = lights
         clock.begin("shadow pass")

@@ -41,13 +41,17 @@ class ShadowPass:
         self._reaches = None  # {light index: reach} the frame's first plan grew the scene by
         self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
         self.reflective = False  # the maps hold what each light sees too (features/bounce.py)
+        self.receivers = None  # boxes beyond the draws that take light (``begin_frame``)
 
-    def begin_frame(self, reach=0.0, reflective=False):
+    def begin_frame(self, reach=0.0, reflective=False, receivers=None):
         """Forget the last frame's camera-dependent bounds, casters and map sizes. ``reach``:
         how many pixels beyond the image the frame's samples look (the pixel filter's reach in
         a multi-sample frame; 0 for one sample), so maps are planned for all of them;
-        ``reflective``: the maps are reflective shadow maps (``FramePlan.reflective``)."""
+        ``reflective``: the maps are reflective shadow maps (``FramePlan.reflective``);
+        ``receivers``: boxes beyond the draws that take light (``FramePlan.receivers``: the
+        media), which the maps cover as they cover the surfaces the camera sees."""
         self.reflective = bool(reflective)
+        self.receivers = None if receivers is None or not len(receivers) else np.asarray(receivers, np.float64)
         self.depth_range = UNSET
         self._receivers = None
         self._sun_parts = None
@@ -108,6 +112,8 @@ class ShadowPass:
         sizes, derived = known if known is not None else (None, None)
         cones, reaches = spread if spread is not None else (None, None)
         corners = corners_of(draws)
+        # What takes light: the draws' boxes and the receivers beyond them (the media).
+        seen = corners if self.receivers is None else np.concatenate([corners, self.receivers])
         if self.reach > 0.0 and size is not None:
             projection, size = sampling.widened_projection(camera.projection, self.reach, *size)
             camera = dataclasses.replace(camera, projection=projection)
@@ -116,11 +122,11 @@ class ShadowPass:
         if self.depth_range is UNSET:
             # The visible depth range and the visible receivers depend only on the unjittered
             # camera and the instances' bounds: once per frame, not per sample.
-            self.depth_range = lightspace.view_depth_range(camera.projection, camera.view, corners, camera.is_ortho)
-            self._receivers = lightspace.visible_receivers(corners, camera.projection @ camera.view)
+            self.depth_range = lightspace.view_depth_range(camera.projection, camera.view, seen, camera.is_ortho)
+            self._receivers = lightspace.visible_receivers(seen, camera.projection @ camera.view)
         if view_corners is not None and self._sun_parts is None:
             # Every sun fitted to the whole view (the world's directions too) fits to these.
-            self._sun_parts = lightspace.view_parts(corners, view_corners)
+            self._sun_parts = lightspace.view_parts(seen, view_corners)
         options = MapOptions(
             map_size,
             int(settings.shadow_cascades),
@@ -136,6 +142,7 @@ class ShadowPass:
             receivers=self._receivers,
             density=_density(camera, settings, size),
             sun_parts=self._sun_parts,
+            extra=self.receivers,
         )
         share = FrameShare(known_sizes=sizes, cones=cones, reaches=reaches, derived=derived)
         return plan_shadows(lights, corners, options, fit, share)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import hair
+from . import hair, volumes
 from .geometry import ContentCache, Geometry, content_key
 from .materials import material_from_blender, world_from_blender
 from .terminator import Terminator
@@ -196,6 +196,7 @@ class Light:
     jittered: bool = False  # its maps are shifted per sample (sampling.map_jitter) in this frame
     diffuse_factor: float = 1.0  # Light > Influence: how much it adds to diffuse and specular
     specular_factor: float = 1.0
+    volume_factor: float = 1.0  # Light > Influence > Volume: how much it adds to media's scattering
     receivers: LinkSet | None = None  # light linking: what it lights (None: everything)
     blockers: LinkSet | None = None  # shadow linking: what casts its shadow (None: everything)
     name: str = ""  # the light object's name (what the SHADOW_MAPS debug view labels its maps with)
@@ -296,6 +297,9 @@ class Snapshot:
     planes: tuple = ()
     # Sphere Light Probes (``SphereProbe``): cube maps by the lit pass (``frame/features/cubes.py``).
     spheres: tuple = ()
+    # Participating media (``volumes.Medium``): the world's Volume and meshes' interiors
+    # (``frame/features/volumes.py``); empty with View Layer > Filter > Volumes off.
+    media: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -834,6 +838,8 @@ class _Reading:
         layer = depsgraph.view_layer
         self.material_override = getattr(layer, "material_override", None)
         self.surfaces = bool(getattr(layer, "use_solid", True))
+        self.volumes = bool(getattr(layer, "use_volumes", True))
+        self.media = []
         self.curves = bool(getattr(layer, "use_strand", True))
         self._own, self._held, self._sets, self._terminators = {}, {}, {}, {}
 
@@ -1058,6 +1064,9 @@ class SceneCache:
             del self.geometry[key]
         world = self._world(scene, getattr(depsgraph.view_layer, "world_override", None))
         messages += world.messages
+        media = list(reading.media)
+        if world.volume is not None and reading.volumes:
+            media.insert(0, world.volume)
         return Snapshot(
             instances=reading.instances,
             lights=reading.lights,
@@ -1069,6 +1078,7 @@ class SceneCache:
             portals=tuple(reading.portals),
             planes=tuple(reading.planes),
             spheres=tuple(reading.spheres),
+            media=tuple(media),
         )
 
     def _read_object(self, reading, inst):
@@ -1076,7 +1086,8 @@ class SceneCache:
         drawn and seen by the camera or shadows."""
         ob = inst.object
         if ob.type in _NOT_DRAWN:
-            reading.messages.append(f"{_NOT_DRAWN[ob.type]} '{ob.name}' is not drawn")
+            why = ": its OpenVDB grids are not read (a mesh's Volume material is drawn)" if ob.type == "VOLUME" else ""
+            reading.messages.append(f"{_NOT_DRAWN[ob.type]} '{ob.name}' is not drawn{why}")
             return
         if ob.type not in GEOMETRY_TYPES and ob.type != "CURVES":
             return
@@ -1111,8 +1122,33 @@ class SceneCache:
         self._read_particle_hair(reading, obj, systems, slots)
         if not inst.is_instance and not inst.show_self:
             return  # a particle emitter with Show Emitter off for this render
+        if any(m is not None and m.volume is not None for m in slots) and camera:
+            self._read_medium(reading, obj, slots)
+        if slots and all(m is not None and not m.surface for m in slots):
+            return  # only a Volume output: the interior alone, no surface (as Cycles)
+        if any(m is not None and not m.surface for m in slots):
+            reading.messages.append(
+                f"object '{ob.name}': a material with only a Volume output among its surfaces is drawn as black faces"
+            )
         if reading.surfaces:  # View Layer > Filter > Surfaces
             self._read_surface(reading, obj, slots)
+
+    def _read_medium(self, reading, obj, slots):
+        """The medium of ``obj``'s first material with a Volume output, filling its bounding box
+        (named where the mesh is not a box); View Layer > Filter > Volumes off: none."""
+        ob = obj.ob
+        if not reading.volumes:
+            return
+        mat = next(m for m in slots if m is not None and m.volume is not None)
+        if sum(1 for m in slots if m is not None and m.volume is not None) > 1:
+            reading.messages.append(f"object '{ob.name}': only its first material's Volume is drawn")
+        matrix = volumes.box_matrix(obj.matrix, [tuple(c) for c in ob.bound_box])
+        if matrix is None:
+            reading.messages.append(f"object '{ob.name}': its volume is flat or empty and is not drawn")
+            return
+        if not (ob.type == "MESH" and volumes.is_box(ob.data)):
+            reading.messages.append(f"object '{ob.name}': its volume fills its bounding box (the mesh is not a box)")
+        reading.media.append(mat.volume.placed("BOX", matrix, ob.name))
 
     def _read_particle_hair(self, reading, obj, systems, slots):
         """The strips of the hair particle ``systems`` of ``obj``, each with its settings'
@@ -1211,6 +1247,7 @@ def light_from_blender(data, matrix):
     light = Light(type=data.type, color=color, matrix=matrix, radius=radius, use_shadow=bool(data.use_shadow))
     light.diffuse_factor = float(getattr(data, "diffuse_factor", 1.0))
     light.specular_factor = float(getattr(data, "specular_factor", 1.0))
+    light.volume_factor = float(getattr(data, "volume_factor", 1.0))
     if data.type == "SPOT":
         light.spot_size = float(data.spot_size)
         light.spot_blend = float(data.spot_blend)

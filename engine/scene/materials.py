@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import volumes
+
 # Channels a texture can drive, in the order of the shader's texture slots.
 CHANNELS = ("base_color", "roughness", "metallic", "alpha", "emission", "normal")
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # Rec.709: Blender's colour -> value conversion
@@ -69,6 +71,11 @@ class Material:
     tree: object = None  # nodetree.CompiledTree: the node tree drawn as generated GLSL
     name: str = ""  # the material's name (its Cryptomatte id)
     pass_index: int = 0  # Material > Settings > Pass Index (the Material Index pass)
+    # Its Volume output (``volumes.Medium``): the object's interior is that medium; None: none.
+    volume: object = None
+    # False: nothing is linked to its Surface output while its Volume output is (as in Cycles,
+    # the surface is not drawn: light crosses it).
+    surface: bool = True
 
     @property
     def f0(self):
@@ -313,17 +320,26 @@ def _material_surface(mat):
             metallic=float(mat.metallic),
         )
         return out
-    out = _shader(mat, _surface(mat), notes)
-    whole = out is None
+    surface = _surface(mat)
+    # Only a Volume output: no surface, the interior alone (as Cycles draws it).
+    whole_volume = surface is None and _linked_outputs(
+        mat.node_tree, "ShaderNodeOutputMaterial", "Volume", {"ALL", "EEVEE"}
+    )
+    out = _shader(mat, surface, notes)
+    whole = out is None and not whole_volume
     if out is None:
         out = _display(mat, notes, "its surface shader is drawn with the viewport display colour")
     elif "alpha" in out.textures or out.alpha < 1.0:
         out.blend = _blend_mode(mat)
     if notes or _writes_aovs(mat):
         out, notes = _compiled(mat, out, notes, whole or _writes_aovs(mat))
-    for socket in ("Volume", "Displacement"):
-        if _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", socket, {"ALL", "EEVEE"}):
-            notes.append(f"its {socket} output is not drawn")
+    if _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", "Displacement", {"ALL", "EEVEE"}):
+        notes.append("its Displacement output is not drawn")
+    medium = volumes.medium_of(mat.node_tree, "ShaderNodeOutputMaterial", "", {"ALL", "EEVEE"})
+    if medium is not None:
+        notes.extend(medium.messages)
+        out.volume = None if medium.empty else medium
+        out.surface = not whole_volume
     if out.transmits and _linked_outputs(mat.node_tree, "ShaderNodeOutputMaterial", "Thickness", {"ALL", "EEVEE"}):
         notes.append("its Thickness output is not read (the object's smallest dimension is its thickness)")
     out.messages = tuple(f"material '{mat.name}': {n}" for n in dict.fromkeys(notes))
@@ -726,6 +742,8 @@ class World:
     # Where the sun took the image's light above its threshold: that threshold (radiance, with
     # the strength), what the rest of the world's light is clamped to; None where it took none.
     sun_clamp: float | None = None
+    # World > Volume (``volumes.Medium``): a medium filling the view to the clip end; None: none.
+    volume: object = None
 
     @property
     def mean(self):
@@ -832,17 +850,17 @@ def _environment_rotation(world, env, messages):
 
 def world_from_blender(scene, world=None):
     """The scene world's light (``World``, see ``_world_surface``), or ``world``'s (a view
-    layer's World Override); a Volume shader on the world's output is named (not drawn)."""
+    layer's World Override), with its Volume shader's medium (``World.volume``)."""
     world = scene.world if world is None else world
     out = _world_surface(world)
     out.lightgroup = str(getattr(world, "lightgroup", "") or "") if world is not None else ""
     tree = getattr(world, "node_tree", None) if world is not None else None
-    if (
-        tree is not None
-        and getattr(world, "use_nodes", True)
-        and _linked_outputs(tree, "ShaderNodeOutputWorld", "Volume")
-    ):
-        out.messages = (*out.messages, f"world '{world.name}': its Volume shader is not drawn")
+    if tree is not None and getattr(world, "use_nodes", True):
+        label = f"world '{world.name}': "
+        medium = volumes.medium_of(tree, "ShaderNodeOutputWorld", label)
+        if medium is not None:
+            out.messages = (*out.messages, *medium.messages)
+            out.volume = None if medium.empty else medium.placed("WORLD", np.eye(4), world.name)
     return out
 
 

@@ -358,7 +358,10 @@ class ViewFit:
     that many texels per screen pixel (times the fixed filter's radius: its blur stays within
     half a pixel); the light is then planned again at that size. ``sun_parts``:
     ``lightspace.view_parts(corners, view_corners)``, when the caller keeps them for the frame
-    (every sun fitted to the whole view reads them; else once a plan)."""
+    (every sun fitted to the whole view reads them; else once a plan; with ``extra``, of the
+    geometry's boxes and then those). ``extra``: boxes (n, 8, 3) that take light and cast
+    none (the media, ``frame/features/volumes.py``): suns are fitted to them as to the
+    geometry (``receivers`` should hold them for the other lights)."""
 
     view_corners: np.ndarray = None
     camera: object = None
@@ -366,6 +369,7 @@ class ViewFit:
     receivers: object = None
     density: Density = None
     sun_parts: tuple = None
+    extra: np.ndarray = None
 
 
 @dataclass(frozen=True)
@@ -406,7 +410,10 @@ class _Scene:
 
     def parts(self):
         if self.sun_parts is None:
-            self.sun_parts = lightspace.view_parts(self.boxes.corners, self.view.view_corners)
+            corners, extra = self.boxes.corners, self.view.extra
+            if extra is not None and len(extra):
+                corners = np.concatenate([corners, np.asarray(extra, np.float64).reshape(-1, 8, 3)])
+            self.sun_parts = lightspace.view_parts(corners, self.view.view_corners)
         return self.sun_parts
 
 
@@ -439,7 +446,8 @@ def plan_shadows(lights, corners, options, view=None, share=None):
     corners = np.asarray(corners, dtype=np.float64).reshape(-1, 8, 3)
     if len(corners) == 0:
         return plan
-    slices = _cascade_slices(corners, view.view_corners, view.camera, options.cascades, view.depth_range)
+    seen = corners if view.extra is None else np.concatenate([corners, np.asarray(view.extra).reshape(-1, 8, 3)])
+    slices = _cascade_slices(seen, view.view_corners, view.camera, options.cascades, view.depth_range)
     # What the camera sees, once for every spot, point and area map of the frame.
     receivers = view.receivers
     if receivers is None and view.camera is not None:
@@ -548,12 +556,22 @@ def _sun_tiles(scene, job, sizes):
     """A sun's map fitted to the whole scene, to the whole view, or one per cascade."""
     light, corners = job.light, scene.boxes.corners
     view_corners, slices = scene.view.view_corners, scene.slices
+    count, flat_free = len(corners), job.flat_free
+    extra = scene.view.extra
+    if extra is not None and len(extra):
+        # Receivers that cast nothing: after the geometry's boxes (caster indices stay the
+        # draws'), never casters.
+        if flat_free is None and view_corners is not None:
+            flat_free = lightspace.flat_casters_without_shadow(corners, light.direction)
+        corners = np.concatenate([corners, np.asarray(extra, np.float64).reshape(-1, 8, 3)])
+        if flat_free is not None:
+            flat_free = np.concatenate([flat_free, np.ones(len(corners) - count, dtype=bool)])
     # How far a PCSS penumbra spreads out of a caster's footprint, per unit of depth.
     angle = min(max(light.angle, 0.0), math.pi * 0.99)
     spread = math.tan(0.5 * angle) * light.penumbra_scale if job.soft else 0.0
     if view_corners is None:
         fit = lightspace.fit_sun_ortho(light.direction, corners.reshape(-1, 3), sizes[0])
-        tiles = [Tile(fit, np.arange(len(corners)))] if fit is not None else []
+        tiles = [Tile(fit, np.arange(count))] if fit is not None else []
     elif slices is None or light.world:
         fitted = lightspace.fit_sun_to_view(
             light.direction,
@@ -561,7 +579,7 @@ def _sun_tiles(scene, job, sizes):
             view_corners,
             sizes[0],
             soft=spread,
-            flat_free=job.flat_free,
+            flat_free=flat_free,
             parts=scene.parts(),
             cone=job.cone,
         )
@@ -569,7 +587,7 @@ def _sun_tiles(scene, job, sizes):
     else:
         fits = [
             lightspace.fit_sun_to_view(
-                light.direction, corners, sc, sizes[k], soft=spread, flat_free=job.flat_free, cone=job.cone
+                light.direction, corners, sc, sizes[k], soft=spread, flat_free=flat_free, cone=job.cone
             )
             for k, (sc, _end) in enumerate(slices)
         ]

@@ -1,4 +1,4 @@
-// requires: lib/lights.glsl lib/lit_debug.glsl lib/shadow_filters.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl lib/lit_world.glsl lib/lit_settle.glsl
+// requires: lib/lights.glsl lib/lit_debug.glsl lib/shadow_filters.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl lib/lit_world.glsl lib/lit_settle.glsl lib/volumes.glsl
 #ifndef PENUMBRA_LIB_LIT_LIGHTS
 #define PENUMBRA_LIB_LIT_LIGHTS
 
@@ -81,6 +81,10 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
       reflected += (s.lobe[k].weight * cosines[k]) * f;
     }
   }
+#if VOLUMES
+  /* What the media between here and the light let through (features/volumes.py). */
+  reflected *= light_transmittance(s.P, L, to_light);
+#endif
   vec3 added = (L.color * visibility) * irradiance * reflected;
   color += added;
 #if DEBUG_TERM == 1

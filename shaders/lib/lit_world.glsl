@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl lib/cubes.glsl
+// requires: lib/common.glsl lib/world_sh.glsl lib/volumes.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl lib/cubes.glsl
 #ifndef PENUMBRA_LIB_LIT_WORLD
 #define PENUMBRA_LIB_LIT_WORLD
 
@@ -84,20 +84,6 @@ vec2 world_direction_weights(vec3 E, vec3 albedo, vec3 f, float cosine, LightDat
   return cosine * vec2(world_luminance(E * fd), world_ratio_share(rough) * world_luminance(E * max(f - fd, vec3(0.0))));
 }
 #endif
-
-/* The world's radiance around direction d from its SH coefficients, each band scaled by
- * g.x (band 1) and g.y (band 2): (1, 1) is the radiance itself, (2/3, 1/4) the cosine-lobe
- * convolution (irradiance / pi). */
-vec3 world_sh(vec3 d, vec2 g)
-{
-  vec3 r = frame.world_color;
-  r += g.x * 0.4886025 * (frame.world_sh1.xyz * d.y + frame.world_sh2.xyz * d.z + frame.world_sh3.xyz * d.x);
-  r += g.y * (1.0925484 * (frame.world_sh4.xyz * d.x * d.y + frame.world_sh5.xyz * d.y * d.z +
-                           frame.world_sh7.xyz * d.x * d.z) +
-              0.3153916 * frame.world_sh6.xyz * (3.0 * d.z * d.z - 1.0) +
-              0.5462742 * frame.world_sh8.xyz * (d.x * d.x - d.y * d.y));
-  return max(r, vec3(0.0));
-}
 
 #if WORLD_ENV
 /* The image's radiance about direction ``R`` (world space) as a GGX lobe of Principled roughness
@@ -268,8 +254,15 @@ vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
   }
 #endif
   vec3 color = vec3(0.0);
+#if VOLUMES
+  /* What the media let through of it (features/volumes.py). */
+  vec3 through = world_transmittance(s.P, s.Ng);
+#endif
   for (int k = 0; k < NODE_LOBES; k++) {
     float w = s.lobe[k].weight;
+#if VOLUMES
+    w *= dot(through, vec3(1.0 / 3.0));
+#endif
 #if WORLD_AO
     world_visibility = gtao_visibility(ao_horizons, normalize(ao_rotation * s.lobe[k].N));
 #  if DEBUG_LIT

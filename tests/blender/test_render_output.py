@@ -289,9 +289,8 @@ def test_features_penumbra_does_not_render_are_named_in_the_report():
         "object 'Ball': Shadow Catcher is Cycles-only (drawn as an ordinary object)",
         "area light 'Panel': Spread is not rendered (it emits over the whole half-space)",
         "point cloud object 'Pointclouds' is not drawn",
-        "volume object 'Volumes' is not drawn",
-        "material 'Ball': its Volume output is not drawn",
-        "world 'World': its Volume shader is not drawn",
+        "volume object 'Volumes' is not drawn: its OpenVDB grids are not read (a mesh's Volume material is drawn)",
+        "object 'Ball': its volume fills its bounding box (the mesh is not a box)",
         "Blender's Shadow pass is not written (switch on Penumbra's own in View Layer > Passes)",
     ):
         assert output.count(f"Penumbra: {message}") == 1, message

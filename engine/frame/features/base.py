@@ -10,7 +10,8 @@ class LitPart:
     program (libraries, samplers, outputs and the defines that switch it on; None: it changes
     no program), ``blended`` the one blended surfaces take (None: ``program``'s); ``rows``,
     fields of the frame block (``programs.FRAME_STRUCT``) this technique sets; ``samplers``,
-    {sampler name: texture} the lit program reads (bound with the frame's blocks); ``begin``:
+    {sampler name: texture} the lit program reads (bound with the frame's blocks); ``blocks``,
+    {block name: packed std140 bytes} of uniform blocks its ``program`` declares; ``begin``:
     GPU work over the sample's frame block before the lit pass's draws
     (``begin(frame_block, stats)``), or None; ``between``: GPU work after the opaque surfaces
     are drawn and before the transmissive ones (``between(film, stats)``: what they see
@@ -20,6 +21,7 @@ class LitPart:
     blended: object = None
     rows: dict = dataclasses.field(default_factory=dict)
     samplers: dict = dataclasses.field(default_factory=dict)
+    blocks: dict = dataclasses.field(default_factory=dict)
     begin: object = None
     between: object = None
 

@@ -38,7 +38,9 @@ class MotionBlur(Feature):
         )
         sample.lights = motion_mod.lights_at(sample.lights, motion, u)
         sample.camera = sample.view_camera = motion_mod.camera_at(sample.camera, motion, u)
-        renderer.shadow_pass.begin_frame(frame.reach, frame.reflective)  # this sample's maps from its own scene
+        renderer.shadow_pass.begin_frame(
+            frame.reach, frame.reflective, frame.receivers
+        )  # this sample's maps from its own scene
 
     @staticmethod
     def _deformed(frame, snapshot, motion, u):

@@ -245,6 +245,7 @@ class Settling(Feature):
         adaptive = frame.adaptive
         return (
             frame.motion is None
+            and not frame.unsettled
             and adaptive is not None
             and adaptive.settle > 0.0
             and flag_reach(frame.settings.filter_size, frame.lens_reach) is not None
