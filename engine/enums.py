@@ -296,10 +296,23 @@ DEBUG_VIEW = Enum(
                 "legend": "the diffuse bounce alone, in the render's colours; black with Diffuse Bounces 0",
             },
         ),
+        (
+            "VOLUME_LIGHT",
+            "Volume Light",
+            "The light the media scatter and emit towards the camera alone (World > Volume, meshes' Volume "
+            "materials), averaged over the frame's samples",
+            11,
+            {
+                "lit": True,
+                "term": 3,
+                "legend": "the media's in-scattered and emitted light alone, in the render's colours; black "
+                "without media",
+            },
+        ),
     ),
     # lit: the lit pass writes the view's values instead of colour (the DEBUG_LIT variant);
     # term: instead, the lit pass writes one term of its colour alone (DEBUG_TERM: 1 the world's
-    # light, 2 the diffuse bounce); legend: what the colours mean (the viewport's text and the
-    # render report).
+    # light, 2 the diffuse bounce, 3 none: the volumes' march adds its light alone); legend: what
+    # the colours mean (the viewport's text and the render report).
     fact_defaults={"lit": False, "term": 0, "legend": ""},
 )

@@ -5,7 +5,8 @@
  *   DEBUG_LIT, WORLD_AO  the world's visibility (WORLD_AO)
  *   DEBUG_LIT, DEBUG_REFLECTIONS  where the traced rays met the scene (REFLECTIONS)
  *   DEBUG_TERM 1         the world's light with its visibility (WORLD_LIGHT)
- *   DEBUG_TERM 2         the diffuse bounce (INDIRECT) */
+ *   DEBUG_TERM 2         the diffuse bounce (INDIRECT)
+ *   DEBUG_TERM 3         nothing: the volumes' march adds the media's light alone (VOLUME_LIGHT) */
 
 void main()
 {

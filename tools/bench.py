@@ -22,6 +22,9 @@
               -> <out>/soak.csv
     terminator  frame time with Shadow Terminator Geometry Offset 0 against 0.1 (smooth
               spheres) -> stdout
+    volumes   fog, light shafts and a backlit box: single scattering through the shadow maps,
+              error against time vs Cycles (Volume Bounces 0) and EEVEE
+              -> <out>/volumes.csv, volumes.png
     world     the world's light with visibility: error against time on scenes lit by the world
               alone, Penumbra (world shadows on and off, one bounce) against Cycles and EEVEE
               -> <out>/world.csv, world.png
@@ -50,6 +53,7 @@ from tools.benchmarks import (
     shadows,
     soak,
     terminator,
+    volumes,
     world,
 )
 
@@ -65,6 +69,7 @@ COMMANDS = {
     "shadows": shadows,
     "soak": soak,
     "terminator": terminator,
+    "volumes": volumes,
     "world": world,
 }
 

@@ -321,6 +321,7 @@ class PENUMBRA_PT_light(PenumbraPanel, bpy.types.Panel):
         influence = layout.column(align=True, heading="Influence")
         influence.prop(context.light, "diffuse_factor", text="Diffuse")
         influence.prop(context.light, "specular_factor", text="Specular")
+        influence.prop(context.light, "volume_factor", text="Volume")
         layout.prop(context.light, "use_shadow")
         col = layout.column()
         col.active = context.light.use_shadow

@@ -216,3 +216,92 @@ def test_the_extremes_render_finite_non_negative_frames(penumbra, case):
         assert centre.max() > 0.0
     elif case == "past the clip range":
         assert centre.max() > 0.0  # marched from the clip start to the clip end
+
+
+def test_the_volume_light_view_shows_the_media_light_alone(penumbra, gpu_call):
+    """Debug view Volume Light: in the fog with no surface it is the whole frame; over an
+    emitting floor behind an absorbing slab (nothing scattered, nothing emitted) it is black."""
+    from penumbra.engine.scene.extract import camera_from_scene
+
+    def frame(scene, view):
+        scene.penumbra.debug_view = view
+
+        def job(engine, depsgraph):
+            cam = camera_from_scene(depsgraph, scene, W, H)
+            out = engine.render_frame(depsgraph, cam, W, H, samples=(0, 4), sample_count=4, aux=False)
+            return out.lit_array().copy() if view == "NONE" else out.debug.image.copy()
+
+        return gpu_call(job)[..., :3]
+
+    fog = _fog_scene(0.3, 4)
+    shown = frame(fog, "VOLUME_LIGHT")
+    np.testing.assert_allclose(shown, frame(fog, "NONE"), rtol=1e-5, atol=1e-7)
+    assert shown.max() > 0.01
+    slab = _slab_scene(kind="ABSORB", color=(0.0, 0.0, 0.0), density=0.7)
+    assert frame(slab, "VOLUME_LIGHT").max() == 0.0
+    assert frame(slab, "NONE").max() > 0.4
+
+
+def _glow(strength):
+    """The emitting floor's strength (``scenes.emissive``)."""
+    bsdf = next(n for n in bpy.data.materials["Glow"].node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Emission Strength"].default_value = strength
+
+
+def _shader_slab(build):
+    """``_slab_scene`` over a black floor, the slab's tree built by ``build(tree, output)``."""
+    scene = _slab_scene(kind="ABSORB", density=0.0)
+    _glow(0.0)
+    tree = bpy.data.materials["Slab"].node_tree
+    for node in [n for n in tree.nodes if n.bl_idname != "ShaderNodeOutputMaterial"]:
+        tree.nodes.remove(node)
+    build(tree, next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial"))
+    return scene
+
+
+def test_emitting_and_mixed_media_follow_the_closures_sums(penumbra):
+    """Add Shader (absorption 2 + emission 0.6) over a black floor: the slab's own light,
+    e / a (1 - exp(-a)); Mix Shader at 0.25 of absorptions 1 and 3 over the emitting floor:
+    exp(-1.5)."""
+
+    def emitting(tree, out):
+        absorb = tree.nodes.new("ShaderNodeVolumeAbsorption")
+        absorb.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        absorb.inputs["Density"].default_value = 2.0
+        glow = tree.nodes.new("ShaderNodeEmission")
+        glow.inputs["Strength"].default_value = 0.6
+        add = tree.nodes.new("ShaderNodeAddShader")
+        tree.links.new(absorb.outputs[0], add.inputs[0])
+        tree.links.new(glow.outputs[0], add.inputs[1])
+        tree.links.new(add.outputs[0], out.inputs["Volume"])
+
+    pixel = render(_shader_slab(emitting))["Combined"][H // 2, W // 2, :3]
+    assert np.allclose(pixel, 0.6 / 2.0 * (1.0 - math.exp(-2.0)), rtol=0.005), pixel
+
+    def mixed(tree, out):
+        mix = tree.nodes.new("ShaderNodeMixShader")
+        mix.inputs["Fac"].default_value = 0.25
+        for slot, density in ((1, 1.0), (2, 3.0)):
+            absorb = tree.nodes.new("ShaderNodeVolumeAbsorption")
+            absorb.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+            absorb.inputs["Density"].default_value = density
+            tree.links.new(absorb.outputs[0], mix.inputs[slot])
+        tree.links.new(mix.outputs[0], out.inputs["Volume"])
+
+    scene = _shader_slab(mixed)
+    _glow(1.0)
+    pixel = render(scene)["Combined"][H // 2, W // 2, :3]
+    assert np.allclose(pixel, math.exp(-1.5), rtol=0.005), pixel
+
+
+def test_a_volume_input_fed_by_a_node_is_named(penumbra):
+    """A Density from a texture: drawn at the socket's value, and the material says so."""
+    from penumbra.engine.scene.materials import material_from_blender
+
+    mat = vs.volume_material("Smoke", kind="PRINCIPLED", density=0.5)
+    noise = mat.node_tree.nodes.new("ShaderNodeTexNoise")
+    mat.node_tree.links.new(noise.outputs["Fac"], mat.node_tree.nodes["Principled Volume"].inputs["Density"])
+    read = material_from_blender(mat)
+    assert not read.surface and read.volume is not None
+    assert np.allclose(read.volume.extinction, 0.5)  # the socket's own value
+    assert any("Density is fed by a node" in m for m in read.messages), read.messages

@@ -104,6 +104,7 @@ def test_every_scene_setting_is_drawn_by_a_panel_section():
         settings.SHADOWS,
         settings.LIGHTING,
         settings.LIGHT_PATHS,
+        settings.VOLUMES,
         settings.WORLD,
         settings.VIEWPORT,
         settings.SIMPLIFY,

@@ -40,6 +40,7 @@ from ..programs import FRAME_STRUCT, LIGHT_STRUCT, LIT, MAX_LIGHTS, SHADOW_SAMPL
 from .base import Feature, LitPart
 
 MAX_MEDIA = 8
+VOLUME_TERM = 3  # the Volume Light debug view's DEBUG_TERM: surfaces write 0, the march adds its light
 MEDIUM_KIND = {"WORLD": 0, "BOX": 1}
 
 MEDIUM_STRUCT = Struct(
@@ -208,8 +209,8 @@ class Volumes(Feature):
         return self._part(frame, sample)  # what a probe's view shows is lit through the media too
 
     def after_lit(self, frame, sample):
-        if frame.debug.lit or sample.data is None:
-            return  # a lit debug view's values are not light
+        if (frame.debug.lit and frame.debug.term != VOLUME_TERM) or sample.data is None:
+            return  # a lit debug view's values are not light (the Volume Light view's surfaces are 0)
         import gpu
 
         renderer = self.renderer
