@@ -138,7 +138,7 @@ class UniformBlocks:
     small, and each pass keeps its own between frames."""
 
     def __init__(self):
-        self._blocks = {}  # name -> (GPUUniformBuf, bytes)
+        self._blocks = {}  # name -> (GPUUniformBuf, its size in bytes, the bytes it holds)
 
     def get(self, name, raw):
         """The block ``name`` holding ``raw`` (bytes)."""
@@ -146,10 +146,17 @@ class UniformBlocks:
 
         block = self._blocks.get(name)
         if block is None or block[1] != len(raw):
-            block = self._blocks[name] = (gpu.types.GPUUniformBuf(raw), len(raw))
+            block = (gpu.types.GPUUniformBuf(raw), len(raw), raw)
         else:
             block[0].update(raw)
+            block = (block[0], block[1], raw)
+        self._blocks[name] = block
         return block[0]
+
+    def holding(self, name, raw):
+        """The block ``name`` when it holds ``raw`` already (nothing to upload), else None."""
+        block = self._blocks.get(name)
+        return block[0] if block is not None and block[2] == raw else None
 
     def peek(self, name):
         """The block ``name`` as last set, or None."""

@@ -166,6 +166,13 @@ def media_block(media, origin):
     return MEDIUM_STRUCT.pack([medium_row(m, origin) for m in media], MAX_MEDIA), len(media)
 
 
+def _bound(lit, name, raw):
+    """The lit pass's uniform block ``name`` where its draws left ``raw`` in it (this sample's),
+    else ``raw`` uploaded."""
+    block = lit._ubos.holding(name, raw.tobytes())
+    return block if block is not None else lit._ubo(name, raw)
+
+
 class Volumes(Feature):
     name = "volumes"
 
@@ -220,11 +227,13 @@ class Volumes(Feature):
         data = sample.data
         atlas = sample.atlas
         tiles = atlas.tiles_block(data.tiles) if atlas is not None else None
+        # The blocks the sample's lit pass bound last (its own frame, lights and tiles): bound
+        # again, not uploaded again.
         blocks = {
-            "frame": lit._ubo("frame", data.frame),
-            "lights": lit._ubo("lights", data.lights),
-            "shadow_tiles": tiles if tiles is not None else lit._ubo("tiles", data.tiles),
-            "media": lit._ubo("media", self._block),
+            "frame": _bound(lit, "frame", data.frame),
+            "lights": _bound(lit, "lights", data.lights),
+            "shadow_tiles": tiles if tiles is not None else _bound(lit, "tiles", data.tiles),
+            "media": _bound(lit, "media", self._block),
         }
         samplers = {
             SHADOW_SAMPLER: atlas.texture if atlas is not None else lit._shadow_dummy(),
