@@ -517,8 +517,9 @@ SCENE_PARAMS = (
         "volume_samples",
         "INT",
         64,
-        "Steps of each pixel's march through the media it crosses (EEVEE's Volumes > Samples); each sample "
-        "of a frame places them anew, so the frame's samples converge to the media's single scattering",
+        "Steps of each pixel's march through the media it crosses (EEVEE's Volumes > Samples), spread over "
+        "the frame's samples (8 a sample at least); each sample places its steps anew, so the frame's samples "
+        "converge to the media's single scattering",
         min=1,
         max=256,
         label="Steps",

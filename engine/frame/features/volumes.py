@@ -95,6 +95,18 @@ APPROXIMATE = (
 )
 
 
+MIN_STEPS = 8  # a sample's steps at least
+
+
+def march_steps(frame):
+    """Steps of one sample's march: the frame's Steps (``settings.volume_samples``) spread over
+    its samples, MIN_STEPS at least. Each sample draws its steps' points anew, so the frame's
+    points together sample the ray as densely as Steps would in every sample."""
+    steps = max(int(frame.settings.volume_samples), 1)
+    samples = max(int(frame.sample_count), 1) if frame.accumulate else 1
+    return max(min(MIN_STEPS, steps), math.ceil(steps / samples))
+
+
 def clip_end(camera):
     """The distance of the camera's far clip plane along its axis (``projection``'s)."""
     p = np.asarray(camera.projection, np.float64)
@@ -192,7 +204,7 @@ class Volumes(Feature):
         if len(media) > MAX_MEDIA:
             stats.messages.append(f"Penumbra: {len(media)} volumes; only the first {MAX_MEDIA} are drawn")
         self._block, count = media_block(media, frame.origin)
-        self._params = (float(count), clip_end(frame.camera), float(max(int(frame.settings.volume_samples), 1)))
+        self._params = (float(count), clip_end(frame.camera), float(march_steps(frame)))
         frame.unsettled = True  # every pixel the media cover changes from sample to sample
         frame.receivers = media_receivers(media, frame.camera, frame.draws)
         if APPROXIMATE not in stats.messages:
