@@ -1,5 +1,7 @@
 """Analytic references: camera rays, plane hits and box shadows computed in numpy."""
 
+import math
+
 import numpy as np
 
 
@@ -134,6 +136,35 @@ def principled_dielectric_albedo(base, rough, mu_v, ior=1.5):
     ``mu_v``: its diffuse (1 - A) base plus its specular's albedo A (multiple scattering in)."""
     albedo = ggx_albedo(rough, mu_v, lambda c: fresnel_dielectric(c, ior)) * _multiple_scattering(rough, mu_v, ior)
     return float((1.0 - albedo) * base + albedo)
+
+
+def coat_albedo(rough, mu_v, ior=1.5):
+    """What a Principled coat (a dielectric GGX of ``rough`` and ``ior``) reflects of a uniform
+    world at N.V = ``mu_v``, multiple scattering in (as Cycles' coat closure)."""
+    return ggx_albedo(rough, mu_v, lambda c: fresnel_dielectric(c, ior)) * _multiple_scattering(rough, mu_v, ior)
+
+
+def coat_below(weight, rough, mu_v, ior=1.5, tint=(1.0, 1.0, 1.0)):
+    """What reaches the layers under a Principled coat and back, per channel: 1 - weight x its
+    albedo towards the viewer (closure_layering_weight), times mix(1, tint^(1 / cos_t), weight)
+    with cos_t the view refracted into the coat (Cycles' coat tint)."""
+    cos_t = math.sqrt(max(1.0 - (1.0 - mu_v * mu_v) / (ior * ior), 1e-8))
+    through = np.power(np.clip(np.asarray(tint, float), 1e-6, 1.0), 1.0 / cos_t)
+    return (1.0 - weight * coat_albedo(rough, mu_v, ior)) * ((1.0 - weight) + weight * through)
+
+
+def coat_reflectance(weight, rough, v, to_light, ior=1.5):
+    """f cos(theta_l) of a Principled coat alone for unit ``v`` and ``to_light`` about +z: GGX,
+    height-correlated Smith, the exact dielectric Fresnel of ``ior``, times ``weight``."""
+    v, w = np.asarray(v, float), np.asarray(to_light, float)
+    mu_v, mu_l = v[2], w[2]
+    if mu_l <= 0.0:
+        return 0.0
+    a2 = max(rough * rough, 1e-3) ** 2
+    h = (v + w) / np.linalg.norm(v + w)
+    d = a2 / (np.pi * (h[2] ** 2 * (a2 - 1.0) + 1.0) ** 2)
+    g2 = 1.0 / (1.0 + smith_lambda(a2, mu_v) + smith_lambda(a2, mu_l))
+    return float(weight * fresnel_dielectric(np.dot(h, w), ior) * d * g2 / (4.0 * mu_v))
 
 
 def _multiple_scattering(rough, mu_v, ior):

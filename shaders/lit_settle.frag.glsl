@@ -23,6 +23,10 @@ void main()
   /* A lobe later samples trace (features/reflections.py) changes with every sample. */
   settle_unstable = settle_unstable || world_traced;
 #endif
+#if NODE_COAT
+  /* A coat's highlight is not in the test's lobes: it keeps sampling. */
+  settle_unstable = settle_unstable || s.coat.weight > 0.0;
+#endif
 #if TRANSMISSION
   /* What a transmissive surface shows through it (features/refraction.py) is traced anew
    * every sample. */

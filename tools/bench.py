@@ -15,6 +15,8 @@
               -> <out>/reflections.csv, reflections.png; --cost: on against off, 160x90 and 960x540
     samples   render samples: error against time vs Cycles spp and EEVEE, cost per sample,
               an edge close-up -> <out>/samples.csv, samples.png, samples_closeup.png
+    principled  the Principled BSDF's input groups (the coat at its extremes) on spheres under a
+              sun and an HDRI, against Cycles 1024 spp and EEVEE -> <out>/principled.csv
     post      cost of each post layer; separable against direct 2-D blur -> <out>/post_costs.csv
     shadows   shadow error against frame time, scaling, per-frame work, JITTER early out
               -> <out>/shadow_tradeoff.csv, shadow_pareto.png, scaling.csv, scaling.png
@@ -48,6 +50,7 @@ from tools.benchmarks import (
     passes,
     perf,
     post,
+    principled,
     reflections,
     samples,
     shadows,
@@ -64,6 +67,7 @@ COMMANDS = {
     "passes": passes,
     "perf": perf,
     "post": post,
+    "principled": principled,
     "reflections": reflections,
     "samples": samples,
     "shadows": shadows,

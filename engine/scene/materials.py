@@ -122,6 +122,8 @@ class Material:
                 out.add("TREE_NORMAL")
             if self.tree.lobes == 2:
                 out.add("TREE_LOBES")
+            if self.tree.coat:
+                out.add("TREE_COAT")
         return frozenset(out)
 
 
@@ -406,6 +408,9 @@ def _shader(mat, node, notes, depth=0):
         out.base_color = _color_channel(node.inputs["Color"], notes, "Color", out, "base_color", (0.8, 0.8, 0.8, 1.0))
         out.roughness = _value_channel(node.inputs["Roughness"], notes, "Roughness", out, "roughness", 0.5)
         _normal_map(None, node, notes, out)
+        from .nodetree import anisotropy_unread
+
+        notes += anisotropy_unread(node)
         return out
     if idname == "ShaderNodeBsdfTransparent":
         out = _black()

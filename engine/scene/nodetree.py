@@ -151,6 +151,7 @@ class CompiledTree:
     normal: bool = False  # it computes the shading normal (a Bump, ...): NODE_NORMAL
     lobes: int = 1  # 2: a Mix / Add Shader of two surfaces, shaded as two lobes (NODE_LOBES == 2)
     aovs: tuple = ()  # the AOV names its AOV Output nodes write, in node_aovs' order (NODE_AOVS)
+    coat: bool = False  # a Principled BSDF's coat is drawn (NODE_COAT; node_coat_keep)
 
 
 # --- the registry -------------------------------------------------------------------------
@@ -230,6 +231,7 @@ class Compiler:
         self.fallbacks = 0
         self.surface_fallback = False
         self.normal = False
+        self.coat = False  # a Principled BSDF's coat is drawn (NODE_COAT)
 
     # -- emitting --
 
@@ -432,6 +434,23 @@ class Compiler:
                 return self.const(fallback, typ) if typ != "float" else self.const(float(fallback), "float")
             return self.default(socket, typ)
 
+    def coat_normal_input(self, node, ctx):
+        """A Principled BSDF's Coat Normal: vec3(0.0) (the surface's own interpolated normal,
+        as Blender's coat takes it) where unlinked, else the compiled vector; a Normal Map there
+        is named and not drawn (the reader's normal-map path draws the base's only)."""
+        socket = next((s for s in node.inputs if s.identifier == "Coat Normal"), None)
+        link = _link(socket) if socket is not None else None
+        if link is None:
+            return Value("vec3(0.0)", "vec3")
+        src = link.from_node
+        while src.bl_idname == "NodeReroute" and _link(src.inputs[0]) is not None:
+            src = _link(src.inputs[0]).from_node
+        if src.bl_idname == "ShaderNodeNormalMap":
+            self.messages.append("a Normal Map on the Coat Normal (the coat takes the surface's normal)")
+            return Value("vec3(0.0)", "vec3")
+        value = self.shader_input(node, "Coat Normal", ctx, "vec3")
+        return Value("vec3(0.0)", "vec3") if value.expr.startswith("node_constants") else value
+
     def normal_input(self, node, ctx):
         """A shader's Normal input: N where unlinked or fed by a Normal Map (the reader's
         normal-map path draws that one), else the compiled vector (a Bump, ...)."""
@@ -470,9 +489,10 @@ class Compiler:
             "               inout float metallic, inout vec4 specular, inout float alpha, inout vec3 emission,\n"
             "               inout vec3 normal)\n"
         )
+        keep = f"  node_coat_keep({v.expr});\n" if self.coat else ""
         if v.lobes < 2:
             code = _prelude(self.needs) + (
-                f"{signature}{{\n{body}\n"
+                f"{signature}{{\n{body}\n{keep}"
                 f"  node_closure_resolve({v.expr}, base, roughness, metallic, specular, alpha, emission, normal);\n"
                 "}\n"
             )
@@ -509,6 +529,7 @@ class Compiler:
             normal=self.normal,
             lobes=max(1, v.lobes),
             aovs=aovs,
+            coat=self.coat,
         )
 
     def compile_aovs(self, nodes):
@@ -622,11 +643,24 @@ def _principled(c, node, socket, ctx):
     if _first(node, "Emission Strength"):
         strength = c.shader_input(node, "Emission Strength", ctx, "float", 1.0).expr
     normal = c.normal_input(node, ctx)
-    c.messages += [f"{name} is not drawn" for name in principled_unread(node)]
+    unread = principled_unread(node)
     expr = (
         f"node_principled({base.expr}, {metal.expr}, {rough.expr}, {spec.expr}, {alpha.expr}, "
         f"({emission.expr}).rgb * {strength}, {normal.expr})"
     )
+    if "Coat Weight" in unread:  # linked or above 0: the coat over the surface (NODE_COAT)
+        unread.remove("Coat Weight")
+        weight = c.shader_input(node, "Coat Weight", ctx, "float", 0.0)
+        coat_rough = c.shader_input(node, "Coat Roughness", ctx, "float", 0.03)
+        coat_ior = c.shader_input(node, "Coat IOR", ctx, "float", 1.5)
+        tint = c.shader_input(node, "Coat Tint", ctx, "vec4", (1.0, 1.0, 1.0, 1.0))
+        coat_normal = c.coat_normal_input(node, ctx)
+        expr = (
+            f"node_principled_coat({expr}, {weight.expr}, {coat_rough.expr}, {coat_ior.expr}, {tint.expr}, "
+            f"{coat_normal.expr})"
+        )
+        c.coat = True
+    c.messages += [f"{name} is not drawn" for name in unread]
     return c.temp("closure", expr, 1)
 
 
@@ -648,6 +682,7 @@ def _glossy(c, node, socket, ctx):
     color = c.shader_input(node, "Color", ctx, "vec4")
     rough = c.shader_input(node, "Roughness", ctx, "float")
     normal = c.normal_input(node, ctx)
+    c.messages += anisotropy_unread(node)
     expr = f"node_principled({color.expr}, 1.0, {rough.expr}, vec4(0.04), 1.0, vec3(0.0), {normal.expr})"
     return c.temp("closure", expr, 1)
 
@@ -1218,7 +1253,24 @@ def _image(c, node, socket, ctx):
 # Principled BSDF inputs Penumbra does not draw, named when they would change the surface: a
 # weight above 0, or any of them linked. (IOR, Specular IOR Level and Specular Tint are drawn:
 # node_principled_f0.)
-PRINCIPLED_UNREAD = ("Transmission Weight", "Transmission", "Coat Weight", "Sheen Weight", "Subsurface Weight")
+PRINCIPLED_UNREAD = (
+    "Transmission Weight",
+    "Transmission",
+    "Coat Weight",
+    "Sheen Weight",
+    "Subsurface Weight",
+    "Anisotropic",
+    "Thin Film Thickness",
+)
+
+
+def anisotropy_unread(node):
+    """["Anisotropy is not drawn"] for a Glossy (Anisotropic) BSDF whose Anisotropy is linked
+    or not 0: it is drawn isotropic."""
+    sock = node.inputs.get("Anisotropy")
+    if sock is not None and (sock.is_linked or abs(float(sock.default_value)) > 0.0):
+        return ["Anisotropy is not drawn"]
+    return []
 
 
 def principled_unread(node):

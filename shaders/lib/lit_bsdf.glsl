@@ -107,4 +107,51 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   return b;
 }
 
+#if NODE_COAT
+/* The coat over the lobes (Blender's Principled BSDF, as Cycles layers it): a dielectric GGX
+ * of Coat Roughness and IOR with its own normal, weighted by Coat Weight. What it reflects
+ * (its directional albedo towards the viewer, E = f0 A + B from the same table as the
+ * lobes' specular, env_brdf) does not reach the lobes below; what does is tinted by Coat Tint
+ * over the path through the coat, tint^(1 / cos) with cos the refracted view's (Beer's law
+ * with the tint the transmittance straight across). ``params``: (weight, roughness, IOR, 0). */
+Coat coat_setup(vec4 params, vec3 tint, vec3 N, vec3 V)
+{
+  Coat c;
+  c.N = N;
+  c.weight = clamp(params.x, 0.0, 1.0);
+  c.rough = clamp(params.y, 0.0, 1.0);
+  c.alpha = max(c.rough * c.rough, 0.002);
+  float ior = max(params.z, 1.0);
+  float r = (ior - 1.0) / (ior + 1.0);
+  c.f0 = r * r;
+  float NdotV = max(dot(N, V), 1e-4);
+  /* Its Fresnel rim follows f0 as the lobes' does (lobe_setup): a coat of IOR 1 reflects nothing. */
+  float f90 = clamp(50.0 * c.f0, 0.0, 1.0);
+  c.ab = env_brdf(c.f0, f90, c.rough, NdotV);
+  float albedo = clamp(c.f0 * c.ab.x + c.ab.y, 0.0, 1.0);
+  float cos_t = sqrt(max(1.0 - (1.0 - NdotV * NdotV) / (ior * ior), 1e-8));
+  vec3 through = pow(clamp(tint, vec3(1e-6), vec3(1.0)), vec3(1.0 / cos_t));
+  c.below = (1.0 - c.weight * albedo) * mix(vec3(1.0), through, c.weight);
+  return c;
+}
+
+/* The coat's reflection of light from ``to_light`` (N.L > 0 for the coat's normal): GGX with
+ * height-correlated Smith visibility and the dielectric Fresnel of fresnel_shape from f0. */
+float coat_brdf(Coat c, vec3 V, vec3 to_light, float NdotL)
+{
+  vec3 H = normalize(to_light + V);
+  float NdotH = max(dot(c.N, H), 0.0);
+  float NdotV = max(dot(c.N, V), 1e-4);
+  float a2 = c.alpha * c.alpha;
+  float dd = NdotH * NdotH * (a2 - 1.0) + 1.0;
+  float D = a2 / (M_PI * dd * dd);
+  float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
+  float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
+  float Vis = 0.5 / max(gv + gl, 1e-8);
+  float f90 = clamp(50.0 * c.f0, 0.0, 1.0);
+  float F = c.f0 + (f90 - c.f0) * fresnel_shape(dot(to_light, H));
+  return c.weight * F * D * Vis;
+}
+#endif
+
 #endif /* PENUMBRA_LIB_LIT_BSDF */

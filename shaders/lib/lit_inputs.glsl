@@ -18,6 +18,11 @@ struct MaterialInputs {
   vec4 spec_f0;     /* the dielectric's F0 (lobe_setup) */
   float transmission; /* Principled Transmission Weight (TRANSMISSION, lib/refraction.glsl) */
   vec3 tree_normal; /* the tree's shading normal (NODE_NORMAL) */
+#if NODE_COAT
+  vec4 coat;        /* (weight, roughness, IOR, 0) of a Principled coat (shaders/nodes/shader.glsl) */
+  vec3 coat_tint;
+  vec3 coat_normal; /* 0: the surface's interpolated normal */
+#endif
 #if NODE_LOBES == 2
   vec4 base_b;
   float rough_b, metal_b;
@@ -53,11 +58,19 @@ MaterialInputs material_inputs()
   Nt = (l > 1e-20) ? Nt / l : vec3(0.0, 0.0, 1.0);
   bool front = dot(Nt, V) >= 0.0;
 #  if NODE_LOBES == 2
-  node_closure_resolve_lobes(node_tree_closure(front ? Nt : -Nt, V, front), m.base, m.rough, m.metal, m.spec_f0,
-                             m.coverage, m.emission, m.tree_normal, m.base_b, m.rough_b, m.metal_b, m.spec_f0_b,
-                             m.tree_normal_b, m.weights);
+  NodeClosure closure = node_tree_closure(front ? Nt : -Nt, V, front);
+  node_closure_resolve_lobes(closure, m.base, m.rough, m.metal, m.spec_f0, m.coverage, m.emission, m.tree_normal,
+                             m.base_b, m.rough_b, m.metal_b, m.spec_f0_b, m.tree_normal_b, m.weights);
+#    if NODE_COAT
+  node_coat_keep(closure);
+#    endif
 #  else
   node_tree(front ? Nt : -Nt, V, front, m.base, m.rough, m.metal, m.spec_f0, m.coverage, m.emission, m.tree_normal);
+#  endif
+#  if NODE_COAT
+  m.coat = node_coat_params;
+  m.coat_tint = node_coat_tint;
+  m.coat_normal = node_coat_normal;
 #  endif
 #endif
 #if TEX_BASE_COLOR
@@ -88,6 +101,12 @@ Surface surface_setup(MaterialInputs m, out vec2 ab[NODE_LOBES])
   Surface s;
   vec3 N = surface_geometry(s);
   terminator_setup(s);
+#if NODE_COAT
+  /* The coat over every lobe, with its own normal: the tree's, else the interpolated one (not
+   * the base's normal map), as Blender's coat takes it. */
+  vec3 Nc = (dot(m.coat_normal, m.coat_normal) > 0.0) ? normalize(m.coat_normal) : N;
+  s.coat = coat_setup(m.coat, m.coat_tint, (dot(Nc, s.V) < 0.0) ? -Nc : Nc, s.V);
+#endif
   N = shading_normal(N, m.tree_normal, s);
 #if NODE_LOBES == 2
   s.lobe[0] = lobe_setup(m.base.rgb, m.rough, m.metal, m.spec_f0, N, s.V, m.weights.x, ab[0]);

@@ -81,6 +81,17 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
       reflected += (s.lobe[k].weight * cosines[k]) * f;
     }
   }
+#if NODE_COAT
+  /* The coat over the lobes (lit_bsdf.glsl): what reaches them under it, and its own reflection
+   * (a glossy lobe: the Glossy passes, not the Diffuse ones). */
+  reflected *= s.coat.below;
+#  if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_GLOSSY || LIGHT_PASS == LIGHT_PASS_GROUP
+  float NcdotL = dot(s.coat.N, to_light);
+  if (NcdotL > 0.0) {
+    reflected += vec3(coat_brdf(s.coat, s.V, to_light, NcdotL) * NcdotL * L.specular_factor);
+  }
+#  endif
+#endif
 #if VOLUMES
   /* What the media between here and the light let through (features/volumes.py). */
   reflected *= light_transmittance(s.P, L, to_light);

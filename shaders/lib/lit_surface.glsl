@@ -40,6 +40,23 @@ struct Lobe {
   float weight; /* the lobe's share of the surface (1 for a single lobe) */
 };
 
+#ifndef NODE_COAT
+#  define NODE_COAT 0
+#endif
+
+/* A Principled BSDF's coat (NODE_COAT; lit_bsdf.glsl coat_setup): a dielectric GGX layer over
+ * every lobe. ``below``: what reaches the lobes under it and back (1 - weight x the coat's
+ * directional albedo towards the viewer, times its tint over the path through it). */
+struct Coat {
+  vec3 N;
+  float weight;
+  float alpha; /* GGX roughness (Coat Roughness squared, at least 0.002) */
+  float rough;
+  float f0;    /* ((IOR - 1) / (IOR + 1))^2 */
+  vec3 below;
+  vec2 ab;     /* its environment BRDF towards the viewer (env_brdf) */
+};
+
 struct Surface {
   vec3 P, V;
   vec3 Ng; /* the interpolated mesh normal, before any normal map: what shadow biases follow */
@@ -49,6 +66,9 @@ struct Surface {
   vec3 smooth_offset; /* from the flat triangle to the smooth surface (world) */
 #endif
   Lobe lobe[NODE_LOBES];
+#if NODE_COAT
+  Coat coat;
+#endif
 };
 
 #define NO_SHADOW -1

@@ -232,6 +232,22 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
 #endif
 }
 
+#if NODE_COAT
+/* The coat's reflection of the world: its radiance about the coat's reflected direction,
+ * blurred with the coat's roughness, times the coat's environment BRDF and weight. */
+vec3 coat_world_light(Coat c, vec3 V)
+{
+  vec3 R = reflect(-V, c.N);
+  float t = c.rough * c.rough;
+#  if WORLD_ENV
+  vec3 radiance = world_env_radiance(R, c.rough);
+#  else
+  vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
+#  endif
+  return radiance * (c.weight * (c.f0 * c.ab.x + c.ab.y));
+}
+#endif
+
 /* The world's light on every lobe of ``s``, summed by their weights (``ab``: each lobe's
  * environment BRDF, lobe_setup). With WORLD_AO the horizons are marched once and integrated for
  * each lobe's normal; with WORLD_RATIO each lobe's U goes into world_d and world_s, and a sample
@@ -279,8 +295,28 @@ vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
 #  endif
 #endif
   }
+#if NODE_COAT
+  /* The coat: what reaches the lobes under it, and its own reflection of the world (not
+   * traced against the scene, not occluded by WORLD_AO). */
+  color *= s.coat.below;
+#  if WORLD_RATIO
+  world_d *= s.coat.below;
+  world_s *= s.coat.below;
+#  endif
+#  if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_GLOSSY || (LIGHT_PASS == LIGHT_PASS_GROUP && LIGHT_GROUP_WORLD)
+  vec3 coat = coat_world_light(s.coat, s.V);
+#    if VOLUMES
+  coat *= dot(through, vec3(1.0 / 3.0));
+#    endif
+  color += coat;
+#    if WORLD_RATIO
+  world_s += coat * world_ratio_share(s.coat.rough);
+#    endif
+#  endif
+#endif
   return color;
 }
+
 
 #if WORLD_RATIO
 /* A direction of the world's light (``L.world``) adds to the ratio's sums, by lobe: diffuse and

@@ -20,7 +20,14 @@
  * (node_lobe_distance) merge, per pixel, into one with their weighted parameters, until two
  * are left. node_closure_resolve gives one set of parameters (the lobes summed: trees of one
  * lobe, and the shadow pass's alpha); node_closure_resolve_lobes the two lobes and their
- * weights (the lit pass under NODE_LOBES == 2). */
+ * weights (the lit pass under NODE_LOBES == 2).
+ *
+ * A Principled BSDF's coat (Coat Weight above 0 or linked: node_principled_coat) is the
+ * closure's, not a lobe's: it lies over both lobes. Its parameters are sums weighted by the
+ * coat's weight times the surface's share, as the lobes' are: coat (weight, roughness, IOR, 0),
+ * coat_tint and coat_normal; a closure without a coat has weight 0 there. node_coat_keep
+ * resolves them for the lit pass (NODE_COAT: node_coat_params, node_coat_tint,
+ * node_coat_normal). */
 
 struct NodeLobe {
   vec3 color;
@@ -36,6 +43,9 @@ struct NodeClosure {
   NodeLobe b;
   float alpha;
   vec3 emission;
+  vec4 coat; /* (weight, roughness, IOR, 0), each x the coat's weight */
+  vec3 coat_tint;
+  vec3 coat_normal;
 };
 
 NodeLobe node_lobe_empty()
@@ -45,7 +55,7 @@ NodeLobe node_lobe_empty()
 
 NodeClosure node_closure_empty()
 {
-  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0));
+  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0), vec4(0.0), vec3(0.0), vec3(0.0));
 }
 
 /* The Principled BSDF's dielectric reflectance at normal incidence, as Blender's (Cycles'
@@ -70,17 +80,33 @@ NodeClosure node_principled(vec4 base, float metallic, float roughness, vec4 spe
 {
   float a = clamp(alpha, 0.0, 1.0);
   return NodeClosure(NodeLobe(base.rgb * a, roughness * a, metallic * a, specular * a, a, normal * a),
-                     node_lobe_empty(), a, emission * a);
+                     node_lobe_empty(), a, emission * a, vec4(0.0), vec3(0.0), vec3(0.0));
+}
+
+/* The Principled BSDF ``c`` (node_principled) with its coat: Coat Weight, Roughness, IOR, Tint
+ * and Normal, scaled by the surface's coverage as its lobe is. */
+NodeClosure node_principled_coat(NodeClosure c, float weight, float roughness, float ior, vec4 tint, vec3 normal)
+{
+  float w = clamp(isnan(weight) ? 0.0 : weight, 0.0, 1.0) * c.alpha;
+  float r = clamp(isnan(roughness) ? 0.0 : roughness, 0.0, 1.0);
+  float eta = clamp(isnan(ior) ? 1.5 : ior, 1.0, 1e6);
+  c.coat = vec4(w, w * r, w * eta, 0.0);
+  vec3 t = vec3(isnan(tint.r) ? 0.0 : tint.r, isnan(tint.g) ? 0.0 : tint.g, isnan(tint.b) ? 0.0 : tint.b);
+  c.coat_tint = w * clamp(t, 0.0, 1e6);
+  c.coat_normal = w * normal;
+  return c;
 }
 
 NodeClosure node_emission(vec4 color, float strength)
 {
-  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 1.0, color.rgb * strength);
+  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 1.0, color.rgb * strength, vec4(0.0), vec3(0.0),
+                     vec3(0.0));
 }
 
 NodeClosure node_diffuse(vec4 color, vec3 normal)
 {
-  return NodeClosure(NodeLobe(color.rgb, 1.0, 0.0, vec4(0.0), 1.0, normal), node_lobe_empty(), 1.0, vec3(0.0));
+  return NodeClosure(NodeLobe(color.rgb, 1.0, 0.0, vec4(0.0), 1.0, normal), node_lobe_empty(), 1.0, vec3(0.0),
+                     vec4(0.0), vec3(0.0), vec3(0.0));
 }
 
 NodeClosure node_transparent()
@@ -104,7 +130,8 @@ NodeLobe node_lobe_sum(NodeLobe x, NodeLobe y)
 NodeClosure node_mix_shader_weights(float g, NodeClosure a, float f, NodeClosure b)
 {
   return NodeClosure(node_lobe_mix(g, a.a, f, b.a), node_lobe_mix(g, a.b, f, b.b), g * a.alpha + f * b.alpha,
-                     g * a.emission + f * b.emission);
+                     g * a.emission + f * b.emission, g * a.coat + f * b.coat, g * a.coat_tint + f * b.coat_tint,
+                     g * a.coat_normal + f * b.coat_normal);
 }
 
 NodeClosure node_mix_shader(float f, NodeClosure a, NodeClosure b)
@@ -123,7 +150,8 @@ NodeClosure node_mix_split_weights(float g, NodeClosure a, float f, NodeClosure 
 {
   NodeLobe none = node_lobe_empty();
   return NodeClosure(node_lobe_mix(g, a.a, 0.0, none), node_lobe_mix(f, b.a, 0.0, none),
-                     g * a.alpha + f * b.alpha, g * a.emission + f * b.emission);
+                     g * a.alpha + f * b.alpha, g * a.emission + f * b.emission, g * a.coat + f * b.coat,
+                     g * a.coat_tint + f * b.coat_tint, g * a.coat_normal + f * b.coat_normal);
 }
 
 NodeClosure node_mix_split(float f, NodeClosure a, NodeClosure b)
@@ -205,6 +233,9 @@ NodeClosure node_mix_merge_weights(float g, NodeClosure a, float f, NodeClosure 
   node_lobes_reduce3(p, q, r, c.a, c.b);
   c.alpha = g * a.alpha + f * b.alpha;
   c.emission = g * a.emission + f * b.emission;
+  c.coat = g * a.coat + f * b.coat;
+  c.coat_tint = g * a.coat_tint + f * b.coat_tint;
+  c.coat_normal = g * a.coat_normal + f * b.coat_normal;
   return c;
 }
 
@@ -268,6 +299,27 @@ void node_closure_resolve_lobes(NodeClosure c, inout vec4 base, inout float roug
   weights = max(weights, vec2(0.0));
   emission = node_finite3(c.emission * inv, 1e20);
   alpha = node_finite3(vec3(coverage), 1.0).x;
+}
+
+/* The closure's coat as parameters (NODE_COAT, lib/lit_inputs.glsl): (its share of the surface,
+ * roughness, IOR, 0), its tint and normal (0: the surface's). */
+vec4 node_coat_params = vec4(0.0, 0.0, 1.5, 0.0);
+vec3 node_coat_tint = vec3(1.0);
+vec3 node_coat_normal = vec3(0.0);
+
+void node_coat_keep(NodeClosure c)
+{
+  float w = c.coat.x;
+  float coverage = clamp(c.alpha, 0.0, 1.0);
+  float winv = (w > 1e-6) ? 1.0 / w : 0.0;
+  node_coat_params = vec4(node_finite3(vec3((coverage > 1e-6) ? w / coverage : 0.0), 1.0).x,
+                          node_finite3(vec3(c.coat.y * winv), 1.0).x, max(c.coat.z * winv, 1.0), 0.0);
+  if (!(w > 1e-6)) {
+    node_coat_params = vec4(0.0, 0.0, 1.5, 0.0);
+  }
+  node_coat_tint = (w > 1e-6) ? clamp(node_finite3(c.coat_tint * winv, 1e6), 0.0, 1.0) : vec3(1.0);
+  float nl = length(c.coat_normal);
+  node_coat_normal = (nl > 1e-12 && !isinf(nl)) ? c.coat_normal / nl : vec3(0.0);
 }
 
 #endif /* PENUMBRA_LIB_NODES_SHADER */

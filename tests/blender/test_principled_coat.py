@@ -1,0 +1,143 @@
+"""The Principled BSDF's coat (shaders/lib/lit_bsdf.glsl coat_setup, coat_brdf) against the same
+layering integrated in numpy (devkit.analytic: the coat a dielectric GGX of its roughness and
+IOR, what it reflects towards the viewer kept from the layers below, its tint over the path
+through it, as Cycles' Principled BSDF layers them). A plane fills an orthographic view, so every
+pixel sees the same angles and the image mean is one evaluation of the BSDF."""
+
+import math
+
+import numpy as np
+import pytest
+
+from devkit import analytic, engines, scenes
+from devkit.render import render, technique_frame
+
+SUN = 3.0
+WORLD = 0.5
+
+
+def _material(base, rough, weight, coat_rough, ior=1.5, tint=(1.0, 1.0, 1.0), specular=0.5):
+    mat = scenes.material("Coated", (base, base, base), roughness=rough, specular=specular)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Coat Weight"].default_value = weight
+    bsdf.inputs["Coat Roughness"].default_value = coat_rough
+    bsdf.inputs["Coat IOR"].default_value = ior
+    bsdf.inputs["Coat Tint"].default_value = (*tint, 1.0)
+    return mat
+
+
+def _plane(make, view_deg, sun_elevation=None, samples=4, sun_azimuth=0.0):
+    """The plane of material ``make()`` (made in the fresh scene) seen at ``view_deg`` from the
+    normal (the camera towards +y), under a sun of that elevation shining from +y (turned by
+    ``sun_azimuth``), or under a uniform world."""
+    scene = scenes.empty_scene(16, 16)
+    scenes.plane(scene, size=400.0, mat=make())
+    t = math.radians(view_deg)
+    scenes.camera(scene, (0, -20 * math.sin(t), 20 * math.cos(t)), (t, 0, 0), ortho_scale=1.0)
+    if sun_elevation is None:
+        scenes.set_world(scene, (WORLD, WORLD, WORLD))
+    else:
+        z = math.radians(90 - sun_elevation)
+        scenes.light(scene, "Sun", "SUN", SUN, rotation=(-z, 0, sun_azimuth), angle=math.radians(0.5))
+    engines.configure(scene, "PENUMBRA", render_samples=samples)
+    return render(scene)["Combined"][..., :3].mean(axis=(0, 1))
+
+
+def _directions(view_deg, elevation):
+    t, z = math.radians(view_deg), math.radians(90 - elevation)
+    return (0.0, -math.sin(t), math.cos(t)), (0.0, math.sin(z), math.cos(z))
+
+
+@pytest.mark.parametrize(
+    ("weight", "coat_rough", "tint", "elevation"),
+    [(1.0, 0.3, (1.0, 1.0, 1.0), 40), (0.5, 0.5, (1.0, 1.0, 1.0), 25), (1.0, 0.2, (0.9, 0.6, 0.3), 40)],
+)
+def test_a_coat_under_a_sun_matches_the_layered_bsdf(penumbra, weight, coat_rough, tint, elevation):
+    """A rough grey dielectric (roughness 0.8) under a coat, seen at 60 degrees under a sun:
+    the layers below through what the coat lets through, plus the coat's own highlight, within
+    3 % per channel (the lights' specular carries no multiple scattering: docs/design.md)."""
+    v, to_light = _directions(60, elevation)
+    below = analytic.coat_below(weight, coat_rough, v[2], 1.5, tint)
+    base = sum(analytic.principled_dielectric(0.45, 0.8, v, to_light))
+    ref = SUN * (below * base + analytic.coat_reflectance(weight, coat_rough, v, to_light))
+    ours = _plane(lambda: _material(0.45, 0.8, weight, coat_rough, tint=tint), 60, elevation)
+    assert np.allclose(ours, ref, rtol=0.03), (ours, ref)
+    if weight == 1.0 and tint == (1.0, 1.0, 1.0):
+        uncoated = _plane(lambda: scenes.material("Plain", (0.45, 0.45, 0.45), roughness=0.8), 60, elevation)
+        assert abs(ours.mean() - uncoated.mean()) > 0.02 * uncoated.mean()  # the coat changes it
+
+
+@pytest.mark.parametrize(("coat_rough", "tint"), [(0.3, (1.0, 1.0, 1.0)), (0.05, (0.5, 0.7, 1.0))])
+def test_the_coat_keeps_the_worlds_energy(penumbra, coat_rough, tint):
+    """A white diffuse (albedo 1, no specular of its own) under a coat in a uniform world: what
+    the coat reflects is what the diffuse below no longer gets, so an untinted coat sends back
+    exactly the world (within 0.5 %); a tinted one (1 - E) tint^(1 / cos_t) + E of it."""
+    ours = _plane(lambda: _material(1.0, 0.5, 1.0, coat_rough, tint=tint, specular=0.0), 60)
+    mu = math.cos(math.radians(60))
+    ref = WORLD * (analytic.coat_below(1.0, coat_rough, mu, 1.5, tint) + analytic.coat_albedo(coat_rough, mu, 1.5))
+    assert np.allclose(ours, ref, rtol=0.01), (ours, ref)
+    if tint == (1.0, 1.0, 1.0):
+        assert np.allclose(ours, WORLD, rtol=0.005), ours
+
+
+def test_the_coats_reflection_is_reciprocal(penumbra):
+    """A black base under a coat (only the coat reflects): swapping the view and the sun's
+    directions gives the same BRDF, f(v, l) = f(l, v), within 1 %."""
+
+    def make():
+        return _material(0.0, 0.5, 1.0, 0.35, specular=0.0)
+
+    a, b = 50.0, 70.0  # angles from the normal
+    forward = _plane(make, a, 90.0 - b, samples=1)  # view a, sun at b (elevation 90 - b)
+    backward = _plane(make, b, 90.0 - a, samples=1)
+    f_forward = forward.mean() / (SUN * math.cos(math.radians(b)))
+    f_backward = backward.mean() / (SUN * math.cos(math.radians(a)))
+    assert f_forward > 1e-3
+    assert f_forward == pytest.approx(f_backward, rel=0.01)
+    v, to_light = _directions(a, 90.0 - b)
+    ref = analytic.coat_reflectance(1.0, 0.35, v, to_light) / math.cos(math.radians(b))
+    assert f_forward == pytest.approx(ref, rel=0.03)
+
+
+def test_coat_weight_zero_is_the_surface_without_a_coat(penumbra, gpu_call):
+    """Coat Weight 0: the same image bit for bit as a Principled BSDF never given a coat, with
+    no coat in its program (no NODE_COAT variant); above 0 the variant has it."""
+    scene = scenes.demo_scene(48, 32)
+    mat = next(m for m in (s.material for o in scene.objects for s in o.material_slots) if m is not None)
+    plain, _stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Coat Roughness"].default_value = 0.2  # inputs of a coat of weight 0
+    bsdf.inputs["Coat Tint"].default_value = (0.2, 0.5, 0.9, 1.0)
+    zero, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
+    assert np.array_equal(plain, zero)
+    assert not any(
+        dict(k.defines()).get("NODE_COAT") or "TREE_COAT" in k.program().name.upper() for k in stats.lit_keys
+    )
+    bsdf.inputs["Coat Weight"].default_value = 1.0
+    coated, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
+    assert any(dict(k.program().defines).get("NODE_COAT") for k in stats.lit_keys)
+    assert not np.array_equal(plain, coated)
+
+
+def test_the_groups_not_drawn_are_named_and_the_coat_is_not(penumbra):
+    """Sheen, Subsurface, Anisotropic and Thin Film set on a Principled BSDF, and a Glossy
+    BSDF's Anisotropy, are each named in the material's messages; a coat is drawn, not named."""
+    from penumbra.engine.scene.materials import material_from_blender
+
+    scenes.empty_scene(8, 8)
+    mat = _material(0.5, 0.5, 1.0, 0.2)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    for name, value in (("Sheen Weight", 1.0), ("Subsurface Weight", 0.5), ("Anisotropic", 0.5)):
+        bsdf.inputs[name].default_value = value
+    bsdf.inputs["Thin Film Thickness"].default_value = 300.0
+    read = material_from_blender(mat)
+    for name in ("Sheen Weight", "Subsurface Weight", "Anisotropic", "Thin Film Thickness"):
+        assert any(f"{name} is not drawn" in m for m in read.messages), (name, read.messages)
+    assert not any("Coat Weight" in m for m in read.messages), read.messages
+    assert read.tree is not None and read.tree.coat
+    glossy = scenes.material("Brushed", (0.8, 0.8, 0.8))
+    tree = glossy.node_tree
+    node = tree.nodes.new("ShaderNodeBsdfAnisotropic")
+    node.inputs["Anisotropy"].default_value = 0.7
+    tree.links.new(node.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    assert any("Anisotropy is not drawn" in m for m in material_from_blender(glossy).messages)

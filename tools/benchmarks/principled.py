@@ -1,0 +1,180 @@
+"""The Principled BSDF's input groups, one sphere each, against Cycles and EEVEE.
+
+Each case is a sphere of radius 1 filling an orthographic view (64x64): its material a
+Principled BSDF with one input group set (and the group's extremes), lit by a sun over a dim
+grey world (``sun``) or by Blender's forest HDRI (``hdri``). Penumbra at ``--samples`` (64) and
+EEVEE (16) are compared with Cycles at ``--reference`` spp (1024; direct light, which the
+world's light and the lights are, cached per clone under out/reference_cache). The error is the
+display MAE (Standard view, sRGB-encoded, clipped to [0, 1]) over the pixels whose centre sees
+the sphere (its disc, analytically).
+
+Cases: ``base`` (no group: the reference of the rest), ``coat r0`` and ``coat r1`` (Coat Weight 1
+at Coat Roughness 0 and 1, over a red rough dielectric), ``coat tint`` (an orange tint at
+roughness 0.1), ``metal`` (a rough gold, no coat) and ``coat on metal`` (Coat 1 at roughness
+0.05 over it), ``coat half``
+(Coat Weight 0.5 at roughness 0.3). Writes ``<out>/principled.csv`` and a Markdown table to stdout.
+``--quick``: reference 256 spp.
+"""
+
+import hashlib
+import sys
+import time
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from devkit import report, scenes, session
+from devkit.engines import EEVEE_SAMPLES, configure
+from devkit.reflection_scenes import hdri_path
+from devkit.render import render
+
+HELP = "the Principled BSDF's input groups on spheres vs Cycles and EEVEE -> <out>/principled.csv"
+
+CACHE = Path("out") / "reference_cache"
+SIZE = 64
+CSV_FIELDS = ["case", "light", "penumbra", "eevee", "penumbra_s", "eevee_s"]
+
+# name -> the Principled inputs set (besides a red rough dielectric base)
+CASES = {
+    "base": {},
+    "coat r0": {"Coat Weight": 1.0, "Coat Roughness": 0.0},
+    "coat r1": {"Coat Weight": 1.0, "Coat Roughness": 1.0},
+    "coat tint": {"Coat Weight": 1.0, "Coat Roughness": 0.1, "Coat Tint": (1.0, 0.55, 0.2, 1.0)},
+    "metal": {"Base Color": (1.0, 0.78, 0.34, 1.0), "Metallic": 1.0, "Roughness": 0.45},
+    "coat on metal": {
+        "Base Color": (1.0, 0.78, 0.34, 1.0),
+        "Metallic": 1.0,
+        "Roughness": 0.45,
+        "Coat Weight": 1.0,
+        "Coat Roughness": 0.05,
+    },
+    "coat half": {"Coat Weight": 0.5, "Coat Roughness": 0.3},
+}
+LIGHTS = ("sun", "hdri")
+
+
+def add_arguments(parser):
+    parser.add_argument("--out", type=Path, default=Path("out"), help="output folder (default out)")
+    parser.add_argument("--quick", action="store_true", help="reference 256 spp")
+    parser.add_argument("--samples", type=int, default=64, help="Penumbra's render samples (default 64)")
+    parser.add_argument("--reference", type=int, default=1024, help="Cycles' reference spp (default 1024)")
+    parser.add_argument("--cases", default=",".join(CASES), help="comma-separated: " + ", ".join(CASES))
+
+
+def log(message):
+    print(f"bench principled: {message}", file=sys.stderr, flush=True)
+
+
+def sphere_scene(case, light):
+    """The sphere of ``case`` under ``light`` ("sun" or "hdri")."""
+    scene = scenes.empty_scene(SIZE, SIZE)
+    scene.render.filter_size = scene.penumbra.filter_size = 1.5
+    mat = scenes.material("Sphere", (0.6, 0.08, 0.06), roughness=0.5)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    for name, value in CASES[case].items():
+        bsdf.inputs[name].default_value = value
+    scenes.uv_sphere(scene, "Sphere", radius=1.0, segments=96, rings=48, mat=mat)
+    scenes.camera(scene, (0.0, -10.0, 0.0), (np.pi / 2, 0.0, 0.0), ortho_scale=2.2, clip=(0.1, 20.0))
+    if light == "sun":
+        scenes.set_world(scene, (0.05, 0.05, 0.06))
+        scenes.light(scene, "Sun", "SUN", 3.0, rotation=(0.9, 0.3, -0.6), angle=0.02)
+    else:
+        tree = scene.world.node_tree
+        env = tree.nodes.new("ShaderNodeTexEnvironment")
+        env.image = bpy.data.images.load(str(hdri_path()))
+        background = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeBackground")
+        tree.links.new(env.outputs[0], background.inputs["Color"])
+    return scene
+
+
+def sphere_mask():
+    """The pixels whose centre sees the sphere (radius 1 in an orthographic view 2.2 wide),
+    rows from the bottom."""
+    c = (np.arange(SIZE) + 0.5) / SIZE * 2.2 - 1.1
+    x, z = np.meshgrid(c, c)
+    return x * x + z * z < 0.97 * 0.97  # off the silhouette's antialiased edge
+
+
+def display(image):
+    c = np.clip(np.asarray(image, np.float64)[..., :3], 0.0, 1.0)
+    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+
+
+def cycles(scene, spp):
+    configure(scene, "CYCLES", samples=spp)
+    scene.cycles.pixel_filter_type = "BLACKMAN_HARRIS"
+    scene.cycles.filter_width = scene.penumbra.filter_size
+
+
+def reference(case, light, spp):
+    own = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:10]
+    key = f"principled-{own}-{bpy.app.version_string}-{case}-{light}-{SIZE}-{spp}"
+    path = CACHE / f"{hashlib.sha256(key.encode()).hexdigest()[:16]}.npy"
+    if path.exists():
+        return np.load(path)
+    scene = sphere_scene(case, light)
+    cycles(scene, spp)
+    image = display(render(scene)["Combined"])
+    CACHE.mkdir(parents=True, exist_ok=True)
+    np.save(path, image)
+    return image
+
+
+def timed(scene):
+    start = time.perf_counter()
+    image = display(render(scene)["Combined"])
+    return image, time.perf_counter() - start
+
+
+def run(args):
+    spp = 256 if args.quick else args.reference
+    names = [n.strip() for n in args.cases.split(",") if n.strip()]
+    args.out.mkdir(parents=True, exist_ok=True)
+    session.load_penumbra().register()
+    mask = sphere_mask()
+    started = time.perf_counter()
+    rows = []
+    with session.stdout_to_stderr():
+        for case in names:
+            for light in LIGHTS:
+                log(f"{case}, {light}")
+                ref = reference(case, light, spp)
+                scene = sphere_scene(case, light)
+                configure(scene, "PENUMBRA", render_samples=args.samples)
+                ours, ours_s = timed(scene)
+                configure(scene, "EEVEE", taa_render_samples=EEVEE_SAMPLES)
+                eevee, eevee_s = timed(scene)
+                rows.append(
+                    {
+                        "case": case,
+                        "light": light,
+                        "penumbra": float(np.abs(ours - ref)[mask].mean()),
+                        "eevee": float(np.abs(eevee - ref)[mask].mean()),
+                        "penumbra_s": ours_s,
+                        "eevee_s": eevee_s,
+                    }
+                )
+    report.write_csv(args.out / "principled.csv", rows, CSV_FIELDS)
+    title = (
+        f"Principled BSDF input groups on a sphere, {SIZE}x{SIZE}, display MAE over the sphere against Cycles "
+        f"{spp} spp; Penumbra {args.samples} samples, EEVEE {EEVEE_SAMPLES}; Blender {bpy.app.version_string}"
+    )
+    cells = [
+        [
+            r["case"],
+            r["light"],
+            f"{r['penumbra']:.4f}",
+            f"{r['eevee']:.4f}",
+            f"{r['penumbra_s']:.2f}",
+            f"{r['eevee_s']:.2f}",
+        ]
+        for r in rows
+    ]
+    print(f"### {title}\n")
+    print(report.markdown_table(["Case", "Light", "Penumbra", "EEVEE", "Penumbra (s)", "EEVEE (s)"], cells))
+    print(
+        f"\nGPU: {session.gpu_renderer() or 'n/a'}; one render per engine and case; "
+        f"{(time.perf_counter() - started) / 60:.1f} min. Wrote principled.csv."
+    )
+    return 0
