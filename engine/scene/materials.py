@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import volumes
+from .sockets import source as _source
 
 # Channels a texture can drive, in the order of the shader's texture slots.
 CHANNELS = ("base_color", "roughness", "metallic", "alpha", "emission", "normal")
@@ -146,22 +147,6 @@ def _bounded(value, nan):
 
 
 # --- reading ------------------------------------------------------------------------------
-
-
-def _source(socket):
-    """The node and output socket feeding ``socket`` (through reroutes), or (None, None)."""
-    seen = 0
-    while socket is not None and socket.is_linked and seen < 64:
-        link = socket.links[0]
-        if not getattr(link, "is_valid", True) or getattr(link, "is_muted", False):
-            return None, None
-        node, out = link.from_node, link.from_socket
-        if node.bl_idname == "NodeReroute":
-            socket = node.inputs[0]
-            seen += 1
-            continue
-        return node, out
-    return None, None
 
 
 def _mapping_transform(mapping):

@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .sockets import source as _source
+
 # A medium thinner than this (extinction and emission per unit of length, every channel) is
 # nothing at all: it is not marched.
 NEGLIGIBLE = 1e-12
@@ -144,12 +146,6 @@ def _mix(media, weights):
         g_weight += s
     out.anisotropy = out.anisotropy / g_weight if g_weight > 0.0 else 0.0
     return out
-
-
-def _source(socket):
-    from .materials import _source as source
-
-    return source(socket)
 
 
 def _read(node, notes, label, depth=0):
