@@ -686,6 +686,18 @@ def summary(read):
     if read.transmits:
         mode = "a slab" if read.thickness_mode == "SLAB" else "a sphere"
         lines.append(("MATERIAL", f"Transmission: {read.transmission:.2f}, through {mode} (Thickness Mode)"))
+    if read.tree is not None and read.tree.coat:
+        lines.append(("MATERIAL", "Coat: a GGX layer over the surface"))
+    if read.volume is not None:
+        v = read.volume
+        where = "its interior (the object's bounding box)" if read.surface else "its interior alone (no surface)"
+        lines.append(
+            (
+                "OUTLINER_DATA_VOLUME",
+                f"Volume: {where}; extinction {float(v.extinction.mean()):.3g}, "
+                f"scattering {float(v.scatter.mean()):.3g} per unit, anisotropy {v.anisotropy:.2f}",
+            )
+        )
     lines += [("ERROR", m.split(": ", 1)[-1]) for m in read.messages]
     return lines
 

@@ -135,6 +135,9 @@ def test_the_groups_not_drawn_are_named_and_the_coat_is_not(penumbra):
         assert any(f"{name} is not drawn" in m for m in read.messages), (name, read.messages)
     assert not any("Coat Weight" in m for m in read.messages), read.messages
     assert read.tree is not None and read.tree.coat
+    from penumbra.engine.scene.materials import summary
+
+    assert any(text.startswith("Coat:") for _icon, text in summary(read))
     glossy = scenes.material("Brushed", (0.8, 0.8, 0.8))
     tree = glossy.node_tree
     node = tree.nodes.new("ShaderNodeBsdfAnisotropic")

@@ -305,3 +305,7 @@ def test_a_volume_input_fed_by_a_node_is_named(penumbra):
     assert not read.surface and read.volume is not None
     assert np.allclose(read.volume.extinction, 0.5)  # the socket's own value
     assert any("Density is fed by a node" in m for m in read.messages), read.messages
+    from penumbra.engine.scene.materials import summary
+
+    lines = [text for _icon, text in summary(read)]
+    assert any(t.startswith("Volume: its interior alone") and "extinction 0.5" in t for t in lines), lines
