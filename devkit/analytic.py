@@ -167,6 +167,83 @@ def coat_reflectance(weight, rough, v, to_light, ior=1.5):
     return float(weight * fresnel_dielectric(np.dot(h, w), ior) * d * g2 / (4.0 * mu_v))
 
 
+def _film_sensitivity(opd, shift):
+    """Belcour and Barla's Gaussian fit of the XYZ sensitivities in Fourier space, at optical
+    path difference ``opd`` (nm) and phase ``shift``."""
+    phase = 2.0 * math.pi * opd * 1e-9
+    val = np.array([5.4856e-13, 4.4201e-13, 5.2481e-13])
+    pos = np.array([1.6810e06, 1.7953e06, 2.2084e06])
+    var = np.array([4.3278e09, 9.3046e09, 6.6121e09])
+    xyz = val * np.sqrt(2 * math.pi * var) * np.cos(pos * phase + shift) * np.exp(-var * phase * phase)
+    xyz[0] += (
+        9.7470e-14
+        * math.sqrt(2 * math.pi * 4.5282e09)
+        * math.cos(2.2399e06 * phase + shift)
+        * math.exp(-4.5282e09 * phase * phase)
+    )
+    return xyz / 1.0685e-7
+
+
+def _film_interface(c, n1, n2):
+    """(R_s, R_p), (phi_s, phi_p) of the interface from n1 to n2 at cosine ``c``."""
+    s2 = 1.0 - c * c
+    nr = n1 / n2
+    if nr * nr * s2 > 1.0:
+        t = math.sqrt(max(s2 - 1.0 / (nr * nr), 0.0)) / max(c, 1e-6)
+        return np.array([1.0, 1.0]), 2.0 * np.arctan(np.array([-nr * nr * t, -t]))
+    c2 = math.sqrt(max(1.0 - nr * nr * s2, 0.0))
+    r = np.array([(n2 * c - n1 * c2) / (n2 * c + n1 * c2), (n1 * c - n2 * c2) / (n1 * c + n2 * c2)])
+    return r * r, np.where(r < 0.0, math.pi, 0.0)
+
+
+XYZ_TO_REC709 = np.array(
+    [[3.2404542, -1.5371385, -0.4985314], [-0.9692660, 1.8760108, 0.0415560], [0.0556434, -0.2040259, 1.0572252]]
+)
+
+
+def thin_film_fresnel(c, thickness, film_ior, base_ior):
+    """The reflectance (linear Rec. 709, white-balanced to the sensitivities' equal-energy
+    white) of a thin dielectric film of ``thickness`` nm and ``film_ior`` on a base of
+    ``base_ior``, from air at cosine ``c``: the Airy summation integrated against the
+    sensitivities (Belcour and Barla 2017; the DC term and three pairs of Diracs)."""
+    c = min(max(c, 1e-4), 1.0)
+    d = max(thickness, 0.0)
+    t = min(max(d / 30.0, 0.0), 1.0)
+    eta2 = 1.0 + (max(film_ior, 1.0) - 1.0) * t * t * (3.0 - 2.0 * t)
+    c2 = math.sqrt(max(1.0 - (1.0 - c * c) / (eta2 * eta2), 0.0))
+    r12, phi12 = _film_interface(c, 1.0, eta2)
+    t121 = 1.0 - r12
+    phi21 = math.pi - phi12
+    r23, phi23 = _film_interface(c2, eta2, max(base_ior, 1.0))
+    opd = 2.0 * eta2 * d * c2
+    phi2 = phi21 + phi23
+    r123 = np.clip(r12 * r23, 1e-7, 0.9999)
+    rs = t121 * t121 * r23 / (1.0 - r123)
+    xyz = 0.5 * (r12[0] + rs[0] + r12[1] + rs[1]) * _film_sensitivity(0.0, 0.0)
+    cm = rs - t121
+    for m in (1, 2, 3):
+        cm = cm * np.sqrt(r123)
+        xyz = xyz + 0.5 * (
+            cm[0] * 2 * _film_sensitivity(m * opd, m * phi2[0]) + cm[1] * 2 * _film_sensitivity(m * opd, m * phi2[1])
+        )
+    white = XYZ_TO_REC709 @ _film_sensitivity(0.0, 0.0)
+    return np.clip((XYZ_TO_REC709 @ xyz) / white, 0.0, 1.0)
+
+
+def ggx_reflectance(fresnel, rough, v, to_light):
+    """f cos(theta_l) of a GGX lobe (height-correlated Smith) whose Fresnel at the half vector
+    is ``fresnel(cos)`` (a scalar or RGB), for unit ``v`` and ``to_light`` about +z."""
+    v, w = np.asarray(v, float), np.asarray(to_light, float)
+    mu_v, mu_l = v[2], w[2]
+    if mu_l <= 0.0:
+        return 0.0
+    a2 = max(rough * rough, 1e-3) ** 2
+    h = (v + w) / np.linalg.norm(v + w)
+    d = a2 / (np.pi * (h[2] ** 2 * (a2 - 1.0) + 1.0) ** 2)
+    g2 = 1.0 / (1.0 + smith_lambda(a2, mu_v) + smith_lambda(a2, mu_l))
+    return np.asarray(fresnel(float(np.dot(h, w)))) * d * g2 / (4.0 * mu_v)
+
+
 def _multiple_scattering(rough, mu_v, ior):
     """Cycles' energy gain of the GGX lobe for light bouncing between microfacets at N.V =
     ``mu_v``: 1 + F_ms (1 - E) / E (Kulla and Conty 2017; microfacet_ggx_preserve_energy)."""

@@ -241,6 +241,7 @@ def material_defines(features):
     out["NODE_TREE"] = any(f.startswith("NODES_") for f in features)
     out["NODE_NORMAL"] = "TREE_NORMAL" in features  # the tree gives the shading normal
     out["NODE_COAT"] = "TREE_COAT" in features  # a Principled coat over the surface (lib/lit_bsdf.glsl)
+    out["NODE_FILM"] = "TREE_FILM" in features  # a Principled thin film on its specular (lib/thin_film.glsl)
     if "TREE_LOBES" in features:  # the tree gives two lobes (one-lobe variants keep their defines)
         out["NODE_LOBES"] = 2
     out["HAS_VCOL"] = "VCOL" in features

@@ -125,6 +125,8 @@ class Material:
                 out.add("TREE_LOBES")
             if self.tree.coat:
                 out.add("TREE_COAT")
+            if self.tree.film:
+                out.add("TREE_FILM")
         return frozenset(out)
 
 

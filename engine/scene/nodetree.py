@@ -152,6 +152,7 @@ class CompiledTree:
     lobes: int = 1  # 2: a Mix / Add Shader of two surfaces, shaded as two lobes (NODE_LOBES == 2)
     aovs: tuple = ()  # the AOV names its AOV Output nodes write, in node_aovs' order (NODE_AOVS)
     coat: bool = False  # a Principled BSDF's coat is drawn (NODE_COAT; node_coat_keep)
+    film: bool = False  # its Thin Film is drawn (NODE_FILM; node_film_keep)
 
 
 # --- the registry -------------------------------------------------------------------------
@@ -232,6 +233,7 @@ class Compiler:
         self.surface_fallback = False
         self.normal = False
         self.coat = False  # a Principled BSDF's coat is drawn (NODE_COAT)
+        self.film = False  # and its Thin Film (NODE_FILM)
 
     # -- emitting --
 
@@ -490,6 +492,7 @@ class Compiler:
             "               inout vec3 normal)\n"
         )
         keep = f"  node_coat_keep({v.expr});\n" if self.coat else ""
+        keep += f"  node_film_keep({v.expr});\n" if self.film else ""
         if v.lobes < 2:
             code = _prelude(self.needs) + (
                 f"{signature}{{\n{body}\n{keep}"
@@ -530,6 +533,7 @@ class Compiler:
             lobes=max(1, v.lobes),
             aovs=aovs,
             coat=self.coat,
+            film=self.film,
         )
 
     def compile_aovs(self, nodes):
@@ -660,6 +664,15 @@ def _principled(c, node, socket, ctx):
             f"{coat_normal.expr})"
         )
         c.coat = True
+    if "Thin Film Thickness" in unread:  # linked or above 0: the film on its specular (NODE_FILM)
+        unread.remove("Thin Film Thickness")
+        thickness = c.shader_input(node, "Thin Film Thickness", ctx, "float", 0.0)
+        film_ior = c.shader_input(node, "Thin Film IOR", ctx, "float", 1.33)
+        expr = f"node_principled_film({expr}, {thickness.expr}, {film_ior.expr}, {ior.expr})"
+        c.film = True
+        metallic = node.inputs.get("Metallic")
+        if metallic is not None and (metallic.is_linked or float(metallic.default_value) > 0.0):
+            c.messages.append("Thin Film on the metallic part is not drawn (on the dielectric's specular only)")
     c.messages += [f"{name} is not drawn" for name in unread]
     return c.temp("closure", expr, 1)
 

@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/ggx_albedo.glsl lib/lit_surface.glsl
+// requires: lib/common.glsl lib/ggx_albedo.glsl lib/lit_surface.glsl lib/thin_film.glsl
 #ifndef PENUMBRA_LIB_LIT_BSDF
 #define PENUMBRA_LIB_LIT_BSDF
 
@@ -19,6 +19,12 @@ float fresnel_shape(float c)
   return (0.5 * a * a * (1.0 + b * b) - 0.04) / 0.96;
 }
 
+#if NODE_FILM
+/* The surface's Thin Film (weight, thickness nm, film IOR, base IOR): lib/lit_inputs.glsl sets
+ * it before the lobes are set up. */
+vec4 lit_film = vec4(0.0, 0.0, 1.33, 1.5);
+#endif
+
 /* One lobe's BSDF for light from ``to_light`` (N.L > 0): its diffuse and specular parts, each
  * scaled by the light's factors. */
 vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
@@ -37,7 +43,15 @@ vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
   /* Fresnel from f0.rgb towards f90 (f0.a: lobe_setup) along the exact dielectric curve
    * (fresnel_shape). */
   float fw = fresnel_shape(dot(to_light, H));
-  vec3 spec = (b.f0.rgb + (b.f0.a - b.f0.rgb) * fw) * (D * Vis);
+  vec3 F = b.f0.rgb + (b.f0.a - b.f0.rgb) * fw;
+#  if NODE_FILM
+  if (b.film > 0.0) {
+    /* The film on the dielectric's specular (its Fresnel at the half vector); the metal keeps its own. */
+    vec3 film = film_fresnel(dot(to_light, H), lit_film.y, lit_film.z, lit_film.w);
+    F = mix(F, mix(film, b.metal_f0 + (b.f0.a - b.metal_f0) * fw, b.metal), b.film);
+  }
+#  endif
+  vec3 spec = F * (D * Vis);
   return b.albedo / M_PI * L.diffuse_factor + spec * L.specular_factor;
 #else
 #  if SPECULAR_MODEL == SPECULAR_BLINN
@@ -103,7 +117,18 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   /* Metallic mixes a metal and a dielectric; only the dielectric's own specular sits over its
    * diffuse, per channel (a tinted specular takes its own colour out of the diffuse). */
   vec2 ab_dielectric = env_brdf(dot(spec.rgb, vec3(0.3333)), clamp(50.0 * spec.a, 0.0, 1.0), rough, NdotV);
-  b.albedo *= clamp(1.0 - (spec.rgb * ab_dielectric.x + ab_dielectric.y), 0.0, 1.0);
+  vec3 reflected = spec.rgb * ab_dielectric.x + ab_dielectric.y;
+#if NODE_FILM
+  /* A Thin Film: the dielectric reflects the film's reflectance towards the viewer times the
+   * lobe's albedo at F = 1, and the diffuse below loses that instead. */
+  b.film = clamp(lit_film.x, 0.0, 1.0);
+  b.metal = metal;
+  b.metal_f0 = base;
+  vec2 ab_one = env_brdf(1.0, 1.0, rough, NdotV);
+  b.film_dfg = film_fresnel(NdotV, lit_film.y, lit_film.z, lit_film.w) * (ab_one.x + ab_one.y);
+  reflected = mix(reflected, b.film_dfg, b.film);
+#endif
+  b.albedo *= clamp(1.0 - reflected, 0.0, 1.0);
   return b;
 }
 

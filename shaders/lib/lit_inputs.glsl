@@ -18,6 +18,9 @@ struct MaterialInputs {
   vec4 spec_f0;     /* the dielectric's F0 (lobe_setup) */
   float transmission; /* Principled Transmission Weight (TRANSMISSION, lib/refraction.glsl) */
   vec3 tree_normal; /* the tree's shading normal (NODE_NORMAL) */
+#if NODE_FILM
+  vec4 film;        /* (weight, thickness nm, film IOR, base IOR) of a Principled Thin Film */
+#endif
 #if NODE_COAT
   vec4 coat;        /* (weight, roughness, IOR, 0) of a Principled coat (shaders/nodes/shader.glsl) */
   vec3 coat_tint;
@@ -64,8 +67,14 @@ MaterialInputs material_inputs()
 #    if NODE_COAT
   node_coat_keep(closure);
 #    endif
+#    if NODE_FILM
+  node_film_keep(closure);
+#    endif
 #  else
   node_tree(front ? Nt : -Nt, V, front, m.base, m.rough, m.metal, m.spec_f0, m.coverage, m.emission, m.tree_normal);
+#  endif
+#  if NODE_FILM
+  m.film = node_film_params;
 #  endif
 #  if NODE_COAT
   m.coat = node_coat_params;
@@ -108,6 +117,9 @@ Surface surface_setup(MaterialInputs m, out vec2 ab[NODE_LOBES])
   s.coat = coat_setup(m.coat, m.coat_tint, (dot(Nc, s.V) < 0.0) ? -Nc : Nc, s.V);
 #endif
   N = shading_normal(N, m.tree_normal, s);
+#if NODE_FILM
+  lit_film = m.film; /* the lobes' Fresnel (lib/lit_bsdf.glsl lobe_setup, lobe_brdf) */
+#endif
 #if NODE_LOBES == 2
   s.lobe[0] = lobe_setup(m.base.rgb, m.rough, m.metal, m.spec_f0, N, s.V, m.weights.x, ab[0]);
   /* The second lobe: its own normal where the tree gives one, else the first lobe's. */

@@ -38,10 +38,19 @@ struct Lobe {
   float alpha;  /* GGX roughness (Principled roughness squared, at least 0.002) */
   float rough;  /* the Principled roughness (what blurs the world's specular) */
   float weight; /* the lobe's share of the surface (1 for a single lobe) */
+#if NODE_FILM
+  float film;      /* the Thin Film's share of its dielectric specular (lib/thin_film.glsl) */
+  float metal;     /* its metallic, whose Fresnel the film leaves */
+  vec3 metal_f0;   /* the metal's reflectance at normal incidence (the base colour) */
+  vec3 film_dfg;   /* the film's reflectance towards the viewer x the lobe's albedo at F = 1 */
+#endif
 };
 
 #ifndef NODE_COAT
 #  define NODE_COAT 0
+#endif
+#ifndef NODE_FILM
+#  define NODE_FILM 0
 #endif
 
 /* A Principled BSDF's coat (NODE_COAT; lit_bsdf.glsl coat_setup): a dielectric GGX layer over

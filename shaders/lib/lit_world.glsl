@@ -162,6 +162,10 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
   vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
 #endif
   vec3 dfg = b.f0.rgb * ab.x + ab.y;
+#if NODE_FILM
+  /* A Thin Film's dielectric (lit_bsdf.glsl lobe_setup), the metal's own. */
+  dfg = mix(dfg, mix(b.film_dfg, b.metal_f0 * ab.x + ab.y, b.metal), b.film);
+#endif
   vec3 specular = radiance * dfg;
 #if WORLD_AO && WORLD_RATIO
   /* The occlusion goes into the ratio's sums (surface_world_light), the colour keeps U whole. */

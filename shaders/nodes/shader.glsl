@@ -46,6 +46,7 @@ struct NodeClosure {
   vec4 coat; /* (weight, roughness, IOR, 0), each x the coat's weight */
   vec3 coat_tint;
   vec3 coat_normal;
+  vec4 film; /* (weight, thickness, film IOR, base IOR), each x the film's weight: Thin Film */
 };
 
 NodeLobe node_lobe_empty()
@@ -55,7 +56,8 @@ NodeLobe node_lobe_empty()
 
 NodeClosure node_closure_empty()
 {
-  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0), vec4(0.0), vec3(0.0), vec3(0.0));
+  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0), vec4(0.0), vec3(0.0), vec3(0.0),
+                     vec4(0.0));
 }
 
 /* The Principled BSDF's dielectric reflectance at normal incidence, as Blender's (Cycles'
@@ -80,7 +82,7 @@ NodeClosure node_principled(vec4 base, float metallic, float roughness, vec4 spe
 {
   float a = clamp(alpha, 0.0, 1.0);
   return NodeClosure(NodeLobe(base.rgb * a, roughness * a, metallic * a, specular * a, a, normal * a),
-                     node_lobe_empty(), a, emission * a, vec4(0.0), vec3(0.0), vec3(0.0));
+                     node_lobe_empty(), a, emission * a, vec4(0.0), vec3(0.0), vec3(0.0), vec4(0.0));
 }
 
 /* The Principled BSDF ``c`` (node_principled) with its coat: Coat Weight, Roughness, IOR, Tint
@@ -97,16 +99,28 @@ NodeClosure node_principled_coat(NodeClosure c, float weight, float roughness, f
   return c;
 }
 
+/* The Principled BSDF ``c`` with its Thin Film: Thickness (nm) and IOR over a base of IOR
+ * ``ior`` (the BSDF's), scaled by the surface's coverage. */
+NodeClosure node_principled_film(NodeClosure c, float thickness, float film_ior, float ior)
+{
+  float w = c.alpha;
+  float d = clamp(isnan(thickness) ? 0.0 : thickness, 0.0, 1e5);
+  float eta = clamp(isnan(film_ior) ? 1.33 : film_ior, 1.0, 1e6);
+  float base = clamp(isnan(ior) ? 1.5 : ior, 1.0, 1e6);
+  c.film = vec4(w, w * d, w * eta, w * base);
+  return c;
+}
+
 NodeClosure node_emission(vec4 color, float strength)
 {
   return NodeClosure(node_lobe_empty(), node_lobe_empty(), 1.0, color.rgb * strength, vec4(0.0), vec3(0.0),
-                     vec3(0.0));
+                     vec3(0.0), vec4(0.0));
 }
 
 NodeClosure node_diffuse(vec4 color, vec3 normal)
 {
   return NodeClosure(NodeLobe(color.rgb, 1.0, 0.0, vec4(0.0), 1.0, normal), node_lobe_empty(), 1.0, vec3(0.0),
-                     vec4(0.0), vec3(0.0), vec3(0.0));
+                     vec4(0.0), vec3(0.0), vec3(0.0), vec4(0.0));
 }
 
 NodeClosure node_transparent()
@@ -131,7 +145,7 @@ NodeClosure node_mix_shader_weights(float g, NodeClosure a, float f, NodeClosure
 {
   return NodeClosure(node_lobe_mix(g, a.a, f, b.a), node_lobe_mix(g, a.b, f, b.b), g * a.alpha + f * b.alpha,
                      g * a.emission + f * b.emission, g * a.coat + f * b.coat, g * a.coat_tint + f * b.coat_tint,
-                     g * a.coat_normal + f * b.coat_normal);
+                     g * a.coat_normal + f * b.coat_normal, g * a.film + f * b.film);
 }
 
 NodeClosure node_mix_shader(float f, NodeClosure a, NodeClosure b)
@@ -151,7 +165,7 @@ NodeClosure node_mix_split_weights(float g, NodeClosure a, float f, NodeClosure 
   NodeLobe none = node_lobe_empty();
   return NodeClosure(node_lobe_mix(g, a.a, 0.0, none), node_lobe_mix(f, b.a, 0.0, none),
                      g * a.alpha + f * b.alpha, g * a.emission + f * b.emission, g * a.coat + f * b.coat,
-                     g * a.coat_tint + f * b.coat_tint, g * a.coat_normal + f * b.coat_normal);
+                     g * a.coat_tint + f * b.coat_tint, g * a.coat_normal + f * b.coat_normal, g * a.film + f * b.film);
 }
 
 NodeClosure node_mix_split(float f, NodeClosure a, NodeClosure b)
@@ -236,6 +250,7 @@ NodeClosure node_mix_merge_weights(float g, NodeClosure a, float f, NodeClosure 
   c.coat = g * a.coat + f * b.coat;
   c.coat_tint = g * a.coat_tint + f * b.coat_tint;
   c.coat_normal = g * a.coat_normal + f * b.coat_normal;
+  c.film = g * a.film + f * b.film;
   return c;
 }
 
@@ -320,6 +335,20 @@ void node_coat_keep(NodeClosure c)
   node_coat_tint = (w > 1e-6) ? clamp(node_finite3(c.coat_tint * winv, 1e6), 0.0, 1.0) : vec3(1.0);
   float nl = length(c.coat_normal);
   node_coat_normal = (nl > 1e-12 && !isinf(nl)) ? c.coat_normal / nl : vec3(0.0);
+}
+
+/* The closure's Thin Film as parameters (NODE_FILM, lib/lit_inputs.glsl): (its share of the
+ * surface, thickness, film IOR, base IOR). */
+vec4 node_film_params = vec4(0.0, 0.0, 1.33, 1.5);
+
+void node_film_keep(NodeClosure c)
+{
+  float w = c.film.x;
+  float coverage = clamp(c.alpha, 0.0, 1.0);
+  float winv = (w > 1e-6) ? 1.0 / w : 0.0;
+  node_film_params = (w > 1e-6) ? vec4(node_finite3(vec3(w / max(coverage, 1e-6)), 1.0).x,
+                                       node_finite3(c.film.yzw * winv, 1e5)) :
+                                  vec4(0.0, 0.0, 1.33, 1.5);
 }
 
 #endif /* PENUMBRA_LIB_NODES_SHADER */

@@ -12,7 +12,9 @@ Cases: ``base`` (no group: the reference of the rest), ``coat r0`` and ``coat r1
 at Coat Roughness 0 and 1, over a red rough dielectric), ``coat tint`` (an orange tint at
 roughness 0.1), ``metal`` (a rough gold, no coat) and ``coat on metal`` (Coat 1 at roughness
 0.05 over it), ``coat half``
-(Coat Weight 0.5 at roughness 0.3). Writes ``<out>/principled.csv`` and a Markdown table to stdout.
+(Coat Weight 0.5 at roughness 0.3), ``film 0`` and ``film 300`` (a near-black glossy dielectric
+without and with a 300 nm Thin Film of IOR 1.33), ``film 600 on metal`` (a half-metallic white
+under a 600 nm film of IOR 1.6). Writes ``<out>/principled.csv`` and a Markdown table to stdout.
 ``--quick``: reference 256 spp.
 """
 
@@ -50,6 +52,15 @@ CASES = {
         "Coat Roughness": 0.05,
     },
     "coat half": {"Coat Weight": 0.5, "Coat Roughness": 0.3},
+    "film 0": {"Base Color": (0.02, 0.02, 0.02, 1.0), "Roughness": 0.2},
+    "film 300": {"Base Color": (0.02, 0.02, 0.02, 1.0), "Roughness": 0.2, "Thin Film Thickness": 300.0},
+    "film 600 on metal": {
+        "Base Color": (0.9, 0.9, 0.9, 1.0),
+        "Metallic": 0.5,
+        "Roughness": 0.2,
+        "Thin Film Thickness": 600.0,
+        "Thin Film IOR": 1.6,
+    },
 }
 LIGHTS = ("sun", "hdri")
 
