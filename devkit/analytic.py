@@ -156,15 +156,7 @@ def coat_below(weight, rough, mu_v, ior=1.5, tint=(1.0, 1.0, 1.0)):
 def coat_reflectance(weight, rough, v, to_light, ior=1.5):
     """f cos(theta_l) of a Principled coat alone for unit ``v`` and ``to_light`` about +z: GGX,
     height-correlated Smith, the exact dielectric Fresnel of ``ior``, times ``weight``."""
-    v, w = np.asarray(v, float), np.asarray(to_light, float)
-    mu_v, mu_l = v[2], w[2]
-    if mu_l <= 0.0:
-        return 0.0
-    a2 = max(rough * rough, 1e-3) ** 2
-    h = (v + w) / np.linalg.norm(v + w)
-    d = a2 / (np.pi * (h[2] ** 2 * (a2 - 1.0) + 1.0) ** 2)
-    g2 = 1.0 / (1.0 + smith_lambda(a2, mu_v) + smith_lambda(a2, mu_l))
-    return float(weight * fresnel_dielectric(np.dot(h, w), ior) * d * g2 / (4.0 * mu_v))
+    return float(weight * ggx_reflectance(lambda c: fresnel_dielectric(c, ior), rough, v, to_light))
 
 
 def _film_sensitivity(opd, shift):

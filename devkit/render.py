@@ -1,10 +1,13 @@
 """Rendering to numpy arrays: through Blender's own output path (what a batch render writes),
 or one frame of Penumbra's engine core inside a GPU context."""
 
+import hashlib
 import os
 import tempfile
+from pathlib import Path
 
 import bpy
+import numpy as np
 
 from devkit.imageio import read_exr, set_format
 
@@ -80,3 +83,21 @@ def viewport_calls(runner, scene, width, height, calls):
         return out.color_array().copy(), stats
 
     return runner(job)
+
+
+REFERENCE_CACHE = Path("out") / "reference_cache"
+
+
+def cached_image(tag, source, key, make, cache_dir=REFERENCE_CACHE):
+    """``make()``'s image (an array), cached per clone under ``cache_dir`` by ``tag``, the content
+    of the file ``source`` (the benchmark that defines the scene), Blender's version and
+    ``key``: a reference rendered once (Cycles at many samples) and read back after."""
+    own = hashlib.sha256(Path(source).read_bytes()).hexdigest()[:10]
+    name = f"{tag}-{own}-{bpy.app.version_string}-{key}"
+    path = Path(cache_dir) / f"{hashlib.sha256(name.encode()).hexdigest()[:16]}.npy"
+    if path.exists():
+        return np.load(path)
+    image = make()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.save(path, image)
+    return image

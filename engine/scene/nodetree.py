@@ -215,6 +215,9 @@ def _socket(sockets, key):
     raise Fallback(f"no socket '{key}'")
 
 
+_NORMAL_MAP = object()  # a normal input fed by a Normal Map node (``Compiler._vector_input``)
+
+
 class Compiler:
     def __init__(self, mat):
         self.mat = mat
@@ -440,36 +443,37 @@ class Compiler:
         """A Principled BSDF's Coat Normal: vec3(0.0) (the surface's own interpolated normal,
         as Blender's coat takes it) where unlinked, else the compiled vector; a Normal Map there
         is named and not drawn (the reader's normal-map path draws the base's only)."""
-        socket = next((s for s in node.inputs if s.identifier == "Coat Normal"), None)
-        link = _link(socket) if socket is not None else None
-        if link is None:
-            return Value("vec3(0.0)", "vec3")
-        src = link.from_node
-        while src.bl_idname == "NodeReroute" and _link(src.inputs[0]) is not None:
-            src = _link(src.inputs[0]).from_node
-        if src.bl_idname == "ShaderNodeNormalMap":
+        value = self._vector_input(node, "Coat Normal", ctx, "vec3(0.0)")
+        if value is _NORMAL_MAP:
             self.messages.append("a Normal Map on the Coat Normal (the coat takes the surface's normal)")
             return Value("vec3(0.0)", "vec3")
-        value = self.shader_input(node, "Coat Normal", ctx, "vec3")
-        return Value("vec3(0.0)", "vec3") if value.expr.startswith("node_constants") else value
+        return value
 
     def normal_input(self, node, ctx):
         """A shader's Normal input: N where unlinked or fed by a Normal Map (the reader's
         normal-map path draws that one), else the compiled vector (a Bump, ...)."""
-        socket = next((s for s in node.inputs if s.identifier == "Normal"), None)
+        value = self._vector_input(node, "Normal", ctx, "N")
+        if value is _NORMAL_MAP:
+            return Value("N", "vec3")
+        if value.expr != "N":
+            self.normal = True
+        return value
+
+    def _vector_input(self, node, identifier, ctx, unlinked):
+        """The normal input ``identifier`` of ``node``: ``unlinked`` (a GLSL expression) where
+        nothing feeds it or it fell back to its socket's value, _NORMAL_MAP where a Normal Map
+        node feeds it, else the compiled vector."""
+        socket = next((s for s in node.inputs if s.identifier == identifier), None)
         link = _link(socket) if socket is not None else None
         if link is None:
-            return Value("N", "vec3")
+            return Value(unlinked, "vec3")
         src = link.from_node
         while src.bl_idname == "NodeReroute" and _link(src.inputs[0]) is not None:
             src = _link(src.inputs[0]).from_node
         if src.bl_idname == "ShaderNodeNormalMap":
-            return Value("N", "vec3")
-        value = self.shader_input(node, "Normal", ctx, "vec3")
-        if value.expr.startswith("node_constants"):  # fell back to the socket's value: no normal
-            return Value("N", "vec3")
-        self.normal = True
-        return value
+            return _NORMAL_MAP
+        value = self.shader_input(node, identifier, ctx, "vec3")
+        return Value(unlinked, "vec3") if value.expr.startswith("node_constants") else value
 
     def display_closure(self):
         """The material's viewport display values as a surface."""

@@ -25,21 +25,27 @@ float fresnel_shape(float c)
 vec4 lit_film = vec4(0.0, 0.0, 1.33, 1.5);
 #endif
 
+/* GGX's distribution times the height-correlated Smith visibility G / (4 N.L N.V) for GGX
+ * roughness ``alpha``, normal ``N``, view ``V``, light ``to_light`` (N.L = ``NdotL`` > 0) and
+ * half vector ``H``: what each GGX lobe (the lobes' specular, the coat) multiplies its Fresnel by. */
+float ggx_d_vis(vec3 N, vec3 V, vec3 H, float NdotL, float alpha)
+{
+  float NdotH = max(dot(N, H), 0.0);
+  float NdotV = max(dot(N, V), 1e-4);
+  float a2 = alpha * alpha;
+  float dd = NdotH * NdotH * (a2 - 1.0) + 1.0;
+  float D = a2 / (M_PI * dd * dd);
+  float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
+  float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
+  return D * (0.5 / max(gv + gl, 1e-8));
+}
+
 /* One lobe's BSDF for light from ``to_light`` (N.L > 0): its diffuse and specular parts, each
  * scaled by the light's factors. */
 vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
 {
 #if SPECULAR_MODEL == SPECULAR_GGX
   vec3 H = normalize(to_light + V);
-  float NdotH = max(dot(b.N, H), 0.0);
-  float NdotV = max(dot(b.N, V), 1e-4);
-  float a2 = b.alpha * b.alpha;
-  float dd = NdotH * NdotH * (a2 - 1.0) + 1.0;
-  float D = a2 / (M_PI * dd * dd);
-  /* Height-correlated Smith visibility G / (4 N.L N.V). */
-  float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
-  float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
-  float Vis = 0.5 / max(gv + gl, 1e-8);
   /* Fresnel from f0.rgb towards f90 (f0.a: lobe_setup) along the exact dielectric curve
    * (fresnel_shape). */
   float fw = fresnel_shape(dot(to_light, H));
@@ -51,7 +57,7 @@ vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
     F = mix(F, mix(film, b.metal_f0 + (b.f0.a - b.metal_f0) * fw, b.metal), b.film);
   }
 #  endif
-  vec3 spec = F * (D * Vis);
+  vec3 spec = F * ggx_d_vis(b.N, V, H, NdotL, b.alpha);
   return b.albedo / M_PI * L.diffuse_factor + spec * L.specular_factor;
 #else
 #  if SPECULAR_MODEL == SPECULAR_BLINN
@@ -165,17 +171,9 @@ Coat coat_setup(vec4 params, vec3 tint, vec3 N, vec3 V)
 float coat_brdf(Coat c, vec3 V, vec3 to_light, float NdotL)
 {
   vec3 H = normalize(to_light + V);
-  float NdotH = max(dot(c.N, H), 0.0);
-  float NdotV = max(dot(c.N, V), 1e-4);
-  float a2 = c.alpha * c.alpha;
-  float dd = NdotH * NdotH * (a2 - 1.0) + 1.0;
-  float D = a2 / (M_PI * dd * dd);
-  float gv = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
-  float gl = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
-  float Vis = 0.5 / max(gv + gl, 1e-8);
   float f90 = clamp(50.0 * c.f0, 0.0, 1.0);
   float F = c.f0 + (f90 - c.f0) * fresnel_shape(dot(to_light, H));
-  return c.weight * F * D * Vis;
+  return c.weight * F * ggx_d_vis(c.N, V, H, NdotL, c.alpha);
 }
 #endif
 

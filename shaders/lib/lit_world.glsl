@@ -150,17 +150,26 @@ float world_visibility = 1.0;
  * reflected direction, wider with roughness, weighted by the environment BRDF ``ab``. With
  * WORLD_AO the diffuse is scaled by the world's visibility and the specular by the specular
  * occlusion it implies for this lobe (gtao_specular). */
+/* The world's radiance about the reflected direction ``R`` as a glossy lobe of Principled
+ * roughness ``rough`` sees it: the image's prefiltered levels (WORLD_ENV), else the SH light
+ * convolved towards the cosine lobe with roughness. */
+vec3 world_glossy_radiance(vec3 R, float rough)
+{
+#if WORLD_ENV
+  return world_env_radiance(R, rough);
+#else
+  float t = rough * rough;
+  return world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
+#endif
+}
+
 vec3 world_light(Lobe b, vec3 V, vec2 ab)
 {
   vec3 scene_seen = vec3(0.0); /* what traced rays met of the scene (Glossy Indirect) */
   vec3 diffuse = b.albedo * world_sh(b.N, vec2(2.0 / 3.0, 0.25));
   vec3 R = reflect(-V, b.N);
   float t = b.rough * b.rough;
-#if WORLD_ENV
-  vec3 radiance = world_env_radiance(R, b.rough);
-#else
-  vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
-#endif
+  vec3 radiance = world_glossy_radiance(R, b.rough);
   vec3 dfg = b.f0.rgb * ab.x + ab.y;
 #if NODE_FILM
   /* A Thin Film's dielectric (lit_bsdf.glsl lobe_setup), the metal's own. */
@@ -241,14 +250,7 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
  * blurred with the coat's roughness, times the coat's environment BRDF and weight. */
 vec3 coat_world_light(Coat c, vec3 V)
 {
-  vec3 R = reflect(-V, c.N);
-  float t = c.rough * c.rough;
-#  if WORLD_ENV
-  vec3 radiance = world_env_radiance(R, c.rough);
-#  else
-  vec3 radiance = world_sh(R, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
-#  endif
-  return radiance * (c.weight * (c.f0 * c.ab.x + c.ab.y));
+  return world_glossy_radiance(reflect(-V, c.N), c.rough) * (c.weight * (c.f0 * c.ab.x + c.ab.y));
 }
 #endif
 

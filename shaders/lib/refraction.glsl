@@ -33,15 +33,10 @@ float transmission_share(float transmission, float metal)
   return clamp(transmission, 0.0, 1.0) * (1.0 - clamp(metal, 0.0, 1.0));
 }
 
-/* The world's light along ``T`` for a lobe of roughness ``rough``. */
+/* The world's light along ``T`` for a lobe of roughness ``rough`` (lib/lit_world.glsl). */
 vec3 refraction_world(vec3 T, float rough)
 {
-#  if WORLD_ENV
-  return world_env_radiance(T, rough);
-#  else
-  float t = rough * rough;
-  return world_sh(T, vec2(mix(1.0, 2.0 / 3.0, t), mix(1.0, 0.25, t)));
-#  endif
+  return world_glossy_radiance(T, rough);
 }
 
 /* The light that comes through surface ``s`` of base colour ``base`` (lobe 0: the dielectric;

@@ -18,7 +18,6 @@ under a 600 nm film of IOR 1.6). Writes ``<out>/principled.csv`` and a Markdown 
 ``--quick``: reference 256 spp.
 """
 
-import hashlib
 import sys
 import time
 from pathlib import Path
@@ -29,11 +28,11 @@ import numpy as np
 from devkit import report, scenes, session
 from devkit.engines import EEVEE_SAMPLES, configure
 from devkit.reflection_scenes import hdri_path
-from devkit.render import render
+from devkit.render import cached_image, render
+from devkit.world_scenes import display
 
 HELP = "the Principled BSDF's input groups on spheres vs Cycles and EEVEE -> <out>/principled.csv"
 
-CACHE = Path("out") / "reference_cache"
 SIZE = 64
 CSV_FIELDS = ["case", "light", "penumbra", "eevee", "penumbra_s", "eevee_s"]
 
@@ -107,11 +106,6 @@ def sphere_mask():
     return x * x + z * z < 0.97 * 0.97  # off the silhouette's antialiased edge
 
 
-def display(image):
-    c = np.clip(np.asarray(image, np.float64)[..., :3], 0.0, 1.0)
-    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-
-
 def cycles(scene, spp):
     configure(scene, "CYCLES", samples=spp)
     scene.cycles.pixel_filter_type = "BLACKMAN_HARRIS"
@@ -119,17 +113,12 @@ def cycles(scene, spp):
 
 
 def reference(case, light, spp):
-    own = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:10]
-    key = f"principled-{own}-{bpy.app.version_string}-{case}-{light}-{SIZE}-{spp}"
-    path = CACHE / f"{hashlib.sha256(key.encode()).hexdigest()[:16]}.npy"
-    if path.exists():
-        return np.load(path)
-    scene = sphere_scene(case, light)
-    cycles(scene, spp)
-    image = display(render(scene)["Combined"])
-    CACHE.mkdir(parents=True, exist_ok=True)
-    np.save(path, image)
-    return image
+    def make():
+        scene = sphere_scene(case, light)
+        cycles(scene, spp)
+        return display(render(scene)["Combined"])
+
+    return cached_image("principled", __file__, f"{case}-{light}-{SIZE}-{spp}", make)
 
 
 def timed(scene):

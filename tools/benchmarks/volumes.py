@@ -18,7 +18,6 @@ scene's reference beside Penumbra's 64 samples and EEVEE's image); a Markdown ta
 (Volume objects are named, not drawn).
 """
 
-import hashlib
 import math
 import sys
 import time
@@ -30,11 +29,11 @@ import numpy as np
 from devkit import report, scenes, session, timing
 from devkit import volume_scenes as vs
 from devkit.engines import EEVEE_SAMPLES, configure
-from devkit.render import render
+from devkit.render import cached_image, render
+from devkit.world_scenes import display
 
 HELP = "volumes: error against time vs Cycles single scattering and EEVEE -> <out>/volumes.csv, volumes.png"
 
-CACHE = Path("out") / "reference_cache"
 CSV_FIELDS = ["scene", "engine", "samples", "time_s", "mae"]
 
 
@@ -142,25 +141,16 @@ def cycles(scene, spp):
     scene.cycles.filter_width = scene.penumbra.filter_size
 
 
-def display(image):
-    c = np.clip(np.asarray(image, np.float64)[..., :3], 0.0, 1.0)
-    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-
-
 def reference(name, scene, spp):
     """Cycles' image of scene ``name`` at ``spp`` (display values), cached by Blender version,
     scene, size and spp (and this file's content)."""
-    own = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()[:10]
     size = f"{scene.render.resolution_x}x{scene.render.resolution_y}"
-    key = f"volumes-{own}-{bpy.app.version_string}-{name}-{size}-{spp}"
-    path = CACHE / f"{hashlib.sha256(key.encode()).hexdigest()[:16]}.npy"
-    if path.exists():
-        return np.load(path)
-    cycles(scene, spp)
-    image = display(render(scene)["Combined"])
-    CACHE.mkdir(parents=True, exist_ok=True)
-    np.save(path, image)
-    return image
+
+    def make():
+        cycles(scene, spp)
+        return display(render(scene)["Combined"])
+
+    return cached_image("volumes", __file__, f"{name}-{size}-{spp}", make)
 
 
 def measure(scene, runs, ref):
