@@ -236,6 +236,57 @@ def ggx_reflectance(fresnel, rough, v, to_light):
     return np.asarray(fresnel(float(np.dot(h, w)))) * d * g2 / (4.0 * mu_v)
 
 
+_SHEEN_TABLE = []
+
+
+def sheen_table():
+    """The sheen's LTC table as the lit pass reads it (shaders/lib/sheen_ltc.glsl, written by
+    tools/make_sheen_table.py): (N, N, 3) of (a, b, R) by [roughness, N.V] nodes."""
+    if not _SHEEN_TABLE:
+        import re
+        from pathlib import Path
+
+        text = (Path(__file__).resolve().parent.parent / "shaders" / "lib" / "sheen_ltc.glsl").read_text()
+        body = text[text.index("SHEEN_LTC[") :]
+        values = np.array(re.findall(r"vec3\(([-\d.e]+), ([-\d.e]+), ([-\d.e]+)\)", body), float)
+        n = math.isqrt(len(values))
+        _SHEEN_TABLE.append(values.reshape(n, n, 3))
+    return _SHEEN_TABLE[0]
+
+
+def sheen_ltc(rough, mu):
+    """(a, b, R) at Sheen Roughness ``rough`` and N.V ``mu``, bilinear between the nodes (with
+    the lobe left empty where the transform or R vanish), as lib/sheen.glsl reads them."""
+    table = sheen_table()
+    n = table.shape[0]
+    p = np.array([min(max(rough, 1e-3), 1.0), min(max(mu, 0.0), 1.0)]) * (n - 1)
+    i = np.minimum(p.astype(int), n - 2)
+    f = p - i
+    lo = table[i[0], i[1]] * (1 - f[1]) + table[i[0], i[1] + 1] * f[1]
+    hi = table[i[0] + 1, i[1]] * (1 - f[1]) + table[i[0] + 1, i[1] + 1] * f[1]
+    out = lo * (1 - f[0]) + hi * f[0]
+    return np.zeros(3) if abs(out[0]) < 1e-5 or out[2] < 1e-5 else out
+
+
+def sheen_lobe(a, b, local):
+    """D(w) of the sheen's transformed cosine at local directions ``local`` (..., 3), x the view
+    projected on the surface, z the normal: it integrates to 1 over the hemisphere."""
+    x, y, z = local[..., 0], local[..., 1], local[..., 2]
+    len2 = (a * x + b * z) ** 2 + (a * y) ** 2 + z * z
+    return np.where(z > 0.0, z / np.pi * (a / np.maximum(len2, 1e-300)) ** 2, 0.0)
+
+
+def sheen_reflectance(rough, v, to_light):
+    """f cos(theta_l) of Blender's microfiber sheen (weight 1, white) for unit ``v`` and
+    ``to_light`` about +z: R D in the frame whose x axis is v on the surface."""
+    v, w = np.asarray(v, float), np.asarray(to_light, float)
+    a, b, r = sheen_ltc(rough, v[2])
+    t = v - np.array([0.0, 0.0, v[2]])
+    t = t / np.linalg.norm(t) if np.linalg.norm(t) > 1e-9 else np.array([1.0, 0.0, 0.0])
+    bt = np.cross([0.0, 0.0, 1.0], t)
+    return r * float(sheen_lobe(a, b, np.array([w @ t, w @ bt, w[2]])))
+
+
 def _multiple_scattering(rough, mu_v, ior):
     """Cycles' energy gain of the GGX lobe for light bouncing between microfacets at N.V =
     ``mu_v``: 1 + F_ms (1 - E) / E (Kulla and Conty 2017; microfacet_ggx_preserve_energy)."""

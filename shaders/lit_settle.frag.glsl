@@ -27,6 +27,10 @@ void main()
   /* A coat's highlight is not in the test's lobes: it keeps sampling. */
   settle_unstable = settle_unstable || s.coat.weight > 0.0;
 #endif
+#if NODE_SHEEN
+  /* Nor is the sheen's light. */
+  settle_unstable = settle_unstable || s.sheen.ltc.z > 0.0;
+#endif
 #if TRANSMISSION
   /* What a transmissive surface shows through it (features/refraction.py) is traced anew
    * every sample. */

@@ -127,6 +127,8 @@ class Material:
                 out.add("TREE_COAT")
             if self.tree.film:
                 out.add("TREE_FILM")
+            if self.tree.sheen:
+                out.add("TREE_SHEEN")
         return frozenset(out)
 
 
@@ -690,6 +692,8 @@ def summary(read):
         lines.append(("MATERIAL", f"Transmission: {read.transmission:.2f}, through {mode} (Thickness Mode)"))
     if read.tree is not None and read.tree.coat:
         lines.append(("MATERIAL", "Coat: a GGX layer over the surface"))
+    if read.tree is not None and read.tree.sheen:
+        lines.append(("MATERIAL", "Sheen: microfiber, over the surface and under any coat"))
     if read.volume is not None:
         v = read.volume
         where = "its interior (the object's bounding box)" if read.surface else "its interior alone (no surface)"

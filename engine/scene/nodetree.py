@@ -153,6 +153,7 @@ class CompiledTree:
     aovs: tuple = ()  # the AOV names its AOV Output nodes write, in node_aovs' order (NODE_AOVS)
     coat: bool = False  # a Principled BSDF's coat is drawn (NODE_COAT; node_coat_keep)
     film: bool = False  # its Thin Film is drawn (NODE_FILM; node_film_keep)
+    sheen: bool = False  # its Sheen is drawn (NODE_SHEEN; node_sheen_keep)
 
 
 # --- the registry -------------------------------------------------------------------------
@@ -237,6 +238,7 @@ class Compiler:
         self.normal = False
         self.coat = False  # a Principled BSDF's coat is drawn (NODE_COAT)
         self.film = False  # and its Thin Film (NODE_FILM)
+        self.sheen = False  # and its Sheen (NODE_SHEEN)
 
     # -- emitting --
 
@@ -497,6 +499,7 @@ class Compiler:
         )
         keep = f"  node_coat_keep({v.expr});\n" if self.coat else ""
         keep += f"  node_film_keep({v.expr});\n" if self.film else ""
+        keep += f"  node_sheen_keep({v.expr});\n" if self.sheen else ""
         if v.lobes < 2:
             code = _prelude(self.needs) + (
                 f"{signature}{{\n{body}\n{keep}"
@@ -538,6 +541,7 @@ class Compiler:
             aovs=aovs,
             coat=self.coat,
             film=self.film,
+            sheen=self.sheen,
         )
 
     def compile_aovs(self, nodes):
@@ -668,6 +672,13 @@ def _principled(c, node, socket, ctx):
             f"{coat_normal.expr})"
         )
         c.coat = True
+    if "Sheen Weight" in unread:  # linked or above 0: the sheen over the surface (NODE_SHEEN)
+        unread.remove("Sheen Weight")
+        weight = c.shader_input(node, "Sheen Weight", ctx, "float", 0.0)
+        sheen_rough = c.shader_input(node, "Sheen Roughness", ctx, "float", 0.5)
+        sheen_tint = c.shader_input(node, "Sheen Tint", ctx, "vec4", (1.0, 1.0, 1.0, 1.0))
+        expr = f"node_principled_sheen({expr}, {weight.expr}, {sheen_rough.expr}, {sheen_tint.expr})"
+        c.sheen = True
     if "Thin Film Thickness" in unread:  # linked or above 0: the film on its specular (NODE_FILM)
         unread.remove("Thin Film Thickness")
         thickness = c.shader_input(node, "Thin Film Thickness", ctx, "float", 0.0)
@@ -702,6 +713,19 @@ def _glossy(c, node, socket, ctx):
     c.messages += anisotropy_unread(node)
     expr = f"node_principled({color.expr}, 1.0, {rough.expr}, vec4(0.04), 1.0, vec3(0.0), {normal.expr})"
     return c.temp("closure", expr, 1)
+
+
+@node("ShaderNodeBsdfSheen")
+def _sheen(c, node, socket, ctx):
+    color = c.shader_input(node, "Color", ctx, "vec4")
+    rough = c.shader_input(node, "Roughness", ctx, "float")
+    if getattr(node, "distribution", "MICROFIBER") != "MICROFIBER":
+        c.messages.append("a Sheen BSDF's Ashikhmin distribution (drawn as Microfiber)")
+    normal = node.inputs.get("Normal")
+    if normal is not None and normal.is_linked:
+        c.messages.append("a Sheen BSDF's Normal (it takes the surface's)")
+    c.sheen = True
+    return c.temp("closure", f"node_sheen_bsdf({color.expr}, {rough.expr})")
 
 
 @node("ShaderNodeBsdfTransparent")

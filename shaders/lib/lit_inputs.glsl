@@ -21,6 +21,10 @@ struct MaterialInputs {
 #if NODE_FILM
   vec4 film;        /* (weight, thickness nm, film IOR, base IOR) of a Principled Thin Film */
 #endif
+#if NODE_SHEEN
+  vec4 sheen;       /* a Principled Sheen: colour (Weight x Tint) and roughness (lib/sheen.glsl) */
+  float sheen_layered; /* the share of it over the lobes (a Sheen BSDF's lies beside them) */
+#endif
 #if NODE_COAT
   vec4 coat;        /* (weight, roughness, IOR, 0) of a Principled coat (shaders/nodes/shader.glsl) */
   vec3 coat_tint;
@@ -70,11 +74,18 @@ MaterialInputs material_inputs()
 #    if NODE_FILM
   node_film_keep(closure);
 #    endif
+#    if NODE_SHEEN
+  node_sheen_keep(closure);
+#    endif
 #  else
   node_tree(front ? Nt : -Nt, V, front, m.base, m.rough, m.metal, m.spec_f0, m.coverage, m.emission, m.tree_normal);
 #  endif
 #  if NODE_FILM
   m.film = node_film_params;
+#  endif
+#  if NODE_SHEEN
+  m.sheen = node_sheen_params;
+  m.sheen_layered = node_sheen_layered;
 #  endif
 #  if NODE_COAT
   m.coat = node_coat_params;
@@ -127,6 +138,9 @@ Surface surface_setup(MaterialInputs m, out vec2 ab[NODE_LOBES])
                          m.weights.y, ab[1]);
 #else
   s.lobe[0] = lobe_setup(m.base.rgb, m.rough, m.metal, m.spec_f0, N, s.V, 1.0, ab[0]);
+#endif
+#if NODE_SHEEN
+  s.sheen = sheen_setup(m.sheen, m.sheen_layered, N, s.V); /* on the first lobe's shading normal */
 #endif
   return s;
 }

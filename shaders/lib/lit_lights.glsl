@@ -1,4 +1,4 @@
-// requires: lib/lights.glsl lib/lit_debug.glsl lib/shadow_filters.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl lib/lit_world.glsl lib/lit_settle.glsl lib/volumes.glsl
+// requires: lib/lights.glsl lib/lit_debug.glsl lib/shadow_filters.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl lib/lit_world.glsl lib/lit_settle.glsl lib/volumes.glsl lib/sheen.glsl
 #ifndef PENUMBRA_LIB_LIT_LIGHTS
 #define PENUMBRA_LIB_LIT_LIGHTS
 
@@ -81,6 +81,14 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
       reflected += (s.lobe[k].weight * cosines[k]) * f;
     }
   }
+#if NODE_SHEEN
+  /* The sheen over the lobes (lib/sheen.glsl): what they keep under it, and its own light (a
+   * diffuse lobe in Blender's passes). */
+  reflected *= s.sheen.below;
+#  if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_GROUP
+  reflected += sheen_light(s.sheen, to_light) * L.diffuse_factor;
+#  endif
+#endif
 #if NODE_COAT
   /* The coat over the lobes (lit_bsdf.glsl): what reaches them under it, and its own reflection
    * (a glossy lobe: the Glossy passes, not the Diffuse ones). */

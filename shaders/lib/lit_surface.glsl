@@ -1,4 +1,4 @@
-// requires: lib/material.glsl
+// requires: lib/material.glsl lib/sheen.glsl
 #ifndef PENUMBRA_LIB_LIT_SURFACE
 #define PENUMBRA_LIB_LIT_SURFACE
 
@@ -77,6 +77,9 @@ struct Surface {
   Lobe lobe[NODE_LOBES];
 #if NODE_COAT
   Coat coat;
+#endif
+#if NODE_SHEEN
+  Sheen sheen; /* over the lobes, under the coat (lib/sheen.glsl) */
 #endif
 };
 

@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/world_sh.glsl lib/volumes.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl lib/cubes.glsl
+// requires: lib/common.glsl lib/world_sh.glsl lib/volumes.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl lib/cubes.glsl lib/sheen.glsl
 #ifndef PENUMBRA_LIB_LIT_WORLD
 #define PENUMBRA_LIB_LIT_WORLD
 
@@ -301,6 +301,30 @@ vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
 #  endif
 #endif
   }
+#if NODE_SHEEN
+  /* The sheen: what the lobes keep under it, and its own light from the world: one direction
+   * drawn from its lobe per pixel and sample (lib/sheen.glsl), the world there lightly blurred,
+   * so the frame's samples converge to its integral (a diffuse lobe: occluded as the lobes'
+   * diffuse is, the Diffuse passes). */
+  color *= s.sheen.below;
+#  if WORLD_RATIO
+  world_d *= s.sheen.below;
+  world_s *= s.sheen.below;
+#  endif
+#  if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE || (LIGHT_PASS == LIGHT_PASS_GROUP && LIGHT_GROUP_WORLD)
+  vec2 u = pixel_r2(37.0, frame.sample_index);
+  vec3 sheen = s.sheen.color * s.sheen.ltc.z * world_glossy_radiance(sheen_direction(s.sheen, u), 0.3);
+#    if VOLUMES
+  sheen *= dot(through, vec3(1.0 / 3.0));
+#    endif
+#    if WORLD_RATIO
+  world_d += sheen;
+#    elif WORLD_AO
+  sheen *= world_visibility;
+#    endif
+  color += sheen;
+#  endif
+#endif
 #if NODE_COAT
   /* The coat: what reaches the lobes under it, and its own reflection of the world (not
    * traced against the scene, not occluded by WORLD_AO). */

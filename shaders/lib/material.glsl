@@ -184,4 +184,13 @@ float pixel_hash(vec2 frag)
   return float(h >> 8) / 16777216.0;
 }
 
+/* Two uniforms in [0, 1)^2 for this pixel and the frame's sample ``sample_index``: the R2
+ * sequence (Roberts 2018) over the samples, shifted per pixel by pixel_hash salted with ``salt``
+ * (a Cranley-Patterson rotation), so any run of a pixel's samples covers the square evenly. */
+vec2 pixel_r2(float salt, int sample_index)
+{
+  vec2 shift = vec2(pixel_hash(gl_FragCoord.xy + salt), pixel_hash(gl_FragCoord.xy + salt + 101.0));
+  return fract(shift + float(sample_index) * vec2(0.7548776662, 0.5698402910));
+}
+
 #endif /* PENUMBRA_LIB_MATERIAL */

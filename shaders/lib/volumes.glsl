@@ -78,12 +78,12 @@ vec3 light_transmittance(vec3 P, LightData L, vec3 to_light)
 }
 
 /* What the media let through of the world's light reaching P around normal N: along one
- * direction of the cosine lobe about N, drawn anew each pixel and sample (frame.volume_params.w),
- * so a frame's samples average the lobe's transmittance. */
+ * direction of the cosine lobe about N, drawn anew each pixel and sample (pixel_r2: the R2
+ * sequence over the samples), so a frame's samples average the lobe's transmittance. */
 vec3 world_transmittance(vec3 P, vec3 N)
 {
-  float u = fract(pixel_hash(gl_FragCoord.xy + 29.0) + frame.volume_params.w);
-  float v = fract(pixel_hash(gl_FragCoord.xy + 71.0) + frame.volume_params.w * 0.7548776662);
+  vec2 uv = pixel_r2(29.0, frame.sample_index);
+  float u = uv.x, v = uv.y;
   vec3 t = normalize(abs(N.z) < 0.9 ? cross(N, vec3(0.0, 0.0, 1.0)) : cross(N, vec3(1.0, 0.0, 0.0)));
   vec3 b = cross(N, t);
   float r = sqrt(u), phi = 2.0 * M_PI * v;

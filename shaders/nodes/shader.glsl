@@ -27,7 +27,8 @@
  * coat's weight times the surface's share, as the lobes' are: coat (weight, roughness, IOR, 0),
  * coat_tint and coat_normal; a closure without a coat has weight 0 there. node_coat_keep
  * resolves them for the lit pass (NODE_COAT: node_coat_params, node_coat_tint,
- * node_coat_normal). */
+ * node_coat_normal). The Thin Film (film) and the Sheen (sheen, sheen_tint: node_sheen_keep,
+ * NODE_SHEEN) are the closure's too, with the same weighted sums. */
 
 struct NodeLobe {
   vec3 color;
@@ -47,6 +48,9 @@ struct NodeClosure {
   vec3 coat_tint;
   vec3 coat_normal;
   vec4 film; /* (weight, thickness, film IOR, base IOR), each x the film's weight: Thin Film */
+  vec4 sheen; /* (weight, roughness, layered, 0), each x the sheen's weight: a Principled Sheen
+              * (layered 1: over the lobes) or a Sheen BSDF (0: beside them) */
+  vec3 sheen_tint; /* Sheen Tint x the sheen's weight */
 };
 
 NodeLobe node_lobe_empty()
@@ -57,7 +61,7 @@ NodeLobe node_lobe_empty()
 NodeClosure node_closure_empty()
 {
   return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0), vec4(0.0), vec3(0.0), vec3(0.0),
-                     vec4(0.0));
+                     vec4(0.0), vec4(0.0), vec3(0.0));
 }
 
 /* The Principled BSDF's dielectric reflectance at normal incidence, as Blender's (Cycles'
@@ -81,8 +85,11 @@ NodeClosure node_principled(vec4 base, float metallic, float roughness, vec4 spe
                             vec3 emission, vec3 normal)
 {
   float a = clamp(alpha, 0.0, 1.0);
-  return NodeClosure(NodeLobe(base.rgb * a, roughness * a, metallic * a, specular * a, a, normal * a),
-                     node_lobe_empty(), a, emission * a, vec4(0.0), vec3(0.0), vec3(0.0), vec4(0.0));
+  NodeClosure c = node_closure_empty();
+  c.a = NodeLobe(base.rgb * a, roughness * a, metallic * a, specular * a, a, normal * a);
+  c.alpha = a;
+  c.emission = emission * a;
+  return c;
 }
 
 /* The Principled BSDF ``c`` (node_principled) with its coat: Coat Weight, Roughness, IOR, Tint
@@ -111,16 +118,45 @@ NodeClosure node_principled_film(NodeClosure c, float thickness, float film_ior,
   return c;
 }
 
+/* The Principled BSDF ``c`` with its Sheen: Weight, Roughness and Tint, scaled by the surface's
+ * coverage. */
+NodeClosure node_principled_sheen(NodeClosure c, float weight, float roughness, vec4 tint)
+{
+  float w = clamp(isnan(weight) ? 0.0 : weight, 0.0, 1e3) * c.alpha;
+  float r = clamp(isnan(roughness) ? 0.0 : roughness, 0.0, 1.0);
+  vec3 t = vec3(isnan(tint.r) ? 0.0 : tint.r, isnan(tint.g) ? 0.0 : tint.g, isnan(tint.b) ? 0.0 : tint.b);
+  c.sheen = vec4(w, w * r, w, 0.0);
+  c.sheen_tint = w * clamp(t, 0.0, 1e6);
+  return c;
+}
+
+/* A Sheen BSDF (Microfiber) of ``color`` and ``roughness``: a sheen beside whatever it is mixed
+ * or added with, as Cycles sums closures (not layered over them). */
+NodeClosure node_sheen_bsdf(vec4 color, float roughness)
+{
+  NodeClosure c = node_closure_empty();
+  c.alpha = 1.0;
+  float r = clamp(isnan(roughness) ? 0.0 : roughness, 0.0, 1.0);
+  vec3 t = vec3(isnan(color.r) ? 0.0 : color.r, isnan(color.g) ? 0.0 : color.g, isnan(color.b) ? 0.0 : color.b);
+  c.sheen = vec4(1.0, r, 0.0, 0.0);
+  c.sheen_tint = clamp(t, 0.0, 1e6);
+  return c;
+}
+
 NodeClosure node_emission(vec4 color, float strength)
 {
-  return NodeClosure(node_lobe_empty(), node_lobe_empty(), 1.0, color.rgb * strength, vec4(0.0), vec3(0.0),
-                     vec3(0.0), vec4(0.0));
+  NodeClosure c = node_closure_empty();
+  c.alpha = 1.0;
+  c.emission = color.rgb * strength;
+  return c;
 }
 
 NodeClosure node_diffuse(vec4 color, vec3 normal)
 {
-  return NodeClosure(NodeLobe(color.rgb, 1.0, 0.0, vec4(0.0), 1.0, normal), node_lobe_empty(), 1.0, vec3(0.0),
-                     vec4(0.0), vec3(0.0), vec3(0.0), vec4(0.0));
+  NodeClosure c = node_closure_empty();
+  c.a = NodeLobe(color.rgb, 1.0, 0.0, vec4(0.0), 1.0, normal);
+  c.alpha = 1.0;
+  return c;
 }
 
 NodeClosure node_transparent()
@@ -140,12 +176,28 @@ NodeLobe node_lobe_sum(NodeLobe x, NodeLobe y)
   return node_lobe_mix(1.0, x, 1.0, y);
 }
 
+/* What two closures weighted g and f share beyond their lobes, summed into ``c``: coverage,
+ * emission, and the closure-wide layers (coat, Thin Film, Sheen). */
+void node_shared_mix(float g, NodeClosure a, float f, NodeClosure b, inout NodeClosure c)
+{
+  c.alpha = g * a.alpha + f * b.alpha;
+  c.emission = g * a.emission + f * b.emission;
+  c.coat = g * a.coat + f * b.coat;
+  c.coat_tint = g * a.coat_tint + f * b.coat_tint;
+  c.coat_normal = g * a.coat_normal + f * b.coat_normal;
+  c.film = g * a.film + f * b.film;
+  c.sheen = g * a.sheen + f * b.sheen;
+  c.sheen_tint = g * a.sheen_tint + f * b.sheen_tint;
+}
+
 /* Closures whose lobes stay where they are: a with a, b with b. */
 NodeClosure node_mix_shader_weights(float g, NodeClosure a, float f, NodeClosure b)
 {
-  return NodeClosure(node_lobe_mix(g, a.a, f, b.a), node_lobe_mix(g, a.b, f, b.b), g * a.alpha + f * b.alpha,
-                     g * a.emission + f * b.emission, g * a.coat + f * b.coat, g * a.coat_tint + f * b.coat_tint,
-                     g * a.coat_normal + f * b.coat_normal, g * a.film + f * b.film);
+  NodeClosure c;
+  c.a = node_lobe_mix(g, a.a, f, b.a);
+  c.b = node_lobe_mix(g, a.b, f, b.b);
+  node_shared_mix(g, a, f, b, c);
+  return c;
 }
 
 NodeClosure node_mix_shader(float f, NodeClosure a, NodeClosure b)
@@ -163,9 +215,11 @@ NodeClosure node_add_shader(NodeClosure a, NodeClosure b)
 NodeClosure node_mix_split_weights(float g, NodeClosure a, float f, NodeClosure b)
 {
   NodeLobe none = node_lobe_empty();
-  return NodeClosure(node_lobe_mix(g, a.a, 0.0, none), node_lobe_mix(f, b.a, 0.0, none),
-                     g * a.alpha + f * b.alpha, g * a.emission + f * b.emission, g * a.coat + f * b.coat,
-                     g * a.coat_tint + f * b.coat_tint, g * a.coat_normal + f * b.coat_normal, g * a.film + f * b.film);
+  NodeClosure c;
+  c.a = node_lobe_mix(g, a.a, 0.0, none);
+  c.b = node_lobe_mix(f, b.a, 0.0, none);
+  node_shared_mix(g, a, f, b, c);
+  return c;
 }
 
 NodeClosure node_mix_split(float f, NodeClosure a, NodeClosure b)
@@ -245,12 +299,7 @@ NodeClosure node_mix_merge_weights(float g, NodeClosure a, float f, NodeClosure 
   }
   NodeClosure c;
   node_lobes_reduce3(p, q, r, c.a, c.b);
-  c.alpha = g * a.alpha + f * b.alpha;
-  c.emission = g * a.emission + f * b.emission;
-  c.coat = g * a.coat + f * b.coat;
-  c.coat_tint = g * a.coat_tint + f * b.coat_tint;
-  c.coat_normal = g * a.coat_normal + f * b.coat_normal;
-  c.film = g * a.film + f * b.film;
+  node_shared_mix(g, a, f, b, c);
   return c;
 }
 
@@ -349,6 +398,24 @@ void node_film_keep(NodeClosure c)
   node_film_params = (w > 1e-6) ? vec4(node_finite3(vec3(w / max(coverage, 1e-6)), 1.0).x,
                                        node_finite3(c.film.yzw * winv, 1e5)) :
                                   vec4(0.0, 0.0, 1.33, 1.5);
+}
+
+/* The closure's Sheen as parameters (NODE_SHEEN, lib/lit_inputs.glsl): its colour (Sheen Weight x
+ * Tint, over the surface) and roughness in w; node_sheen_layered: the share of it that lies over
+ * the lobes (a Principled BSDF's) rather than beside them (a Sheen BSDF's). */
+vec4 node_sheen_params = vec4(0.0);
+float node_sheen_layered = 1.0;
+
+void node_sheen_keep(NodeClosure c)
+{
+  float w = c.sheen.x;
+  float coverage = clamp(c.alpha, 0.0, 1.0);
+  float winv = (w > 1e-6) ? 1.0 / w : 0.0;
+  float share = (coverage > 1e-6) ? w / coverage : 0.0;
+  node_sheen_params = (w > 1e-6) ? vec4(node_finite3(c.sheen_tint * winv * share, 1e6),
+                                        node_finite3(vec3(c.sheen.y * winv), 1.0).x) :
+                                   vec4(0.0);
+  node_sheen_layered = (w > 1e-6) ? node_finite3(vec3(c.sheen.z * winv), 1.0).x : 1.0;
 }
 
 #endif /* PENUMBRA_LIB_NODES_SHADER */

@@ -120,9 +120,9 @@ def test_coat_weight_zero_is_the_surface_without_a_coat(penumbra, gpu_call):
 
 
 def test_the_groups_not_drawn_are_named_and_the_coat_is_not(penumbra):
-    """Sheen, Subsurface and Anisotropic set on a Principled BSDF, and a Glossy BSDF's
-    Anisotropy, are each named in the material's messages; a coat and a thin film are drawn,
-    not named."""
+    """Subsurface and Anisotropic set on a Principled BSDF, and a Glossy BSDF's Anisotropy, are
+    each named in the material's messages; a coat, a sheen and a thin film are drawn, not
+    named, and the Material panel's summary says so."""
     from penumbra.engine.scene.materials import material_from_blender
 
     scenes.empty_scene(8, 8)
@@ -132,13 +132,14 @@ def test_the_groups_not_drawn_are_named_and_the_coat_is_not(penumbra):
         bsdf.inputs[name].default_value = value
     bsdf.inputs["Thin Film Thickness"].default_value = 300.0
     read = material_from_blender(mat)
-    for name in ("Sheen Weight", "Subsurface Weight", "Anisotropic"):
+    for name in ("Subsurface Weight", "Anisotropic"):
         assert any(f"{name} is not drawn" in m for m in read.messages), (name, read.messages)
-    assert not any("Coat Weight" in m or "Thin Film" in m for m in read.messages), read.messages
-    assert read.tree is not None and read.tree.coat and read.tree.film
+    assert not any("Coat Weight" in m or "Thin Film" in m or "Sheen" in m for m in read.messages), read.messages
+    assert read.tree is not None and read.tree.coat and read.tree.film and read.tree.sheen
     from penumbra.engine.scene.materials import summary
 
     assert any(text.startswith("Coat:") for _icon, text in summary(read))
+    assert any(text.startswith("Sheen:") for _icon, text in summary(read))
     glossy = scenes.material("Brushed", (0.8, 0.8, 0.8))
     tree = glossy.node_tree
     node = tree.nodes.new("ShaderNodeBsdfAnisotropic")

@@ -14,7 +14,10 @@ roughness 0.1), ``metal`` (a rough gold, no coat) and ``coat on metal`` (Coat 1 
 0.05 over it), ``coat half``
 (Coat Weight 0.5 at roughness 0.3), ``film 0`` and ``film 300`` (a near-black glossy dielectric
 without and with a 300 nm Thin Film of IOR 1.33), ``film 600 on metal`` (a half-metallic white
-under a 600 nm film of IOR 1.6). Writes ``<out>/principled.csv`` and a Markdown table to stdout.
+under a 600 nm film of IOR 1.6), ``sheen 0``, ``sheen 0.3`` and ``sheen 1 on black`` (Sheen Weight 1
+at Sheen Roughness 0, 0.3 and 1 over a black base: the sheen alone), ``sheen tint`` (a blue tint at
+roughness 0.5 over the red base) and ``sheen under coat`` (the same untinted, under Coat 1 at
+roughness 0.1). Writes ``<out>/principled.csv`` and a Markdown table to stdout.
 ``--quick``: reference 256 spp.
 """
 
@@ -60,6 +63,11 @@ CASES = {
         "Thin Film Thickness": 600.0,
         "Thin Film IOR": 1.6,
     },
+    "sheen 0 on black": {"Base Color": (0.0, 0.0, 0.0, 1.0), "Sheen Weight": 1.0, "Sheen Roughness": 0.0},
+    "sheen 0.3 on black": {"Base Color": (0.0, 0.0, 0.0, 1.0), "Sheen Weight": 1.0, "Sheen Roughness": 0.3},
+    "sheen 1 on black": {"Base Color": (0.0, 0.0, 0.0, 1.0), "Sheen Weight": 1.0, "Sheen Roughness": 1.0},
+    "sheen tint": {"Sheen Weight": 1.0, "Sheen Roughness": 0.5, "Sheen Tint": (0.3, 0.6, 1.0, 1.0)},
+    "sheen under coat": {"Sheen Weight": 1.0, "Sheen Roughness": 0.5, "Coat Weight": 1.0, "Coat Roughness": 0.1},
 }
 LIGHTS = ("sun", "hdri")
 
