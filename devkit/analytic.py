@@ -287,6 +287,64 @@ def sheen_reflectance(rough, v, to_light):
     return r * float(sheen_lobe(a, b, np.array([w @ t, w @ bt, w[2]])))
 
 
+def ggx_aniso_reflectance(fresnel, ax, ay, v, to_light):
+    """f cos(theta_l) of an anisotropic GGX lobe (height-correlated Smith) of roughness ``ax``
+    along +x and ``ay`` along +y, whose Fresnel at the half vector is ``fresnel(cos)``, for unit
+    ``v`` and ``to_light`` about +z."""
+    v, w = np.asarray(v, float), np.asarray(to_light, float)
+    if w[2] <= 0.0:
+        return 0.0
+    h = (v + w) / np.linalg.norm(v + w)
+    d = 1.0 / (np.pi * ax * ay * ((h[0] / ax) ** 2 + (h[1] / ay) ** 2 + h[2] ** 2) ** 2)
+
+    def lam(u):
+        return 0.5 * (math.sqrt(1.0 + ((ax * u[0]) ** 2 + (ay * u[1]) ** 2) / u[2] ** 2) - 1.0)
+
+    g2 = 1.0 / (1.0 + lam(v) + lam(w))
+    return np.asarray(fresnel(float(np.dot(h, w)))) * d * g2 / (4.0 * v[2])
+
+
+def ggx_aniso_albedo(ax, ay, v, n=512):
+    """The directional albedo (Fresnel 1, single scattering) of an anisotropic GGX lobe of
+    roughness ``ax`` along +x and ``ay`` along +y seen from unit ``v`` about +z: half vectors
+    drawn from D(h) (n.h) on an n x n midpoint grid, each reflection weighted by f cos / pdf =
+    G2 (v.h) / (n.v n.h) (0 below the surface)."""
+    v = np.asarray(v, float)
+    u1, u2 = np.meshgrid((np.arange(n) + 0.5) / n, (np.arange(n) + 0.5) / n, indexing="ij")
+    phi = np.arctan(ay / ax * np.tan(2.0 * np.pi * u2))
+    phi = np.where((u2 > 0.25) & (u2 <= 0.75), phi + np.pi, phi)
+    phi = np.where(u2 > 0.75, phi + 2.0 * np.pi, phi)
+    a2 = 1.0 / ((np.cos(phi) / ax) ** 2 + (np.sin(phi) / ay) ** 2)
+    tan2 = a2 * u1 / (1.0 - u1)
+    cos_t = 1.0 / np.sqrt(1.0 + tan2)
+    sin_t = np.sqrt(np.maximum(1.0 - cos_t**2, 0.0))
+    h = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], -1)
+    vh = h @ v
+    w = 2.0 * vh[..., None] * h - v
+    ok = (w[..., 2] > 0.0) & (vh > 0.0)
+
+    def lam(d):
+        z = np.maximum(d[..., 2], 1e-9)
+        return 0.5 * (np.sqrt(1.0 + ((ax * d[..., 0]) ** 2 + (ay * d[..., 1]) ** 2) / z**2) - 1.0)
+
+    g2 = 1.0 / (1.0 + lam(v[None, None]) + lam(w))
+    return float(np.where(ok, g2 * vh / (v[2] * h[..., 2]), 0.0).mean())
+
+
+def ggx_ms_gain(f, f90, rough, mu_v):
+    """The lit pass's multiple-scattering gain of a GGX lobe of mean reflectance ``f`` and rim
+    ``f90`` (lib/lit_bsdf.glsl ggx_ms_gain): 1 + F_ms (1 - E) / E, F_ss from the IOR-1.5 Fresnel
+    curve's cosine-weighted mean, as Cycles' microfacet_ggx_preserve_energy."""
+    one = np.ones_like
+    e = ggx_albedo(rough, mu_v, one)
+    mus = (np.arange(64) + 0.5) / 64
+    e_avg = 2.0 * np.mean([ggx_albedo(rough, m, one, 256, 64) * m for m in mus])
+    s_avg = 2.0 * np.mean(fresnel_shape(mus) * mus)
+    f_ss = min(max(f + (1.0 - f) * s_avg * f90, 0.0), 1.0)
+    f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg))
+    return 1.0 + f_ms * (1.0 - e) / e
+
+
 def _multiple_scattering(rough, mu_v, ior):
     """Cycles' energy gain of the GGX lobe for light bouncing between microfacets at N.V =
     ``mu_v``: 1 + F_ms (1 - E) / E (Kulla and Conty 2017; microfacet_ggx_preserve_energy)."""

@@ -27,6 +27,12 @@ void main()
   /* A coat's highlight is not in the test's lobes: it keeps sampling. */
   settle_unstable = settle_unstable || s.coat.weight > 0.0;
 #endif
+#if NODE_ANISO
+  /* An anisotropic lobe's world light is drawn anew each sample (lib/anisotropy.glsl). */
+  for (int k = 0; k < NODE_LOBES; k++) {
+    settle_unstable = settle_unstable || s.lobe[k].ax != s.lobe[k].ay;
+  }
+#endif
 #if NODE_SHEEN
   /* Nor is the sheen's light. */
   settle_unstable = settle_unstable || s.sheen.ltc.z > 0.0;

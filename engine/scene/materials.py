@@ -129,6 +129,8 @@ class Material:
                 out.add("TREE_FILM")
             if self.tree.sheen:
                 out.add("TREE_SHEEN")
+            if self.tree.aniso:
+                out.add("TREE_ANISO")
         return frozenset(out)
 
 
@@ -399,7 +401,7 @@ def _shader(mat, node, notes, depth=0):
         _normal_map(None, node, notes, out)
         from .nodetree import anisotropy_unread
 
-        notes += anisotropy_unread(node)
+        notes += [f"{name} is not drawn" for name in anisotropy_unread(node)]  # the compiled tree draws it
         return out
     if idname == "ShaderNodeBsdfTransparent":
         out = _black()
@@ -694,6 +696,8 @@ def summary(read):
         lines.append(("MATERIAL", "Coat: a GGX layer over the surface"))
     if read.tree is not None and read.tree.sheen:
         lines.append(("MATERIAL", "Sheen: microfiber, over the surface and under any coat"))
+    if read.tree is not None and read.tree.aniso:
+        lines.append(("MATERIAL", "Anisotropic: GGX stretched along the tangent"))
     if read.volume is not None:
         v = read.volume
         where = "its interior (the object's bounding box)" if read.surface else "its interior alone (no surface)"

@@ -154,6 +154,7 @@ class CompiledTree:
     coat: bool = False  # a Principled BSDF's coat is drawn (NODE_COAT; node_coat_keep)
     film: bool = False  # its Thin Film is drawn (NODE_FILM; node_film_keep)
     sheen: bool = False  # its Sheen is drawn (NODE_SHEEN; node_sheen_keep)
+    aniso: bool = False  # an anisotropic lobe is drawn (NODE_ANISO; node_aniso_keep)
 
 
 # --- the registry -------------------------------------------------------------------------
@@ -239,6 +240,7 @@ class Compiler:
         self.coat = False  # a Principled BSDF's coat is drawn (NODE_COAT)
         self.film = False  # and its Thin Film (NODE_FILM)
         self.sheen = False  # and its Sheen (NODE_SHEEN)
+        self.aniso = False  # an anisotropic lobe (NODE_ANISO)
 
     # -- emitting --
 
@@ -451,6 +453,14 @@ class Compiler:
             return Value("vec3(0.0)", "vec3")
         return value
 
+    def tangent_input(self, node, ctx):
+        """A shader's Tangent input: Cycles' radial tangent about Z of the generated coordinates
+        where unlinked (what Cycles links there), else the compiled vector."""
+        socket = _socket(node.inputs, "Tangent")
+        if socket is not None and _link(socket) is not None:
+            return self.shader_input(node, "Tangent", ctx, "vec3")
+        return Value(f"node_radial_tangent({self.generated().expr}, mat3(model), N, 2)", "vec3")
+
     def normal_input(self, node, ctx):
         """A shader's Normal input: N where unlinked or fed by a Normal Map (the reader's
         normal-map path draws that one), else the compiled vector (a Bump, ...)."""
@@ -500,6 +510,7 @@ class Compiler:
         keep = f"  node_coat_keep({v.expr});\n" if self.coat else ""
         keep += f"  node_film_keep({v.expr});\n" if self.film else ""
         keep += f"  node_sheen_keep({v.expr});\n" if self.sheen else ""
+        keep += f"  node_aniso_keep({v.expr});\n" if self.aniso else ""
         if v.lobes < 2:
             code = _prelude(self.needs) + (
                 f"{signature}{{\n{body}\n{keep}"
@@ -542,6 +553,7 @@ class Compiler:
             coat=self.coat,
             film=self.film,
             sheen=self.sheen,
+            aniso=self.aniso,
         )
 
     def compile_aovs(self, nodes):
@@ -679,6 +691,13 @@ def _principled(c, node, socket, ctx):
         sheen_tint = c.shader_input(node, "Sheen Tint", ctx, "vec4", (1.0, 1.0, 1.0, 1.0))
         expr = f"node_principled_sheen({expr}, {weight.expr}, {sheen_rough.expr}, {sheen_tint.expr})"
         c.sheen = True
+    if "Anisotropic" in unread:  # linked or above 0: an anisotropic specular (NODE_ANISO)
+        unread.remove("Anisotropic")
+        amount = c.shader_input(node, "Anisotropic", ctx, "float", 0.0)
+        rotation = c.shader_input(node, "Anisotropic Rotation", ctx, "float", 0.0)
+        tangent = c.tangent_input(node, ctx)
+        expr = f"node_principled_aniso({expr}, {amount.expr}, {rotation.expr}, {tangent.expr}, {normal.expr})"
+        c.aniso = True
     if "Thin Film Thickness" in unread:  # linked or above 0: the film on its specular (NODE_FILM)
         unread.remove("Thin Film Thickness")
         thickness = c.shader_input(node, "Thin Film Thickness", ctx, "float", 0.0)
@@ -710,9 +729,23 @@ def _glossy(c, node, socket, ctx):
     color = c.shader_input(node, "Color", ctx, "vec4")
     rough = c.shader_input(node, "Roughness", ctx, "float")
     normal = c.normal_input(node, ctx)
-    c.messages += anisotropy_unread(node)
     expr = f"node_principled({color.expr}, 1.0, {rough.expr}, vec4(0.04), 1.0, vec3(0.0), {normal.expr})"
+    if anisotropy_unread(node):  # linked or not 0: anisotropic (NODE_ANISO)
+        amount = c.shader_input(node, "Anisotropy", ctx, "float", 0.0)
+        rotation = c.shader_input(node, "Rotation", ctx, "float", 0.0)
+        tangent = c.tangent_input(node, ctx)
+        expr = f"node_glossy_aniso({expr}, {amount.expr}, {rotation.expr}, {tangent.expr}, {normal.expr})"
+        c.aniso = True
     return c.temp("closure", expr, 1)
+
+
+@node("ShaderNodeTangent")
+def _tangent(c, node, socket, ctx):
+    axis = {"X": 0, "Y": 1, "Z": 2}.get(getattr(node, "axis", "Z"), 2)
+    if getattr(node, "direction_type", "RADIAL") != "RADIAL":
+        c.messages.append("a Tangent node's UV Map tangent (drawn as Radial about Z)")
+        axis = 2
+    return c.temp("vec3", f"node_radial_tangent({c.generated().expr}, mat3(model), N, {axis})")
 
 
 @node("ShaderNodeBsdfSheen")
@@ -1306,11 +1339,11 @@ PRINCIPLED_UNREAD = (
 
 
 def anisotropy_unread(node):
-    """["Anisotropy is not drawn"] for a Glossy (Anisotropic) BSDF whose Anisotropy is linked
-    or not 0: it is drawn isotropic."""
+    """["Anisotropy"] for a Glossy (Anisotropic) BSDF whose Anisotropy is linked or not 0 (what
+    NODE_ANISO draws), else []."""
     sock = node.inputs.get("Anisotropy")
     if sock is not None and (sock.is_linked or abs(float(sock.default_value)) > 0.0):
-        return ["Anisotropy is not drawn"]
+        return ["Anisotropy"]
     return []
 
 

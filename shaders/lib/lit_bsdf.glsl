@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/ggx_albedo.glsl lib/lit_surface.glsl lib/thin_film.glsl
+// requires: lib/common.glsl lib/ggx_albedo.glsl lib/lit_surface.glsl lib/thin_film.glsl lib/anisotropy.glsl
 #ifndef PENUMBRA_LIB_LIT_BSDF
 #define PENUMBRA_LIB_LIT_BSDF
 
@@ -57,7 +57,12 @@ vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
     F = mix(F, mix(film, b.metal_f0 + (b.f0.a - b.metal_f0) * fw, b.metal), b.film);
   }
 #  endif
-  vec3 spec = F * ggx_d_vis(b.N, V, H, NdotL, b.alpha);
+  /* Times the multiple-scattering gain (ggx_ms_gain), as Cycles scales the lobe. */
+#  if NODE_ANISO
+  vec3 spec = F * (ggx_aniso_d_vis(b.N, b.T, b.B, V, to_light, H, NdotL, b.ax, b.ay) * b.ms);
+#  else
+  vec3 spec = F * (ggx_d_vis(b.N, V, H, NdotL, b.alpha) * b.ms);
+#  endif
   return b.albedo / M_PI * L.diffuse_factor + spec * L.specular_factor;
 #else
 #  if SPECULAR_MODEL == SPECULAR_BLINN
@@ -71,6 +76,23 @@ vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
 #endif
 }
 
+/* The GGX lobe's multiple-scattering gain towards the viewer, 1 + F_ms (1 - E) / E (Kulla and
+ * Conty 2017, as Cycles' microfacet_ggx_preserve_energy scales the lobe: F_ms = F_ss E_avg /
+ * (1 - F_ss (1 - E_avg)), F_ss the Fresnel's cosine-weighted mean) for ``f`` the lobe's mean f0:
+ * what its value under each light and its albedo (env_brdf) are multiplied by. */
+float ggx_ms_gain(float f, float f90, float rough, float NdotV)
+{
+  float e = ggx_albedo(rough, NdotV).x;
+  float e_avg = ggx_albedo_avg(rough);
+  /* F_ss is a mean reflectance: within [0, 1] whatever f0 is. A metal's f0 is its base colour,
+   * which may exceed 1 (an image's premultiplied texel, an HDR colour): unbounded, F_ss past
+   * 1 / (1 - E_avg) turned the multiple-scattering term negative and the world's light on the
+   * surface below zero. */
+  float f_ss = clamp(f + (1.0 - f) * GGX_S_AVG * f90, 0.0, 1.0);
+  float f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg));
+  return 1.0 + f_ms * (1.0 - e) / max(e, 1e-4);
+}
+
 /* The specular lobe's directional albedo as a scale and bias of f0 (the split sum's
  * environment BRDF): f0 a + b is what the lobe reflects of light from all directions, the
  * energy the diffuse layer below does not get and the weight of the world's specular. (E, S)
@@ -82,15 +104,7 @@ vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
 vec2 env_brdf(float f, float f90, float rough, float NdotV)
 {
   vec2 es = ggx_albedo(rough, NdotV);
-  float e_avg = ggx_albedo_avg(rough);
-  /* F_ss is a mean reflectance: within [0, 1] whatever f0 is. A metal's f0 is its base colour,
-   * which may exceed 1 (an image's premultiplied texel, an HDR colour): unbounded, F_ss past
-   * 1 / (1 - E_avg) turned the multiple-scattering term negative and the world's light on the
-   * surface below zero. */
-  float f_ss = clamp(f + (1.0 - f) * GGX_S_AVG * f90, 0.0, 1.0);
-  float f_ms = f_ss * e_avg / (1.0 - f_ss * (1.0 - e_avg));
-  float ms = 1.0 + f_ms * (1.0 - es.x) / max(es.x, 1e-4);
-  return vec2(max(es.x - es.y, 0.0), es.y * f90) * ms;
+  return vec2(max(es.x - es.y, 0.0), es.y * f90) * ggx_ms_gain(f, f90, rough, NdotV);
 }
 
 /* One lobe's shading values from its Principled parameters, with normal ``N`` and ``weight``;
@@ -120,6 +134,7 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
    * Principled BSDF's layering), estimated per pixel from the directional albedo. */
   float NdotV = max(dot(N, V), 1e-4);
   ab = env_brdf(dot(b.f0.rgb, vec3(0.3333)), f90, rough, NdotV);
+  b.ms = ggx_ms_gain(dot(b.f0.rgb, vec3(0.3333)), f90, rough, NdotV);
   /* Metallic mixes a metal and a dielectric; only the dielectric's own specular sits over its
    * diffuse, per channel (a tinted specular takes its own colour out of the diffuse). */
   vec2 ab_dielectric = env_brdf(dot(spec.rgb, vec3(0.3333)), clamp(50.0 * spec.a, 0.0, 1.0), rough, NdotV);
@@ -137,6 +152,31 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   b.albedo *= clamp(1.0 - reflected, 0.0, 1.0);
   return b;
 }
+
+#if NODE_ANISO
+/* The lobe's anisotropy (lib/anisotropy.glsl) from ``aniso`` (tangent, ln k): its frame about
+ * its own normal and its roughness along each axis; isotropic where the tangent or k vanish.
+ * Where a roughness is clamped, its albedo (``ab``) and multiple-scattering gain are the
+ * isotropic lobe's of alpha = sqrt(alpha_x alpha_y), as Cycles takes them. */
+void lobe_anisotropy(inout Lobe b, vec4 aniso, vec3 V, inout vec2 ab)
+{
+  vec3 T = aniso.xyz - b.N * dot(b.N, aniso.xyz);
+  float tl = length(T);
+  vec3 up = (abs(b.N.z) < 0.9) ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0);
+  b.T = (tl > 1e-6) ? T / tl : normalize(cross(up, b.N));
+  b.B = cross(b.N, b.T);
+  float k = (tl > 1e-6) ? exp(clamp(aniso.w, -10.0, 10.0)) : 1.0;
+  b.ax = clamp(b.alpha * k, 0.002, 1.0);
+  b.ay = clamp(b.alpha / k, 0.002, 1.0);
+  float rough = sqrt(sqrt(b.ax * b.ay));
+  if (abs(rough - b.rough) > 1e-3) {
+    float NdotV = max(dot(b.N, V), 1e-4);
+    float f = dot(b.f0.rgb, vec3(0.3333));
+    ab = env_brdf(f, b.f0.a, rough, NdotV);
+    b.ms = ggx_ms_gain(f, b.f0.a, rough, NdotV);
+  }
+}
+#endif
 
 #if NODE_COAT
 /* The coat over the lobes (Blender's Principled BSDF, as Cycles layers it): a dielectric GGX
@@ -159,6 +199,7 @@ Coat coat_setup(vec4 params, vec3 tint, vec3 N, vec3 V)
   /* Its Fresnel rim follows f0 as the lobes' does (lobe_setup): a coat of IOR 1 reflects nothing. */
   float f90 = clamp(50.0 * c.f0, 0.0, 1.0);
   c.ab = env_brdf(c.f0, f90, c.rough, NdotV);
+  c.ms = ggx_ms_gain(c.f0, f90, c.rough, NdotV);
   float albedo = clamp(c.f0 * c.ab.x + c.ab.y, 0.0, 1.0);
   float cos_t = sqrt(max(1.0 - (1.0 - NdotV * NdotV) / (ior * ior), 1e-8));
   vec3 through = pow(clamp(tint, vec3(1e-6), vec3(1.0)), vec3(1.0 / cos_t));
@@ -173,7 +214,7 @@ float coat_brdf(Coat c, vec3 V, vec3 to_light, float NdotL)
   vec3 H = normalize(to_light + V);
   float f90 = clamp(50.0 * c.f0, 0.0, 1.0);
   float F = c.f0 + (f90 - c.f0) * fresnel_shape(dot(to_light, H));
-  return c.weight * F * ggx_d_vis(c.N, V, H, NdotL, c.alpha);
+  return c.weight * F * ggx_d_vis(c.N, V, H, NdotL, c.alpha) * c.ms;
 }
 #endif
 

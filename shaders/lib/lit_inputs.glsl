@@ -21,6 +21,9 @@ struct MaterialInputs {
 #if NODE_FILM
   vec4 film;        /* (weight, thickness nm, film IOR, base IOR) of a Principled Thin Film */
 #endif
+#if NODE_ANISO
+  vec4 aniso;       /* an anisotropic specular: tangent and ln k (lib/anisotropy.glsl) */
+#endif
 #if NODE_SHEEN
   vec4 sheen;       /* a Principled Sheen: colour (Weight x Tint) and roughness (lib/sheen.glsl) */
   float sheen_layered; /* the share of it over the lobes (a Sheen BSDF's lies beside them) */
@@ -77,11 +80,17 @@ MaterialInputs material_inputs()
 #    if NODE_SHEEN
   node_sheen_keep(closure);
 #    endif
+#    if NODE_ANISO
+  node_aniso_keep(closure);
+#    endif
 #  else
   node_tree(front ? Nt : -Nt, V, front, m.base, m.rough, m.metal, m.spec_f0, m.coverage, m.emission, m.tree_normal);
 #  endif
 #  if NODE_FILM
   m.film = node_film_params;
+#  endif
+#  if NODE_ANISO
+  m.aniso = node_aniso_params;
 #  endif
 #  if NODE_SHEEN
   m.sheen = node_sheen_params;
@@ -138,6 +147,11 @@ Surface surface_setup(MaterialInputs m, out vec2 ab[NODE_LOBES])
                          m.weights.y, ab[1]);
 #else
   s.lobe[0] = lobe_setup(m.base.rgb, m.rough, m.metal, m.spec_f0, N, s.V, 1.0, ab[0]);
+#endif
+#if NODE_ANISO
+  for (int k = 0; k < NODE_LOBES; k++) {
+    lobe_anisotropy(s.lobe[k], m.aniso, s.V, ab[k]);
+  }
 #endif
 #if NODE_SHEEN
   s.sheen = sheen_setup(m.sheen, m.sheen_layered, N, s.V); /* on the first lobe's shading normal */

@@ -1,4 +1,4 @@
-// requires: lib/material.glsl lib/sheen.glsl
+// requires: lib/material.glsl lib/sheen.glsl lib/anisotropy.glsl
 #ifndef PENUMBRA_LIB_LIT_SURFACE
 #define PENUMBRA_LIB_LIT_SURFACE
 
@@ -38,6 +38,11 @@ struct Lobe {
   float alpha;  /* GGX roughness (Principled roughness squared, at least 0.002) */
   float rough;  /* the Principled roughness (what blurs the world's specular) */
   float weight; /* the lobe's share of the surface (1 for a single lobe) */
+  float ms;     /* the specular's multiple-scattering gain (lit_bsdf.glsl ggx_ms_gain) */
+#if NODE_ANISO
+  vec3 T, B;       /* its tangent frame (lib/anisotropy.glsl lobe_anisotropy) */
+  float ax, ay;    /* GGX roughness along T and B */
+#endif
 #if NODE_FILM
   float film;      /* the Thin Film's share of its dielectric specular (lib/thin_film.glsl) */
   float metal;     /* its metallic, whose Fresnel the film leaves */
@@ -64,6 +69,7 @@ struct Coat {
   float f0;    /* ((IOR - 1) / (IOR + 1))^2 */
   vec3 below;
   vec2 ab;     /* its environment BRDF towards the viewer (env_brdf) */
+  float ms;    /* its multiple-scattering gain (ggx_ms_gain) */
 };
 
 struct Surface {

@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/world_sh.glsl lib/volumes.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl lib/cubes.glsl lib/sheen.glsl
+// requires: lib/common.glsl lib/world_sh.glsl lib/volumes.glsl lib/lit_debug.glsl lib/gtao.glsl lib/world_ratio.glsl lib/lit_surface.glsl lib/lit_bsdf.glsl lib/material.glsl lib/world_env.glsl lib/ssr.glsl lib/planar.glsl lib/cubes.glsl lib/sheen.glsl lib/anisotropy.glsl
 #ifndef PENUMBRA_LIB_LIT_WORLD
 #define PENUMBRA_LIB_LIT_WORLD
 
@@ -169,7 +169,29 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
   vec3 diffuse = b.albedo * world_sh(b.N, vec2(2.0 / 3.0, 0.25));
   vec3 R = reflect(-V, b.N);
   float t = b.rough * b.rough;
+#if NODE_ANISO
+  /* An anisotropic lobe: the world along ANISO_WORLD_RAYS reflections of visible normals a
+   * pixel and sample (lib/anisotropy.glsl), each weighted by G2 / G1 (0 below the horizon) and
+   * lightly blurred by half the short axis's roughness; over the isotropic lobe's albedo E,
+   * which dfg carries, so the anisotropic lobe's own albedo replaces it. */
+  vec3 radiance;
+  if (b.ax != b.ay) {
+    vec3 sum = vec3(0.0);
+    float blur = sqrt(0.5 * min(b.ax, b.ay));
+    for (int j = 0; j < ANISO_WORLD_RAYS; j++) {
+      vec2 u = pixel_r2(83.0 + float(world_lobe), frame.sample_index * ANISO_WORLD_RAYS + j);
+      vec3 L = ggx_aniso_reflection(b.N, b.T, b.B, V, b.ax, b.ay, u);
+      sum += ggx_aniso_weight(b.N, b.T, b.B, V, L, b.ax, b.ay) * world_glossy_radiance(L, blur);
+    }
+    float e = ggx_albedo(sqrt(sqrt(b.ax * b.ay)), max(dot(b.N, V), 1e-4)).x;
+    radiance = sum / (float(ANISO_WORLD_RAYS) * max(e, 1e-4));
+  }
+  else {
+    radiance = world_glossy_radiance(R, b.rough);
+  }
+#else
   vec3 radiance = world_glossy_radiance(R, b.rough);
+#endif
   vec3 dfg = b.f0.rgb * ab.x + ab.y;
 #if NODE_FILM
   /* A Thin Film's dielectric (lit_bsdf.glsl lobe_setup), the metal's own. */

@@ -1,4 +1,4 @@
-// requires:
+// requires: nodes/common.glsl
 #ifndef PENUMBRA_LIB_NODES_SHADER
 #define PENUMBRA_LIB_NODES_SHADER
 
@@ -51,6 +51,7 @@ struct NodeClosure {
   vec4 sheen; /* (weight, roughness, layered, 0), each x the sheen's weight: a Principled Sheen
               * (layered 1: over the lobes) or a Sheen BSDF (0: beside them) */
   vec3 sheen_tint; /* Sheen Tint x the sheen's weight */
+  vec4 aniso; /* (tangent, ln k), each x the surface's coverage: anisotropy (lib/anisotropy.glsl) */
 };
 
 NodeLobe node_lobe_empty()
@@ -61,7 +62,7 @@ NodeLobe node_lobe_empty()
 NodeClosure node_closure_empty()
 {
   return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0), vec4(0.0), vec3(0.0), vec3(0.0),
-                     vec4(0.0), vec4(0.0), vec3(0.0));
+                     vec4(0.0), vec4(0.0), vec3(0.0), vec4(0.0));
 }
 
 /* The Principled BSDF's dielectric reflectance at normal incidence, as Blender's (Cycles'
@@ -130,6 +131,47 @@ NodeClosure node_principled_sheen(NodeClosure c, float weight, float roughness, 
   return c;
 }
 
+/* ``T`` turned about ``N`` by ``turns`` of a full turn (Rodrigues), as Cycles' rotate_around_axis. */
+vec3 node_rotate_tangent(vec3 T, vec3 N, float turns)
+{
+  float a = 2.0 * NODE_PI * (isnan(turns) ? 0.0 : clamp(turns, -1e4, 1e4));
+  float c = cos(a), s = sin(a);
+  return T * c + cross(N, T) * s + N * (dot(N, T) * (1.0 - c));
+}
+
+/* Cycles' radial tangent (the Tangent node's Radial, and what the Principled BSDF's Tangent
+ * takes unlinked: about Z): around ``axis`` (0 X, 1 Y, 2 Z) of the generated coordinates
+ * ``g``, turned to the world as a normal is (``m``: the object's matrix), on the surface of ``N``. */
+vec3 node_radial_tangent(vec3 g, mat3 m, vec3 N, int axis)
+{
+  vec3 d = g - 0.5;
+  vec3 t = (axis == 0) ? vec3(0.0, -d.z, d.y) : (axis == 1) ? vec3(-d.z, 0.0, d.x) : vec3(-d.y, d.x, 0.0);
+  t = transpose(inverse(m)) * t;
+  vec3 c = cross(t, N);
+  float cl = length(c);
+  return (cl > 1e-12 && !isinf(cl)) ? cross(N, c / cl) : vec3(0.0);
+}
+
+/* The Principled BSDF ``c`` with its Anisotropic (0 to 1) and Anisotropic Rotation about ``N``
+ * for ``tangent``: k = 1 / sqrt(1 - 0.9 Anisotropic), as Cycles' principled closure. */
+NodeClosure node_principled_aniso(NodeClosure c, float anisotropic, float rotation, vec3 tangent, vec3 N)
+{
+  float a = clamp(isnan(anisotropic) ? 0.0 : anisotropic, 0.0, 1.0);
+  vec3 T = node_rotate_tangent(tangent, N, rotation);
+  c.aniso = c.alpha * vec4(T, -0.5 * log(1.0 - 0.9 * a));
+  return c;
+}
+
+/* A Glossy BSDF ``c`` with its Anisotropy (-0.99 to 0.99) and Rotation about ``N`` for
+ * ``tangent``: k = 1 / (1 + a) below 0, 1 - a above, as Cycles' glossy closure. */
+NodeClosure node_glossy_aniso(NodeClosure c, float anisotropy, float rotation, vec3 tangent, vec3 N)
+{
+  float a = clamp(isnan(anisotropy) ? 0.0 : anisotropy, -0.99, 0.99);
+  vec3 T = node_rotate_tangent(tangent, N, rotation);
+  c.aniso = c.alpha * vec4(T, (a < 0.0) ? -log(1.0 + a) : log(1.0 - a));
+  return c;
+}
+
 /* A Sheen BSDF (Microfiber) of ``color`` and ``roughness``: a sheen beside whatever it is mixed
  * or added with, as Cycles sums closures (not layered over them). */
 NodeClosure node_sheen_bsdf(vec4 color, float roughness)
@@ -188,6 +230,7 @@ void node_shared_mix(float g, NodeClosure a, float f, NodeClosure b, inout NodeC
   c.film = g * a.film + f * b.film;
   c.sheen = g * a.sheen + f * b.sheen;
   c.sheen_tint = g * a.sheen_tint + f * b.sheen_tint;
+  c.aniso = g * a.aniso + f * b.aniso;
 }
 
 /* Closures whose lobes stay where they are: a with a, b with b. */
@@ -416,6 +459,19 @@ void node_sheen_keep(NodeClosure c)
                                         node_finite3(vec3(c.sheen.y * winv), 1.0).x) :
                                    vec4(0.0);
   node_sheen_layered = (w > 1e-6) ? node_finite3(vec3(c.sheen.z * winv), 1.0).x : 1.0;
+}
+
+/* The closure's anisotropy as parameters (NODE_ANISO, lib/lit_inputs.glsl): its tangent
+ * direction (0: none) and ln k over the surface (lib/anisotropy.glsl). */
+vec4 node_aniso_params = vec4(0.0);
+
+void node_aniso_keep(NodeClosure c)
+{
+  float coverage = clamp(c.alpha, 0.0, 1.0);
+  float tl = length(c.aniso.xyz);
+  vec3 T = (tl > 1e-12 && !isinf(tl)) ? c.aniso.xyz / tl : vec3(0.0);
+  float k = (coverage > 1e-6) ? c.aniso.w / coverage : 0.0;
+  node_aniso_params = vec4(T, node_finite3(vec3(k), 10.0).x);
 }
 
 #endif /* PENUMBRA_LIB_NODES_SHADER */

@@ -17,7 +17,10 @@ without and with a 300 nm Thin Film of IOR 1.33), ``film 600 on metal`` (a half-
 under a 600 nm film of IOR 1.6), ``sheen 0``, ``sheen 0.3`` and ``sheen 1 on black`` (Sheen Weight 1
 at Sheen Roughness 0, 0.3 and 1 over a black base: the sheen alone), ``sheen tint`` (a blue tint at
 roughness 0.5 over the red base) and ``sheen under coat`` (the same untinted, under Coat 1 at
-roughness 0.1). Writes ``<out>/principled.csv`` and a Markdown table to stdout.
+roughness 0.1); ``aniso 1``, ``aniso 0.5 turned`` (Anisotropic Rotation 0.25) and ``aniso 1 rough 1`` (a
+brushed white metal of roughness 0.4 or 1, its tangent Cycles' radial one about the sphere's Z)
+and ``aniso 1 on plastic`` (the red base at roughness 0.3). Writes ``<out>/principled.csv`` and a
+Markdown table to stdout.
 ``--quick``: reference 256 spp.
 """
 
@@ -68,6 +71,16 @@ CASES = {
     "sheen 1 on black": {"Base Color": (0.0, 0.0, 0.0, 1.0), "Sheen Weight": 1.0, "Sheen Roughness": 1.0},
     "sheen tint": {"Sheen Weight": 1.0, "Sheen Roughness": 0.5, "Sheen Tint": (0.3, 0.6, 1.0, 1.0)},
     "sheen under coat": {"Sheen Weight": 1.0, "Sheen Roughness": 0.5, "Coat Weight": 1.0, "Coat Roughness": 0.1},
+    "aniso 1": {"Base Color": (0.9, 0.9, 0.9, 1.0), "Metallic": 1.0, "Roughness": 0.4, "Anisotropic": 1.0},
+    "aniso 0.5 turned": {
+        "Base Color": (0.9, 0.9, 0.9, 1.0),
+        "Metallic": 1.0,
+        "Roughness": 0.4,
+        "Anisotropic": 0.5,
+        "Anisotropic Rotation": 0.25,
+    },
+    "aniso 1 rough 1": {"Base Color": (0.9, 0.9, 0.9, 1.0), "Metallic": 1.0, "Roughness": 1.0, "Anisotropic": 1.0},
+    "aniso 1 on plastic": {"Roughness": 0.3, "Anisotropic": 1.0},
 }
 LIGHTS = ("sun", "hdri")
 
