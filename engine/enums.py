@@ -309,10 +309,35 @@ DEBUG_VIEW = Enum(
                 "without media",
             },
         ),
+        (
+            "COAT_LIGHT",
+            "Coat Light",
+            "What the Principled BSDF's coats reflect alone, of the lights and the world, averaged over the "
+            "frame's samples",
+            12,
+            {
+                "lit": True,
+                "term": 4,
+                "legend": "the coats' reflection alone, in the render's colours; black without a coat",
+            },
+        ),
+        (
+            "SHEEN_LIGHT",
+            "Sheen Light",
+            "The light of the sheens alone (Principled Sheen, Sheen BSDF), under any coat, averaged over the "
+            "frame's samples",
+            13,
+            {
+                "lit": True,
+                "term": 5,
+                "legend": "the sheens' light alone, in the render's colours; black without a sheen",
+            },
+        ),
     ),
     # lit: the lit pass writes the view's values instead of colour (the DEBUG_LIT variant);
     # term: instead, the lit pass writes one term of its colour alone (DEBUG_TERM: 1 the world's
-    # light, 2 the diffuse bounce, 3 none: the volumes' march adds its light alone); legend: what
+    # light, 2 the diffuse bounce, 3 none: the volumes' march adds its light alone, 4 the coats'
+    # reflection, 5 the sheens' light); legend: what
     # the colours mean (the viewport's text and the render report).
     fact_defaults={"lit": False, "term": 0, "legend": ""},
 )

@@ -6,7 +6,9 @@
  *   DEBUG_LIT, DEBUG_REFLECTIONS  where the traced rays met the scene (REFLECTIONS)
  *   DEBUG_TERM 1         the world's light with its visibility (WORLD_LIGHT)
  *   DEBUG_TERM 2         the diffuse bounce (INDIRECT)
- *   DEBUG_TERM 3         nothing: the volumes' march adds the media's light alone (VOLUME_LIGHT) */
+ *   DEBUG_TERM 3         nothing: the volumes' march adds the media's light alone (VOLUME_LIGHT)
+ *   DEBUG_TERM 4         a Principled coat's reflection alone, lights and world (COAT_LIGHT)
+ *   DEBUG_TERM 5         a sheen's light alone, under any coat (SHEEN_LIGHT) */
 
 void main()
 {

@@ -12,8 +12,8 @@
  * with WORLD_AO (lit_world.glsl), with DEBUG_REFLECTIONS the weight of the surest hit of its
  * lobes' traced rays (SSR, lit_world.glsl: 0 none met the scene). The pixel's footprint (world-space derivatives of P) is set by
  * the entry shader, where derivatives are defined.
- * DEBUG_TERM (``debug_term``): the one term of the colour the WORLD_LIGHT (1) or INDIRECT (2)
- * view shows. */
+ * DEBUG_TERM (``debug_term``): the one term of the colour the WORLD_LIGHT (1), INDIRECT (2),
+ * COAT_LIGHT (4) or SHEEN_LIGHT (5) view shows (lit_lights.glsl, lit_world.glsl). */
 
 #if DEBUG_LIT
 float debug_lights = 0.0;

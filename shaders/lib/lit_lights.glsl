@@ -81,22 +81,36 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
       reflected += (s.lobe[k].weight * cosines[k]) * f;
     }
   }
+#if DEBUG_TERM == 4 || DEBUG_TERM == 5
+  vec3 layer = vec3(0.0); /* the Coat Light (4) or Sheen Light (5) view's layer alone */
+#endif
 #if NODE_SHEEN
   /* The sheen over the lobes (lib/sheen.glsl): what they keep under it, and its own light (a
    * diffuse lobe in Blender's passes). */
   reflected *= s.sheen.below;
 #  if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_GROUP
-  reflected += sheen_light(s.sheen, to_light) * L.diffuse_factor;
+  vec3 sheen = sheen_light(s.sheen, to_light) * L.diffuse_factor;
+  reflected += sheen;
+#    if DEBUG_TERM == 5
+  layer = sheen;
+#    endif
 #  endif
 #endif
 #if NODE_COAT
   /* The coat over the lobes (lit_bsdf.glsl): what reaches them under it, and its own reflection
    * (a glossy lobe: the Glossy passes, not the Diffuse ones). */
   reflected *= s.coat.below;
+#  if DEBUG_TERM == 5
+  layer *= s.coat.below;
+#  endif
 #  if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_GLOSSY || LIGHT_PASS == LIGHT_PASS_GROUP
   float NcdotL = dot(s.coat.N, to_light);
   if (NcdotL > 0.0) {
-    reflected += vec3(coat_brdf(s.coat, s.V, to_light, NcdotL) * NcdotL * L.specular_factor);
+    vec3 coat = vec3(coat_brdf(s.coat, s.V, to_light, NcdotL) * NcdotL * L.specular_factor);
+    reflected += coat;
+#    if DEBUG_TERM == 4
+    layer = coat;
+#    endif
   }
 #  endif
 #endif
@@ -106,6 +120,12 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
 #endif
   vec3 added = (L.color * visibility) * irradiance * reflected;
   color += added;
+#if DEBUG_TERM == 4 || DEBUG_TERM == 5
+#  if VOLUMES
+  layer *= light_transmittance(s.P, L, to_light);
+#  endif
+  debug_term += (L.color * visibility) * irradiance * layer;
+#endif
 #if DEBUG_TERM == 1
   debug_term += world_light * added;
 #endif

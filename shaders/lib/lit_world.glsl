@@ -345,6 +345,11 @@ vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
   sheen *= world_visibility;
 #    endif
   color += sheen;
+#    if DEBUG_TERM == 5 && NODE_COAT
+  debug_term += sheen * s.coat.below;
+#    elif DEBUG_TERM == 5
+  debug_term += sheen;
+#    endif
 #  endif
 #endif
 #if NODE_COAT
@@ -363,6 +368,9 @@ vec3 surface_world_light(Surface s, vec2 ab[NODE_LOBES])
   color += coat;
 #    if WORLD_RATIO
   world_s += coat * world_ratio_share(s.coat.rough);
+#    endif
+#    if DEBUG_TERM == 4
+  debug_term += coat;
 #    endif
 #  endif
 #endif
