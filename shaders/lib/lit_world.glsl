@@ -147,7 +147,8 @@ float world_visibility = 1.0;
 #endif
 
 /* Light from the world on lobe ``b``: diffuse irradiance, and specular radiance around the
- * reflected direction, wider with roughness, weighted by the environment BRDF ``ab``. With
+ * lobe's dominant direction (specular_dominant), wider with roughness, weighted by the
+ * environment BRDF ``ab``. With
  * WORLD_AO the diffuse is scaled by the world's visibility and the specular by the specular
  * occlusion it implies for this lobe (gtao_specular). */
 /* The world's radiance about the reflected direction ``R`` as a glossy lobe of Principled
@@ -163,12 +164,24 @@ vec3 world_glossy_radiance(vec3 R, float rough)
 #endif
 }
 
+/* The direction a GGX lobe of Principled roughness ``rough`` about ``N`` reads the prefiltered
+ * world along, seen from ``V``: the mirror direction turned towards the normal as the lobe's
+ * peak is at rougher lobes and grazing views (Lagarde and de Rousiers 2014, "Moving Frostbite to
+ * Physically Based Rendering", the specular dominant direction); the mirror direction itself
+ * at roughness 0. */
+vec3 specular_dominant(vec3 N, vec3 V, float rough)
+{
+  float t = rough * rough;
+  return normalize(mix(N, reflect(-V, N), (1.0 - t) * (sqrt(1.0 - t) + t)));
+}
+
 vec3 world_light(Lobe b, vec3 V, vec2 ab)
 {
   vec3 scene_seen = vec3(0.0); /* what traced rays met of the scene (Glossy Indirect) */
   vec3 diffuse = b.albedo * world_sh(b.N, vec2(2.0 / 3.0, 0.25));
   vec3 R = reflect(-V, b.N);
   float t = b.rough * b.rough;
+  vec3 Rd = specular_dominant(b.N, V, b.rough);
 #if NODE_ANISO
   /* An anisotropic lobe: the world along ANISO_WORLD_RAYS reflections of visible normals a
    * pixel and sample (lib/anisotropy.glsl), each weighted by G2 / G1 (0 below the horizon) and
@@ -187,10 +200,10 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
     radiance = sum / (float(ANISO_WORLD_RAYS) * max(e, 1e-4));
   }
   else {
-    radiance = world_glossy_radiance(R, b.rough);
+    radiance = world_glossy_radiance(Rd, b.rough);
   }
 #else
-  vec3 radiance = world_glossy_radiance(R, b.rough);
+  vec3 radiance = world_glossy_radiance(Rd, b.rough);
 #endif
   vec3 dfg = b.f0.rgb * ab.x + ab.y;
 #if NODE_FILM
@@ -268,11 +281,12 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
 }
 
 #if NODE_COAT
-/* The coat's reflection of the world: its radiance about the coat's reflected direction,
- * blurred with the coat's roughness, times the coat's environment BRDF and weight. */
+/* The coat's reflection of the world: its radiance about the coat's dominant direction
+ * (specular_dominant), blurred with the coat's roughness, times the coat's environment BRDF
+ * and weight. */
 vec3 coat_world_light(Coat c, vec3 V)
 {
-  return world_glossy_radiance(reflect(-V, c.N), c.rough) * (c.weight * (c.f0 * c.ab.x + c.ab.y));
+  return world_glossy_radiance(specular_dominant(c.N, V, c.rough), c.rough) * (c.weight * (c.f0 * c.ab.x + c.ab.y));
 }
 #endif
 
