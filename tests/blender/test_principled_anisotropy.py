@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from devkit import analytic, engines, scenes
-from devkit.render import render, technique_frame
+from devkit import analytic, scenes
+from devkit.plane_scenes import SUN, plane_mean
+from devkit.plane_scenes import directions as _directions
+from devkit.render import technique_frame
 
-SUN = 3.0
-WORLD = 0.5
 METAL = (0.9, 0.8, 0.7)
 
 
@@ -54,27 +54,7 @@ def _glossy(rough, amount, tangent=(1.0, 0.0, 0.0)):
 
 
 def _plane(make, view_deg, sun_elevation=None, samples=1, sun_azimuth=0.0, at=(0.0, 0.0)):
-    """The plane of material ``make()`` seen at ``view_deg`` from the normal (the camera towards
-    +y) around the point ``at`` of the plane, under a sun of that elevation shining from +y
-    (turned by ``sun_azimuth`` about z), or under a uniform world."""
-    scene = scenes.empty_scene(16, 16)
-    scenes.plane(scene, size=400.0, mat=make())
-    t = math.radians(view_deg)
-    scenes.camera(scene, (at[0], at[1] - 20 * math.sin(t), 20 * math.cos(t)), (t, 0, 0), ortho_scale=1.0)
-    if sun_elevation is None:
-        scenes.set_world(scene, (WORLD, WORLD, WORLD))
-    else:
-        z = math.radians(90 - sun_elevation)
-        scenes.light(scene, "Sun", "SUN", SUN, rotation=(-z, 0, sun_azimuth), angle=0.0)
-    engines.configure(scene, "PENUMBRA", render_samples=samples)
-    return render(scene)["Combined"][..., :3].mean(axis=(0, 1))
-
-
-def _directions(view_deg, elevation, azimuth=0.0):
-    t, z = math.radians(view_deg), math.radians(90 - elevation)
-    s = (0.0, math.sin(z), math.cos(z))
-    c, n = math.cos(azimuth), math.sin(azimuth)
-    return (0.0, -math.sin(t), math.cos(t)), (c * s[0] - n * s[1], n * s[0] + c * s[1], s[2])
+    return plane_mean(make, view_deg, sun_elevation, samples, sun_azimuth, at=at)
 
 
 def _metal_fresnel(c):
@@ -212,17 +192,8 @@ def test_the_anisotropic_lobe_is_cycles_under_a_sun(penumbra, tangent, at):
     one sample (a sun at angle 0 is sampled exactly) within 2 %."""
     view, elevation, azimuth = 50, 35, 0.6
 
-    def scene_of(engine):
-        scene = scenes.empty_scene(16, 16)
-        scenes.plane(scene, size=400.0, mat=_principled(0.4, 1.0, tangent=tangent)())
-        t = math.radians(view)
-        scenes.camera(scene, (at[0], at[1] - 20 * math.sin(t), 20 * math.cos(t)), (t, 0, 0), ortho_scale=1.0)
-        z = math.radians(90 - elevation)
-        scenes.light(scene, "Sun", "SUN", SUN, rotation=(-z, 0, azimuth), angle=0.0)
-        engines.configure(scene, engine, **({"samples": 1} if engine == "CYCLES" else {"render_samples": 1}))
-        return render(scene)["Combined"][..., :3].mean(axis=(0, 1))
-
-    ours = scene_of("PENUMBRA")
-    cycles = scene_of("CYCLES")
+    make = _principled(0.4, 1.0, tangent=tangent)
+    ours = plane_mean(make, view, elevation, 1, azimuth, at=at)
+    cycles = plane_mean(make, view, elevation, 1, azimuth, engine="CYCLES", at=at)
     assert cycles.mean() > 1e-3
     assert np.allclose(ours, cycles, rtol=0.02), (ours, cycles)

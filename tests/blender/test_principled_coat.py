@@ -9,11 +9,10 @@ import math
 import numpy as np
 import pytest
 
-from devkit import analytic, engines, scenes
-from devkit.render import render, technique_frame
-
-SUN = 3.0
-WORLD = 0.5
+from devkit import analytic, scenes
+from devkit.plane_scenes import SUN, WORLD, plane_mean
+from devkit.plane_scenes import directions as _directions
+from devkit.render import technique_frame
 
 
 def _material(base, rough, weight, coat_rough, ior=1.5, tint=(1.0, 1.0, 1.0), specular=0.5):
@@ -27,25 +26,7 @@ def _material(base, rough, weight, coat_rough, ior=1.5, tint=(1.0, 1.0, 1.0), sp
 
 
 def _plane(make, view_deg, sun_elevation=None, samples=4, sun_azimuth=0.0):
-    """The plane of material ``make()`` (made in the fresh scene) seen at ``view_deg`` from the
-    normal (the camera towards +y), under a sun of that elevation shining from +y (turned by
-    ``sun_azimuth``), or under a uniform world."""
-    scene = scenes.empty_scene(16, 16)
-    scenes.plane(scene, size=400.0, mat=make())
-    t = math.radians(view_deg)
-    scenes.camera(scene, (0, -20 * math.sin(t), 20 * math.cos(t)), (t, 0, 0), ortho_scale=1.0)
-    if sun_elevation is None:
-        scenes.set_world(scene, (WORLD, WORLD, WORLD))
-    else:
-        z = math.radians(90 - sun_elevation)
-        scenes.light(scene, "Sun", "SUN", SUN, rotation=(-z, 0, sun_azimuth), angle=math.radians(0.5))
-    engines.configure(scene, "PENUMBRA", render_samples=samples)
-    return render(scene)["Combined"][..., :3].mean(axis=(0, 1))
-
-
-def _directions(view_deg, elevation):
-    t, z = math.radians(view_deg), math.radians(90 - elevation)
-    return (0.0, -math.sin(t), math.cos(t)), (0.0, math.sin(z), math.cos(z))
+    return plane_mean(make, view_deg, sun_elevation, samples, sun_azimuth, sun_angle=math.radians(0.5))
 
 
 @pytest.mark.parametrize(

@@ -16,26 +16,15 @@ import math
 import numpy as np
 import pytest
 
-from devkit import analytic, engines, scenes
-from devkit.render import render
-
-SUN = 3.0
-WORLD = 0.5
+from devkit import analytic, scenes
+from devkit.plane_scenes import SUN, WORLD, plane_mean
 
 
 def _plane(view_deg, rough, base, sun_elevation=None):
-    scene = scenes.empty_scene(16, 16)
-    mat = scenes.material("Rough", (base, base, base), roughness=rough, specular=0.5)
-    scenes.plane(scene, size=400.0, mat=mat)
-    t = math.radians(view_deg)
-    scenes.camera(scene, (0, -20 * math.sin(t), 20 * math.cos(t)), (t, 0, 0), ortho_scale=1.0)
-    if sun_elevation is None:
-        scenes.set_world(scene, (WORLD, WORLD, WORLD))
-    else:
-        z = math.radians(90 - sun_elevation)
-        scenes.light(scene, "Sun", "SUN", SUN, rotation=(-z, 0, 0), angle=math.radians(0.5))
-    engines.configure(scene, "PENUMBRA", render_samples=4)
-    return float(render(scene)["Combined"][..., :3].mean())
+    def make():
+        return scenes.material("Rough", (base, base, base), roughness=rough, specular=0.5)
+
+    return float(plane_mean(make, view_deg, sun_elevation, 4, sun_angle=math.radians(0.5)).mean())
 
 
 @pytest.mark.parametrize(

@@ -8,10 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from devkit import analytic, engines, scenes
-from devkit.render import render, technique_frame
-
-SUN = 3.0
+from devkit import analytic, scenes
+from devkit.plane_scenes import SUN, plane_mean
+from devkit.render import technique_frame
 
 
 def _filmed(base, rough, thickness, film_ior=1.33, ior=1.5, metallic=0.0):
@@ -24,16 +23,8 @@ def _filmed(base, rough, thickness, film_ior=1.33, ior=1.5, metallic=0.0):
 
 
 def _plane(make, view_deg, elevation):
-    """The plane of material ``make()`` seen at ``view_deg`` from the normal (the camera towards
-    +y) under a sun of ``elevation`` shining from +y, with a black world."""
-    scene = scenes.empty_scene(16, 16)
-    scenes.plane(scene, size=400.0, mat=make())
-    t = math.radians(view_deg)
-    scenes.camera(scene, (0, -20 * math.sin(t), 20 * math.cos(t)), (t, 0, 0), ortho_scale=1.0)
-    z = math.radians(90 - elevation)
-    scenes.light(scene, "Sun", "SUN", SUN, rotation=(-z, 0, 0), angle=math.radians(0.5))
-    engines.configure(scene, "PENUMBRA", render_samples=1)
-    return render(scene)["Combined"][..., :3].mean(axis=(0, 1))
+    """The plane of material ``make()`` at ``view_deg`` under a sun of ``elevation``, black world."""
+    return plane_mean(make, view_deg, elevation, 1, sun_angle=math.radians(0.5))
 
 
 @pytest.mark.parametrize("thickness", [250.0, 400.0, 650.0])

@@ -10,10 +10,9 @@ import numpy as np
 import pytest
 
 from devkit import analytic, engines, scenes
+from devkit.plane_scenes import SUN, WORLD, plane_mean, plane_scene
+from devkit.plane_scenes import directions as _directions
 from devkit.render import render, technique_frame
-
-SUN = 3.0
-WORLD = 0.5
 
 
 def _material(base, sheen_rough, weight=1.0, tint=(1.0, 1.0, 1.0), specular=0.0):
@@ -26,33 +25,11 @@ def _material(base, sheen_rough, weight=1.0, tint=(1.0, 1.0, 1.0), specular=0.0)
 
 
 def _plane_scene(make, view_deg, sun_elevation=None, sun_azimuth=0.0):
-    """The plane of material ``make()`` (made in the fresh scene) seen at ``view_deg`` from the
-    normal (the camera towards +y), under a sun of that elevation shining from +y (turned by
-    ``sun_azimuth`` about z), or under a uniform world."""
-    scene = scenes.empty_scene(16, 16)
-    scenes.plane(scene, size=400.0, mat=make())
-    t = math.radians(view_deg)
-    scenes.camera(scene, (0, -20 * math.sin(t), 20 * math.cos(t)), (t, 0, 0), ortho_scale=1.0)
-    if sun_elevation is None:
-        scenes.set_world(scene, (WORLD, WORLD, WORLD))
-    else:
-        z = math.radians(90 - sun_elevation)
-        scenes.light(scene, "Sun", "SUN", SUN, rotation=(-z, 0, sun_azimuth), angle=0.0)
-    return scene
+    return plane_scene(make, view_deg, sun_elevation, sun_azimuth)
 
 
 def _plane(make, view_deg, sun_elevation=None, samples=4, sun_azimuth=0.0):
-    scene = _plane_scene(make, view_deg, sun_elevation, sun_azimuth)
-    engines.configure(scene, "PENUMBRA", render_samples=samples)
-    return render(scene)["Combined"][..., :3].mean(axis=(0, 1))
-
-
-def _directions(view_deg, elevation, azimuth=0.0):
-    t, z = math.radians(view_deg), math.radians(90 - elevation)
-    # The sun's -z axis turned by (-z about x) then ``azimuth`` about z: it shines from there.
-    s = (0.0, math.sin(z), math.cos(z))
-    c, n = math.cos(azimuth), math.sin(azimuth)
-    return (0.0, -math.sin(t), math.cos(t)), (c * s[0] - n * s[1], n * s[0] + c * s[1], s[2])
+    return plane_mean(make, view_deg, sun_elevation, samples, sun_azimuth)
 
 
 @pytest.mark.parametrize(
@@ -75,9 +52,7 @@ def test_the_sheen_matches_cycles_between_the_tables_nodes(penumbra):
     3 % (Cycles at one sample: a sun at angle 0 is sampled exactly)."""
     view, elevation, azimuth = 55, 35, 2.4
     ours = _plane(lambda: _material(0.0, 0.45), view, elevation, samples=1, sun_azimuth=azimuth)
-    scene = _plane_scene(lambda: _material(0.0, 0.45), view, elevation, azimuth)
-    engines.configure(scene, "CYCLES", samples=1)
-    cycles = render(scene)["Combined"][..., :3].mean(axis=(0, 1))
+    cycles = plane_mean(lambda: _material(0.0, 0.45), view, elevation, 1, azimuth, engine="CYCLES")
     assert cycles.mean() > 1e-3
     assert np.allclose(ours, cycles, rtol=0.03), (ours, cycles)
 
