@@ -101,3 +101,25 @@ def cached_image(tag, source, key, make, cache_dir=REFERENCE_CACHE):
     path.parent.mkdir(parents=True, exist_ok=True)
     np.save(path, image)
     return image
+
+
+def group_off_and_on(gpu_call, off_inputs, on_inputs, define, width=48, height=32, samples=2):
+    """A Principled input group at weight 0 and above it, on the demo scene's first material:
+    its frame as it is, with ``off_inputs`` set (the group's other inputs, its weight still 0)
+    and with ``on_inputs`` set too. Returns (plain, zero, on) images and, for the frames with
+    ``off_inputs`` and with ``on_inputs``, whether any lit variant drawn had ``define``."""
+    from devkit import scenes
+
+    scene = scenes.demo_scene(width, height)
+    mat = next(m for m in (s.material for o in scene.objects for s in o.material_slots) if m is not None)
+    bsdf = mat.node_tree.nodes["Principled BSDF"]
+    plain, _stats, _ = technique_frame(gpu_call, scene, width, height, samples)
+    compiled = []
+    images = [plain]
+    for inputs in (off_inputs, on_inputs):
+        for name, value in inputs.items():
+            bsdf.inputs[name].default_value = value
+        image, stats, _ = technique_frame(gpu_call, scene, width, height, samples)
+        images.append(image)
+        compiled.append(any(dict(k.program().defines).get(define) for k in stats.lit_keys))
+    return images, compiled

@@ -12,7 +12,7 @@ import pytest
 from devkit import analytic, scenes
 from devkit.plane_scenes import SUN, plane_mean
 from devkit.plane_scenes import directions as _directions
-from devkit.render import technique_frame
+from devkit.render import group_off_and_on
 
 METAL = (0.9, 0.8, 0.7)
 
@@ -158,17 +158,9 @@ def test_an_anisotropic_metal_in_a_uniform_world_has_its_own_albedo(penumbra, vi
 def test_anisotropic_zero_is_the_isotropic_surface(penumbra, gpu_call):
     """Anisotropic 0: the same image bit for bit as a Principled BSDF never given anisotropy,
     with no NODE_ANISO variant; above 0 the variant has it."""
-    scene = scenes.demo_scene(48, 32)
-    mat = next(m for m in (s.material for o in scene.objects for s in o.material_slots) if m is not None)
-    plain, _stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    bsdf = mat.node_tree.nodes["Principled BSDF"]
-    bsdf.inputs["Anisotropic Rotation"].default_value = 0.3  # an input of anisotropy 0
-    zero, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    assert np.array_equal(plain, zero)
-    assert not any(dict(k.program().defines).get("NODE_ANISO") for k in stats.lit_keys)
-    bsdf.inputs["Anisotropic"].default_value = 1.0
-    aniso, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    assert any(dict(k.program().defines).get("NODE_ANISO") for k in stats.lit_keys)
+    off = {"Anisotropic Rotation": 0.3}  # an input of anisotropy 0
+    (plain, zero, aniso), compiled = group_off_and_on(gpu_call, off, {"Anisotropic": 1.0}, "NODE_ANISO")
+    assert np.array_equal(plain, zero) and compiled == [False, True]
     assert not np.array_equal(plain, aniso)
 
 

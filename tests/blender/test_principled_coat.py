@@ -12,7 +12,7 @@ import pytest
 from devkit import analytic, scenes
 from devkit.plane_scenes import SUN, WORLD, plane_mean
 from devkit.plane_scenes import directions as _directions
-from devkit.render import technique_frame
+from devkit.render import group_off_and_on
 
 
 def _material(base, rough, weight, coat_rough, ior=1.5, tint=(1.0, 1.0, 1.0), specular=0.5):
@@ -83,20 +83,9 @@ def test_the_coats_reflection_is_reciprocal(penumbra):
 def test_coat_weight_zero_is_the_surface_without_a_coat(penumbra, gpu_call):
     """Coat Weight 0: the same image bit for bit as a Principled BSDF never given a coat, with
     no coat in its program (no NODE_COAT variant); above 0 the variant has it."""
-    scene = scenes.demo_scene(48, 32)
-    mat = next(m for m in (s.material for o in scene.objects for s in o.material_slots) if m is not None)
-    plain, _stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    bsdf = mat.node_tree.nodes["Principled BSDF"]
-    bsdf.inputs["Coat Roughness"].default_value = 0.2  # inputs of a coat of weight 0
-    bsdf.inputs["Coat Tint"].default_value = (0.2, 0.5, 0.9, 1.0)
-    zero, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    assert np.array_equal(plain, zero)
-    assert not any(
-        dict(k.defines()).get("NODE_COAT") or "TREE_COAT" in k.program().name.upper() for k in stats.lit_keys
-    )
-    bsdf.inputs["Coat Weight"].default_value = 1.0
-    coated, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    assert any(dict(k.program().defines).get("NODE_COAT") for k in stats.lit_keys)
+    off = {"Coat Roughness": 0.2, "Coat Tint": (0.2, 0.5, 0.9, 1.0)}  # inputs of a coat of weight 0
+    (plain, zero, coated), compiled = group_off_and_on(gpu_call, off, {"Coat Weight": 1.0}, "NODE_COAT")
+    assert np.array_equal(plain, zero) and compiled == [False, True]
     assert not np.array_equal(plain, coated)
 
 

@@ -10,7 +10,7 @@ import pytest
 
 from devkit import analytic, scenes
 from devkit.plane_scenes import SUN, plane_mean
-from devkit.render import technique_frame
+from devkit.render import group_off_and_on
 
 
 def _filmed(base, rough, thickness, film_ior=1.33, ior=1.5, metallic=0.0):
@@ -52,16 +52,10 @@ def test_a_vanishing_film_is_the_plain_dielectric(penumbra):
 def test_film_thickness_zero_compiles_no_film(penumbra, gpu_call):
     """Thickness 0: bit for bit the surface without a film, no NODE_FILM variant; above 0 the
     variant has it."""
-    scene = scenes.demo_scene(48, 32)
-    mat = next(m for m in (s.material for o in scene.objects for s in o.material_slots) if m is not None)
-    plain, _stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    mat.node_tree.nodes["Principled BSDF"].inputs["Thin Film IOR"].default_value = 1.8
-    zero, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    assert np.array_equal(plain, zero)
-    assert not any(dict(k.program().defines).get("NODE_FILM") for k in stats.lit_keys)
-    mat.node_tree.nodes["Principled BSDF"].inputs["Thin Film Thickness"].default_value = 400.0
-    _filmed_frame, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    assert any(dict(k.program().defines).get("NODE_FILM") for k in stats.lit_keys)
+    on = {"Thin Film Thickness": 400.0}
+    (plain, zero, filmed), compiled = group_off_and_on(gpu_call, {"Thin Film IOR": 1.8}, on, "NODE_FILM")
+    assert np.array_equal(plain, zero) and compiled == [False, True]
+    assert not np.array_equal(plain, filmed)
 
 
 def test_a_film_on_a_metal_is_named(penumbra):

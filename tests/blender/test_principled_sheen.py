@@ -12,7 +12,7 @@ import pytest
 from devkit import analytic, engines, scenes
 from devkit.plane_scenes import SUN, WORLD, plane_mean, plane_scene
 from devkit.plane_scenes import directions as _directions
-from devkit.render import render, technique_frame
+from devkit.render import group_off_and_on, render
 
 
 def _material(base, sheen_rough, weight=1.0, tint=(1.0, 1.0, 1.0), specular=0.0):
@@ -132,18 +132,9 @@ def test_the_sheen_is_not_reciprocal_as_cycles_is_not(penumbra):
 def test_sheen_weight_zero_is_the_surface_without_a_sheen(penumbra, gpu_call):
     """Sheen Weight 0: the same image bit for bit as a Principled BSDF never given a sheen, with
     no sheen in its program (no NODE_SHEEN variant); above 0 the variant has it."""
-    scene = scenes.demo_scene(48, 32)
-    mat = next(m for m in (s.material for o in scene.objects for s in o.material_slots) if m is not None)
-    plain, _stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    bsdf = mat.node_tree.nodes["Principled BSDF"]
-    bsdf.inputs["Sheen Roughness"].default_value = 0.2  # inputs of a sheen of weight 0
-    bsdf.inputs["Sheen Tint"].default_value = (0.2, 0.5, 0.9, 1.0)
-    zero, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    assert np.array_equal(plain, zero)
-    assert not any(dict(k.program().defines).get("NODE_SHEEN") for k in stats.lit_keys)
-    bsdf.inputs["Sheen Weight"].default_value = 1.0
-    sheened, stats, _ = technique_frame(gpu_call, scene, 48, 32, 2)
-    assert any(dict(k.program().defines).get("NODE_SHEEN") for k in stats.lit_keys)
+    off = {"Sheen Roughness": 0.2, "Sheen Tint": (0.2, 0.5, 0.9, 1.0)}  # inputs of a sheen of weight 0
+    (plain, zero, sheened), compiled = group_off_and_on(gpu_call, off, {"Sheen Weight": 1.0}, "NODE_SHEEN")
+    assert np.array_equal(plain, zero) and compiled == [False, True]
     assert not np.array_equal(plain, sheened)
 
 
