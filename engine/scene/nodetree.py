@@ -702,7 +702,7 @@ def _principled(c, node, socket, ctx):
         unread.remove("Thin Film Thickness")
         thickness = c.shader_input(node, "Thin Film Thickness", ctx, "float", 0.0)
         film_ior = c.shader_input(node, "Thin Film IOR", ctx, "float", 1.33)
-        expr = f"node_principled_film({expr}, {thickness.expr}, {film_ior.expr}, {ior.expr})"
+        expr = f"node_principled_film({expr}, {thickness.expr}, {film_ior.expr}, {ior.expr}, {level.expr})"
         c.film = True
         metallic = node.inputs.get("Metallic")
         if metallic is not None and (metallic.is_linked or float(metallic.default_value) > 0.0):

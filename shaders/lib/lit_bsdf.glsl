@@ -53,7 +53,7 @@ vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
 #  if NODE_FILM
   if (b.film > 0.0) {
     /* The film on the dielectric's specular (its Fresnel at the half vector); the metal keeps its own. */
-    vec3 film = film_fresnel(dot(to_light, H), lit_film.y, lit_film.z, lit_film.w);
+    vec3 film = film_fresnel(dot(to_light, H), lit_film.y, lit_film.z, lit_film.w) * b.film_tint;
     F = mix(F, mix(film, b.metal_f0 + (b.f0.a - b.metal_f0) * fw, b.metal), b.film);
   }
 #  endif
@@ -146,7 +146,9 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   b.metal = metal;
   b.metal_f0 = base;
   vec2 ab_one = env_brdf(1.0, 1.0, rough, NdotV);
-  b.film_dfg = film_fresnel(NdotV, lit_film.y, lit_film.z, lit_film.w) * (ab_one.x + ab_one.y);
+  /* Specular Tint (the tinted F0 over the untinted) tints the film's reflectance, as Cycles'. */
+  b.film_tint = (spec.a > 1e-6) ? clamp(spec.rgb / spec.a, 0.0, 1e6) : vec3(1.0);
+  b.film_dfg = film_fresnel(NdotV, lit_film.y, lit_film.z, lit_film.w) * (ab_one.x + ab_one.y) * b.film_tint;
   reflected = mix(reflected, b.film_dfg, b.film);
 #endif
   b.albedo *= clamp(1.0 - reflected, 0.0, 1.0);

@@ -108,13 +108,17 @@ NodeClosure node_principled_coat(NodeClosure c, float weight, float roughness, f
 }
 
 /* The Principled BSDF ``c`` with its Thin Film: Thickness (nm) and IOR over a base of IOR
- * ``ior`` (the BSDF's), scaled by the surface's coverage. */
-NodeClosure node_principled_film(NodeClosure c, float thickness, float film_ior, float ior)
+ * ``ior`` (the BSDF's) as Specular IOR Level ``level`` adjusts it (Cycles: the IOR whose F0 is
+ * 2 level times the IOR's), scaled by the surface's coverage. */
+NodeClosure node_principled_film(NodeClosure c, float thickness, float film_ior, float ior, float level)
 {
   float w = c.alpha;
   float d = clamp(isnan(thickness) ? 0.0 : thickness, 0.0, 1e5);
   float eta = clamp(isnan(film_ior) ? 1.33 : film_ior, 1.0, 1e6);
   float base = clamp(isnan(ior) ? 1.5 : ior, 1.0, 1e6);
+  float r = (base - 1.0) / (base + 1.0);
+  float f0 = clamp(r * r * 2.0 * clamp(isnan(level) ? 0.5 : level, 0.0, 1e6), 0.0, 0.99);
+  base = (1.0 + sqrt(f0)) / (1.0 - sqrt(f0));
   c.film = vec4(w, w * d, w * eta, w * base);
   return c;
 }

@@ -42,6 +42,32 @@ def test_a_film_on_a_black_dielectric_reflects_as_the_airy_model(penumbra, thick
     assert ours.max() > 1.3 * ours.min()  # iridescent: not grey
 
 
+def test_specular_tint_and_ior_level_reach_the_film(penumbra):
+    """Specular Tint multiplies the film's reflectance and Specular IOR Level moves the base's
+    IOR to the one whose F0 is 2 level times the IOR's, as Cycles' principled closure does:
+    the airy model at that IOR times the tint, within 3 % per channel."""
+    view, elevation, tint, level = 40.0, 45.0, (1.0, 0.6, 0.3), 0.9
+    t, z = math.radians(view), math.radians(90 - elevation)
+    v, to_light = (0.0, -math.sin(t), math.cos(t)), (0.0, math.sin(z), math.cos(z))
+    f0 = ((1.5 - 1.0) / 2.5) ** 2 * 2.0 * level
+    eta = (1.0 + math.sqrt(f0)) / (1.0 - math.sqrt(f0))
+    ref = (
+        SUN
+        * np.array(tint)
+        * analytic.ggx_reflectance(lambda c: analytic.thin_film_fresnel(c, 400.0, 1.33, eta), 0.3, v, to_light)
+    )
+
+    def make():
+        mat = _filmed(0.0, 0.3, 400.0)
+        bsdf = mat.node_tree.nodes["Principled BSDF"]
+        bsdf.inputs["Specular Tint"].default_value = (*tint, 1.0)
+        bsdf.inputs["Specular IOR Level"].default_value = level
+        return mat
+
+    ours = _plane(make, view, elevation)
+    assert np.allclose(ours, ref, rtol=0.03, atol=1e-4), (ours, ref)
+
+
 def test_a_vanishing_film_is_the_plain_dielectric(penumbra):
     """A film of 1 nm fades to none: the plane is the same as without a film, within 2 %."""
     filmed = _plane(lambda: _filmed(0.0, 0.3, 1.0), 40.0, 45.0)
