@@ -78,11 +78,11 @@ vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
 
 /* The GGX lobe's multiple-scattering gain towards the viewer, 1 + F_ms (1 - E) / E (Kulla and
  * Conty 2017, as Cycles' microfacet_ggx_preserve_energy scales the lobe: F_ms = F_ss E_avg /
- * (1 - F_ss (1 - E_avg)), F_ss the Fresnel's cosine-weighted mean) for ``f`` the lobe's mean f0:
- * what its value under each light and its albedo (env_brdf) are multiplied by. */
-float ggx_ms_gain(float f, float f90, float rough, float NdotV)
+ * (1 - F_ss (1 - E_avg)), F_ss the Fresnel's cosine-weighted mean) for ``f`` the lobe's mean f0
+ * and ``e`` its albedo E towards the viewer (ggx_albedo's x): what its value under each light
+ * and its albedo (env_brdf) are multiplied by. */
+float ggx_ms_gain(float f, float f90, float rough, float e)
 {
-  float e = ggx_albedo(rough, NdotV).x;
   float e_avg = ggx_albedo_avg(rough);
   /* F_ss is a mean reflectance: within [0, 1] whatever f0 is. A metal's f0 is its base colour,
    * which may exceed 1 (an image's premultiplied texel, an HDR colour): unbounded, F_ss past
@@ -99,12 +99,12 @@ float ggx_ms_gain(float f, float f90, float rough, float NdotV)
  * come from lib/ggx_albedo.glsl (GGX, height-correlated Smith, the Fresnel curve of
  * fresnel_shape). Multiple scattering between the microfacets adds 1 + F_ms (1 - E) / E (Kulla
  * and Conty 2017, as Cycles' microfacet_ggx_preserve_energy: F_ms = F_ss E_avg / (1 - F_ss
- * (1 - E_avg)), F_ss the Fresnel's cosine-weighted mean), for ``f`` the lobe's mean f0. The
- * bias (the Fresnel rim) is scaled by ``f90``: a surface without specular has none. */
-vec2 env_brdf(float f, float f90, float rough, float NdotV)
+ * (1 - E_avg)), F_ss the Fresnel's cosine-weighted mean: ggx_ms_gain) as the gain ``ms``. ``es``:
+ * the table's (E, S) at the lobe's roughness and view (looked up once per lobe for its uses).
+ * The bias (the Fresnel rim) is scaled by ``f90``: a surface without specular has none. */
+vec2 env_brdf(vec2 es, float f90, float ms)
 {
-  vec2 es = ggx_albedo(rough, NdotV);
-  return vec2(max(es.x - es.y, 0.0), es.y * f90) * ggx_ms_gain(f, f90, rough, NdotV);
+  return vec2(max(es.x - es.y, 0.0), es.y * f90) * ms;
 }
 
 /* One lobe's shading values from its Principled parameters, with normal ``N`` and ``weight``;
@@ -133,11 +133,13 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   /* Energy: light reflected by the specular layer does not reach the diffuse one below (the
    * Principled BSDF's layering), estimated per pixel from the directional albedo. */
   float NdotV = max(dot(N, V), 1e-4);
-  ab = env_brdf(dot(b.f0.rgb, vec3(0.3333)), f90, rough, NdotV);
-  b.ms = ggx_ms_gain(dot(b.f0.rgb, vec3(0.3333)), f90, rough, NdotV);
+  vec2 es = ggx_albedo(rough, NdotV); /* looked up once for the lobe's three uses below */
+  b.ms = ggx_ms_gain(dot(b.f0.rgb, vec3(0.3333)), f90, rough, es.x);
+  ab = env_brdf(es, f90, b.ms);
   /* Metallic mixes a metal and a dielectric; only the dielectric's own specular sits over its
    * diffuse, per channel (a tinted specular takes its own colour out of the diffuse). */
-  vec2 ab_dielectric = env_brdf(dot(spec.rgb, vec3(0.3333)), clamp(50.0 * spec.a, 0.0, 1.0), rough, NdotV);
+  float f90_d = clamp(50.0 * spec.a, 0.0, 1.0);
+  vec2 ab_dielectric = env_brdf(es, f90_d, ggx_ms_gain(dot(spec.rgb, vec3(0.3333)), f90_d, rough, es.x));
   vec3 reflected = spec.rgb * ab_dielectric.x + ab_dielectric.y;
 #if NODE_FILM
   /* A Thin Film: the dielectric reflects the film's reflectance towards the viewer times the
@@ -145,7 +147,7 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   b.film = clamp(lit_film.x, 0.0, 1.0);
   b.metal = metal;
   b.metal_f0 = base;
-  vec2 ab_one = env_brdf(1.0, 1.0, rough, NdotV);
+  vec2 ab_one = env_brdf(es, 1.0, ggx_ms_gain(1.0, 1.0, rough, es.x));
   /* Specular Tint (the tinted F0 over the untinted) tints the film's reflectance, as Cycles'. */
   b.film_tint = (spec.a > 1e-6) ? clamp(spec.rgb / spec.a, 0.0, 1e6) : vec3(1.0);
   b.film_dfg = film_fresnel(NdotV, lit_film.y, lit_film.z, lit_film.w) * (ab_one.x + ab_one.y) * b.film_tint;
@@ -174,8 +176,9 @@ void lobe_anisotropy(inout Lobe b, vec4 aniso, vec3 V, inout vec2 ab)
   if (abs(rough - b.rough) > 1e-3) {
     float NdotV = max(dot(b.N, V), 1e-4);
     float f = dot(b.f0.rgb, vec3(0.3333));
-    ab = env_brdf(f, b.f0.a, rough, NdotV);
-    b.ms = ggx_ms_gain(f, b.f0.a, rough, NdotV);
+    vec2 es = ggx_albedo(rough, NdotV);
+    b.ms = ggx_ms_gain(f, b.f0.a, rough, es.x);
+    ab = env_brdf(es, b.f0.a, b.ms);
   }
 }
 #endif
@@ -200,8 +203,9 @@ Coat coat_setup(vec4 params, vec3 tint, vec3 N, vec3 V)
   float NdotV = max(dot(N, V), 1e-4);
   /* Its Fresnel rim follows f0 as the lobes' does (lobe_setup): a coat of IOR 1 reflects nothing. */
   float f90 = clamp(50.0 * c.f0, 0.0, 1.0);
-  c.ab = env_brdf(c.f0, f90, c.rough, NdotV);
-  c.ms = ggx_ms_gain(c.f0, f90, c.rough, NdotV);
+  vec2 es = ggx_albedo(c.rough, NdotV);
+  c.ms = ggx_ms_gain(c.f0, f90, c.rough, es.x);
+  c.ab = env_brdf(es, f90, c.ms);
   float albedo = clamp(c.f0 * c.ab.x + c.ab.y, 0.0, 1.0);
   float cos_t = sqrt(max(1.0 - (1.0 - NdotV * NdotV) / (ior * ior), 1e-8));
   vec3 through = pow(clamp(tint, vec3(1e-6), vec3(1.0)), vec3(1.0 / cos_t));
