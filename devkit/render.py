@@ -9,6 +9,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
+from devkit import scenes
 from devkit.imageio import read_exr, set_format
 
 
@@ -108,8 +109,6 @@ def group_off_and_on(gpu_call, off_inputs, on_inputs, define, width=48, height=3
     its frame as it is, with ``off_inputs`` set (the group's other inputs, its weight still 0)
     and with ``on_inputs`` set too. Returns (plain, zero, on) images and, for the frames with
     ``off_inputs`` and with ``on_inputs``, whether any lit variant drawn had ``define``."""
-    from devkit import scenes
-
     scene = scenes.demo_scene(width, height)
     mat = next(m for m in (s.material for o in scene.objects for s in o.material_slots) if m is not None)
     bsdf = mat.node_tree.nodes["Principled BSDF"]
