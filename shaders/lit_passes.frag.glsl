@@ -53,6 +53,17 @@ PassColors pass_colors(Surface s, MaterialInputs m, vec2 ab[NODE_LOBES])
     c.diffuse += w * albedo;
     c.glossy += w * max(s.lobe[k].f0.rgb * ab[k].x + ab[k].y, vec3(0.0));
   }
+  /* The layers over the lobes, as Cycles weighs its closures: what the lobes keep under a
+   * sheen and a coat, the sheen's albedo a diffuse colour, the coat's a glossy one (without
+   * them a sheen over a black base had a Diffuse Color of 0 and its light left the passes). */
+#  if NODE_SHEEN
+  c.diffuse = c.diffuse * s.sheen.below + s.sheen.color * s.sheen.ltc.z;
+  c.glossy *= s.sheen.below;
+#  endif
+#  if NODE_COAT
+  c.diffuse *= s.coat.below;
+  c.glossy = c.glossy * s.coat.below + vec3(s.coat.weight * (s.coat.f0 * s.coat.ab.x + s.coat.ab.y));
+#  endif
 #endif
   return c;
 }

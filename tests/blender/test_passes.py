@@ -351,6 +351,41 @@ def test_light_passes_add_up_to_combined_per_pixel_and_leave_it_as_it_was():
     np.testing.assert_array_equal(out["Combined"], out["bare"])
 
 
+def test_the_passes_hold_a_sheen_and_a_coat_over_black_bases():
+    """A sheen over a black base (the box) and a coat over a black base without specular (the
+    ball): their light is in the Diffuse and Glossy passes, whose colours hold the sheen's and
+    the coat's albedo as Cycles' do, so the algebra adds up to Combined within 1e-3 and the
+    Diffuse Direct pass carries the sheen's light (with a Diffuse Color of 0 it had none)."""
+    out, _ = child(
+        LIGHT_SCENE
+        + textwrap.dedent(
+            """
+        b = red.node_tree.nodes["Principled BSDF"]
+        b.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        b.inputs["Sheen Weight"].default_value = 1.0
+        b.inputs["Sheen Roughness"].default_value = 0.5
+        b = blue.node_tree.nodes["Principled BSDF"]
+        b.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        b.inputs["Metallic"].default_value = 0.0
+        b.inputs["Specular IOR Level"].default_value = 0.0
+        b.inputs["Coat Weight"].default_value = 1.0
+        (passes,) = render("layers", 4).values()
+        save(**{k.replace(" ", "_"): v for k, v in passes.items()})
+        """
+        )
+    )
+
+    def g(name):
+        return out[name.replace(" ", "_")][..., :3].astype(np.float64)
+
+    total = (g("Diffuse Direct") + g("Diffuse Indirect")) * g("Diffuse Color")
+    total += (g("Glossy Direct") + g("Glossy Indirect")) * g("Glossy Color")
+    total += g("Transmission Direct") * g("Transmission Color") + g("Emission") + g("Environment")
+    np.testing.assert_allclose(total, g("Combined"), atol=1e-3)
+    assert (g("Diffuse Direct") * g("Diffuse Color")).max() > 0.01  # the sheen's light
+    assert (g("Glossy Direct") * g("Glossy Color")).max() > 0.01  # the coat's
+
+
 def test_light_groups_add_up_to_combined_and_each_holds_its_own_light():
     """Light groups: the sun in "key", the area light and the world in "fill", the glowing
     box's emission in "glow". Their passes add up to Combined before the post stack (surfaces
