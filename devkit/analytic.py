@@ -369,3 +369,48 @@ def erode(mask, n=1):
         inner[:, :-1] &= out[:, 1:]
         out = inner
     return out
+
+
+# Burley's normalized diffusion (Christensen and Burley 2015), as Cycles draws it and
+# shaders/lib/burley.glsl evaluates it: d per channel, truncated at BURLEY_TRUNCATE d.
+BURLEY_TRUNCATE = 16.0
+BURLEY_TRUNCATE_CDF = 0.9963790093708328
+
+
+def burley_distance(radius, scale):
+    """Burley's d of a subsurface Radius x Scale (Cycles' r / 4 pi: node_sss_distance)."""
+    return np.maximum(np.asarray(radius, np.float64), 0.0) * max(float(scale), 0.0) * 0.25 / math.pi
+
+
+def burley_radial(d, r):
+    """R(r) 2 pi r: the density of the radius ``r`` (burley_radial in lib/burley.glsl)."""
+    r = np.asarray(r, np.float64)
+    e3 = np.exp(-r / (3.0 * d))
+    return np.where(r < BURLEY_TRUNCATE * d, (e3**3 + e3) / (4.0 * d), 0.0)
+
+
+def burley_cdf(d, r):
+    """The share of the profile within ``r``: 1 - exp(-r/d) / 4 - 3 exp(-r/3d) / 4."""
+    x = np.asarray(r, np.float64) / d
+    return 1.0 - 0.25 * np.exp(-x) - 0.75 * np.exp(-x / 3.0)
+
+
+def burley_through(d, s):
+    """The share leaving a slab ``s`` thick on its far face: R over the plane at that depth
+    (burley_through in lib/burley.glsl)."""
+    e3 = np.exp(-np.asarray(s, np.float64) / (3.0 * d))
+    return 0.25 * (e3**3 + 3.0 * e3)
+
+
+def burley_edge(d, x, n=4096):
+    """The light a point ``x`` from the edge of a lit half-plane receives of it (x > 0 on the
+    dark side, < 0 on the lit side) over Burley's truncated, renormalised profile: the profile's
+    share beyond the line at distance |x| (by the radial density and the arc beyond it)."""
+    x = np.atleast_1d(np.asarray(x, np.float64))
+    rm = BURLEY_TRUNCATE * d
+    r = (np.arange(n) + 0.5) / n * rm
+    w = burley_radial(d, r) * (rm / n) / BURLEY_TRUNCATE_CDF
+    a = np.abs(x)[:, None]
+    beyond = np.where(r[None, :] > a, np.arccos(np.clip(a / r[None, :], -1.0, 1.0)) / math.pi, 0.0)
+    share = (w[None, :] * beyond).sum(axis=1)
+    return np.where(x > 0.0, share, 1.0 - share)

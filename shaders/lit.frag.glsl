@@ -58,20 +58,21 @@ void main()
   vec3 color = surface_world_light(s, ab);
   float arriving = 0.0, unshadowed = 0.0;
 #if LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_GLOSSY || \
-    LIGHT_PASS == LIGHT_PASS_GROUP
+    LIGHT_PASS == LIGHT_PASS_GROUP || LIGHT_PASS == LIGHT_PASS_SUBSURFACE
   lights_on(s, color, arriving, unshadowed);
 #endif
 #if TRANSMISSION && (LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_TRANSMISSION)
   color += transmitted * surface_refraction(s, m.base.rgb, ab[0]);
 #endif
-#if INDIRECT_RSM && (LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE_INDIRECT)
+#if INDIRECT_RSM && (LIGHT_PASS == 0 || LIGHT_PASS == LIGHT_PASS_DIFFUSE_INDIRECT || LIGHT_PASS == LIGHT_PASS_SUBSURFACE)
   /* One diffuse bounce from the lights' reflective shadow maps (lib/indirect_rsm.glsl). */
   color += surface_bounce(s);
 #endif
-#if WORLD_RATIO && WORLD_RATIO_OUT != 1
-  /* No film sums for this surface (a blended one): its own ratio within this sample (of the
-   * world's light the variant carries: a light pass's lobe alone). */
-#  if LIGHT_PASS == LIGHT_PASS_DIFFUSE
+#if WORLD_RATIO && (WORLD_RATIO_OUT != 1 || LIGHT_PASS == LIGHT_PASS_SUBSURFACE)
+  /* No film sums for this surface (a blended one, or the light below one that spreads over its
+   * neighbours before the film takes it): its own ratio within this sample (of the world's light
+   * the variant carries: a light pass's lobe alone). */
+#  if LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_SUBSURFACE
   world_s = vec3(0.0);
 #  elif LIGHT_PASS == LIGHT_PASS_GLOSSY
   world_d = vec3(0.0);
@@ -89,6 +90,15 @@ void main()
   m.emission *= group_emission; /* 1 where the object is in the group */
 #elif LIGHT_PASS != 0
   m.emission = vec3(0.0); /* the Emission pass's */
+#endif
+#if LIGHT_PASS == LIGHT_PASS_SUBSURFACE && NODE_SSS
+  /* How that light leaves towards the viewer, and what the diffusion reads besides it
+   * (lib/subsurface.glsl). */
+  vec3 exit = subsurface_exit(s, m.sss_exit);
+  color *= exit;
+  subsurface_outputs(s, m.sss, exit);
+#elif LIGHT_PASS == LIGHT_PASS_SUBSURFACE
+  subsurface_outputs(s, vec4(0.0), vec3(1.0));
 #endif
   write_passes(surface_color(color + m.emission, m.coverage), s, arriving, unshadowed, m.emission, HOLDOUT == 0);
 }

@@ -50,6 +50,10 @@ PassColors pass_colors(Surface s, MaterialInputs m, vec2 ab[NODE_LOBES])
       c.transmission += w * transmitted * albedo;
       albedo *= 1.0 - transmitted;
     }
+#  if NODE_SSS && ALPHA_MODE != 2
+    /* The share below the surface is not the Diffuse passes' (Cycles' Subsurface passes). */
+    albedo *= 1.0 - m.sss.w;
+#  endif
     c.diffuse += w * albedo;
     c.glossy += w * max(s.lobe[k].f0.rgb * ab[k].x + ab[k].y, vec3(0.0));
   }

@@ -37,6 +37,10 @@ void main()
   /* Nor is the sheen's light. */
   settle_unstable = settle_unstable || s.sheen.ltc.z > 0.0;
 #endif
+#if NODE_SSS
+  /* Nor is the light below the surface, spread anew each sample (features/subsurface.py). */
+  settle_unstable = settle_unstable || m.sss.w > 0.0;
+#endif
 #if TRANSMISSION
   /* What a transmissive surface shows through it (features/refraction.py) is traced anew
    * every sample. */

@@ -167,14 +167,20 @@ class LitPass:
             submit.draw(blended, False, blended=True)
         _reset_state(sample.stats)
 
-    def draw_light(self, sample, framebuffers, part, per_draw=None, masks=None):
+    def draw_light(self, sample, framebuffers, part, per_draw=None, masks=None, select=None):
         """The sample's lit pass again over the z-buffer it left, with the frame's techniques'
         parts and ``part`` (a ``ProgramPart`` switching the lit variant to one of Blender's
         light passes, LIGHT_PASS): opaque surfaces (their framebuffer ``framebuffers[0]``) and
         then blended ones blended over them (``framebuffers[1]``), none writing depth;
         ``per_draw(shader, draw, material)`` a draw's own values, ``masks`` {id(draw): light
-        mask} the lights each draw takes (a light group's; ``part`` then switches LIGHT_LINKING on)."""
+        mask} the lights each draw takes (a light group's; ``part`` then switches LIGHT_LINKING on);
+        ``select(material, blended)``: whether a part is drawn (None: all of them)."""
         opaque, blended, submit = self._again(sample)
+        if select is not None:
+            opaque = [e for e in opaque if select(e[4], False)]
+            blended = [e for e in blended if select(e[4], True)]
+        if not opaque and not blended:
+            return
         submit.light = part
         submit.per_draw = per_draw
         if masks is not None:  # each draw's lights through the light-linking variant

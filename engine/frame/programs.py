@@ -244,6 +244,7 @@ def material_defines(features):
     out["NODE_FILM"] = "TREE_FILM" in features  # a Principled thin film on its specular (lib/thin_film.glsl)
     out["NODE_SHEEN"] = "TREE_SHEEN" in features  # a Principled sheen over the surface (lib/sheen.glsl)
     out["NODE_ANISO"] = "TREE_ANISO" in features  # an anisotropic specular (lib/anisotropy.glsl)
+    out["NODE_SSS"] = "TREE_SSS" in features  # a subsurface share of the diffuse (lib/subsurface.glsl)
     if "TREE_LOBES" in features:  # the tree gives two lobes (one-lobe variants keep their defines)
         out["NODE_LOBES"] = 2
     out["HAS_VCOL"] = "VCOL" in features

@@ -122,6 +122,7 @@ class FrameStats:
     # transmissive, and samples that copied the colour transmissive surfaces see through.
     refraction_prepasses: int = 0
     refraction_samples: int = 0
+    subsurface_samples: int = 0  # samples whose subsurface light was spread (features/subsurface.py)
     probe_draws: int = 0  # draw calls of the world's probe (``world/probe.py``), counted apart
     world_guided: bool = False  # the probe found an interior: the world's directions come through its openings
     ao_texels: int = 0  # texels whose horizons were marched (half resolution: a quarter of the film)

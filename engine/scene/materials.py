@@ -97,6 +97,11 @@ class Material:
         return self.tree is None and not self.holdout and self.transmission > 0.0 and self.metallic < 1.0
 
     @property
+    def subsurface(self):
+        """Whether a share of its diffuse scatters below the surface (``features/subsurface.py``)."""
+        return self.tree is not None and self.tree.sss and not self.holdout
+
+    @property
     def uses_alpha(self):
         transparent = self.tree is not None and self.tree.transparent
         return self.blend != "OPAQUE" and (self.alpha < 1.0 or "alpha" in self.textures or transparent)
@@ -131,6 +136,8 @@ class Material:
                 out.add("TREE_SHEEN")
             if self.tree.aniso:
                 out.add("TREE_ANISO")
+            if self.tree.sss:
+                out.add("TREE_SSS")
         return frozenset(out)
 
 
@@ -698,6 +705,8 @@ def summary(read):
         lines.append(("MATERIAL", "Sheen: microfiber, over the surface and under any coat"))
     if read.tree is not None and read.tree.aniso:
         lines.append(("MATERIAL", "Anisotropic: GGX stretched along the tangent"))
+    if read.tree is not None and read.tree.sss:
+        lines.append(("MATERIAL", "Subsurface: Burley diffusion over the screen"))
     if read.volume is not None:
         v = read.volume
         where = "its interior (the object's bounding box)" if read.surface else "its interior alone (no surface)"

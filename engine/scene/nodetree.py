@@ -155,6 +155,7 @@ class CompiledTree:
     film: bool = False  # its Thin Film is drawn (NODE_FILM; node_film_keep)
     sheen: bool = False  # its Sheen is drawn (NODE_SHEEN; node_sheen_keep)
     aniso: bool = False  # an anisotropic lobe is drawn (NODE_ANISO; node_aniso_keep)
+    sss: bool = False  # a share of its diffuse scatters below the surface (NODE_SSS; node_sss_keep)
 
 
 # --- the registry -------------------------------------------------------------------------
@@ -241,6 +242,7 @@ class Compiler:
         self.film = False  # and its Thin Film (NODE_FILM)
         self.sheen = False  # and its Sheen (NODE_SHEEN)
         self.aniso = False  # an anisotropic lobe (NODE_ANISO)
+        self.sss = False  # a subsurface share of the diffuse (NODE_SSS)
 
     # -- emitting --
 
@@ -511,6 +513,7 @@ class Compiler:
         keep += f"  node_film_keep({v.expr});\n" if self.film else ""
         keep += f"  node_sheen_keep({v.expr});\n" if self.sheen else ""
         keep += f"  node_aniso_keep({v.expr});\n" if self.aniso else ""
+        keep += f"  node_sss_keep({v.expr});\n" if self.sss else ""
         if v.lobes < 2:
             code = _prelude(self.needs) + (
                 f"{signature}{{\n{body}\n{keep}"
@@ -554,6 +557,7 @@ class Compiler:
             film=self.film,
             sheen=self.sheen,
             aniso=self.aniso,
+            sss=self.sss,
         )
 
     def compile_aovs(self, nodes):
@@ -698,6 +702,15 @@ def _principled(c, node, socket, ctx):
         tangent = c.tangent_input(node, ctx)
         expr = f"node_principled_aniso({expr}, {amount.expr}, {rotation.expr}, {tangent.expr}, {normal.expr})"
         c.aniso = True
+    if "Subsurface Weight" in unread:  # linked or above 0: a share of the diffuse below (NODE_SSS)
+        unread.remove("Subsurface Weight")
+        weight = c.shader_input(node, "Subsurface Weight", ctx, "float", 0.0)
+        radius = c.shader_input(node, "Subsurface Radius", ctx, "vec3", (1.0, 0.2, 0.1))
+        scale = c.shader_input(node, "Subsurface Scale", ctx, "float", 0.05)
+        walk = "0.0" if getattr(node, "subsurface_method", "RANDOM_WALK") == "BURLEY" else "1.0"
+        expr = f"node_principled_sss({expr}, {weight.expr}, {radius.expr}, {scale.expr}, {walk})"
+        c.sss = True
+        c.messages += subsurface_approximations(node, "Subsurface Anisotropy")
     if "Thin Film Thickness" in unread:  # linked or above 0: the film on its specular (NODE_FILM)
         unread.remove("Thin Film Thickness")
         thickness = c.shader_input(node, "Thin Film Thickness", ctx, "float", 0.0)
@@ -759,6 +772,30 @@ def _sheen(c, node, socket, ctx):
         c.messages.append("a Sheen BSDF's Normal (it takes the surface's)")
     c.sheen = True
     return c.temp("closure", f"node_sheen_bsdf({color.expr}, {rough.expr})")
+
+
+@node("ShaderNodeSubsurfaceScattering")
+def _subsurface(c, node, socket, ctx):
+    color = c.shader_input(node, "Color", ctx, "vec4")
+    scale = c.shader_input(node, "Scale", ctx, "float")
+    radius = c.shader_input(node, "Radius", ctx, "vec3")
+    c.sss = True
+    c.messages += subsurface_approximations(node, "Anisotropy")
+    walk = "0.0" if getattr(node, "falloff", "RANDOM_WALK") == "BURLEY" else "1.0"
+    normal = c.normal_input(node, ctx).expr
+    expr = f"node_subsurface({color.expr}, {scale.expr}, {radius.expr}, {normal}, {walk})"
+    return c.temp("closure", expr, 1)
+
+
+def subsurface_approximations(node, anisotropy):
+    """What a subsurface node sets that the screen-space diffusion (features/subsurface.py)
+    does not draw: a scattering Anisotropy other than 0, the Random Walk (Skin) method's own
+    look; named once."""
+    out = []
+    sock = node.inputs.get(anisotropy)
+    if sock is not None and (sock.is_linked or abs(float(sock.default_value)) > 0.0):
+        out.append(f"{anisotropy} (the diffusion is isotropic)")
+    return out
 
 
 @node("ShaderNodeBsdfTransparent")

@@ -1,4 +1,4 @@
-// requires: lib/material.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl
+// requires: lib/material.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl lib/subsurface.glsl
 #ifndef PENUMBRA_LIB_LIT_INPUTS
 #define PENUMBRA_LIB_LIT_INPUTS
 
@@ -23,6 +23,10 @@ struct MaterialInputs {
 #endif
 #if NODE_ANISO
   vec4 aniso;       /* an anisotropic specular: tangent and ln k (lib/anisotropy.glsl) */
+#endif
+#if NODE_SSS
+  vec4 sss;         /* Burley's d per channel, the share of the diffuse below (lib/subsurface.glsl) */
+  vec3 sss_exit;    /* how that share's light leaves (node_sss_walk: 1 Lambertian) */
 #endif
 #if NODE_SHEEN
   vec4 sheen;       /* a Principled Sheen: colour (Weight x Tint) and roughness (lib/sheen.glsl) */
@@ -83,6 +87,9 @@ MaterialInputs material_inputs()
 #    if NODE_ANISO
   node_aniso_keep(closure);
 #    endif
+#    if NODE_SSS
+  node_sss_keep(closure);
+#    endif
 #  else
   node_tree(front ? Nt : -Nt, V, front, m.base, m.rough, m.metal, m.spec_f0, m.coverage, m.emission, m.tree_normal);
 #  endif
@@ -91,6 +98,10 @@ MaterialInputs material_inputs()
 #  endif
 #  if NODE_ANISO
   m.aniso = node_aniso_params;
+#  endif
+#  if NODE_SSS
+  m.sss = node_sss_params;
+  m.sss_exit = node_sss_exit;
 #  endif
 #  if NODE_SHEEN
   m.sheen = node_sheen_params;
@@ -155,6 +166,17 @@ Surface surface_setup(MaterialInputs m, out vec2 ab[NODE_LOBES])
 #endif
 #if NODE_SHEEN
   s.sheen = sheen_setup(m.sheen, m.sheen_layered, N, s.V); /* on the first lobe's shading normal */
+#endif
+#if NODE_SSS && (SUBSURFACE == 1 || LIGHT_PASS == LIGHT_PASS_SUBSURFACE)
+  /* The technique's split of the diffuse (features/subsurface.py): the lit pass draws the share
+   * that stays on the surface, its subsurface draw the share below it (lib/subsurface.glsl). */
+  float kept = (LIGHT_PASS == LIGHT_PASS_SUBSURFACE) ? m.sss.w : 1.0 - m.sss.w;
+#  if LIGHT_PASS == LIGHT_PASS_SUBSURFACE
+  lit_sss = m.sss;
+#  endif
+  for (int k = 0; k < NODE_LOBES; k++) {
+    s.lobe[k].albedo *= kept;
+  }
 #endif
   return s;
 }

@@ -1,4 +1,4 @@
-// requires: lib/lights.glsl lib/lit_debug.glsl lib/shadow_filters.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl lib/lit_world.glsl lib/lit_settle.glsl lib/volumes.glsl lib/sheen.glsl
+// requires: lib/lights.glsl lib/lit_debug.glsl lib/shadow_filters.glsl lib/lit_surface.glsl lib/lit_terminator.glsl lib/lit_bsdf.glsl lib/lit_world.glsl lib/lit_settle.glsl lib/volumes.glsl lib/sheen.glsl lib/subsurface.glsl
 #ifndef PENUMBRA_LIB_LIT_LIGHTS
 #define PENUMBRA_LIB_LIT_LIGHTS
 
@@ -39,6 +39,15 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
     cosines[k] = (NdotL[k] > 0.0) ? cosine_term(NdotL[k]) : 0.0;
     faces = faces || NdotL[k] > 0.0;
   }
+#if LIGHT_PASS == LIGHT_PASS_SUBSURFACE && !WORLD_RATIO
+  if (filter_id != NO_SHADOW && irradiance > 0.0) {
+    color += (L.color * irradiance) * subsurface_through(s, L, to_light); /* from behind (lib/subsurface.glsl) */
+  }
+#elif LIGHT_PASS == LIGHT_PASS_SUBSURFACE
+  if (filter_id != NO_SHADOW && irradiance > 0.0 && L.world == 0) { /* the ratio's directions carry none */
+    color += (L.color * irradiance) * subsurface_through(s, L, to_light); /* from behind (lib/subsurface.glsl) */
+  }
+#endif
   if (!faces || irradiance <= 0.0) {
 #if SETTLE_TEST
     settle_unreached(L, s, to_light, irradiance, filter_id); /* other points may reach it */
@@ -73,7 +82,7 @@ void add_light(int i, const int filter_id, Surface s, inout vec3 color, inout fl
   for (int k = 0; k < NODE_LOBES; k++) {
     if (NdotL[k] > 0.0) {
       vec3 f = lobe_brdf(s.lobe[k], s.V, to_light, NdotL[k], L);
-#if LIGHT_PASS == LIGHT_PASS_DIFFUSE
+#if LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_SUBSURFACE
       f = min(f, s.lobe[k].albedo / M_PI * L.diffuse_factor); /* its diffuse term (the specular's >= 0) */
 #elif LIGHT_PASS == LIGHT_PASS_GLOSSY
       f = max(f - s.lobe[k].albedo / M_PI * L.diffuse_factor, vec3(0.0)); /* the rest: its specular */

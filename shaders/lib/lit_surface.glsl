@@ -12,6 +12,8 @@
 #define LIGHT_PASS_GROUP 6            /* a light group: its lights (light_mask), its objects' emission
                                        * (group_emission) and the world's light if it is in the group
                                        * (LIGHT_GROUP_WORLD) */
+#define LIGHT_PASS_SUBSURFACE 7       /* the light on the diffuse share below the surface, lights',
+                                       * world's and bounce (features/subsurface.py) */
 
 /* The surface the lit pass shades (lit.frag.glsl): its point, the view, its geometric normals,
  * and its lobes. A material is one lobe. A compiled node tree whose Mix / Add Shader joins two
@@ -57,6 +59,12 @@ struct Lobe {
 #endif
 #ifndef NODE_FILM
 #  define NODE_FILM 0
+#endif
+#ifndef NODE_SSS
+#  define NODE_SSS 0 /* a share of the diffuse scatters below the surface (lib/subsurface.glsl) */
+#endif
+#ifndef SUBSURFACE
+#  define SUBSURFACE 0 /* 1: the lit pass leaves that share to features/subsurface.py */
 #endif
 
 /* A Principled BSDF's coat (NODE_COAT; lit_bsdf.glsl coat_setup): a dielectric GGX layer over

@@ -265,7 +265,7 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
 #  endif
   }
 #endif
-#if LIGHT_PASS == LIGHT_PASS_DIFFUSE
+#if LIGHT_PASS == LIGHT_PASS_DIFFUSE || LIGHT_PASS == LIGHT_PASS_SUBSURFACE
   return diffuse;
 #elif LIGHT_PASS == LIGHT_PASS_GLOSSY
   return specular;

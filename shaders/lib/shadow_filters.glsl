@@ -116,14 +116,13 @@ float shadow_disk(ivec2 origin, vec2 st, float ref, float r, vec2 grad)
   return min(lit / float(DISK_SAMPLES), 1.0);
 }
 
-/* ``filter_id`` is a literal at every call (FILTER_*), so each call compiles to its one filter:
- * lights sampled over their extent use PCSS with their per-sample size, the others the
- * scene's filter. */
-float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float NfdotL, const int filter_id)
+/* The map of light L that holds world point P (an index of shadow_tiles), or -1: none (no
+ * map, or a cube face with no caster in reach, which was not rendered). */
+int shadow_tile(LightData L, vec3 P)
 {
   int mode = L.shadow_mode;
   if (mode == SHADOW_MODE_NONE) {
-    return 1.0;
+    return -1;
   }
   int tile;
   if (mode == SHADOW_MODE_SINGLE) {
@@ -155,8 +154,40 @@ float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float
     int face = cube_face(P - L.position);
     tile = (face < 4) ? L.tiles[face] : L.tiles_45[face - 4];
   }
+  return tile;
+}
+
+/* How far P lies behind the first surface light L's map holds along its axis towards P (world
+ * units: the thickness of what the light crosses to reach P from behind), or -1 where no map
+ * holds P. The nearest texel, no bias: what a back face reads (features/subsurface.py). */
+float shadow_thickness(LightData L, vec3 P)
+{
+  int tile = shadow_tile(L, P);
   if (tile < 0) {
-    return 1.0; /* a cube face with no caster in reach was not rendered */
+    return -1.0;
+  }
+  ShadowTile T = shadow_tiles[tile];
+  vec4 vp = T.view * vec4(P, 1.0);
+  vec4 t = T.proj_tex * vp;
+  if (t.w <= 0.0) {
+    return -1.0;
+  }
+  ivec2 st = ivec2(floor(t.xy / t.w * float(T.size)));
+  if (any(lessThan(st, ivec2(0))) || any(greaterThanEqual(st, ivec2(T.size)))) {
+    return -1.0;
+  }
+  float stored = T.near + decode_depth(texelFetch(shadow_atlas, T.origin + st, 0)) * (T.far - T.near);
+  return max(-vp.z - stored, 0.0);
+}
+
+/* ``filter_id`` is a literal at every call (FILTER_*), so each call compiles to its one filter:
+ * lights sampled over their extent use PCSS with their per-sample size, the others the
+ * scene's filter. */
+float shadow_visibility(LightData L, vec3 P, vec3 N, vec3 Nf, float NdotL, float NfdotL, const int filter_id)
+{
+  int tile = shadow_tile(L, P);
+  if (tile < 0) {
+    return 1.0; /* no map, or a cube face with no caster in reach (not rendered) */
   }
   ShadowTile T = shadow_tiles[tile];
   float near = T.near, far = T.far;

@@ -52,6 +52,9 @@ struct NodeClosure {
               * (layered 1: over the lobes) or a Sheen BSDF (0: beside them) */
   vec3 sheen_tint; /* Sheen Tint x the sheen's weight */
   vec4 aniso; /* (tangent, ln k), each x the surface's coverage: anisotropy (lib/anisotropy.glsl) */
+  vec4 sss; /* (Burley's d per channel x w, w): w the share of the diffuse that scatters below the
+             * surface x the coverage (Subsurface Weight; lib/subsurface.glsl) */
+  vec3 sss_exit; /* its light's share leaving towards the normal x w (1: Lambertian; node_sss_walk) */
 };
 
 NodeLobe node_lobe_empty()
@@ -62,7 +65,7 @@ NodeLobe node_lobe_empty()
 NodeClosure node_closure_empty()
 {
   return NodeClosure(node_lobe_empty(), node_lobe_empty(), 0.0, vec3(0.0), vec4(0.0), vec3(0.0), vec3(0.0),
-                     vec4(0.0), vec4(0.0), vec3(0.0), vec4(0.0));
+                     vec4(0.0), vec4(0.0), vec3(0.0), vec4(0.0), vec4(0.0), vec3(0.0));
 }
 
 /* The Principled BSDF's dielectric reflectance at normal incidence, as Blender's (Cycles'
@@ -235,6 +238,8 @@ void node_shared_mix(float g, NodeClosure a, float f, NodeClosure b, inout NodeC
   c.sheen = g * a.sheen + f * b.sheen;
   c.sheen_tint = g * a.sheen_tint + f * b.sheen_tint;
   c.aniso = g * a.aniso + f * b.aniso;
+  c.sss = g * a.sss + f * b.sss;
+  c.sss_exit = g * a.sss_exit + f * b.sss_exit;
 }
 
 /* Closures whose lobes stay where they are: a with a, b with b. */
@@ -463,6 +468,76 @@ void node_sheen_keep(NodeClosure c)
                                         node_finite3(vec3(c.sheen.y * winv), 1.0).x) :
                                    vec4(0.0);
   node_sheen_layered = (w > 1e-6) ? node_finite3(vec3(c.sheen.z * winv), 1.0).x : 1.0;
+}
+
+/* Burley's profile distance d per channel (world units) of a subsurface Radius x Scale, as
+ * Cycles scales both its Christensen-Burley and Random Walk radii (bssrdf_setup_radius: the
+ * mean free path r / 4 pi), each finite and within [0, 1e4]. */
+vec3 node_sss_distance(vec3 radius, float scale)
+{
+  vec3 d = max(radius, vec3(0.0)) * clamp(isnan(scale) ? 0.0 : scale, 0.0, 1e6) * 0.07957747154594767;
+  return node_finite3(d, 1e4);
+}
+
+/* Cycles' Random Walk as Burley's profile, fitted to Cycles itself (tools/fit_random_walk.py:
+ * a plane lit across a hard edge, Cycles' random walk against the plain diffuse convolved with
+ * the profile, d and amplitude fitted per albedo A from 0.05 to 0.9; the fit's residual 0.3-0.4 %
+ * of the lit light). Its walk spreads the light k(A) times Cycles' mean free path, 2.5 at A = 0
+ * to 14 at 0.9 (within 4.4 %), and leaves the surface unlike a Lambertian one: c0(A) of it
+ * towards the normal (0.77 to 0.96, within 1.4 %) and more at grazing angles, c0 + 3 (1 - c0)
+ * (1 - cos), which keeps its albedo (lib/subsurface.glsl subsurface_exit). Returns (k, c0) per
+ * channel as (x, y, z) pairs: the distance's factor in ``k``, c0 in ``exit``. */
+void node_sss_walk(vec3 albedo, out vec3 k, out vec3 exit)
+{
+  vec3 A = clamp(albedo, 0.0, 1.0);
+  k = 2.545 + A * (4.526 + A * 9.2);
+  exit = 0.768 + 0.209 * A;
+}
+
+/* The subsurface of ``c``'s first lobe: Radius x Scale, Christensen-Burley's (``walk`` 0) or
+ * Cycles' Random Walk as the profile it fits (``walk`` 1, node_sss_walk), its share ``w``. */
+NodeClosure node_sss_set(NodeClosure c, float w, vec3 radius, float scale, float walk)
+{
+  vec3 d = node_sss_distance(radius, scale);
+  vec3 exit = vec3(1.0);
+  if (walk > 0.5) {
+    vec3 k;
+    node_sss_walk(c.a.color / max(c.a.weight, 1e-6), k, exit);
+    d *= k;
+    exit = mix(vec3(1.0), exit, vec3(greaterThan(d, vec3(0.0)))); /* no walk: a plain diffuse */
+  }
+  c.sss = vec4(w * node_finite3(d, 1e4), w);
+  c.sss_exit = w * exit;
+  return c;
+}
+
+/* The Principled BSDF ``c`` with its Subsurface: Weight (the share of the diffuse that
+ * scatters below the surface), Radius x Scale and its method, over the surface's coverage. */
+NodeClosure node_principled_sss(NodeClosure c, float weight, vec3 radius, float scale, float walk)
+{
+  return node_sss_set(c, clamp(isnan(weight) ? 0.0 : weight, 0.0, 1.0) * c.alpha, radius, scale, walk);
+}
+
+/* A Subsurface Scattering node: a diffuse of ``color`` all of which scatters below the surface
+ * (Radius x Scale, its method). */
+NodeClosure node_subsurface(vec4 color, float scale, vec3 radius, vec3 normal, float walk)
+{
+  return node_sss_set(node_diffuse(color, normal), 1.0, radius, scale, walk);
+}
+
+/* The closure's Subsurface as parameters (NODE_SSS, lib/lit_inputs.glsl): Burley's d per
+ * channel and the share of the diffuse that scatters below the surface; how its light leaves
+ * (node_sss_walk's c0, 1: Lambertian). */
+vec4 node_sss_params = vec4(0.0);
+vec3 node_sss_exit = vec3(1.0);
+
+void node_sss_keep(NodeClosure c)
+{
+  float w = c.sss.w;
+  float coverage = clamp(c.alpha, 0.0, 1.0);
+  node_sss_params = (w > 1e-6) ? vec4(node_finite3(c.sss.xyz / w, 1e4), clamp(w / max(coverage, 1e-6), 0.0, 1.0)) :
+                                 vec4(0.0);
+  node_sss_exit = (w > 1e-6) ? clamp(c.sss_exit / w, 0.0, 1.0) : vec3(1.0);
 }
 
 /* The closure's anisotropy as parameters (NODE_ANISO, lib/lit_inputs.glsl): its tangent

@@ -90,9 +90,9 @@ def test_coat_weight_zero_is_the_surface_without_a_coat(penumbra, gpu_call):
 
 
 def test_the_groups_not_drawn_are_named_and_the_coat_is_not(penumbra):
-    """Subsurface set on a Principled BSDF is named in the material's messages; a coat, a
-    sheen, a thin film and anisotropy (the Principled BSDF's and a Glossy BSDF's) are drawn, not
-    named, and the Material panel's summary says so."""
+    """A coat, a sheen, a subsurface, a thin film and anisotropy (the Principled BSDF's and a
+    Glossy BSDF's) are drawn, not named, and the Material panel's summary says so; what the
+    subsurface does not draw (its Anisotropy) is named."""
     from penumbra.engine.scene.materials import material_from_blender
 
     scenes.empty_scene(8, 8)
@@ -101,16 +101,19 @@ def test_the_groups_not_drawn_are_named_and_the_coat_is_not(penumbra):
     for name, value in (("Sheen Weight", 1.0), ("Subsurface Weight", 0.5), ("Anisotropic", 0.5)):
         bsdf.inputs[name].default_value = value
     bsdf.inputs["Thin Film Thickness"].default_value = 300.0
+    bsdf.inputs["Subsurface Anisotropy"].default_value = 0.5
     read = material_from_blender(mat)
-    assert any("Subsurface Weight is not drawn" in m for m in read.messages), read.messages
-    drawn = ("Coat Weight", "Thin Film", "Sheen", "Anisotropic")
+    assert any("Subsurface Anisotropy (the diffusion is isotropic)" in m for m in read.messages), read.messages
+    drawn = ("Coat Weight", "Thin Film", "Sheen", "Anisotropic", "Subsurface Weight")
     assert not any(name in m for m in read.messages for name in drawn), read.messages
-    assert read.tree is not None and read.tree.coat and read.tree.film and read.tree.sheen and read.tree.aniso
+    tree = read.tree
+    assert tree is not None and tree.coat and tree.film and tree.sheen and tree.aniso and tree.sss
     from penumbra.engine.scene.materials import summary
 
     assert any(text.startswith("Coat:") for _icon, text in summary(read))
     assert any(text.startswith("Sheen:") for _icon, text in summary(read))
     assert any(text.startswith("Anisotropic:") for _icon, text in summary(read))
+    assert any(text.startswith("Subsurface:") for _icon, text in summary(read))
     glossy = scenes.material("Brushed", (0.8, 0.8, 0.8))
     tree = glossy.node_tree
     node = tree.nodes.new("ShaderNodeBsdfAnisotropic")

@@ -37,6 +37,7 @@ from devkit.reflection_scenes import hdri_path
 from devkit.render import cached_image, render
 from devkit.world_scenes import display
 
+SKIN = (0.8, 0.45, 0.3, 1.0)
 HELP = "the Principled BSDF's input groups on spheres vs Cycles and EEVEE -> <out>/principled.csv"
 
 SIZE = 64
@@ -81,8 +82,20 @@ CASES = {
     },
     "aniso 1 rough 1": {"Base Color": (0.9, 0.9, 0.9, 1.0), "Metallic": 1.0, "Roughness": 1.0, "Anisotropic": 1.0},
     "aniso 1 on plastic": {"Roughness": 0.3, "Anisotropic": 1.0},
+    "subsurface 0": {"Base Color": SKIN, "Subsurface Weight": 1.0, "Subsurface Scale": 0.0},
+    "subsurface": {"Base Color": SKIN, "Subsurface Weight": 1.0, "Subsurface Scale": 0.1},
+    "subsurface large": {"Base Color": SKIN, "Subsurface Weight": 1.0, "Subsurface Scale": 1.0},
+    "subsurface burley": {
+        "Base Color": SKIN,
+        "Subsurface Weight": 1.0,
+        "Subsurface Scale": 1.0,
+        "method": "BURLEY",
+    },
 }
 LIGHTS = ("sun", "hdri")
+# The subsurface cases' sun lights the sphere from the side (half of what the camera sees):
+# their light spreads across the terminator.
+CASE_LIGHTS = {name: ("side", "hdri") for name in CASES if name.startswith("subsurface")}
 
 
 def add_arguments(parser):
@@ -104,12 +117,16 @@ def sphere_scene(case, light):
     mat = scenes.material("Sphere", (0.6, 0.08, 0.06), roughness=0.5)
     bsdf = mat.node_tree.nodes["Principled BSDF"]
     for name, value in CASES[case].items():
-        bsdf.inputs[name].default_value = value
+        if name == "method":
+            bsdf.subsurface_method = value
+        else:
+            bsdf.inputs[name].default_value = value
     scenes.uv_sphere(scene, "Sphere", radius=1.0, segments=96, rings=48, mat=mat)
     scenes.camera(scene, (0.0, -10.0, 0.0), (np.pi / 2, 0.0, 0.0), ortho_scale=2.2, clip=(0.1, 20.0))
-    if light == "sun":
+    if light in ("sun", "side"):
         scenes.set_world(scene, (0.05, 0.05, 0.06))
-        scenes.light(scene, "Sun", "SUN", 3.0, rotation=(0.9, 0.3, -0.6), angle=0.02)
+        rotation = (0.9, 0.3, -0.6) if light == "sun" else (0.0, np.pi / 2, 0.0)
+        scenes.light(scene, "Sun", "SUN", 3.0, rotation=rotation, angle=0.02)
     else:
         tree = scene.world.node_tree
         env = tree.nodes.new("ShaderNodeTexEnvironment")
@@ -158,7 +175,7 @@ def run(args):
     rows = []
     with session.stdout_to_stderr():
         for case in names:
-            for light in LIGHTS:
+            for light in CASE_LIGHTS.get(case, LIGHTS):
                 log(f"{case}, {light}")
                 ref = reference(case, light, spp)
                 scene = sphere_scene(case, light)

@@ -2,7 +2,8 @@
 
 A technique that a frame may or may not need (the world's ratio estimator, the world's image in
 glossy lobes, a Plane probe's reflection, the scene's reflections, refraction, settling, the
-diffuse bounce, the world's occlusion, depth of field, motion blur, volumes) lives in one
+diffuse bounce, the world's occlusion, depth of field, motion blur, subsurface scattering,
+volumes) lives in one
 module here and is registered in ``REGISTRY``. The renderer asks each registered technique whether the frame needs it
 (``wanted``) and then calls the hooks of those that answered yes, in registry order, at fixed
 points of the frame; it does not name them. The lit pass, the frame data and the film take what
@@ -21,6 +22,7 @@ from .planar import PlanarReflections
 from .reflections import Reflections
 from .refraction import Refraction
 from .settling import Settling
+from .subsurface import Subsurface
 from .volumes import Volumes
 from .world_env import WorldEnvironment
 from .world_occlusion import WorldOcclusion
@@ -31,7 +33,8 @@ from .world_ratio import WorldRatio
 # image in glossy lobes (a Plane probe's capture takes it), a Plane probe's mirrored capture,
 # the scene's reflections in them, the cube maps of what the screen does not hold, what
 # transmissive surfaces refract, the world's occlusion
-# (which keeps the first sample from the directions), the bounce, the media's march (over the
+# (which keeps the first sample from the directions), the bounce, the light below subsurface
+# surfaces (added to the sample's colour before the media dim it), the media's march (over the
 # lit pass's z-buffer; it tells settling that its pixels change), and settling last (it
 # decides over what the others planned); the passes' draws after all of them (they draw over what
 # the lit pass left).
@@ -46,6 +49,7 @@ REGISTRY = (
     Refraction,
     WorldOcclusion,
     Bounce,
+    Subsurface,
     Volumes,
     Settling,
     Passes,

@@ -63,7 +63,7 @@ ENTRY = ProgramPart(
 
 GROUP = "LIGHTGROUP:"  # + a light group's name: its Combined before the post stack
 # Techniques whose light a light group pass leaves out (what they add mixes every group's).
-_MIXED_ACROSS_GROUPS = ("reflections", "planar", "cubes", "refraction", "bounce")
+_MIXED_ACROSS_GROUPS = ("reflections", "planar", "cubes", "refraction", "bounce", "subsurface")
 LIGHT_PASS_GROUP = 6
 
 
