@@ -333,11 +333,24 @@ DEBUG_VIEW = Enum(
                 "legend": "the sheens' light alone, in the render's colours; black without a sheen",
             },
         ),
+        (
+            "SUBSURFACE_LIGHT",
+            "Subsurface Light",
+            "The light scattered below surfaces alone (Principled Subsurface, Subsurface Scattering), spread "
+            "as it is drawn, averaged over the frame's samples",
+            14,
+            {
+                "lit": True,
+                "term": 6,
+                "legend": "the subsurface light alone, in the render's colours; black without a subsurface",
+            },
+        ),
     ),
     # lit: the lit pass writes the view's values instead of colour (the DEBUG_LIT variant);
     # term: instead, the lit pass writes one term of its colour alone (DEBUG_TERM: 1 the world's
     # light, 2 the diffuse bounce, 3 none: the volumes' march adds its light alone, 4 the coats'
-    # reflection, 5 the sheens' light); legend: what
+    # reflection, 5 the sheens' light, 6 none: the subsurface diffusion adds its light alone);
+    # legend: what
     # the colours mean (the viewport's text and the render report).
     fact_defaults={"lit": False, "term": 0, "legend": ""},
 )

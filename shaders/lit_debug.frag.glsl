@@ -8,7 +8,8 @@
  *   DEBUG_TERM 2         the diffuse bounce (INDIRECT)
  *   DEBUG_TERM 3         nothing: the volumes' march adds the media's light alone (VOLUME_LIGHT)
  *   DEBUG_TERM 4         a Principled coat's reflection alone, lights and world (COAT_LIGHT)
- *   DEBUG_TERM 5         a sheen's light alone, under any coat (SHEEN_LIGHT) */
+ *   DEBUG_TERM 5         a sheen's light alone, under any coat (SHEEN_LIGHT)
+ *   DEBUG_TERM 6         nothing: the subsurface diffusion adds its light alone (SUBSURFACE_LIGHT) */
 
 void main()
 {

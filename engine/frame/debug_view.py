@@ -15,7 +15,9 @@ Each view shows numbers the engine itself used for the frame, not a second compu
   the Noise Threshold;
 * WORLD_LIGHT, INDIRECT: the world's light alone (with its visibility) and the diffuse bounce
   alone, in colour: the lit pass's ``DEBUG_TERM`` variant writes that term of its colour; so do
-  COAT_LIGHT and SHEEN_LIGHT (a Principled coat's reflection, a sheen's light, each alone).
+  COAT_LIGHT and SHEEN_LIGHT (a Principled coat's reflection, a sheen's light, each alone);
+  VOLUME_LIGHT and SUBSURFACE_LIGHT write nothing there, and the media's march or the
+  subsurface diffusion adds its light alone.
 * WORLD_AO: the world's visibility from the ambient occlusion (``world/occlusion.py``), written by the
   lit pass's ``DEBUG_LIT`` variant with ``WORLD_AO`` (every sample occluded), in grey.
 * REFLECTIONS: where the reflections' rays met the scene (``features/reflections.py``: the

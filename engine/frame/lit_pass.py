@@ -176,6 +176,7 @@ class LitPass:
         mask} the lights each draw takes (a light group's; ``part`` then switches LIGHT_LINKING on);
         ``select(material, blended)``: whether a part is drawn (None: all of them)."""
         opaque, blended, submit = self._again(sample)
+        submit.entry = None  # the colour's entry shader, in a debug view's frame too
         if select is not None:
             opaque = [e for e in opaque if select(e[4], False)]
             blended = [e for e in blended if select(e[4], True)]

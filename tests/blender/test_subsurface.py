@@ -159,3 +159,30 @@ def test_burleys_profile_in_numpy():
         assert abs(through - analytic.burley_through(d, s)) < 2e-3, (s, through)
     assert abs(float(analytic.burley_edge(d, [0.0])[0]) - 0.5) < 1e-3
     assert analytic.burley_edge(d, [3 * d])[0] < 0.5 < analytic.burley_edge(d, [-3 * d])[0]
+
+
+def _debug_mean(scene, view, samples=2):
+    """``scene``'s F12 image with debug view ``view`` ("NONE": the image), mean above the
+    legend strip."""
+    scene.penumbra.debug_view = view
+    engines.configure(scene, "PENUMBRA", render_samples=samples)
+    try:
+        image = render(scene)["Combined"][..., :3]
+    finally:
+        scene.penumbra.debug_view = "NONE"
+    return image[6:].mean(axis=(0, 1))
+
+
+def test_the_subsurface_light_view_shows_that_light_alone(penumbra):
+    """Debug view Subsurface Light: a plane of Subsurface Weight 1 without specular under a sun
+    is all subsurface light (the view is the image within 1e-3); at weight 0.4 the view is 0.4 of
+    it (within 1 %); a plane without subsurface shows black."""
+    from devkit.plane_scenes import plane_scene
+
+    scene = plane_scene(lambda: _material(weight=1.0, scale=0.5), 40, 50)
+    whole = _debug_mean(scene, "NONE")
+    np.testing.assert_allclose(_debug_mean(scene, "SUBSURFACE_LIGHT"), whole, rtol=1e-3)
+    scene = plane_scene(lambda: _material(weight=0.4, scale=0.5), 40, 50)
+    np.testing.assert_allclose(_debug_mean(scene, "SUBSURFACE_LIGHT"), 0.4 * whole, rtol=0.01)
+    scene = plane_scene(lambda: _material(weight=0.0), 40, 50)
+    assert _debug_mean(scene, "SUBSURFACE_LIGHT").max() == 0.0

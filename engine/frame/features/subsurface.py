@@ -29,6 +29,7 @@ from .base import Feature, LitPart
 TAPS = 16  # points a pixel and sample in a frame of several samples
 TAPS_ONE_SAMPLE = 48  # in a one-sample frame (the viewport while the view moves)
 LIGHT_PASS_SUBSURFACE = 7  # lib/lit_surface.glsl
+SUBSURFACE_TERM = 6  # the Subsurface Light debug view's DEBUG_TERM: surfaces write 0, the diffusion adds its light
 
 # The lit pass's variant: the share below the surface left out (blended surfaces keep theirs).
 SPLIT = LitPart(
@@ -82,7 +83,8 @@ class Subsurface(Feature):
         self._fbs = {}
 
     def wanted(self, frame):
-        return frame.debug.id == "NONE" and sees_subsurface(frame.draws)
+        shown = frame.debug.id == "NONE" or (frame.debug.lit and frame.debug.term == SUBSURFACE_TERM)
+        return shown and sees_subsurface(frame.draws)
 
     def plan(self, frame):
         frame.stats.messages.append(APPROXIMATE)
