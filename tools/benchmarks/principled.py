@@ -19,8 +19,11 @@ at Sheen Roughness 0, 0.3 and 1 over a black base: the sheen alone), ``sheen tin
 roughness 0.5 over the red base) and ``sheen under coat`` (the same untinted, under Coat 1 at
 roughness 0.1); ``aniso 1``, ``aniso 0.5 turned`` (Anisotropic Rotation 0.25) and ``aniso 1 rough 1`` (a
 brushed white metal of roughness 0.4 or 1, its tangent Cycles' radial one about the sphere's Z)
-and ``aniso 1 on plastic`` (the red base at roughness 0.3). Writes ``<out>/principled.csv`` and a
-Markdown table to stdout.
+and ``aniso 1 on plastic`` (the red base at roughness 0.3); ``subsurface 0``, ``subsurface`` and
+``subsurface large`` (a skin-coloured base of Subsurface Weight 1, the default Radius at Scale 0,
+0.1 and 1, Random Walk) and ``subsurface burley`` (Scale 1, Christensen-Burley), lit from the side
+(``side``: half the sphere the camera sees) and by the HDRI. Writes ``<out>/principled.csv`` and a
+Markdown table to stdout; ``--sheet PATH`` draws the spheres into a PNG.
 ``--quick``: reference 256 spp.
 """
 
@@ -104,6 +107,7 @@ def add_arguments(parser):
     parser.add_argument("--samples", type=int, default=64, help="Penumbra's render samples (default 64)")
     parser.add_argument("--reference", type=int, default=1024, help="Cycles' reference spp (default 1024)")
     parser.add_argument("--cases", default=",".join(CASES), help="comma-separated: " + ", ".join(CASES))
+    parser.add_argument("--sheet", type=Path, help="also draw the spheres (Cycles, Penumbra, EEVEE) into this PNG")
 
 
 def log(message):
@@ -165,6 +169,38 @@ def timed(scene):
     return image, time.perf_counter() - start
 
 
+def draw_sheet(path, shown, spp, samples):
+    """The spheres of ``shown`` [(case, light, {engine: display image}, row)] side by side:
+    Cycles, Penumbra and EEVEE, and Penumbra's error x4."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    titles = (f"Cycles {spp} spp", f"Penumbra {samples}", f"EEVEE {EEVEE_SAMPLES}", "|Penumbra - Cycles| x4")
+    fig, axes = plt.subplots(len(shown), 4, figsize=(7.2, 1.9 * len(shown)), dpi=100, squeeze=False)
+    for r, (case, light, images, row) in enumerate(shown):
+        tiles = (
+            images["cycles"],
+            images["penumbra"],
+            images["eevee"],
+            np.abs(images["penumbra"] - images["cycles"]) * 4,
+        )
+        for c, tile in enumerate(tiles):
+            ax = axes[r, c]
+            ax.imshow(np.clip(tile[::-1, :, :3], 0.0, 1.0), interpolation="nearest")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            if r == 0:
+                ax.set_title(titles[c], fontsize=8)
+        axes[r, 0].set_ylabel(f"{case}\n{light}", fontsize=8)
+        axes[r, 1].set_xlabel(f"MAE {row['penumbra']:.4f}", fontsize=7)
+        axes[r, 2].set_xlabel(f"MAE {row['eevee']:.4f}", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
 def run(args):
     spp = 256 if args.quick else args.reference
     names = [n.strip() for n in args.cases.split(",") if n.strip()]
@@ -172,7 +208,7 @@ def run(args):
     session.load_penumbra().register()
     mask = sphere_mask()
     started = time.perf_counter()
-    rows = []
+    rows, shown = [], []
     with session.stdout_to_stderr():
         for case in names:
             for light in CASE_LIGHTS.get(case, LIGHTS):
@@ -193,7 +229,11 @@ def run(args):
                         "eevee_s": eevee_s,
                     }
                 )
+                if args.sheet:
+                    shown.append((case, light, {"cycles": ref, "penumbra": ours, "eevee": eevee}, rows[-1]))
     report.write_csv(args.out / "principled.csv", rows, CSV_FIELDS)
+    if args.sheet:
+        draw_sheet(args.sheet, shown, spp, args.samples)
     title = (
         f"Principled BSDF input groups on a sphere, {SIZE}x{SIZE}, display MAE over the sphere against Cycles "
         f"{spp} spp; Penumbra {args.samples} samples, EEVEE {EEVEE_SAMPLES}; Blender {bpy.app.version_string}"
