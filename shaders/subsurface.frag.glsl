@@ -32,6 +32,8 @@ float pixels_per_unit(float z)
   return (is_ortho > 0.5) ? scale : scale / max(z, 1e-20);
 }
 
+#define ALBEDO_MIN 1e-6
+
 void main()
 {
   ivec2 p = ivec2(gl_FragCoord.xy);
@@ -43,8 +45,9 @@ void main()
   vec3 light = texelFetch(sss_light, p, 0).rgb;
   vec3 d = radius.rgb;
   vec3 A = centre.rgb;
-  vec3 entering = vec3(A.r > 0.0 ? light.r / A.r : 0.0, A.g > 0.0 ? light.g / A.g : 0.0,
-                       A.b > 0.0 ? light.b / A.b : 0.0);
+  /* (An albedo below ALBEDO_MIN in a channel holds no light to divide out there.) */
+  vec3 entering = vec3(A.r > ALBEDO_MIN ? light.r / A.r : 0.0, A.g > ALBEDO_MIN ? light.g / A.g : 0.0,
+                       A.b > ALBEDO_MIN ? light.b / A.b : 0.0);
   float z = centre.a;
   float per_unit = pixels_per_unit(z);
   /* A profile within the pixel: the light stays where it entered. */
@@ -101,7 +104,7 @@ void main()
       continue;
     }
     for (int c = 0; c < 3; c++) {
-      if (live[c] && there[c] > 0.0) {
+      if (live[c] && there[c] > ALBEDO_MIN) {
         float w = burley_radial(d[c], dist) / (dist * density);
         weights[c] += w;
         sum[c] += w * there_light[c] / there[c];

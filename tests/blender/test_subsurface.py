@@ -235,3 +235,15 @@ def test_a_mix_of_a_subsurface_and_a_glossy_surface(penumbra):
     ours = plane_mean(mixed(1.0), 40, 50, samples=2)
     plain = plane_mean(mixed(0.0), 40, 50, samples=2)
     assert np.allclose(ours, plain, rtol=0.01), (ours, plain)
+
+
+def test_a_vanishing_albedo_and_nan_inputs_stay_finite(penumbra):
+    """A channel whose albedo is 1e-30 (nothing to divide the light by) and a Subsurface
+    Weight, Radius and Scale of NaN: finite, non-negative images (the harness checks every
+    frame), the vanishing channel black and the NaN surface the plain diffuse of weight 0."""
+    ours = plane_mean(lambda: _material(base=(1e-30, 0.5, 0.2), scale=0.5), 40, 50, samples=2)
+    assert np.all(np.isfinite(ours)) and ours[0] < 1e-20 and ours[1] > 0.01
+    nan = float("nan")
+    ours = plane_mean(lambda: _material(weight=nan, radius=(nan, 1.0, 1.0), scale=nan), 40, 50, samples=2)
+    plain = plane_mean(lambda: _material(weight=0.0), 40, 50, samples=2)
+    assert np.allclose(ours, plain, rtol=1e-4), (ours, plain)
