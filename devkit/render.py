@@ -9,7 +9,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from devkit import scenes
+from devkit import engines, scenes
 from devkit.imageio import read_exr, set_format
 
 
@@ -122,3 +122,15 @@ def group_off_and_on(gpu_call, off_inputs, on_inputs, define, width=48, height=3
         images.append(image)
         compiled.append(any(dict(k.program().defines).get(define) for k in stats.lit_keys))
     return images, compiled
+
+
+def debug_view_mean(scene, view, samples=2):
+    """``scene``'s F12 image with debug view ``view`` (``"NONE"``: the image itself; a debug
+    image is the Combined pass), its mean RGB above the legend strip; the view is reset after."""
+    scene.penumbra.debug_view = view
+    engines.configure(scene, "PENUMBRA", render_samples=samples)
+    try:
+        image = render(scene)["Combined"][..., :3]
+    finally:
+        scene.penumbra.debug_view = "NONE"
+    return image[6:].mean(axis=(0, 1))

@@ -9,10 +9,10 @@ import math
 import numpy as np
 import pytest
 
-from devkit import analytic, engines, scenes
+from devkit import analytic, scenes
 from devkit.plane_scenes import SUN, WORLD, plane_mean, plane_scene
 from devkit.plane_scenes import directions as _directions
-from devkit.render import group_off_and_on, render
+from devkit.render import debug_view_mean, group_off_and_on
 
 
 def _material(base, sheen_rough, weight=1.0, tint=(1.0, 1.0, 1.0), specular=0.0):
@@ -226,18 +226,6 @@ def test_a_sheen_bsdf_lies_beside_what_it_is_mixed_with(penumbra):
     assert np.allclose(mixed, 0.5 * (sheen + diffuse), rtol=0.02), (mixed, sheen, diffuse)
 
 
-def _debug_frame(gpu_call, scene, view, samples=2):
-    """``scene``'s image (view "NONE") or debug view ``view``'s image through F12 (the debug
-    image is the Combined pass), mean over the frame above the legend strip."""
-    scene.penumbra.debug_view = view
-    engines.configure(scene, "PENUMBRA", render_samples=samples)
-    try:
-        image = render(scene)["Combined"][..., :3]
-    finally:
-        scene.penumbra.debug_view = "NONE"
-    return image[6:].mean(axis=(0, 1))
-
-
 def test_the_sheen_and_coat_light_views_show_their_layer_alone(penumbra, gpu_call):
     """Debug views Sheen Light and Coat Light: over a red diffuse under a sun, each is its
     layer's own light (the numpy lobe's: the sheen within 2 %, the coat within 3 %), not the
@@ -259,17 +247,15 @@ def test_the_sheen_and_coat_light_views_show_their_layer_alone(penumbra, gpu_cal
         return make
 
     scene = _plane_scene(red(), view, elevation)
-    shown = _debug_frame(gpu_call, scene, "SHEEN_LIGHT")
+    shown = debug_view_mean(scene, "SHEEN_LIGHT")
     assert np.allclose(shown, SUN * analytic.sheen_reflectance(0.5, v, to_light), rtol=0.02), shown
-    assert _debug_frame(gpu_call, scene, "NONE")[0] > 1.5 * shown[0]
-    assert _debug_frame(gpu_call, scene, "COAT_LIGHT").max() == 0.0
+    assert debug_view_mean(scene, "NONE")[0] > 1.5 * shown[0]
+    assert debug_view_mean(scene, "COAT_LIGHT").max() == 0.0
     scene = _plane_scene(lambda: _material(0.0, 0.5), view, elevation)
-    np.testing.assert_allclose(
-        _debug_frame(gpu_call, scene, "SHEEN_LIGHT"), _debug_frame(gpu_call, scene, "NONE"), rtol=1e-4
-    )
+    np.testing.assert_allclose(debug_view_mean(scene, "SHEEN_LIGHT"), debug_view_mean(scene, "NONE"), rtol=1e-4)
     scene = _plane_scene(red(sheen=False, coat=True), view, elevation)
-    shown = _debug_frame(gpu_call, scene, "COAT_LIGHT")
+    shown = debug_view_mean(scene, "COAT_LIGHT")
     gain = analytic.ggx_ms_gain(0.04, 1.0, 0.3, v[2])
     ref = SUN * analytic.coat_reflectance(1.0, 0.3, v, to_light) * gain
     assert ref > 1e-3 and np.allclose(shown, ref, rtol=0.03), (shown, ref)
-    assert _debug_frame(gpu_call, scene, "SHEEN_LIGHT").max() == 0.0
+    assert debug_view_mean(scene, "SHEEN_LIGHT").max() == 0.0

@@ -10,7 +10,7 @@ import pytest
 
 from devkit import analytic, engines, scenes, subsurface_scenes
 from devkit.plane_scenes import SUN, plane_mean
-from devkit.render import group_off_and_on, render, technique_frame
+from devkit.render import debug_view_mean, group_off_and_on, render, technique_frame
 
 _material = subsurface_scenes.material
 
@@ -161,18 +161,6 @@ def test_burleys_profile_in_numpy():
     assert analytic.burley_edge(d, [3 * d])[0] < 0.5 < analytic.burley_edge(d, [-3 * d])[0]
 
 
-def _debug_mean(scene, view, samples=2):
-    """``scene``'s F12 image with debug view ``view`` ("NONE": the image), mean above the
-    legend strip."""
-    scene.penumbra.debug_view = view
-    engines.configure(scene, "PENUMBRA", render_samples=samples)
-    try:
-        image = render(scene)["Combined"][..., :3]
-    finally:
-        scene.penumbra.debug_view = "NONE"
-    return image[6:].mean(axis=(0, 1))
-
-
 def test_the_subsurface_light_view_shows_that_light_alone(penumbra):
     """Debug view Subsurface Light: a plane of Subsurface Weight 1 without specular under a sun
     is all subsurface light (the view is the image within 1e-3); at weight 0.4 the view is 0.4 of
@@ -180,12 +168,12 @@ def test_the_subsurface_light_view_shows_that_light_alone(penumbra):
     from devkit.plane_scenes import plane_scene
 
     scene = plane_scene(lambda: _material(weight=1.0, scale=0.5), 40, 50)
-    whole = _debug_mean(scene, "NONE")
-    np.testing.assert_allclose(_debug_mean(scene, "SUBSURFACE_LIGHT"), whole, rtol=1e-3)
+    whole = debug_view_mean(scene, "NONE")
+    np.testing.assert_allclose(debug_view_mean(scene, "SUBSURFACE_LIGHT"), whole, rtol=1e-3)
     scene = plane_scene(lambda: _material(weight=0.4, scale=0.5), 40, 50)
-    np.testing.assert_allclose(_debug_mean(scene, "SUBSURFACE_LIGHT"), 0.4 * whole, rtol=0.01)
+    np.testing.assert_allclose(debug_view_mean(scene, "SUBSURFACE_LIGHT"), 0.4 * whole, rtol=0.01)
     scene = plane_scene(lambda: _material(weight=0.0), 40, 50)
-    assert _debug_mean(scene, "SUBSURFACE_LIGHT").max() == 0.0
+    assert debug_view_mean(scene, "SUBSURFACE_LIGHT").max() == 0.0
 
 
 def test_the_viewport_a_sample_a_call_shows_the_final_render(penumbra, gpu_call):
