@@ -105,6 +105,23 @@ def mesh_object(scene, name, verts, faces, location=(0, 0, 0), mat=None):
     return ob
 
 
+def mix_with(mat, kind, fac=0.5, inputs=None):
+    """``mat``'s Principled BSDF mixed with a new shader node of ``kind`` (its ``inputs``
+    {name: value} set) by a Mix Shader of factor ``fac`` (the new node's share) into the output;
+    returns the new node."""
+    tree = mat.node_tree
+    other = tree.nodes.new(kind)
+    for name, value in (inputs or {}).items():
+        other.inputs[name].default_value = value
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = fac
+    out = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+    tree.links.new(tree.nodes["Principled BSDF"].outputs[0], mix.inputs[1])
+    tree.links.new(other.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], out.inputs["Surface"])
+    return other
+
+
 def plane(scene, name="Plane", size=10.0, z=0.0, mat=None):
     h = size / 2.0
     return mesh_object(scene, name, [(-h, -h, z), (h, -h, z), (h, h, z), (-h, h, z)], [(0, 1, 2, 3)], mat=mat)

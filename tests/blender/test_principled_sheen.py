@@ -155,17 +155,8 @@ def test_a_linked_sheen_and_a_mix_of_sheens(penumbra):
 
     def mixed():
         mat = _material(0.0, 0.6)
-        tree = mat.node_tree
-        bsdf = tree.nodes["Principled BSDF"]
-        plain = tree.nodes.new("ShaderNodeBsdfPrincipled")
-        plain.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
-        plain.inputs["Specular IOR Level"].default_value = 0.0
-        mix = tree.nodes.new("ShaderNodeMixShader")
-        mix.inputs["Fac"].default_value = 0.5
-        out = tree.nodes["Material Output"]
-        tree.links.new(bsdf.outputs[0], mix.inputs[1])
-        tree.links.new(plain.outputs[0], mix.inputs[2])
-        tree.links.new(mix.outputs[0], out.inputs["Surface"])
+        black = {"Base Color": (0.0, 0.0, 0.0, 1.0), "Specular IOR Level": 0.0}
+        scenes.mix_with(mat, "ShaderNodeBsdfPrincipled", 0.5, black)
         return mat
 
     assert full.mean() > 1e-3

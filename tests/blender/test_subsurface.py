@@ -205,17 +205,8 @@ def test_a_mix_of_a_subsurface_and_a_glossy_surface(penumbra):
     def mixed(weight):
         def make():
             mat = _material(weight=weight, scale=0.5)
-            tree = mat.node_tree
-            out = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
-            bsdf = tree.nodes["Principled BSDF"]
-            glossy = tree.nodes.new("ShaderNodeBsdfGlossy")
-            glossy.inputs["Color"].default_value = (0.2, 0.2, 0.2, 1.0)
-            glossy.inputs["Roughness"].default_value = 0.4
-            mix = tree.nodes.new("ShaderNodeMixShader")
-            mix.inputs["Fac"].default_value = 0.5
-            tree.links.new(bsdf.outputs[0], mix.inputs[1])
-            tree.links.new(glossy.outputs[0], mix.inputs[2])
-            tree.links.new(mix.outputs[0], out.inputs["Surface"])
+            glossy = {"Color": (0.2, 0.2, 0.2, 1.0), "Roughness": 0.4}
+            scenes.mix_with(mat, "ShaderNodeBsdfGlossy", 0.5, glossy)
             return mat
 
         return make
