@@ -159,67 +159,79 @@ def coat_reflectance(weight, rough, v, to_light, ior=1.5):
     return float(weight * ggx_reflectance(lambda c: fresnel_dielectric(c, ior), rough, v, to_light))
 
 
-def _film_sensitivity(opd, shift):
-    """Belcour and Barla's Gaussian fit of the XYZ sensitivities in Fourier space, at optical
-    path difference ``opd`` (nm) and phase ``shift``."""
-    phase = 2.0 * math.pi * opd * 1e-9
-    val = np.array([5.4856e-13, 4.4201e-13, 5.2481e-13])
-    pos = np.array([1.6810e06, 1.7953e06, 2.2084e06])
-    var = np.array([4.3278e09, 9.3046e09, 6.6121e09])
-    xyz = val * np.sqrt(2 * math.pi * var) * np.cos(pos * phase + shift) * np.exp(-var * phase * phase)
-    xyz[0] += (
-        9.7470e-14
-        * math.sqrt(2 * math.pi * 4.5282e09)
-        * math.cos(2.2399e06 * phase + shift)
-        * math.exp(-4.5282e09 * phase * phase)
-    )
-    return xyz / 1.0685e-7
-
-
-def _film_interface(c, n1, n2):
-    """(R_s, R_p), (phi_s, phi_p) of the interface from n1 to n2 at cosine ``c``."""
-    s2 = 1.0 - c * c
-    nr = n1 / n2
-    if nr * nr * s2 > 1.0:
-        t = math.sqrt(max(s2 - 1.0 / (nr * nr), 0.0)) / max(c, 1e-6)
-        return np.array([1.0, 1.0]), 2.0 * np.arctan(np.array([-nr * nr * t, -t]))
-    c2 = math.sqrt(max(1.0 - nr * nr * s2, 0.0))
-    r = np.array([(n2 * c - n1 * c2) / (n2 * c + n1 * c2), (n1 * c - n2 * c2) / (n1 * c + n2 * c2)])
-    return r * r, np.where(r < 0.0, math.pi, 0.0)
-
-
+# Rec. 709 (Blender's scene linear) from CIE XYZ.
 XYZ_TO_REC709 = np.array(
     [[3.2404542, -1.5371385, -0.4985314], [-0.9692660, 1.8760108, 0.0415560], [0.0556434, -0.2040259, 1.0572252]]
 )
+FILM_WAVELENGTHS = np.linspace(360.0, 830.0, 1881)  # nm, every 0.25 nm
+
+
+def _lobe(x, mu, s1, s2):
+    return np.exp(-0.5 * ((x - mu) / np.where(x < mu, s1, s2)) ** 2)
+
+
+def cie_cmf(lam):
+    """The CIE 1931 2-degree colour matching functions at wavelengths ``lam`` (nm), as Wyman,
+    Sloan and Shirley's multi-lobe fit ("Simple Analytic Approximations to the CIE XYZ Color
+    Matching Functions", JCGT 2013): (n, 3) XYZ."""
+    lam = np.asarray(lam, float)
+    x = (
+        1.056 * _lobe(lam, 599.8, 37.9, 31.0)
+        + 0.362 * _lobe(lam, 442.0, 16.0, 26.7)
+        - 0.065 * _lobe(lam, 501.1, 20.4, 26.2)
+    )
+    y = 0.821 * _lobe(lam, 568.8, 46.9, 40.5) + 0.286 * _lobe(lam, 530.9, 16.3, 31.1)
+    z = 1.217 * _lobe(lam, 437.0, 11.8, 36.0) + 0.681 * _lobe(lam, 459.0, 26.0, 13.8)
+    return np.stack([x, y, z], axis=-1)
+
+
+def film_rgb_weights():
+    """(wavelengths, (n, 3) Rec. 709 weights per wavelength whose columns each sum to 1): what
+    a spectral reflectance is integrated against to give linear RGB, white-balanced so a flat
+    spectrum is white (the equal-energy white)."""
+    rgb = cie_cmf(FILM_WAVELENGTHS) @ XYZ_TO_REC709.T
+    return FILM_WAVELENGTHS, rgb / rgb.sum(axis=0)
+
+
+def _amplitudes(c, n1, n2):
+    """The s- and p-polarised reflection amplitudes (complex) from index n1 to n2 (n2 may be
+    complex: a conductor n + i k) at cosine ``c``, and the cosine in n2."""
+    s2 = 1.0 - c * c
+    c2 = np.sqrt(complex(1.0 - (n1 / n2) ** 2 * s2))
+    rs = (n1 * c - n2 * c2) / (n1 * c + n2 * c2)
+    rp = (n2 * c - n1 * c2) / (n2 * c + n1 * c2)
+    return rs, rp, c2
+
+
+def _film_spectral(c, thickness, film_ior, r23_of):
+    """The film's reflectance in linear Rec. 709: the exact Airy reflectance at each wavelength
+    (both polarisations averaged) integrated against the colour matching functions.
+    ``r23_of(c2, eta2)`` gives the film-to-base amplitudes (s, p) at the film's cosine."""
+    c = min(max(c, 1e-4), 1.0)
+    d = max(thickness, 0.0)
+    t = min(max(d, 0.0), 1.0)
+    eta2 = 1.0 + (max(film_ior, 1.0) - 1.0) * t * t * (3.0 - 2.0 * t)  # below 1 nm, no film
+    rs12, rp12, c2 = _amplitudes(c, 1.0, eta2)
+    c2 = float(np.real(c2))
+    lam, weights = film_rgb_weights()
+    phase = np.exp(1j * 4.0 * math.pi * eta2 * d * c2 / lam)
+    reflectance = 0.0
+    for r12, r23 in zip((rs12, rp12), r23_of(c2, eta2), strict=True):
+        r = (r12 + r23 * phase) / (1.0 + r12 * r23 * phase)
+        reflectance = reflectance + 0.5 * np.abs(r) ** 2
+    return np.clip(reflectance @ weights, 0.0, 1.0)
 
 
 def thin_film_fresnel(c, thickness, film_ior, base_ior):
-    """The reflectance (linear Rec. 709, white-balanced to the sensitivities' equal-energy
-    white) of a thin dielectric film of ``thickness`` nm and ``film_ior`` on a base of
-    ``base_ior``, from air at cosine ``c``: the Airy summation integrated against the
-    sensitivities (Belcour and Barla 2017; the DC term and three pairs of Diracs)."""
-    c = min(max(c, 1e-4), 1.0)
-    d = max(thickness, 0.0)
-    t = min(max(d / 30.0, 0.0), 1.0)
-    eta2 = 1.0 + (max(film_ior, 1.0) - 1.0) * t * t * (3.0 - 2.0 * t)
-    c2 = math.sqrt(max(1.0 - (1.0 - c * c) / (eta2 * eta2), 0.0))
-    r12, phi12 = _film_interface(c, 1.0, eta2)
-    t121 = 1.0 - r12
-    phi21 = math.pi - phi12
-    r23, phi23 = _film_interface(c2, eta2, max(base_ior, 1.0))
-    opd = 2.0 * eta2 * d * c2
-    phi2 = phi21 + phi23
-    r123 = np.clip(r12 * r23, 1e-7, 0.9999)
-    rs = t121 * t121 * r23 / (1.0 - r123)
-    xyz = 0.5 * (r12[0] + rs[0] + r12[1] + rs[1]) * _film_sensitivity(0.0, 0.0)
-    cm = rs - t121
-    for m in (1, 2, 3):
-        cm = cm * np.sqrt(r123)
-        xyz = xyz + 0.5 * (
-            cm[0] * 2 * _film_sensitivity(m * opd, m * phi2[0]) + cm[1] * 2 * _film_sensitivity(m * opd, m * phi2[1])
-        )
-    white = XYZ_TO_REC709 @ _film_sensitivity(0.0, 0.0)
-    return np.clip((XYZ_TO_REC709 @ xyz) / white, 0.0, 1.0)
+    """The reflectance (linear Rec. 709) of a thin dielectric film of ``thickness`` nm and
+    ``film_ior`` on a dielectric of ``base_ior``, from air at cosine ``c``: the Airy reflectance
+    integrated over the spectrum (what Belcour and Barla's Fourier-space sum approximates)."""
+
+    def r23(c2, eta2):
+        rs, rp, _ = _amplitudes(c2, eta2, max(base_ior, 1.0))
+        return rs, rp
+
+    return _film_spectral(c, thickness, film_ior, r23)
 
 
 def ggx_reflectance(fresnel, rough, v, to_light):
@@ -414,3 +426,60 @@ def burley_edge(d, x, n=4096):
     beyond = np.where(r[None, :] > a, np.arccos(np.clip(a / r[None, :], -1.0, 1.0)) / math.pi, 0.0)
     share = (w[None, :] * beyond).sum(axis=1)
     return np.where(x > 0.0, share, 1.0 - share)
+
+
+def f82_tint_b(f0, tint):
+    """Cycles' F82-tint metal: the b of F = Schlick(f0) - b cos (1 - cos)^6 that makes the value
+    at cos 1/7 (82 degrees) Schlick's times ``tint`` (Kutz et al., Adobe Standard Material)."""
+    f = 6.0 / 7.0
+    schlick = np.asarray(f0) + (1.0 - np.asarray(f0)) * f**5
+    return schlick * (7.0 / f**6) * (1.0 - np.asarray(tint))
+
+
+def f82_b(f0, f82):
+    """The b of the F82 model whose value at cos 1/7 is ``f82``."""
+    f = 6.0 / 7.0
+    schlick = np.asarray(f0) + (1.0 - np.asarray(f0)) * f**5
+    return (7.0 / f**6) * (schlick - np.asarray(f82))
+
+
+def f82_fresnel(c, f0, b):
+    """The F82 model's reflectance at cosine ``c``."""
+    s = min(max(1.0 - c, 0.0), 1.0)
+    return np.clip(np.asarray(f0) + (1.0 - np.asarray(f0)) * s**5 - np.asarray(b) * c * s**6, 0.0, 1.0)
+
+
+def gulbrandsen_ior(f0, f82):
+    """A metal's complex index (n, k) per channel from its reflectance at normal incidence
+    ``f0`` and at 82 degrees ``f82`` read as Gulbrandsen's reflectivity and edge tint
+    ("Artist Friendly Metallic Fresnel", JCGT 2014), as Cycles films its metals."""
+    r = np.minimum(np.asarray(f0, float), 0.999)
+    sr = np.sqrt(r)
+    g = np.asarray(f82, float)
+    n = (1.0 + sr) / (1.0 - sr) * (1.0 - g) + (1.0 - r) / (1.0 + r) * g
+    k = np.sqrt(np.maximum((r * (n + 1.0) ** 2 - (n - 1.0) ** 2) / (1.0 - r), 0.0))
+    return n, k
+
+
+def thin_film_conductor(c, thickness, film_ior, f0, tint=(1.0, 1.0, 1.0)):
+    """The reflectance (linear Rec. 709) of a thin dielectric film on a metal of F82-tint
+    ``f0`` and ``tint``, as Cycles films its Principled metal: the metal's n and k from F0 and
+    its value at 82 degrees (gulbrandsen_ior); under the film its reflectance is the F82 model's
+    at the film's index and its phase the complex Fresnel's; the Airy reflectance per channel,
+    integrated over the spectrum."""
+    f0 = np.clip(np.asarray(f0, float), 0.0, 1.0)
+    g = f82_fresnel(1.0 / 7.0, f0, f82_tint_b(f0, tint))
+    n, k = gulbrandsen_ior(f0, g)
+    out = np.zeros(3)
+    for ch in range(3):
+
+        def r23(c2, eta2, ch=ch):
+            nc = complex(n[ch], k[ch])
+            rs, rp, _ = _amplitudes(c2, eta2, nc)
+            rel = nc / eta2
+            film_f0 = abs((rel - 1.0) / (rel + 1.0)) ** 2
+            size = math.sqrt(float(f82_fresnel(c2, film_f0, f82_b(film_f0, g[ch]))))
+            return size * rs / abs(rs), size * rp / abs(rp)
+
+        out[ch] = _film_spectral(c, thickness, film_ior, r23)[ch]
+    return out

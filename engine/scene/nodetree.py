@@ -717,9 +717,6 @@ def _principled(c, node, socket, ctx):
         film_ior = c.shader_input(node, "Thin Film IOR", ctx, "float", 1.33)
         expr = f"node_principled_film({expr}, {thickness.expr}, {film_ior.expr}, {ior.expr}, {level.expr})"
         c.film = True
-        metallic = node.inputs.get("Metallic")
-        if metallic is not None and (metallic.is_linked or float(metallic.default_value) > 0.0):
-            c.messages.append("Thin Film on the metallic part is not drawn (on the dielectric's specular only)")
     c.messages += [f"{name} is not drawn" for name in unread]
     return c.temp("closure", expr, 1)
 

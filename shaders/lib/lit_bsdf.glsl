@@ -52,9 +52,13 @@ vec3 lobe_brdf(Lobe b, vec3 V, vec3 to_light, float NdotL, LightData L)
   vec3 F = b.f0.rgb + (b.f0.a - b.f0.rgb) * fw;
 #  if NODE_FILM
   if (b.film > 0.0) {
-    /* The film on the dielectric's specular (its Fresnel at the half vector); the metal keeps its own. */
-    vec3 film = film_fresnel(dot(to_light, H), lit_film.y, lit_film.z, lit_film.w) * b.film_tint;
-    F = mix(F, mix(film, b.metal_f0 + (b.f0.a - b.metal_f0) * fw, b.metal), b.film);
+    /* The film on the dielectric's specular and on the metal's (their Fresnel at the half vector). */
+    float cos_h = dot(to_light, H);
+    vec3 film = film_fresnel(cos_h, lit_film.y, lit_film.z, lit_film.w) * b.film_tint;
+    if (b.metal > 0.0) {
+      film = mix(film, film_fresnel_metal(cos_h, lit_film.y, lit_film.z, b.metal_f0, b.film_tint), b.metal);
+    }
+    F = mix(F, film, b.film);
   }
 #  endif
   /* Times the multiple-scattering gain (ggx_ms_gain), as Cycles scales the lobe. */
@@ -151,6 +155,10 @@ Lobe lobe_setup(vec3 base, float rough, float metal, vec4 spec, vec3 N, vec3 V, 
   /* Specular Tint (the tinted F0 over the untinted) tints the film's reflectance, as Cycles'. */
   b.film_tint = (spec.a > 1e-6) ? clamp(spec.rgb / spec.a, 0.0, 1e6) : vec3(1.0);
   b.film_dfg = film_fresnel(NdotV, lit_film.y, lit_film.z, lit_film.w) * (ab_one.x + ab_one.y) * b.film_tint;
+  /* The metal's, as Cycles films its F82-tint metal (lib/thin_film.glsl film_fresnel_metal). */
+  b.metal_film_dfg = (metal > 0.0) ? film_fresnel_metal(NdotV, lit_film.y, lit_film.z, base, b.film_tint) *
+                                         (ab_one.x + ab_one.y) :
+                                     vec3(0.0);
   reflected = mix(reflected, b.film_dfg, b.film);
 #endif
   b.albedo *= clamp(1.0 - reflected, 0.0, 1.0);

@@ -50,6 +50,7 @@ struct Lobe {
   float metal;     /* its metallic, whose Fresnel the film leaves */
   vec3 metal_f0;   /* the metal's reflectance at normal incidence (the base colour) */
   vec3 film_dfg;   /* the film's reflectance towards the viewer x the lobe's albedo at F = 1 */
+  vec3 metal_film_dfg; /* the same of the film on the metal */
   vec3 film_tint;  /* Specular Tint, which the film's reflectance is multiplied by */
 #endif
 };

@@ -208,7 +208,7 @@ vec3 world_light(Lobe b, vec3 V, vec2 ab)
   vec3 dfg = b.f0.rgb * ab.x + ab.y;
 #if NODE_FILM
   /* A Thin Film's dielectric (lit_bsdf.glsl lobe_setup), the metal's own. */
-  dfg = mix(dfg, mix(b.film_dfg, b.metal_f0 * ab.x + ab.y, b.metal), b.film);
+  dfg = mix(dfg, mix(b.film_dfg, b.metal_film_dfg, b.metal), b.film);
 #endif
   vec3 specular = radiance * dfg;
 #if WORLD_AO && WORLD_RATIO

@@ -1,7 +1,8 @@
 """The Principled BSDF's Thin Film (shaders/lib/thin_film.glsl, lit_bsdf.glsl) against the same
-model in numpy (devkit.analytic.thin_film_fresnel: the Airy summation integrated against the
-CIE sensitivities, Belcour and Barla 2017; ggx_reflectance). A plane fills an orthographic
-view, so every pixel sees the same angles and the image mean is one evaluation of the BSDF."""
+film in numpy (devkit.analytic.thin_film_fresnel, thin_film_conductor: the exact Airy reflectance
+integrated over the spectrum against the CIE matching functions; ggx_reflectance) and Cycles.
+A plane fills an orthographic view, so every pixel sees the same angles and the image mean is
+one evaluation of the BSDF."""
 
 import math
 
@@ -84,11 +85,43 @@ def test_film_thickness_zero_compiles_no_film(penumbra, gpu_call):
     assert not np.array_equal(plain, filmed)
 
 
-def test_a_film_on_a_metal_is_named(penumbra):
-    from penumbra.engine.scene.materials import material_from_blender
+@pytest.mark.parametrize(
+    ("thickness", "view", "elevation"), [(150.0, 40.0, 45.0), (400.0, 40.0, 45.0), (700.0, 20.0, 60.0)]
+)
+def test_a_film_on_a_metal_reflects_as_cycles_films_its_metals(penumbra, thickness, view, elevation):
+    """A film of IOR 1.5 on a rough gold-like metal (F0 (0.9, 0.6, 0.3)) under a sun: the GGX
+    lobe with the filmed conductor's reflectance (devkit.analytic.thin_film_conductor: the
+    metal's n and k from F0 and F82, the exact Airy reflectance over the spectrum) within 3 %
+    per channel, and Cycles' own within 3 % (64 spp; measured within 1.5 %)."""
+    base = (0.9, 0.6, 0.3)
+    t, z = math.radians(view), math.radians(90 - elevation)
+    v, to_light = (0.0, -math.sin(t), math.cos(t)), (0.0, math.sin(z), math.cos(z))
+    gain = analytic.ggx_ms_gain(float(np.mean(base)), 1.0, 0.3, v[2])
 
-    scenes.empty_scene(8, 8)
-    read = material_from_blender(_filmed(0.8, 0.3, 500.0, metallic=1.0))
-    assert read.tree is not None and read.tree.film
-    assert any("Thin Film on the metallic part is not drawn" in m for m in read.messages), read.messages
-    assert not any("Thin Film Thickness is not drawn" in m for m in read.messages)
+    def fresnel(c):
+        return analytic.thin_film_conductor(c, thickness, 1.5, np.array(base))
+
+    ref = SUN * gain * analytic.ggx_reflectance(fresnel, 0.3, v, to_light)
+
+    def make():
+        mat = _filmed(0.0, 0.3, thickness, film_ior=1.5, metallic=1.0)
+        mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (*base, 1.0)
+        return mat
+
+    ours = _plane(make, view, elevation)
+    assert np.allclose(ours, ref, rtol=0.03), (ours, ref)
+    cycles = plane_mean(make, view, elevation, 64, engine="CYCLES", sun_angle=math.radians(0.5))
+    assert np.allclose(ours, cycles, rtol=0.03), (ours, cycles)
+
+
+def test_a_film_on_a_dielectric_is_cycles_film(penumbra):
+    """The dielectric's film against Cycles' own (64 spp) at 400 nm, where the sensitivities'
+    Gaussian fit the film first used was 40 % off in red: within 3 % per channel."""
+    view, elevation = 40.0, 45.0
+
+    def make():
+        return _filmed(0.0, 0.3, 400.0)
+
+    ours = _plane(make, view, elevation)
+    cycles = plane_mean(make, view, elevation, 64, engine="CYCLES", sun_angle=math.radians(0.5))
+    assert np.allclose(ours, cycles, rtol=0.03), (ours, cycles)
