@@ -6,12 +6,17 @@ one evaluation of the BSDF."""
 
 import math
 
+import bpy
 import numpy as np
 import pytest
 
 from devkit import analytic, scenes
 from devkit.plane_scenes import SUN, plane_mean
 from devkit.render import group_off_and_on
+
+# Cycles' thin film as Penumbra draws it: Blender 5.0 on (4.5's films no metal, and its
+# dielectric film differs from the spectral integral).
+CYCLES_FILMS_AS_5 = bpy.app.version >= (5, 0, 0)
 
 
 def _filmed(base, rough, thickness, film_ior=1.33, ior=1.5, metallic=0.0):
@@ -92,7 +97,8 @@ def test_a_film_on_a_metal_reflects_as_cycles_films_its_metals(penumbra, thickne
     """A film of IOR 1.5 on a rough gold-like metal (F0 (0.9, 0.6, 0.3)) under a sun: the GGX
     lobe with the filmed conductor's reflectance (devkit.analytic.thin_film_conductor: the
     metal's n and k from F0 and F82, the exact Airy reflectance over the spectrum) within 3 %
-    per channel, and Cycles' own within 3 % (64 spp; measured within 1.5 %)."""
+    per channel, and Cycles' own within 3 % (64 spp; measured within 1.5 %) where Cycles films
+    metals (5.0 on; 4.5's draws them without the film)."""
     base = (0.9, 0.6, 0.3)
     t, z = math.radians(view), math.radians(90 - elevation)
     v, to_light = (0.0, -math.sin(t), math.cos(t)), (0.0, math.sin(z), math.cos(z))
@@ -110,10 +116,12 @@ def test_a_film_on_a_metal_reflects_as_cycles_films_its_metals(penumbra, thickne
 
     ours = _plane(make, view, elevation)
     assert np.allclose(ours, ref, rtol=0.03), (ours, ref)
-    cycles = plane_mean(make, view, elevation, 64, engine="CYCLES", sun_angle=math.radians(0.5))
-    assert np.allclose(ours, cycles, rtol=0.03), (ours, cycles)
+    if CYCLES_FILMS_AS_5:
+        cycles = plane_mean(make, view, elevation, 64, engine="CYCLES", sun_angle=math.radians(0.5))
+        assert np.allclose(ours, cycles, rtol=0.03), (ours, cycles)
 
 
+@pytest.mark.skipif(not CYCLES_FILMS_AS_5, reason="Cycles before 5.0 films otherwise (its red at 400 nm is 0)")
 def test_a_film_on_a_dielectric_is_cycles_film(penumbra):
     """The dielectric's film against Cycles' own (64 spp) at 400 nm, where the sensitivities'
     Gaussian fit the film first used was 40 % off in red: within 3 % per channel."""
