@@ -13,18 +13,6 @@
  * over the points that are subsurface pixels (the rest of the disk leaves the screen or the
  * surface): what lies outside is not counted as dark. */
 
-float screen_hash(vec2 p, float salt)
-{
-  uvec2 q = uvec2(floor(p));
-  uint h = q.x * 1973u + q.y * 9277u + uint(salt) * 26699u;
-  h = (h ^ 61u) ^ (h >> 16);
-  h *= 9u;
-  h ^= h >> 4;
-  h *= 0x27d4eb2du;
-  h ^= h >> 15;
-  return float(h) * (1.0 / 4294967296.0);
-}
-
 /* Pixels per world unit across the view at view depth ``z``. */
 float pixels_per_unit(float z)
 {
@@ -58,7 +46,8 @@ void main()
   }
   bvec3 live = greaterThan(d, vec3(0.0));
   int channels = int(live.r) + int(live.g) + int(live.b);
-  vec2 shift = vec2(screen_hash(gl_FragCoord.xy, 7.0), screen_hash(gl_FragCoord.xy, 11.0));
+  /* The R2 sequence over the frame's taps, rotated per pixel (lib/material.glsl pixel_r2's). */
+  vec2 shift = vec2(pixel_hash(gl_FragCoord.xy + 7.0), pixel_hash(gl_FragCoord.xy + 108.0));
   vec3 sum = vec3(0.0), weights = vec3(0.0);
   for (int i = 0; i < taps; i++) {
     vec2 u = fract(shift + float(sample_index * taps + i) * vec2(0.7548776662, 0.5698402910));

@@ -46,7 +46,7 @@ def _rows(values):
 
 
 def glsl(nu, a):
-    return f"""// requires:
+    return f"""// requires: lib/lit_surface.glsl
 #ifndef PENUMBRA_LIB_THIN_FILM_TABLE
 #define PENUMBRA_LIB_THIN_FILM_TABLE
 
@@ -55,11 +55,7 @@ def glsl(nu, a):
  * demodulated by each channel's mean wavenumber FILM_NU (1/nm): FILM_A_RE + i FILM_A_IM at
  * FILM_TABLE_SIZE points from 0 to FILM_REACH nm. */
 
-#ifndef NODE_FILM
-#  define NODE_FILM 0 /* a Principled thin film is drawn (engine/frame/programs.py material_defines) */
-#endif
-
-#if NODE_FILM /* only variants that draw a film carry the table */
+#if NODE_FILM /* only variants that draw a film carry the table (lib/lit_surface.glsl) */
 
 #define FILM_TABLE_SIZE {SIZE}
 #define FILM_REACH {REACH:.1f}

@@ -1,4 +1,4 @@
-// requires: lib/common.glsl lib/thin_film_table.glsl
+// requires: lib/common.glsl lib/lit_surface.glsl lib/thin_film_table.glsl
 #ifndef PENUMBRA_LIB_THIN_FILM
 #define PENUMBRA_LIB_THIN_FILM
 

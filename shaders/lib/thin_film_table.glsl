@@ -1,4 +1,4 @@
-// requires:
+// requires: lib/lit_surface.glsl
 #ifndef PENUMBRA_LIB_THIN_FILM_TABLE
 #define PENUMBRA_LIB_THIN_FILM_TABLE
 
@@ -7,11 +7,7 @@
  * demodulated by each channel's mean wavenumber FILM_NU (1/nm): FILM_A_RE + i FILM_A_IM at
  * FILM_TABLE_SIZE points from 0 to FILM_REACH nm. */
 
-#ifndef NODE_FILM
-#  define NODE_FILM 0 /* a Principled thin film is drawn (engine/frame/programs.py material_defines) */
-#endif
-
-#if NODE_FILM /* only variants that draw a film carry the table */
+#if NODE_FILM /* only variants that draw a film carry the table (lib/lit_surface.glsl) */
 
 #define FILM_TABLE_SIZE 256
 #define FILM_REACH 16000.0

@@ -104,6 +104,12 @@ class Feature:
         pass
 
 
+def outputs_of(parts):
+    """Colour targets ``parts`` (``ProgramPart``s, None for none) write besides the lit pass's
+    colour: what a draw of the lit program again (``LitPass.draw_light``) must bind after it."""
+    return sum(len(p.outputs) for p in parts if p is not None)
+
+
 def captured_parts(frame, sample):
     """The ``LitPart``s the frame's techniques give a capture of ``sample`` (``Feature.capture``)."""
     return tuple(p for p in (f.capture(frame, sample) for f in frame.features) if p is not None)

@@ -15,7 +15,7 @@ from ...gpu_pool import new_texture
 from .. import cryptomatte, sampling
 from ..film import FilmPart, clear_zero
 from ..film_programs import SCALED_COPY, WEIGHTED_RESOLVE
-from .base import Feature
+from .base import Feature, outputs_of
 
 # Each pass a frame can ask for: its id in lit_passes.frag.glsl, and how the samples give it
 # (MEAN: averaged as Combined; CENTRE: the centred sample's; IDS: read back every sample).
@@ -265,7 +265,7 @@ class Passes(Feature):
         values = _draw_values({id(d): i for i, d in enumerate(sample.draws)})
         if sample.index == 0 and not sample.pilot:
             self._centre_draws = [(d.instance.motion_key, d.instance.matrix) for d in sample.draws]
-        outputs = max(_outputs(data.parts), _outputs(data.blended_parts))
+        outputs = max(outputs_of(data.parts), outputs_of(data.blended_parts))
         for key in keys:
             if _mode(key) != LIGHT:
                 continue  # (a pilot sample, settling's, draws what a settled pixel keeps of it)
@@ -279,8 +279,8 @@ class Passes(Feature):
             if key in targets.world_groups and not frame.settings.film_transparent:
                 renderer.lit_pass.background_into(targets.sample[key], frame, sample)  # the world seen
             fbs = (
-                targets.light_framebuffer(renderer.film, key, _outputs(data.parts)),
-                targets.light_framebuffer(renderer.film, key, _outputs(data.blended_parts)),
+                targets.light_framebuffer(renderer.film, key, outputs_of(data.parts)),
+                targets.light_framebuffer(renderer.film, key, outputs_of(data.blended_parts)),
             )
             if outputs > len(targets.scratch):
                 raise RuntimeError("a technique writes more targets than the light passes' scratch holds")
@@ -360,11 +360,6 @@ def _group_draw(frame, sample, name):
         set_uniforms(shader, {"group_emission": 1.0 if draw.instance.lightgroup == name else 0.0})
 
     return part, per_draw, masks
-
-
-def _outputs(parts):
-    """Colour targets ``parts`` (``ProgramPart``) write besides the lit pass's colour."""
-    return sum(len(p.outputs) for p in parts if p is not None)
 
 
 def _draw_values(numbers):

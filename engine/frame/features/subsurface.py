@@ -24,7 +24,7 @@ Wanted where the camera sees a subsurface material; a frame without one pays not
 
 from ....shaders.loader import Program, ProgramPart
 from ...gpu_pool import new_texture
-from .base import Feature, LitPart
+from .base import Feature, LitPart, outputs_of
 
 TAPS = 16  # points a pixel and sample in a frame of several samples
 TAPS_ONE_SAMPLE = 48  # in a one-sample frame (the viewport while the view moves)
@@ -47,7 +47,7 @@ DIFFUSION = Program(
     name="subsurface",
     vertex="fullscreen.vert.glsl",
     fragment="subsurface.frag.glsl",
-    libs=("lib/burley.glsl",),
+    libs=("lib/burley.glsl", "lib/material.glsl"),
     vertex_in=(("VEC2", "pos"),),
     push_constants=(
         ("MAT4", "projection"),
@@ -117,7 +117,7 @@ class Subsurface(Feature):
         from mathutils import Matrix
 
         film = self.renderer.film
-        outputs = sum(len(p.outputs) for p in sample.data.parts if p is not None)
+        outputs = outputs_of(sample.data.parts)
         with frame.clock.stage("subsurface"):
             self._ensure(film.size, outputs)
             for target in self.targets:
