@@ -63,8 +63,15 @@ vec3 subsurface_exit(Surface s, vec3 exit)
 
 void subsurface_outputs(Surface s, vec4 sss, vec3 exit)
 {
+#  if HOLDOUT
+  /* A hole in the film (Object > Visibility > Holdout): not a subsurface pixel, nothing spreads
+   * into it or out of it. */
+  out_sss_albedo = vec4(0.0, 0.0, 0.0, v_view_depth);
+  out_sss_radius = vec4(0.0);
+#  else
   out_sss_albedo = vec4(subsurface_albedo(s) * exit, v_view_depth);
   out_sss_radius = vec4(max(sss.rgb, vec3(0.0)), 1.0);
+#  endif
 }
 #endif
 

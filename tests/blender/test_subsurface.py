@@ -228,3 +228,18 @@ def test_a_vanishing_albedo_and_nan_inputs_stay_finite(penumbra):
     ours = plane_mean(lambda: _material(weight=nan, radius=(nan, 1.0, 1.0), scale=nan), 40, 50, samples=2)
     plain = plane_mean(lambda: _material(weight=0.0), 40, 50, samples=2)
     assert np.allclose(ours, plain, rtol=1e-4), (ours, plain)
+
+
+def test_a_holdout_with_subsurface_stays_a_hole(penumbra):
+    """Object > Visibility > Holdout on a subsurface plane in front of another one: its pixels
+    stay a hole (RGBA 0) and no light spreads into them from the plane beside it."""
+    from devkit.plane_scenes import plane_scene
+
+    scene = plane_scene(lambda: _material(scale=2.0), 0, 50)
+    near = scenes.plane(scene, "Near", size=0.5, z=0.5, mat=_material(scale=2.0))
+    near.is_holdout = True
+    engines.configure(scene, "PENUMBRA", render_samples=4)
+    image = render(scene)["Combined"]
+    centre = image[6:10, 6:10]
+    assert np.array_equal(centre, np.zeros_like(centre)), centre[..., :3].max()
+    assert image[0, 0, :3].max() > 0.01
