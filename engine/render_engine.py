@@ -8,7 +8,7 @@ import traceback
 import bpy
 import numpy as np
 
-from . import gpu_pool
+from . import gpu_pool, store
 from .frame import cryptomatte, sampling
 from .frame.output import (
     CRYPTOMATTE_SWITCHES,
@@ -93,8 +93,9 @@ class PenumbraEngineCore:
         from .frame.renderer import FrameRequest, Renderer
 
         if self.renderer is None:
-            shaders = gpu_pool.final_shaders() if self.texture_pool is not None else None
-            self.renderer = Renderer(self.texture_pool, shaders)
+            final = self.texture_pool is not None
+            shaders = gpu_pool.final_shaders() if final else None
+            self.renderer = Renderer(self.texture_pool, shaders, store=self.cache.store if final else None)
         scene = depsgraph.scene
         self.cache.uv_pass = "UV" in passes  # every mesh's UV map read (geometry keyed by what it reads)
         snapshot = self.cache.snapshot(depsgraph)
@@ -410,6 +411,8 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         scene = depsgraph.scene
         layer = depsgraph.view_layer.name
         self.texture_pool = gpu_pool.FINAL_RENDERS
+        self.cache.store = store.STORE  # meshes and their batches kept between final renders
+        store.STORE.pressure()  # the system short of memory: the store sheds its older half
         r = scene.render
         self.texture_pool.begin_render(
             (scene.name, scene.frame_current, self.resolution_x, self.resolution_y, r.use_border)
@@ -786,8 +789,10 @@ def _gpu_texture_limit():
 
 def register():
     bpy.utils.register_class(PenumbraRenderEngine)
+    store.register()
 
 
 def unregister():
+    store.unregister()  # what final renders kept (meshes, their batches) is let go
     bpy.utils.unregister_class(PenumbraRenderEngine)
     gpu_pool.clear()  # Blender unregisters add-ons on exit, before its GPU module

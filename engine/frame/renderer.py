@@ -182,12 +182,13 @@ class Renderer:
     # splits CPU time from GPU time (the benchmarks set it; it stalls the pipeline).
     fence_stages = False
 
-    def __init__(self, pool=None, shaders=None, features=None):
+    def __init__(self, pool=None, shaders=None, features=None, store=None):
         """``pool``: a ``gpu_pool.TexturePool`` the frame's targets and shadow atlas come from
         (final renders); ``release`` gives them back. ``shaders``: a ``ShaderCache`` shared
         with other renderers (final renders), else one of its own. ``features``: the
-        techniques' classes (``features.REGISTRY`` unless given; one left out is off)."""
-        self.caches = GpuCaches.create(pool, shaders)
+        techniques' classes (``features.REGISTRY`` unless given; one left out is off).
+        ``store``: the extension's ``store.Store`` (final renders) its batches are kept in."""
+        self.caches = GpuCaches.create(pool, shaders, store)
         self.film = Film(self.caches.shaders, pool)
         self.shadow_pass = ShadowPass(pool)
         self.lit_pass = LitPass(self.caches, self.film)
@@ -236,7 +237,13 @@ class Renderer:
         sample (``_sample_at``: shadow maps, lit pass, accumulate), then resolve
         (``_resolve``) and post (``_post``). Each takes the ``FramePlan`` (and the ``Sample``)."""
         clock = StageClock(self.wait_gpu if self.fence_stages else None)
-        counters = (self._uploaded(), self.shaders.compiled, self.shaders.compile_seconds)
+        counters = (
+            self._uploaded(),
+            self.shaders.compiled,
+            self.shaders.compile_seconds,
+            self.batches.uploaded,
+            self.textures.upload_bytes,
+        )
         self.film.clock = clock
         with clock.stage("prepare"):
             frame = self._plan(snapshot, request, clock)
@@ -268,6 +275,8 @@ class Renderer:
         stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
         stats.cpu_seconds, stats.gpu_seconds = clock.cpu, clock.gpu
         stats.upload_bytes = self._uploaded() - counters[0]
+        stats.mesh_upload_bytes = self.batches.uploaded - counters[3]
+        stats.image_upload_bytes = self.textures.upload_bytes - counters[4]
         stats.shaders_compiled = self.shaders.compiled - counters[1]
         stats.compile_seconds = self.shaders.compile_seconds - counters[2]
         return self._output(frame, color, debug_image)

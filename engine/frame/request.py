@@ -68,16 +68,17 @@ class GpuCaches:
     pool: object = None
 
     @classmethod
-    def create(cls, pool=None, shaders=None):
+    def create(cls, pool=None, shaders=None, store=None):
         """Fresh caches (inside a GPU context); ``shaders``: a ``ShaderCache`` shared with
-        other renderers (final renders), else one of their own."""
+        other renderers (final renders), else one of their own; ``store``: the extension's
+        ``store.Store`` batches are also kept in between renders (final renders), or None."""
         from ...shaders.loader import ShaderCache
         from ..scene.textures import TextureCache
         from .batches import Batches
         from .material_blocks import MaterialBlocks
 
         shaders = shaders if shaders is not None else ShaderCache()
-        return cls(shaders, MaterialBlocks(), TextureCache(), Batches(), pool)
+        return cls(shaders, MaterialBlocks(), TextureCache(), Batches(store), pool)
 
     @property
     def uploaded(self):

@@ -127,6 +127,8 @@ class FrameStats:
     world_guided: bool = False  # the probe found an interior: the world's directions come through its openings
     ao_texels: int = 0  # texels whose horizons were marched (half resolution: a quarter of the film)
     upload_bytes: int = 0  # bytes sent to the GPU: uniform blocks, batches built, textures of data
+    mesh_upload_bytes: int = 0  # of those, vertex and index buffers (not found in a cache or the store)
+    image_upload_bytes: int = 0  # image textures Blender made for this frame (``textures._first_take``)
     cpu_seconds: dict = field(default_factory=dict)  # stage -> render-thread CPU seconds (``StageClock.cpu``)
     gpu_seconds: dict = field(default_factory=dict)  # stage -> seconds waiting on the GPU (with a fence only)
     sample_cpu_seconds: list = field(default_factory=list)  # CPU seconds of each sample (its stages)

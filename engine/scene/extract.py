@@ -12,8 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..store import Kind
 from . import hair, volumes
-from .geometry import ContentCache, Geometry, content_key
+from .geometry import Geometry, content_key
 from .materials import material_from_blender, world_from_blender
 from .terminator import Terminator
 
@@ -616,7 +617,45 @@ def geometry_from_mesh(mesh, needs=None):
     )
 
 
-_CLOSED = ContentCache(1024)  # content digest of (triangles, positions) -> closed_outward, a unit each
+def mesh_content_key(mesh, needs=None):
+    """A digest of all that ``geometry_from_mesh(mesh, needs)`` reads: positions, the corners'
+    vertices, the faces' first corners and material indices, the normals it takes (on points
+    or corners), the UV map and colour attribute ``needs`` asks for, and the mesh's name (its
+    messages name it). Reading these costs a small part of an extraction (no triangulation,
+    no tangents, no re-indexing): final renders find the geometry in the store by it."""
+    nv, nc, nf = len(mesh.vertices), len(mesh.loops), len(mesh.polygons)
+    co = _attribute(mesh, "position", "vector", nv, np.float32, 3)
+    if co is None:
+        co = _read(mesh.vertices, "co", nv, np.float32, 3)
+    corner_vert = _attribute(mesh, ".corner_vert", "value", nc, np.int32)
+    if corner_vert is None:
+        corner_vert = _read(mesh.loops, "vertex_index", nc, np.int32)
+    loop_start = _read(mesh.polygons, "loop_start", nf, np.int32) if nf else np.zeros(0, np.int32)
+    material = _attribute(mesh, "material_index", "value", nf, np.int32)
+    if mesh.normals_domain == "POINT":
+        normals = _read(mesh.vertex_normals, "vector", nv, np.float32, 3)
+    else:
+        normals = _read(mesh.corner_normals, "vector", nc, np.float32, 3)
+    arrays = [co, corner_vert, loop_start, np.zeros(0, np.int32) if material is None else material, normals]
+    header = [mesh.name, mesh.normals_domain, needs]
+    if needs is not None and needs.uv_map is not None:
+        layers = mesh.uv_layers
+        layer = layers.get(needs.uv_map) if needs.uv_map else next((u for u in layers if u.active_render), None)
+        header.append(None if layer is None else layer.name)
+        if layer is not None:
+            arrays.append(_read(layer.uv, "vector", nc, np.float32, 2))
+    if needs is not None and needs.color_attribute is not None:
+        attrs, name = mesh.color_attributes, needs.color_attribute
+        attr = attrs.get(name) if name else None
+        if attr is None and not name and 0 <= attrs.render_color_index < len(attrs):
+            attr = attrs[attrs.render_color_index]
+        header.append(None if attr is None else (attr.name, attr.domain))
+        if attr is not None and attr.domain in {"POINT", "CORNER"}:
+            arrays.append(_read(attr.data, "color", nv if attr.domain == "POINT" else nc, np.float32, 4))
+    return content_key(np.frombuffer(repr(header).encode(), np.uint8), *arrays)
+
+
+_CLOSED = Kind("closed")  # content digest of (triangles, positions) -> closed_outward
 
 
 def _closed_cached(tris, co):
@@ -625,7 +664,7 @@ def _closed_cached(tris, co):
     key = content_key(np.asarray(tris, np.int32), np.asarray(co, np.float32))
     closed = _CLOSED.get(key)
     if closed is None:
-        closed = _CLOSED.put(key, closed_outward(tris, co), 1)
+        closed = _CLOSED.put(key, closed_outward(tris, co), 64)
     return closed
 
 
@@ -736,7 +775,7 @@ def _tangents(mesh, layer, nc, messages):
     return tangents
 
 
-_TANGENTS = ContentCache(256 * 2**20)  # content digest -> (tangents, n-gons): final renders extract anew
+_TANGENTS = Kind("tangents")  # content digest -> (tangents, n-gons): final renders extract anew
 
 
 def _tangents_cached(mesh, layer, uvs, positions, normals, nc, messages):
@@ -959,6 +998,8 @@ class SceneCache:
         self.materials_read = 0
         self.images_changed = set()  # image names updated since the renderer last looked
         self.world = None  # (world name, materials.World) until a world or image update
+        self.store = None  # ``store.Store`` of final renders: meshes found there by content
+        self.extracted = 0  # meshes extracted (not found in the store) since creation
 
     def apply_updates(self, depsgraph):
         """Drop the geometry of every datablock whose geometry the depsgraph says changed, and
@@ -1017,11 +1058,11 @@ class SceneCache:
         if geo is not None:
             return geo
         if ob.type == "MESH":
-            geo = geometry_from_mesh(ob.data, needs)
+            geo = self._extract(ob.data, needs)
         else:
             mesh = ob.to_mesh()
             try:
-                geo = geometry_from_mesh(mesh, needs) if mesh is not None else None
+                geo = self._extract(mesh, needs) if mesh is not None else None
             finally:
                 ob.to_mesh_clear()
             if geo is None:
@@ -1031,6 +1072,22 @@ class SceneCache:
         self.built += 1
         geo.serial = self.built
         return geo
+
+    def _extract(self, mesh, needs):
+        """``geometry_from_mesh``, or with a ``store`` (final renders) the geometry it holds
+        for the same content (a copy of its record sharing the arrays: ``deps`` and
+        ``serial`` are this cache's)."""
+        if self.store is None:
+            self.extracted += 1
+            return geometry_from_mesh(mesh, needs)
+        content = mesh_content_key(mesh, needs)
+        kept = self.store.get("geometry", content)
+        if kept is None:
+            kept = geometry_from_mesh(mesh, needs)
+            kept.content = content
+            self.store.put("geometry", content, kept, kept.nbytes)
+            self.extracted += 1
+        return dataclasses.replace(kept)
 
     def _strips_for(self, key, deps, build):
         """The hair strips kept under ``key``, built by ``build()`` on first use."""

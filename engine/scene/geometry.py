@@ -1,6 +1,6 @@
 """A mesh's triangles as the GPU draws them: the record extraction, hair and levels of detail
 all build (``extract``, ``hair``, ``simplify``); and the content keys that let what is derived
-from them outlive an F12 render's engine (``content_key``, ``ContentCache``)."""
+from them outlive an F12 render's engine (``content_key``, the keys of ``engine/store.py``)."""
 
 import hashlib
 from dataclasses import dataclass
@@ -18,36 +18,6 @@ def content_key(*arrays):
         digest.update(repr((a.dtype.str, a.shape)).encode())
         digest.update(a.data)
     return digest.digest()
-
-
-class ContentCache:
-    """Values kept by ``content_key`` up to ``budget`` bytes, the oldest dropped first."""
-
-    def __init__(self, budget):
-        self.budget = budget
-        self._items = {}  # key -> (value, bytes)
-        self._bytes = 0
-
-    def get(self, key):
-        item = self._items.get(key)
-        return None if item is None else item[0]
-
-    def put(self, key, value, nbytes):
-        """Keep ``value`` (``nbytes`` large) unless it alone exceeds the budget; returns it."""
-        while self._items and self._bytes + nbytes > self.budget:
-            _value, size = self._items.pop(next(iter(self._items)))
-            self._bytes -= size
-        if nbytes <= self.budget:
-            self._items[key] = (value, nbytes)
-            self._bytes += nbytes
-        return value
-
-    def clear(self):
-        self._items.clear()
-        self._bytes = 0
-
-    def __len__(self):
-        return len(self._items)
 
 
 @dataclass
@@ -74,7 +44,14 @@ class Geometry:
     messages: tuple = ()
     deps: frozenset = frozenset()
     serial: int = 0  # distinguishes rebuilt geometry of the same key (GPU batches key on it)
+    content: bytes | None = None  # digest of what it was extracted from (final renders' store key)
 
     @property
     def triangle_count(self):
         return len(self.indices)
+
+    @property
+    def nbytes(self):
+        """Bytes of its arrays (what the store counts it as)."""
+        arrays = (self.positions, self.normals, self.indices, self.uvs, self.colors, self.tangents, self.strands)
+        return sum(a.nbytes for a in arrays if a is not None)

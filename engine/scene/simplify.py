@@ -20,14 +20,14 @@ import math
 
 import numpy as np
 
+from ..store import Kind
 from .geometry import Geometry, content_key
 
 MIN_LEVEL = 2  # 4 cells along the longest side: the coarsest level
 MAX_LEVEL = 12  # 4096 cells: finer ones keep nearly every triangle of real meshes
 MIN_TRIANGLES = 2048  # smaller meshes are drawn whole (their draw costs more than their triangles)
 WORTH = 0.7  # a level keeping more than this fraction of the triangles is not used
-_CACHE = {}  # (content digest, level) -> Geometry or None: final renders extract anew
-_CACHE_TRIANGLES = 8_000_000  # the levels kept hold at most about this many triangles
+_LEVELS = Kind("levels")  # (content digest, level) -> (Geometry or None,): final renders extract anew
 
 
 def level_for(extent, stretch, nearest_depth, footprint, pixels):
@@ -52,13 +52,13 @@ def simplified(geo, level):
         ranges = np.asarray(geo.ranges, np.int64).reshape(-1, 3)
         digest = geo._simplify_digest = content_key(geo.indices, geo.positions, geo.normals, ranges)
     key = (digest, level)
-    if key not in _CACHE:
+    held = _LEVELS.get(key)
+    if held is None:
         lod = cluster(geo, level)
-        held = sum(g.triangle_count for g in _CACHE.values() if g is not None)
-        if held + (lod.triangle_count if lod is not None else 0) > _CACHE_TRIANGLES or len(_CACHE) >= 4096:
-            _CACHE.clear()
-        _CACHE[key] = lod
-    return _CACHE[key]
+        if lod is not None:  # its batches are kept by it in final renders (``frame/batches.py``)
+            lod.content = digest + int(level).to_bytes(4, "little", signed=True)
+        held = _LEVELS.put(key, (lod,), 64 if lod is None else lod.nbytes)
+    return held[0]
 
 
 def cluster(geo, level):

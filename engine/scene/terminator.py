@@ -23,7 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import ContentCache, content_key
+from ..store import Kind
+from .geometry import content_key
 
 # Names of the per-corner vertex attributes of ``corner_data`` (and the shader's inputs).
 ATTRIBUTES = ("tbary", "tabc", "tfront", "tback")
@@ -65,7 +66,7 @@ class Terminator:
 
 
 # content digest of (positions, normals, indices) -> corner_data: final renders build anew
-_CORNERS = ContentCache(256 * 2**20)
+_CORNERS = Kind("corners")
 
 
 def corner_data_cached(positions, normals, indices):

@@ -46,11 +46,13 @@ class TextureCache:
         self._env = {}  # image name -> the image box-filtered as the SH saw it (h, w, 3), strength 1
         self._prefiltered = {}  # (image name, clamp) -> (its prefiltered atlas, bytes) (``world_prefiltered``)
         self.uploads = 0  # images taken from Blender since creation (tests and the benchmark read it)
+        self.upload_bytes = 0  # bytes of those Blender made a texture of for them (``_first_take``)
         self.bytes = 0
         self._messages = {}  # image name -> what the user must be told of it (``messages``)
 
     def forget(self, names):
         for name in names:
+            _TAKEN.difference_update([k for k in _TAKEN if k[1] == name])
             entry = self._textures.pop(name, None)
             self._sh.pop(name, None)
             self._env.pop(name, None)
@@ -91,6 +93,7 @@ class TextureCache:
         if image is None:
             self._messages[name] = f"Penumbra: image '{name}' not found: drawn magenta"
             return _missing_texture(), False
+        made = _first_take(image)
         texture = gpu.texture.from_image(image)
         self.uploads += 1
         if not image.has_data:
@@ -107,6 +110,8 @@ class TextureCache:
             self._messages[name] = (
                 f"Penumbra: image '{name}' has UDIM tiles: only tile {image.tiles[0].number} is drawn"
             )
+        if made:
+            self.upload_bytes += _texture_bytes(texture)
         return texture, stores_premultiplied(image)
 
     def world_sh(self, name, reduce):
@@ -147,6 +152,22 @@ class TextureCache:
     def messages(self):
         """What the user must be told of the images taken so far (until they change)."""
         return list(self._messages.values())
+
+
+# (session uid, name) of the images whose texture this session has taken, until they change:
+# Blender keeps an image's texture on the datablock, so only a first take uploads its pixels.
+_TAKEN = set()
+
+
+def _first_take(image):
+    """Whether Blender makes ``image``'s texture for this take: its first in this session, or
+    the first since a depsgraph update said the image changed (``TextureCache.forget``).
+    Blender 4.5 tells directly (``Image.bindcode`` 0: no texture yet); 5.x does not say."""
+    key = (getattr(image, "session_uid", 0), image.name_full)
+    first = key not in _TAKEN
+    _TAKEN.add(key)
+    bindcode = getattr(image, "bindcode", None)
+    return first if bindcode is None else bindcode == 0
 
 
 def world_background(sh):

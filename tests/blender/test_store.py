@@ -1,0 +1,168 @@
+"""The store final renders keep between them (``engine/store.py``): a second F12 of an
+unchanged scene extracts no mesh and uploads no vertex data or image, and draws the same
+image; an edited mesh is extracted again; the store is emptied on file load and on
+unregister, and sheds under memory pressure and beyond its budget. Each case runs in a
+child process: the store is the process's."""
+
+import textwrap
+
+from devkit.session import run_result
+
+PRELUDE = """
+import json, os, tempfile
+import numpy as np
+import bpy
+from devkit import engines, scenes, session
+penumbra = session.load_penumbra()
+penumbra.register()
+from penumbra.engine import store
+from penumbra.engine.frame.renderer import Renderer
+from penumbra.engine.scene import extract
+
+EXTRACTED = []
+_extract = extract.geometry_from_mesh
+
+def counted(mesh, needs=None):
+    EXTRACTED.append(mesh.name)
+    return _extract(mesh, needs)
+
+extract.geometry_from_mesh = counted
+SEEN = []
+_render = Renderer.render
+
+def recorded(self, *args, **kwargs):
+    out = _render(self, *args, **kwargs)
+    SEEN.append(out.stats)
+    return out
+
+Renderer.render = recorded
+
+def f12(scene):
+    '''(FrameStats, meshes extracted, Combined as an array) of an F12 render of ``scene``.'''
+    EXTRACTED.clear()
+    with session.stdout_to_stderr():
+        bpy.ops.render.render(write_still=False)
+    result = bpy.data.images["Render Result"]
+    path = os.path.join(tempfile.mkdtemp(), "f.exr")
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    result.save_render(path)
+    from devkit import imageio
+    return SEEN[-1], len(EXTRACTED), imageio.read_image(path)
+
+def report(**values):
+    print("RESULT " + json.dumps(values))
+    session.hard_exit(0)
+"""
+
+
+def run_child(body):
+    return run_result(textwrap.dedent(PRELUDE) + textwrap.dedent(body), timeout=300)
+
+
+def test_a_second_f12_of_an_unchanged_scene_extracts_and_uploads_nothing():
+    """The textured asset (UVs, tangents, five images; ``scenes.textured_asset``): the first
+    F12 after the store is emptied extracts its mesh and uploads its batches; the second
+    extracts nothing, uploads no vertex buffer and no image, and draws the same pixels. A
+    moved vertex is extracted again (the store holds no stale mesh) and draws what an empty
+    store draws."""
+    result, _ = run_child(
+        """
+        scene = scenes.textured_asset(96, 54)
+        engines.configure(scene, "PENUMBRA")
+        f12(scene)  # programs compiled, images made
+        store.clear()
+        cold, cold_n, cold_img = f12(scene)
+        warm, warm_n, warm_img = f12(scene)
+        mesh = next(o.data for o in scene.objects if o.type == "MESH" and len(o.data.polygons) > 1000)
+        mesh.vertices[0].co.z += 0.5
+        mesh.update()
+        edited, edited_n, edited_img = f12(scene)
+        store.clear()
+        fresh, fresh_n, fresh_img = f12(scene)
+        report(
+            cold=[cold_n, cold.mesh_upload_bytes, cold.image_upload_bytes],
+            warm=[warm_n, warm.mesh_upload_bytes, warm.image_upload_bytes],
+            edited=[edited_n, edited.mesh_upload_bytes],
+            same=float(np.abs(cold_img - warm_img).max()),
+            edit_fresh=float(np.abs(edited_img - fresh_img).max()),
+            moved=float(np.abs(edited_img - warm_img).max()),
+            held=store.STORE.held_bytes,
+        )
+        """
+    )
+    assert result["cold"][0] >= 1 and result["cold"][1] > 100_000, result
+    assert result["cold"][2] == 0  # the images' textures were made by the render before
+    assert result["warm"] == [0, 0, 0], result
+    assert result["same"] == 0.0  # bit for bit
+    assert result["edited"][0] >= 1 and result["edited"][1] > 0, result
+    assert result["edit_fresh"] == 0.0
+    assert result["moved"] > 0.0  # the vertex moved in the image (the edit reached the frame)
+    assert result["held"] > 100_000
+
+
+def test_the_store_is_emptied_when_a_file_is_loaded_and_on_unregister():
+    result, _ = run_child(
+        """
+        scene = scenes.textured_asset(48, 27)
+        engines.configure(scene, "PENUMBRA")
+        f12(scene)
+        after_render = len(store.STORE)
+        path = os.path.join(tempfile.mkdtemp(), "other.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        bpy.ops.wm.open_mainfile(filepath=path)
+        after_load = len(store.STORE)
+        scene = bpy.context.scene
+        f12(scene)
+        again = len(store.STORE)
+        penumbra.unregister()
+        after_unregister = len(store.STORE)
+        handlers = [h for h in bpy.app.handlers.load_pre if getattr(h, "__module__", "").startswith("penumbra")]
+        report(
+            after_render=after_render,
+            after_load=after_load,
+            again=again,
+            after_unregister=after_unregister,
+            handlers=len(handlers),
+        )
+        """
+    )
+    assert result["after_render"] >= 2  # the geometry and its batches at least
+    assert result["after_load"] == 0
+    assert result["again"] >= 2
+    assert result["after_unregister"] == 0 and result["handlers"] == 0
+
+
+def test_the_store_sheds_under_memory_pressure_and_stays_within_its_budget():
+    """With the system's available memory reported under ``store.LOW_MEMORY`` of its total,
+    the next final render first sheds the older half of the store; with a budget smaller than
+    a frame's meshes, the store holds at most its budget and the images are unchanged."""
+    result, _ = run_child(
+        """
+        scene = scenes.textured_asset(48, 27)
+        engines.configure(scene, "PENUMBRA")
+        _, _, full = f12(scene)
+        held = store.STORE.held_bytes
+        store.STORE.memory = lambda: (1, 100)
+        dropped = store.STORE.dropped
+        f12(scene)  # sheds first, then keeps what this frame made again
+        shed = store.STORE.dropped - dropped
+        store.STORE.memory = store.available_memory
+        store.clear()
+        store.STORE.budget = held // 4
+        _, _, small = f12(scene)
+        report(
+            held=held,
+            shed=shed,
+            budget=store.STORE.budget,
+            small_held=store.STORE.held_bytes,
+            same=float(np.abs(full - small).max()),
+            probe=list(store.available_memory() or (0, 0)),
+        )
+        """
+    )
+    assert result["shed"] >= 1
+    assert 0 < result["small_held"] <= result["budget"]
+    assert result["same"] == 0.0
+    available, total = result["probe"]
+    assert 0 < available <= total  # the probe reads this system's memory (Linux)
