@@ -103,7 +103,8 @@ def deformed(geometry, shapes, times, u):
     drawn = positions[np.unique(geometry.indices)] if len(geometry.indices) else positions
     bounds = np.array([drawn.min(axis=0), drawn.max(axis=0)], np.float64) if len(drawn) else geometry.bounds
     _SERIAL[0] += 1
-    return replace(geometry, positions=positions, normals=normals, bounds=bounds, serial=_SERIAL[0])
+    # Its own batches, this frame only: no content key (the store holds the undeformed mesh's).
+    return replace(geometry, positions=positions, normals=normals, bounds=bounds, serial=_SERIAL[0], content=None)
 
 
 def moving_only(matrices):

@@ -321,7 +321,7 @@ class Renderer:
                 features.append(feature)
         frame.features = tuple(features)
         stats.techniques = [f.name for f in features]
-        self.shadow_pass.begin_frame(frame.reach, frame.reflective, frame.receivers)
+        self.shadow_pass.begin_frame(frame.reach, frame.reflective, frame.receivers, request.navigating)
         room = MAX_LIGHTS - frame.directions
         frame.lights = select_lights(snapshot.lights, camera.position, room)
         if len(frame.lights) < len(snapshot.lights):
@@ -394,6 +394,8 @@ class Renderer:
                 self.shadow_pass.use_sizes(last[1])
                 self._navigation = (nav_key, last[1], last[2] + 1)
             else:
+                if request.navigating and last is not None and last[0] == nav_key and last[1] is not None:
+                    self.shadow_pass.hint_sizes(last[1])  # sizes kept where density asks for close ones
                 self._navigation = (nav_key, None, 1) if request.navigating else None
         else:
             targets = {}

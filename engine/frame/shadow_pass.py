@@ -37,19 +37,27 @@ class ShadowPass:
         self._sun_parts = None  # and the boxes' parts in its frustum (lightspace.view_parts)
         self._casters = (None, None, False)  # (the frame's draw list, what each draw casts, rsm): once a frame
         self._sizes = None  # {light index: map sizes} of the frame's first plan (``keep_sizes``)
+        self._hints = None  # {light index: map sizes} a navigation frame keeps where close (``hint_sizes``)
+        self.windows = None  # the cropped maps' windows while the view moves (``begin_frame``)
         self._derived = None  # {light index: (mode, tiles, position)}: what later samples shear or move
         self._reaches = None  # {light index: reach} the frame's first plan grew the scene by
         self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
         self.reflective = False  # the maps hold what each light sees too (features/bounce.py)
         self.receivers = None  # boxes beyond the draws that take light (``begin_frame``)
 
-    def begin_frame(self, reach=0.0, reflective=False, receivers=None):
+    def begin_frame(self, reach=0.0, reflective=False, receivers=None, navigating=False):
         """Forget the last frame's camera-dependent bounds, casters and map sizes. ``reach``:
         how many pixels beyond the image the frame's samples look (the pixel filter's reach in
         a multi-sample frame; 0 for one sample), so maps are planned for all of them;
         ``reflective``: the maps are reflective shadow maps (``FramePlan.reflective``);
         ``receivers``: boxes beyond the draws that take light (``FramePlan.receivers``: the
-        media), which the maps cover as they cover the surfaces the camera sees."""
+        media), which the maps cover as they cover the surfaces the camera sees.
+        ``navigating``: a frame while the view moves, whose cropped maps keep the windows of
+        the navigation frames before it while those hold what it needs (``ViewFit.windows``);
+        any other frame forgets them."""
+        self.windows = self.windows if navigating else None
+        if navigating and self.windows is None:
+            self.windows = {}
         self.reflective = bool(reflective)
         self.receivers = None if receivers is None or not len(receivers) else np.asarray(receivers, np.float64)
         self.depth_range = UNSET
@@ -57,6 +65,7 @@ class ShadowPass:
         self._sun_parts = None
         self._casters = (None, None, False)
         self._sizes = None
+        self._hints = None
         self._derived = None
         self.reach = float(reach)
 
@@ -72,6 +81,11 @@ class ShadowPass:
     def sizes(self):
         """The frame's map sizes and derived suns (``keep_sizes``), or None."""
         return None if self._sizes is None else (self._sizes, self._derived)
+
+    def hint_sizes(self, sizes):
+        """A navigation frame that plans afresh: each light keeps ``sizes`` (the last planning
+        navigation frame's) where density asks for sizes close to them (``FrameShare``)."""
+        self._hints = sizes
 
     def use_sizes(self, sizes):
         """A later call of the same frame: what its first call kept (``sizes``: the property's
@@ -143,8 +157,9 @@ class ShadowPass:
             density=_density(camera, settings, size),
             sun_parts=self._sun_parts,
             extra=self.receivers,
+            windows=self.windows,
         )
-        share = FrameShare(known_sizes=sizes, cones=cones, reaches=reaches, derived=derived)
+        share = FrameShare(known_sizes=sizes, hinted_sizes=self._hints, cones=cones, reaches=reaches, derived=derived)
         return plan_shadows(lights, corners, options, fit, share)
 
     def draw(self, frame, sample):

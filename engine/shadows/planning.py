@@ -149,6 +149,7 @@ class Crop(NamedTuple):
 
     receivers: object
     flat_free: np.ndarray = None
+    windows: dict = None  # ``ViewFit.windows``
 
 
 class _Frustum(NamedTuple):
@@ -226,7 +227,7 @@ def perspective_tile(eye, boxes, map_size, kernel=0.0, soft_radius=0.0, crop=Non
         key = (face, "window", fov, near, far)
         if key not in memo:
             memo[key] = _window(frustum, corners, inside, crop, soft_radius)
-        cropped = _crop(frustum, size, corners, crop.receivers, pad, memo[key])
+        cropped = _crop(frustum, size, corners, crop.receivers, pad, memo[key], crop.windows)
         if cropped is _NOTHING:
             return None
         if cropped is not None:
@@ -247,7 +248,7 @@ def _window(frustum, corners, inside, crop, soft_radius):
     (of ``inside``) can shadow in the perspective map ``frustum`` (a ``_Frustum``), with those
     casters; or _NOTHING. Does not depend on the map's size."""
     view, fov, near, far = frustum
-    receivers, flat_free = crop
+    receivers, flat_free = crop.receivers, crop.flat_free
     half = math.tan(fov / 2.0)
     planes = light_bins.frustum_planes(lightspace.perspective(fov, 1.0, near, far) @ view)
     seen = lightspace.pieces_in(planes, receivers.whole, receivers.pieces)
@@ -270,11 +271,13 @@ def _window(frustum, corners, inside, crop, soft_radius):
     return w_lo, w_hi, casters
 
 
-def _crop(frustum, size, corners, receivers, pad, window):
+def _crop(frustum, size, corners, receivers, pad, window, kept=None):
     """The perspective map ``frustum`` of ``size`` texels cut to what it must hold (see
     ``perspective_tile``): (projection, texel per distance, casters, far, the visible
     receivers' points it holds), None when cropping gains nothing, or _NOTHING. ``window``:
-    ``_window``'s answer."""
+    ``_window``'s answer. ``kept`` (``ViewFit.windows``): the window and far plane an earlier
+    frame cut this same frustum (eye, direction, depth range, size) to are taken again while
+    they hold this one's, and this one's are kept there for the next frame."""
     if window is _NOTHING:
         return _NOTHING
     view, fov, near, far = frustum
@@ -291,6 +294,16 @@ def _crop(frustum, size, corners, receivers, pad, window):
     centre = np.floor(0.5 * (w_lo + w_hi) / texel) * texel
     left, bottom = centre - 0.5 * total
     right, top = centre + 0.5 * total
+    slot = old = None
+    if kept is not None:
+        slot = (view.tobytes(), near, far, size, fov)
+        old = kept.get(slot)
+        holds = old is not None and old[0] <= left and old[1] >= right and old[2] <= bottom and old[3] >= top
+        if holds and old[1] - old[0] <= 2.0 * (right - left):  # and at most twice as coarse
+            left, right, bottom, top = old[:4]
+            texel = (right - left) / size
+        else:
+            old = None
     # Casters whose window misses the map's cannot shadow into it (those reaching behind the
     # light's near plane are kept).
     q = corners[casters] @ view[:3, :3].T + view[:3, 3]
@@ -302,15 +315,23 @@ def _crop(frustum, size, corners, receivers, pad, window):
     if len(casters) == 0:
         return _NOTHING
     proj = lightspace.off_center_perspective(left, right, bottom, top, near, far)
-    # Nothing beyond the farthest visible receiver in the map's window needs a depth.
+    # Nothing beyond the farthest visible receiver in the map's window needs a depth. The far
+    # plane is quantised up in 2^(1/8) steps of its ratio to the near one, as the extent is, so
+    # a moving view that sees a little more or less depth keeps the map (and its content key).
     held = lightspace.pieces_in(light_bins.frustum_planes(proj @ view), receivers.whole, receivers.pieces)
     if not held:
         return _NOTHING
     held = np.concatenate(held)
     deepest = -float((held @ view[2, :3] + view[2, 3]).min())
     if near < deepest * 1.01 < far:
-        far = deepest * 1.01
+        far = min(far, near * 2.0 ** (math.ceil(math.log2(deepest * 1.01 / near) * 8.0) / 8.0))
+        if old is not None and far <= old[4]:
+            far = old[4]
         proj = lightspace.off_center_perspective(left, right, bottom, top, near, far)
+    if slot is not None:
+        if len(kept) >= 1024:  # a bound: lights and sizes come and go while the view moves
+            kept.clear()
+        kept[slot] = (left, right, bottom, top, far)
     return proj, texel, casters, far, held
 
 
@@ -361,7 +382,11 @@ class ViewFit:
     (every sun fitted to the whole view reads them; else once a plan; with ``extra``, of the
     geometry's boxes and then those). ``extra``: boxes (n, 8, 3) that take light and cast
     none (the media, ``frame/features/volumes.py``): suns are fitted to them as to the
-    geometry (``receivers`` should hold them for the other lights)."""
+    geometry (``receivers`` should hold them for the other lights). ``windows``: a dict the
+    caller keeps between navigation frames (while the view moves): a cropped perspective map
+    keeps the window, and depth, an earlier frame cropped it to while they still hold what
+    this view needs of it, so the map's fit, and its content, do not change (``_crop``).
+    None elsewhere: a frame's maps then depend on that frame's view alone."""
 
     view_corners: np.ndarray = None
     camera: object = None
@@ -370,6 +395,7 @@ class ViewFit:
     density: Density = None
     sun_parts: tuple = None
     extra: np.ndarray = None
+    windows: dict = None
 
 
 @dataclass(frozen=True)
@@ -386,11 +412,16 @@ class FrameShare:
     spot, point and area lights: their maps are planned over the scene's boxes and receivers
     grown by that much (``lightspace.dilated_boxes``), so they hold what any of those points
     needs, from the same window, once the eye moves there (``lightspace.moved``).
+    ``hinted_sizes``: {light index: map sizes} a light planned at density keeps wherever the
+    size density asks for is within SIZE_HYSTERESIS of it (navigation frames: the sizes of the
+    last one that planned, so a moving view that needs a little more or less detail keeps its
+    maps' sizes, and with them their places in the atlas and their content).
     ``derived``: {light index: (mode, tiles, position) of the frame's first plan}: those
     lights are not planned again, each tile is the first plan's sheared to the sun's direction
     or moved to the light's position (planning a sample costs a matrix product)."""
 
     known_sizes: dict = None
+    hinted_sizes: dict = None
     cones: dict = None
     reaches: dict = None
     derived: dict = None
@@ -491,11 +522,24 @@ def _planned_tiles(scene, share, index, light):
         known = [largest] * 6  # a direction of the world is drawn once: one fit, no density pass
     tiles, mode = _light_tiles(scene, job, list(known) if known else [largest] * 6)
     if not known:
-        tiles, mode = _at_density(scene, job, tiles, mode, largest)
+        hint = share.hinted_sizes.get(index) if share.hinted_sizes is not None and not world else None
+        tiles, mode = _at_density(scene, job, tiles, mode, largest, hint)
     return mode, tiles
 
 
-def _at_density(scene, job, tiles, mode, largest):
+# A hinted map size is kept while density asks for at most twice and at least a quarter of it.
+SIZE_HYSTERESIS = (0.25, 2.0)
+
+
+def _hinted(sizes, hint):
+    """``sizes`` with each replaced by ``hint``'s where that is within SIZE_HYSTERESIS of it."""
+    if not hint:
+        return sizes
+    lo, hi = SIZE_HYSTERESIS
+    return [h if h is not None and lo * h <= s <= hi * h else s for s, h in zip(sizes, list(hint) + [None] * 6)]
+
+
+def _at_density(scene, job, tiles, mode, largest, hint=None):
     """A map needs no more texels than the pixels it shadows can show (density): each map
     (cascade, cube face) of the light, planned at ``largest``, is planned again at the size
     it needs. A sun fitted to the whole scene (no view corners) keeps its size: it must not
@@ -506,6 +550,7 @@ def _at_density(scene, job, tiles, mode, largest):
         return tiles, mode
     per_pixel = density.texels_per_pixel * (1.0 if job.soft else max(1.0, scene.options.kernel - 1.0))
     sizes = [largest if t is None else needed_size(t, largest, receivers, density, per_pixel) for t in tiles]
+    sizes = [min(s, largest) for s in _hinted(sizes, hint)]
     if min(sizes, default=largest) < largest:
         smaller, smaller_mode = _light_tiles(scene, job, sizes)
         if [t is None for t in smaller] == [t is None for t in tiles]:
@@ -601,7 +646,7 @@ def _spot_tiles(scene, job, sizes):
     light = job.light
     fov = min(light.cone_size * 1.05 + 4.0 / max(scene.options.map_size, 1), math.radians(170.0))
     boxes, seen = _grown(scene, job)
-    crop = None if seen is None else Crop(seen, job.flat_free)
+    crop = None if seen is None else Crop(seen, job.flat_free, scene.view.windows)
     tile = perspective_tile(Eye(light.position, light.direction, fov), boxes, sizes[0], crop=crop, memo=job.memo)
     return [tile] if tile is not None else [], "SINGLE"
 
@@ -610,7 +655,7 @@ def _cube_tiles(scene, job, sizes):
     """A point or area light's cube faces (None for an area light's face wholly behind it)."""
     light = job.light
     boxes, seen = _grown(scene, job)
-    crop = None if seen is None else Crop(seen, job.flat_free)
+    crop = None if seen is None else Crop(seen, job.flat_free, scene.view.windows)
     soft = job.soft
     tiles = [
         None

@@ -4,6 +4,7 @@ the scene: planning once per light per sample, no batch or material block rebuil
 image is read into Python is test_materials' tracemalloc test). Counts, not seconds: the
 speed itself is measured by ``tools.bench perf --sections cpu``."""
 
+import math
 from contextlib import contextmanager
 
 import pytest
@@ -176,7 +177,7 @@ def test_frames_while_the_view_moves_keep_their_map_sizes(demo, gpu_call):
             out = engine.render_frame(
                 depsgraph, dataclasses.replace(camera, view=moved), *SIZE, aux=False, navigating=True
             )
-            counts.append((len(fits), out.stats.shadow_maps))
+            counts.append((len(fits), out.stats.shadow_maps + out.stats.shadow_maps_reused))  # planned
         return counts
 
     with counting_fits() as fits:
@@ -184,3 +185,58 @@ def test_frames_while_the_view_moves_keep_their_map_sizes(demo, gpu_call):
     assert counts[0][0] > counts[0][1] >= 2, counts  # planned afresh: two fits where sizes shrink
     assert all(fitted == maps for fitted, maps in counts[1:NAVIGATION_REPLAN]), counts
     assert counts[NAVIGATION_REPLAN][0] > counts[NAVIGATION_REPLAN][1], counts
+
+
+def orbit_scene(penumbra):
+    """A still scene lit by a spot, a point and an area light (no sun, a black world: every
+    map belongs to a local light), seen by a camera that orbits it."""
+    scene = scenes.empty_scene(*SIZE)
+    scenes.set_world(scene, (0.0, 0.0, 0.0))
+    scenes.plane(scene, "Ground", size=12.0)
+    scenes.box(scene, "Crate", center=(-1.0, 0.5, 0.75), size=(1.5, 1.5, 1.5))
+    scenes.uv_sphere(scene, "Ball", center=(1.2, -0.6, 1.0), radius=1.0)
+    spot = scenes.light(scene, "Spot", "SPOT", 500.0, location=(-3.0, -3.0, 5.0), spot_size=math.radians(70))
+    scenes.aim(spot, (0, 0, 0))
+    scenes.light(scene, "Bulb", "POINT", 300.0, location=(2.5, 2.0, 3.0), shadow_soft_size=0.1)
+    area = scenes.light(scene, "Panel", "AREA", 200.0, location=(0.0, 3.5, 4.0), size=1.0)
+    scenes.aim(area, (0, 0, 0))
+    scenes.look_at(scene, (8.0, 0.0, 5.0), (0, 0, 0.5))
+    scene.penumbra.layers.clear()
+    return scene
+
+
+def orbit(camera, degrees):
+    """``camera`` (``extract.Camera``) turned ``degrees`` about the world's z axis through the origin."""
+    import dataclasses
+
+    import numpy as np
+
+    a = math.radians(degrees)
+    turn = np.array([[math.cos(a), -math.sin(a), 0, 0], [math.sin(a), math.cos(a), 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+    return dataclasses.replace(camera, view=camera.view @ np.linalg.inv(turn))
+
+
+def test_an_orbit_around_a_still_scene_redraws_no_spot_point_or_area_map(penumbra, gpu_call):
+    """Navigation frames (one sample while the view moves) of a camera orbiting a still scene:
+    the first draws the spot's, the point light's and the area light's maps; every later one,
+    through more than NAVIGATION_REPLAN frames and a quarter turn, reuses them all (each map is
+    fitted with room for the view to move, and kept while what it must hold stays inside that
+    room). Moving a light redraws its maps, and only its."""
+    from penumbra.engine.frame.renderer import NAVIGATION_REPLAN
+
+    scene = orbit_scene(penumbra)
+
+    def job(engine, depsgraph):
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, scene, *SIZE)
+        counts = []
+        for k in range(2 * NAVIGATION_REPLAN + 2):
+            out = engine.render_frame(depsgraph, orbit(camera, 6.0 * k), *SIZE, aux=False, navigating=True)
+            counts.append((out.stats.shadow_maps, out.stats.shadow_maps_reused))
+        return counts
+
+    counts = gpu_call(job)
+    first, later = counts[0], counts[1:]
+    assert first[0] >= 1 + 1 + 3, counts  # the spot's map, and the point's and the area's faces
+    assert all(drawn == 0 and reused == first[0] for drawn, reused in later), counts
