@@ -7,9 +7,10 @@ costs its zero-fill: about 17 ms for the 32 MiB atlas of the demo at 960x540 (tw
 Only textures and programs are kept: render targets (``FINAL_RENDERS``) and compiled programs
 (``final_shaders``: a variant compiles once a session, not once a render, about 7 ms a render
 for the demo). Image textures need no pool: they are Blender's own, kept by each image
-datablock between renders (``scene/textures.py``). Textures and programs are shared between
-GPU contexts, while framebuffers and batches belong to the context that made them and are
-made again by each render. A texture taken from the pool holds the last render's pixels; the
+datablock between renders (``scene/textures.py``); meshes and their batches are kept by
+content in the extension's store (``engine/store.py``). Textures and programs are shared
+between GPU contexts, while framebuffers belong to the context that made them and are made
+again by each render. A texture taken from the pool holds the last render's pixels; the
 renderer clears or redraws all of it (its shadow maps start empty, so every map is drawn
 again).
 

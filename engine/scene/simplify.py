@@ -47,7 +47,8 @@ def level_for(extent, stretch, nearest_depth, footprint, pixels):
 def simplified(geo, level):
     """``geo`` (a ``geometry.Geometry``) clustered at ``level``, remembered by content; None when
     the level would keep more than WORTH of the triangles or none at all."""
-    digest = getattr(geo, "_simplify_digest", None)
+    # An extracted mesh kept in the store is named by its content already (``Geometry.content``).
+    digest = geo.content if geo.content is not None else getattr(geo, "_simplify_digest", None)
     if digest is None:
         ranges = np.asarray(geo.ranges, np.int64).reshape(-1, 3)
         digest = geo._simplify_digest = content_key(geo.indices, geo.positions, geo.normals, ranges)

@@ -13,7 +13,8 @@ Sections (``--sections``, all by default):
               Workbench on the same scene, and the demo at 16 samples against Workbench's one;
               then one fenced frame of each (``Renderer.fence_stages``): the render thread's
               CPU time and the GPU's per stage, per sample, bytes uploaded, draw calls and
-              triangles per pass
+              triangles per pass; and the asset's second F12 against its first with the
+              extension's store emptied (``engine/store.py``): render-thread CPU, bytes uploaded
   resolution  demo scene without post layers at 480x270, 960x540 and 1920x1080
   passes      the demo scene at 960x540, F12, timed pass by pass (the GPU waited for with a
               one-pixel read-back before and after each pass): the depth pass and the lit pass
@@ -22,7 +23,9 @@ Sections (``--sections``, all by default):
               settling (Noise Threshold 0.01) and without (0): one further sample's cost
               against the first, the pixels settled, each frame's lit and shadow passes
   viewport    the viewport path at 960x540 (demo scene with its post layers), one engine
-              instance: display only, redraw with nothing changed, camera moving, scene edited
+              instance: display only, redraw with nothing changed, camera moving (sideways),
+              camera orbiting (2 degrees a frame about the world's z), scene edited; each with
+              the render thread's CPU a frame and the most maps a frame drew
   lights      N shadowed spot lights over a field of boxes (N = 1, 8, 32, 64): F12, and the
               viewport path with every map reused
   objects     N separate objects (each its own mesh) and N instances of one mesh
@@ -332,7 +335,33 @@ def section_cpu(plan):
     scene.penumbra.render_samples = 16
     note = cpu_note(_fenced_stats(scene))
     rows.append(_row("cpu", "demo 160x90, 16 samples (Workbench: 1 sample)", t, note, plan["runs"]))
+    rows.append(_warm_f12(asset, plan["runs"]))
     return rows
+
+
+def _warm_f12(scene, runs):
+    """The render thread's CPU of an F12 of ``scene`` with the extension's store warm (the
+    same scene rendered just before) against one with it emptied first (``engine/store.py``;
+    programs and image textures made in both), medians of ``runs`` pairs; what the warm one
+    uploaded of meshes and images."""
+    from penumbra.engine import store
+
+    _penumbra(scene)
+    _render()
+    cold, warm = [], []
+    for _ in range(runs):
+        store.clear()
+        for times in (cold, warm):
+            start = time.thread_time()
+            _render()
+            times.append(time.thread_time() - start)
+    stats = fenced_stats()
+    t = {"PENUMBRA": statistics.median(warm), "WORKBENCH": statistics.median(cold)}
+    note = (
+        f"render thread's CPU, a second F12 (store warm) against the first (store emptied: the baseline column); "
+        f"the second uploaded {stats.mesh_upload_bytes} bytes of meshes and {stats.image_upload_bytes} of images"
+    )
+    return _row("cpu", "textured asset 160x90: a second F12's CPU", t, note, runs)
 
 
 def section_resolution(plan):
@@ -537,31 +566,42 @@ def _viewport(plan, navigation_scale, cases=None):
             v.translation.x += 0.01 * moved[0]
             return v
 
+        def orbit():
+            from mathutils import Matrix
+
+            moved[0] += 1
+            return view @ Matrix.Rotation(math.radians(2.0 * moved[0]), 4, "Z")
+
         out = engine.viewport_frame(depsgraph, view, window, w, h)[0]
         every = {
             "display only": lambda: show(out),
             "redraw, nothing changed": lambda: show(engine.viewport_frame(depsgraph, view, window, w, h)[0]),
             "camera moving": lambda: show(engine.viewport_frame(depsgraph, move(), window, w, h)[0]),
+            "camera orbiting": lambda: show(engine.viewport_frame(depsgraph, orbit(), window, w, h)[0]),
             "scene edited (view still)": lambda: (
                 engine.scene_changed(),
                 show(engine.viewport_frame(depsgraph, view, window, w, h)[0]),
             ),
         }
         chosen = {k: v for k, v in every.items() if cases is None or k in cases}
-        times = {}
+        times, cpu, maps = {}, {}, {}
         for name, fn in chosen.items():
             fn()
-            samples = []
+            samples, threads, drawn = [], [], []
             for _ in range(runs):
-                start = time.perf_counter()
+                start, thread = time.perf_counter(), time.thread_time()
                 fn()
+                threads.append(time.thread_time() - thread)
                 samples.append(time.perf_counter() - start)
+                drawn.append(engine._shown[1].stats.shadow_maps if engine._shown else 0)
             times[name] = statistics.median(samples)
+            cpu[name] = statistics.median(threads)
+            maps[name] = max(drawn)
         offscreen.free()
-        return times
+        return times, cpu, maps
 
     try:
-        times = runner(job)
+        times, cpu, maps = runner(job)
     finally:
         runner.unregister()
     base = times["display only"]
@@ -572,7 +612,8 @@ def _viewport(plan, navigation_scale, cases=None):
             "penumbra_ms": t * 1e3,
             "workbench_ms": None,
             "ratio": t / base,
-            "note": "ratio to display only",
+            "note": f"ratio to display only; render thread's CPU {cpu[name] * 1e3:.1f} ms a frame; "
+            f"maps drawn in a frame at most {maps[name]}",
             "runs": runs,
             "blender": bpy.app.version_string,
         }
