@@ -538,12 +538,7 @@ def geometry_from_mesh(mesh, needs=None):
         empty = np.zeros((0, 3), np.float32)
         return Geometry(empty, empty, np.zeros((0, 3), np.int32), [], np.full((2, 3), np.nan))
     nv, nc = len(mesh.vertices), len(mesh.loops)
-    co = _attribute(mesh, "position", "vector", nv, np.float32, 3)
-    if co is None:
-        co = _read(mesh.vertices, "co", nv, np.float32, 3)
-    corner_vert = _attribute(mesh, ".corner_vert", "value", nc, np.int32)
-    if corner_vert is None:
-        corner_vert = _read(mesh.loops, "vertex_index", nc, np.int32)
+    co, corner_vert = _positions_and_corners(mesh)
     corners = _read(mesh.loop_triangles, "loops", n, np.int32, 3)
     face_material = _attribute(mesh, "material_index", "value", len(mesh.polygons), np.int32)
     if face_material is None:
@@ -617,6 +612,19 @@ def geometry_from_mesh(mesh, needs=None):
     )
 
 
+def _positions_and_corners(mesh):
+    """A mesh's vertex positions (nv, 3) and each face corner's vertex (nc,), from Blender's
+    attribute arrays where it has them."""
+    nv, nc = len(mesh.vertices), len(mesh.loops)
+    co = _attribute(mesh, "position", "vector", nv, np.float32, 3)
+    if co is None:
+        co = _read(mesh.vertices, "co", nv, np.float32, 3)
+    corner_vert = _attribute(mesh, ".corner_vert", "value", nc, np.int32)
+    if corner_vert is None:
+        corner_vert = _read(mesh.loops, "vertex_index", nc, np.int32)
+    return co, corner_vert
+
+
 def mesh_content_key(mesh, needs=None):
     """A digest of all that ``geometry_from_mesh(mesh, needs)`` reads: positions, the corners'
     vertices, the faces' first corners and material indices, the normals it takes (on points
@@ -624,12 +632,7 @@ def mesh_content_key(mesh, needs=None):
     messages name it). Reading these costs a small part of an extraction (no triangulation,
     no tangents, no re-indexing): final renders find the geometry in the store by it."""
     nv, nc, nf = len(mesh.vertices), len(mesh.loops), len(mesh.polygons)
-    co = _attribute(mesh, "position", "vector", nv, np.float32, 3)
-    if co is None:
-        co = _read(mesh.vertices, "co", nv, np.float32, 3)
-    corner_vert = _attribute(mesh, ".corner_vert", "value", nc, np.int32)
-    if corner_vert is None:
-        corner_vert = _read(mesh.loops, "vertex_index", nc, np.int32)
+    co, corner_vert = _positions_and_corners(mesh)
     loop_start = _read(mesh.polygons, "loop_start", nf, np.int32) if nf else np.zeros(0, np.int32)
     material = _attribute(mesh, "material_index", "value", nf, np.int32)
     if mesh.normals_domain == "POINT":
