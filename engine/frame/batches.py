@@ -39,12 +39,14 @@ class Batches:
         self._used.add(cache_key)
         cached = self.terminators.get(cache_key)
         if cached is None:
-            cached = self._kept("terminator", geo)
-        if cached is None:
-            cached = _terminator_parts(geo)
-            nbytes = _upload_bytes(_attributes(geo), 3 * len(geo.indices), len(geo.indices))
-            self.uploaded += nbytes
-            self._keep("terminator", geo, cached, nbytes)
+            buffers = self._kept("terminator", geo)
+            if buffers is None:
+                buffers = _terminator_buffers(geo)
+                nbytes = _upload_bytes(_attributes(geo), 3 * len(geo.indices), len(geo.indices))
+                self.uploaded += nbytes
+                self._keep("terminator", geo, buffers, nbytes)
+            vbo, ibos = buffers
+            cached = [(mat_index, _batch(vbo, ibo)) for mat_index, ibo in ibos]
         self.terminators[cache_key] = cached
         return cached
 
@@ -71,28 +73,46 @@ class Batches:
         self._used = set()
 
     def _get(self, cache, cache_key, geo):
-        import gpu
-
+        """The (whole, parts) batches of ``geo``. The store keeps their vertex and index
+        buffers (the uploaded data) between final renders, not the batches: each render makes
+        its own batch objects over them (no upload), so no vertex-array state a batch keeps
+        per GPU context outlives a render."""
         cached = cache.get(cache_key)
-        if cached is None:
-            cached = self._kept("batches", geo)
         if cached is not None:
-            cache[cache_key] = cached
             return cached
-        nbytes = _upload_bytes(_attributes(geo), len(geo.positions), len(geo.indices))
-        self.uploaded += nbytes
-        vbo = _vertex_buffer(_attributes(geo), len(geo.positions))
-        whole = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices))
-        parts = []
-        for mat_index, first, count in geo.ranges:
-            if first == 0 and count == len(geo.indices):
-                parts.append((mat_index, whole))
-                continue
-            ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices[first : first + count])
-            parts.append((mat_index, gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)))
+        buffers = self._kept("batches", geo)
+        if buffers is None:
+            nbytes = _upload_bytes(_attributes(geo), len(geo.positions), len(geo.indices))
+            self.uploaded += nbytes
+            buffers = _mesh_buffers(geo)
+            self._keep("batches", geo, buffers, nbytes)
+        vbo, whole_ibo, ibos = buffers
+        whole = _batch(vbo, whole_ibo)
+        parts = [(mat_index, whole if ibo is None else _batch(vbo, ibo)) for mat_index, ibo in ibos]
         cache[cache_key] = (whole, parts)
-        self._keep("batches", geo, cache[cache_key], nbytes)
         return cache[cache_key]
+
+
+def _batch(vbo, ibo):
+    import gpu
+
+    return gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)
+
+
+def _mesh_buffers(geo):
+    """(vertex buffer, index buffer of every triangle, [(material index, its index buffer, or
+    None where it is every triangle)]) of ``geo``."""
+    import gpu
+
+    vbo = _vertex_buffer(_attributes(geo), len(geo.positions))
+    whole = gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices)
+    ibos = []
+    for mat_index, first, count in geo.ranges:
+        if first == 0 and count == len(geo.indices):
+            ibos.append((mat_index, None))
+        else:
+            ibos.append((mat_index, gpu.types.GPUIndexBuf(type="TRIS", seq=geo.indices[first : first + count])))
+    return vbo, whole, ibos
 
 
 def _upload_bytes(attrs, vertices, triangles):
@@ -125,19 +145,17 @@ def _vertex_buffer(attrs, count):
     return vbo
 
 
-def _terminator_parts(geo):
-    """[(material index, GPUBatch)] of ``geo`` with a vertex per triangle corner carrying the
-    geometry offset's corner data (``terminator.ATTRIBUTES``)."""
+def _terminator_buffers(geo):
+    """(vertex buffer, [(material index, index buffer)]) of ``geo`` with a vertex per triangle
+    corner carrying the geometry offset's corner data (``terminator.ATTRIBUTES``)."""
     import gpu
 
     corners = np.ascontiguousarray(geo.indices, np.int32).ravel()
     attrs = {name: np.ascontiguousarray(data[corners]) for name, data in _attributes(geo).items()}
     attrs.update(terminator.corner_data_cached(geo.positions, geo.normals, geo.indices))
     vbo = _vertex_buffer(attrs, len(corners))
-    parts = []
+    ibos = []
     for mat_index, first, count in geo.ranges:
         seq = np.arange(3 * first, 3 * (first + count), dtype=np.int32).reshape(-1, 3)
-        parts.append(
-            (mat_index, gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=seq)))
-        )
-    return parts
+        ibos.append((mat_index, gpu.types.GPUIndexBuf(type="TRIS", seq=seq)))
+    return vbo, ibos
