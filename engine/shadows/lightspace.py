@@ -504,7 +504,9 @@ def view_parts(corners, view_corners):
     return clipped_points(boxes, hull_planes(view_corners), per_box=True)
 
 
-def fit_sun_to_view(direction, corners, view_corners, map_size, soft=0.0, flat_free=None, parts=None, cone=0.0):
+def fit_sun_to_view(
+    direction, corners, view_corners, map_size, soft=0.0, flat_free=None, parts=None, cone=0.0, kept=None
+):
     """Tight sun fit (a loose box wastes the map's texels; cf. Lauritzen, Salvi and Lefohn 2011,
     "Sample Distribution Shadow Maps"): the map covers only the receivers
     the camera can see that some caster can shadow, and every caster that can shadow them.
@@ -516,7 +518,10 @@ def fit_sun_to_view(direction, corners, view_corners, map_size, soft=0.0, flat_f
     map will be ``sheared`` to (a sampled sun's half-angle): every receiver and caster is then
     taken as sliding by ``cone`` x its depth from the fit's pivot, so one fit holds the map
     of every direction in the cone. Returns ``(Fit, caster indices)``, or ``None`` when
-    nothing the camera sees can be shadowed.
+    nothing the camera sees can be shadowed. ``kept``: (a dict kept between navigation
+    frames, this map's slot in it): the fit an earlier frame made for the slot is taken again
+    while its rectangle and depth range hold this one's and it is at most twice as wide (its
+    casters those that reach its rectangle), so a moving view keeps the map.
 
     Receivers: the part of every box inside the frustum (box ∩ frustum, exact for a ground
     plane under a perspective camera). Casters: every box except flat ones that shadow
@@ -578,6 +583,21 @@ def fit_sun_to_view(direction, corners, view_corners, map_size, soft=0.0, flat_f
         texel = float(max(hi[0] - lo[0], hi[1] - lo[1])) / max(int(map_size) - 4, 1)
         reach = max_filter_radius(map_size) * texel / float(soft)
         hi[2] = max(hi[2], min(float(bhi[casters, 2].max()), hi[2] + reach))
+    if kept is not None:
+        store, slot = kept
+        old = store.get(slot)
+        if (
+            old is not None
+            and np.all(old[0] <= lo)
+            and np.all(old[1] >= hi)
+            and max(old[1][0] - old[0][0], old[1][1] - old[0][1]) <= 2.0 * max(hi[0] - lo[0], hi[1] - lo[1])
+        ):
+            lo, hi = old[0].copy(), old[1].copy()
+            reach = np.all((blo[:, :2] <= hi[:2]) & (bhi[:, :2] >= lo[:2]), axis=1) & (bhi[:, 2] >= lo[2])
+            casters = np.nonzero(reach & can_cast)[0]
+        if len(store) >= 1024:
+            store.clear()
+        store[slot] = (lo.copy(), hi.copy())
     scale = float(np.abs(np.concatenate([lo, hi])).max())
     fit = _ortho_fit(view, lo, hi, scale, map_size)
     fit.pivot = pivot

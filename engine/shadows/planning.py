@@ -627,18 +627,36 @@ def _sun_tiles(scene, job, sizes):
             flat_free=flat_free,
             parts=scene.parts(),
             cone=job.cone,
+            kept=_sun_slot(scene, light, sizes[0], spread, job.cone, 0),
         )
         tiles = [Tile(*fitted)] if fitted is not None else []
     else:
         fits = [
             lightspace.fit_sun_to_view(
-                light.direction, corners, sc, sizes[k], soft=spread, flat_free=flat_free, cone=job.cone
+                light.direction,
+                corners,
+                sc,
+                sizes[k],
+                soft=spread,
+                flat_free=flat_free,
+                cone=job.cone,
+                kept=_sun_slot(scene, light, sizes[k], spread, job.cone, k),
             )
             for k, (sc, _end) in enumerate(slices)
         ]
         tiles = [Tile(*f) if f is not None else None for f in fits]
     cascaded = view_corners is not None and slices is not None and len(slices) > 1 and not light.world
     return tiles, "CASCADE" if cascaded else "SINGLE"
+
+
+def _sun_slot(scene, light, size, spread, cone, cascade):
+    """(``ViewFit.windows``, this sun map's slot in it) while the view moves, else None. The
+    world's directions change every frame and keep nothing."""
+    windows = scene.view.windows
+    if windows is None or light.world:
+        return None
+    direction = np.asarray(light.direction, np.float64).tobytes()
+    return windows, ("sun", direction, int(size), float(spread), float(cone), cascade)
 
 
 def _spot_tiles(scene, job, sizes):

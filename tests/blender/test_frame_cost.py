@@ -240,3 +240,36 @@ def test_an_orbit_around_a_still_scene_redraws_no_spot_point_or_area_map(penumbr
     first, later = counts[0], counts[1:]
     assert first[0] >= 1 + 1 + 3, counts  # the spot's map, and the point's and the area's faces
     assert all(drawn == 0 and reused == first[0] for drawn, reused in later), counts
+
+
+def test_an_orbit_keeps_the_suns_map_until_the_view_outgrows_it(penumbra, gpu_call):
+    """The demo (a sun fitted to the view and a spot) orbited 4 degrees a navigation frame for
+    a third of a turn: the spot's map is drawn once, the sun's again only when what the view
+    needs of it leaves the rectangle it was fitted to (a few times), not every frame as
+    before; and the last frame, drawn with maps fitted frames earlier, shows what a fresh
+    engine's navigation frame shows at that view (its maps fitted to that view alone)."""
+    import numpy as np
+
+    scene = scenes.demo_scene(*SIZE)
+    scene.penumbra.layers.clear()
+
+    def job(engine, depsgraph):
+        from penumbra.engine.frame.film import texture_array
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, scene, *SIZE)
+        drawn = []
+        for k in range(30):
+            view = orbit(camera, 4.0 * k)
+            out = engine.render_frame(depsgraph, view, *SIZE, aux=False, navigating=True)
+            drawn.append(out.stats.shadow_maps)
+        kept = texture_array(out.color, 4).copy()
+        engine.free_gpu()  # a fresh renderer: nothing kept, its maps fitted to this view
+        out = engine.render_frame(depsgraph, view, *SIZE, aux=False, navigating=True)
+        return drawn, kept, texture_array(out.color, 4)
+
+    drawn, kept, fresh = gpu_call(job)
+    assert drawn[0] == 2, drawn  # the sun's and the spot's
+    assert sum(drawn[1:]) <= 6, drawn  # before: the sun's every frame (29)
+    diff = np.abs(kept[..., :3].astype(np.float64) - fresh[..., :3])
+    assert float(diff.mean()) < 2e-3 and float(np.quantile(diff, 0.99)) < 0.05, (diff.mean(), np.quantile(diff, 0.99))
