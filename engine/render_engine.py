@@ -412,6 +412,7 @@ class PenumbraRenderEngine(PenumbraEngineCore, bpy.types.RenderEngine):
         layer = depsgraph.view_layer.name
         self.texture_pool = gpu_pool.FINAL_RENDERS
         self.cache.store = store.STORE  # meshes and their batches kept between final renders
+        store.STORE.collect()  # what a file load emptied out of it, freed in this GPU context
         store.STORE.pressure()  # the system short of memory: the store sheds its older half
         r = scene.render
         self.texture_pool.begin_render(

@@ -26,8 +26,9 @@ recently used entries dropped first; an entry larger than the budget is not kept
 when a file is loaded (``load_pre``: nothing of another file's meshes stays), when the
 extension is unregistered, and at exit; under memory pressure (``pressure``: the system's
 available memory below ``LOW_MEMORY`` of its total, checked when a final render begins) it
-drops its older half. GPU entries are only dropped by Python references going away; Blender
-frees buffers released outside a GPU context when the context is next active.
+drops its older half. GPU objects are freed only inside a GPU context: what a file load
+empties outside one is held aside (``clear``) until the next final render lets it go inside
+its own (``collect``); room made during a render is made inside it.
 """
 
 import atexit
@@ -58,6 +59,7 @@ class Store:
         self.misses = 0
         self.dropped = 0  # entries dropped for room or pressure since creation
         self.cleared = 0  # times emptied (file load, unregister)
+        self._released = []  # what ``clear`` emptied, held until ``collect`` (inside a GPU context)
         self.memory = available_memory  # the probe ``pressure`` reads (tests may replace it)
 
     def __len__(self):
@@ -113,10 +115,26 @@ class Store:
         for key in [k for k in self._items if k[0] == kind]:
             self.held_bytes -= self._items.pop(key)[1]
 
-    def clear(self):
+    def clear(self, now=False):
+        """Empty the store. Its values are held aside until ``collect`` (GPU objects must be
+        freed inside a GPU context, and a file load is outside one), unless ``now`` (on
+        unregister and at exit, as Blender's GPU module still runs)."""
+        if not now:
+            self._released.extend(value for value, _size in self._items.values())
+        else:
+            self._released.clear()
         self._items.clear()
         self.held_bytes = 0
         self.cleared += 1
+
+    @property
+    def released(self):
+        """How many values ``clear`` holds aside for ``collect``."""
+        return len(self._released)
+
+    def collect(self):
+        """Let go of what ``clear`` held aside: call it inside a GPU context."""
+        self._released.clear()
 
 
 STORE = Store()
@@ -146,16 +164,16 @@ class Kind:
         return self.store.count(self.kind)
 
 
-def clear():
-    """Empty the store (file load, unregister, exit)."""
-    STORE.clear()
+def clear(now=False):
+    """Empty the store (file load; ``now``: unregister, exit)."""
+    STORE.clear(now)
 
 
-atexit.register(clear)
+atexit.register(clear, True)
 
 
 def _on_load(*_args):
-    clear()
+    clear()  # outside a GPU context: freed by the next final render (``Store.collect``)
 
 
 def register():
@@ -174,7 +192,7 @@ def unregister():
         if handler in bpy.app.handlers.load_pre:
             bpy.app.handlers.load_pre.remove(handler)
     _handlers.clear()
-    clear()
+    clear(now=True)
 
 
 _handlers = []

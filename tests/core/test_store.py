@@ -46,3 +46,27 @@ def test_a_kind_is_a_view_of_its_entries():
     assert closed.get(b"x") is None and levels.get(b"x") == (None,) and s.held_bytes == 8
     s.clear()
     assert len(s) == 0 and s.held_bytes == 0 and s.cleared == 1
+
+
+def test_a_clear_outside_a_render_holds_its_values_until_the_next_render_collects_them():
+    """GPU objects are freed inside a GPU context only: ``clear`` (a file load) keeps the
+    values alive aside, ``collect`` (the next final render) lets them go; ``clear(now=True)``
+    (unregister, exit) lets them go at once."""
+    import weakref
+
+    class Buffer:  # stands for a GPU object: what matters is when its last reference goes
+        pass
+
+    s = Store(budget=1000)
+    value = Buffer()
+    alive = weakref.ref(value)
+    s.put("batches", b"k", value, 10)
+    del value
+    s.clear()
+    assert len(s) == 0 and s.get("batches", b"k") is None
+    assert s.released == 1 and alive() is not None  # held aside, not freed outside a context
+    s.collect()
+    assert s.released == 0 and alive() is None
+    s.put("batches", b"k", Buffer(), 10)
+    s.clear(now=True)
+    assert s.released == 0
