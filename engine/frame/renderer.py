@@ -72,6 +72,8 @@ class Sample:
     seen: list = None
     masks: dict = None
     mirrored: bool = False  # its view camera mirrors the scene (a Plane probe's capture): windings turn
+    rects: list = None  # the screen rectangle each of its lights in view reaches
+    cpu: float = 0.0  # CPU seconds its set-up and map planning took (``Renderer._batch``)
 
 
 @dataclasses.dataclass
@@ -170,6 +172,10 @@ class FramePlan:
         return any(f.name == name for f in self.features)
 
 
+# A frame's samples are drawn in batches of at most this many: their maps planned, then drawn
+# together, one instanced draw per caster batch (``Renderer._batch``, ``ShadowPass.batches``).
+MAP_BATCH = 8
+
 # While the view moves, a frame's maps keep the sizes of the last navigation frame that
 # planned them afresh, this many frames ago at most (``FrameRequest.navigating``).
 NAVIGATION_REPLAN = 8
@@ -251,22 +257,33 @@ class Renderer:
         stats = frame.stats
         drawn = None
         pixels = request.width * request.height
-        for s in range(*request.samples):
+        s, end = request.samples
+        while s < end and not (stats.stopped or stats.cancelled):
             for feature in frame.features:
                 feature.before_sample(frame, s)
             if frame.accumulate and self.film.converged >= pixels:
                 stats.stopped = "converged"  # every pixel settled, or a later call of a converged frame
                 break
-            drawn = self._sample_at(frame, s)
-            if frame.deadline is not None and frame.accumulate and not stats.stopped:
-                self.film.finish()  # the sample's GPU work done, so the clock counts it
-                if sampling.clock() >= frame.deadline:
-                    stats.stopped = "time limit"
-            if on_sample is not None and on_sample(s + 1) is False:
-                stats.cancelled = True
-                break
-            if stats.stopped:
-                break
+            batch = self._batch(frame, s, self._batch_end(frame, s, end))
+            s += len(batch)
+            for group in self.shadow_pass.batches(frame, batch):
+                start = clock.cpu_seconds
+                with clock.stage("shadow pass"):
+                    self.shadow_pass.draw_batch(frame, group)
+                shared = clock.cpu_seconds - start  # booked to the group's first sample
+                for sample in group:
+                    drawn = self._sample_at(frame, sample, shared)
+                    shared = 0.0
+                    if frame.deadline is not None and frame.accumulate and not stats.stopped:
+                        self.film.finish()  # the sample's GPU work done, so the clock counts it
+                        if sampling.clock() >= frame.deadline:
+                            stats.stopped = "time limit"
+                    if on_sample is not None and on_sample(sample.index + 1) is False:
+                        stats.cancelled = True
+                    if stats.stopped or stats.cancelled:
+                        break
+                if stats.stopped or stats.cancelled:
+                    break
         self.last_sample = drawn
         with clock.stage("resolve"):
             self._resolve(frame, drawn)
@@ -494,15 +511,57 @@ class Renderer:
             stats.world_directions += frame.directions
         return sample
 
-    def _sample_at(self, frame, s):
-        """Sample ``s`` of the frame (``sample``), drawn (``draw_sample``), then its weight
-        added to the film and, every few samples, the noise check (``stats.stopped``)."""
+    def _batch_end(self, frame, s, end):
+        """Where the batch of samples that starts at ``s`` ends (the frame's samples run to
+        ``end``): at most MAP_BATCH samples of a frame that accumulates, sharing one draw list
+        (not with motion blur, where each sample has its own), and never past a sample after
+        which adaptive sampling checks the noise or before which a technique works
+        (``Feature.starts_batch``: settling's test), so a batch ends where the frame may. The
+        first sample is a batch of its own: settling's test reads it, and a frame with settling
+        and one without then draw their later samples in the same batches, their maps placed
+        alike, so they agree to the bit where no pixel settled (a map placed elsewhere in the
+        atlas may rasterise a texel's edge otherwise: ``gl_Position``'s rounding)."""
+        if not frame.accumulate or frame.motion is not None or s == 0:
+            return s + 1
+        last = min(end, s + MAP_BATCH)
+        for k in range(s + 1, last):
+            if frame.noise and frame.adaptive.checks_at(k):
+                return k
+            if any(feature.starts_batch(frame, k) for feature in frame.features):
+                return k
+        return last
+
+    def _batch(self, frame, s, end):
+        """Samples ``s`` .. ``end - 1`` set up (``sample``: the techniques' ``before_sample``
+        first for all but ``s``, whose the caller ran), with their lights in view and their
+        maps planned (``ShadowPass.plan_sample``), nothing drawn: the batch whose maps are drawn
+        together (``ShadowPass.batches``, ``draw_batch``). A batch of one is the frame one
+        sample at a time."""
+        clock = frame.clock
+        batch = []
+        for k in range(s, end):
+            if k > s:
+                for feature in frame.features:
+                    feature.before_sample(frame, k)
+            start = clock.cpu_seconds
+            with clock.stage("sample set-up"):
+                sample = self.sample(frame, k)
+                self._lights_in_view(frame, sample)
+            with clock.stage("shadow pass"):
+                sample.plan = self.shadow_pass.plan_sample(frame, sample)
+            sample.cpu = clock.cpu_seconds - start
+            batch.append(sample)
+        return batch
+
+    def _sample_at(self, frame, sample, shared=0.0):
+        """``sample`` (set up, its maps drawn: ``_batch``) drawn (``draw_lit``), then its weight
+        added to the film and, every few samples, the noise check (``stats.stopped``).
+        ``shared``: CPU seconds of its batch's map pass booked to it."""
         film, settings, stats, clock = self.film, frame.settings, frame.stats, frame.clock
         accumulate, count = frame.accumulate, frame.sample_count
-        sample_start = clock.cpu_seconds
-        with clock.stage("sample set-up"):
-            sample = self.sample(frame, s)
-        self.draw_sample(frame, sample)
+        s = sample.index
+        sample_start = clock.cpu_seconds - sample.cpu - shared
+        self.draw_lit(frame, sample)
         with clock.stage("accumulate"):
             if accumulate:
                 stats.pixel_samples_skipped += film.converged
@@ -521,21 +580,29 @@ class Renderer:
         return sample
 
     def draw_sample(self, frame, sample):
-        """Draw ``sample`` (a ``Sample``) of ``frame``: its shadow maps (planned from its
-        unjittered camera, so a light that does not move between samples keeps its map), the
-        techniques' work before the lit pass (``Feature.before_lit``: the world occlusion's
-        depth prepass through the raster camera), then the lit pass seen through its view
-        camera. Fills in and returns ``sample``."""
-        film, clock = self.film, frame.clock
-        width, height = film.size
-        view_camera, camera = sample.view_camera, sample.camera
-        lights, rects = lights_in_view(
-            sample.lights, sample.draws, view_camera, width, height, sample.stats, frame.rects, frame.receivers
+        """Draw ``sample`` (a ``Sample``) of ``frame`` on its own (a batch of one): its shadow
+        maps (planned from its unjittered camera, so a light that does not move between
+        samples keeps its map), then ``draw_lit``. Fills in and returns ``sample``."""
+        self._lights_in_view(frame, sample)
+        with frame.clock.stage("shadow pass"):
+            self.shadow_pass.draw(frame, sample)
+        return self.draw_lit(frame, sample)
+
+    def _lights_in_view(self, frame, sample):
+        """The sample's lights that light something it sees (``sample.lights``) and the screen
+        rectangles they reach (``sample.rects``)."""
+        width, height = self.film.size
+        sample.lights, sample.rects = lights_in_view(
+            sample.lights, sample.draws, sample.view_camera, width, height, sample.stats, frame.rects, frame.receivers
         )
-        sample.lights = lights
-        clock.begin("shadow pass")
-        sample.plan = self.shadow_pass.draw(frame, sample)
-        clock.end()
+
+    def draw_lit(self, frame, sample):
+        """``sample`` after its maps are drawn (``sample.plan``): the techniques' work before
+        the lit pass (``Feature.before_lit``: the world occlusion's depth prepass through the
+        raster camera), then the lit pass seen through its view camera, then the techniques'
+        work after it. Fills in and returns ``sample``."""
+        clock = frame.clock
+        view_camera, camera, rects = sample.view_camera, sample.camera, sample.rects
         sample.atlas = self.shadows if sample.plan is not None and sample.plan.tiles else None
         depth_range = self.shadow_pass.depth_range
         if depth_range is UNSET:  # no shadow plan this frame: the quick, wider bound
@@ -721,12 +788,24 @@ class Renderer:
                     atlas._framebuffer.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
 
     def release(self):
-        """Give the frame's targets and the shadow atlas back to the pool: at the end of a
-        final render, inside its GPU context. The renderer is not used again."""
-        if self.pool is None:
-            return
-        self.film.release()
-        self.shadows.free()
+        """Give the frame's targets and the shadow atlas back to the pool (final renders) and
+        free every other GPU object the renderer holds, now: inside its GPU context, where the
+        engine lets it go (``close``). The renderer is not used again."""
+        if self.pool is not None:
+            self.film.release()
+            self.shadows.free()
+            for feature in self.features:
+                feature.release()
+            self.world_probe.release()
+        self.close()
+
+    def close(self):
+        """Break the references that lead back to the renderer (each technique's, the film's
+        clock), so that letting it go frees its framebuffers, blocks, batches and textures at
+        once, in the GPU context that is current, not whenever Python's cycle collector runs:
+        possibly in another render's context, or in none (``test_sample_batches.py``:
+        ``test_a_renderer_let_go_frees_its_gpu_objects_at_once``)."""
         for feature in self.features:
-            feature.release()
-        self.world_probe.release()
+            feature.renderer = None
+        self.features = ()
+        self.film.clock = None

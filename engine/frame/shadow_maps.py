@@ -150,6 +150,9 @@ class ShadowAtlas:
         self._instanced = UniformBlocks()  # the instanced pass's blocks: the tiles, the instance table
         self._tiles_bytes = None  # what its tiles block holds
         self._contents = {}  # tile index -> what its map holds
+        # Inside a frame the atlas only grows (``ShadowPass.draw_batch``): a batch with fewer
+        # maps than the last, or the settling pilot's, keeps the larger atlas, not a new one.
+        self.growing = False
         self.uploaded = 0  # bytes of tile blocks sent to the GPU since creation
 
     @staticmethod
@@ -181,10 +184,11 @@ class ShadowAtlas:
         rsm = bool(rsm)
         if (
             self.texture is not None
-            and (self.size, self.columns, self.depth_format, self.rsm) == (size, columns, depth_format, rsm)
+            and (self.size, self.depth_format, self.rsm) == (size, depth_format, rsm)
             and self.count >= count
+            and (self.columns == columns or self.growing)
         ):
-            return
+            return  # (while ``growing`` a larger grid holds the maps too: ``place`` uses its columns)
         self.free()
         self.size, self.count, self.columns, self.depth_format = size, columns * rows, columns, depth_format
         self.rsm = rsm
@@ -279,8 +283,11 @@ class ShadowAtlas:
         ``Caster``, or None for an instance that casts no shadow; a tile's key is its fit and
         its casters. ``origin``: the frame origin the casters' model matrices are relative to.
         ``levels``: {(tile index, instance index): (batches, level, triangles)}, casters drawn
-        into that tile at a level of detail (``shadow_pass.map_levels``) instead of whole."""
-        work = self._changed(plan, draws, cull_front, stats, alpha_offset, levels or {})
+        into that tile at a level of detail (``shadow_pass.map_levels``) instead of whole.
+        ``alpha_offset``: the sample's alpha-hash offset, or one per tile (the maps of a batch
+        of samples, ``ShadowPass.draw_batch``): alpha cut-outs cover other texels in each."""
+        alphas = list(alpha_offset) if isinstance(alpha_offset, (list, tuple)) else [alpha_offset] * len(plan.tiles)
+        work = self._changed(plan, draws, cull_front, stats, alphas, levels or {})
         depth_only = DEPTH_FORMAT[self.depth_format].depth_only
         # Every map redrawn (a final render's frame) and filling most of the atlas: one clear of
         # the whole atlas, not one scissored clear per map (which GL may draw as a quad).
@@ -293,13 +300,13 @@ class ShadowAtlas:
                 else:
                     self._framebuffer.clear(depth=1.0)
         if depth_only and not self.rsm:
-            self._render_depth_maps(plan, work, shaders, cull_front, stats, (alpha_offset, origin), cleared)
+            self._render_depth_maps(plan, work, shaders, cull_front, stats, (alphas, origin), cleared)
             return
         for index, tile, casters, key in work:
-            self._render_tile(index, tile, casters, shaders, cull_front, stats, (alpha_offset, origin), cleared)
+            self._render_tile(index, tile, casters, shaders, cull_front, stats, (alphas[index], origin), cleared)
             self._drawn(index, key, tile, casters, stats)
 
-    def _changed(self, plan, draws, cull_front, stats, alpha_offset, levels):
+    def _changed(self, plan, draws, cull_front, stats, alphas, levels):
         """[(tile index, tile, its casters, its content key)] of the tiles of ``plan`` whose
         content is not already in the atlas (those that are count as reused)."""
         work = []
@@ -320,7 +327,7 @@ class ShadowAtlas:
                 # The reflective targets hold the casters' albedo as well.
                 tuple(c.rsm_key for c in casters) if self.rsm else None,
                 # Alpha casters cover other texels in each sample: such a map is redrawn per sample.
-                alpha_offset if any(c.cutouts for c in casters) else None,
+                alphas[index] if any(c.cutouts for c in casters) else None,
             )
             if self._contents.get(index) == key:
                 stats.shadow_maps_reused += 1
@@ -339,7 +346,8 @@ class ShadowAtlas:
     def _render_depth_maps(self, plan, work, shaders, cull_front, stats, sample, cleared):
         """Depth-buffer maps (FLOAT32, no reflective targets): each opaque caster batch is drawn
         once for all the maps of the sample it is in (instanced); alpha cut-outs and hair strips
-        tile by tile. ``sample``: (alpha offset, frame origin); ``cleared``: the whole atlas was."""
+        tile by tile. ``sample``: (alpha offset per tile, frame origin); ``cleared``: the whole
+        atlas was."""
         import gpu
 
         if not cleared and work:
@@ -350,7 +358,7 @@ class ShadowAtlas:
                     gpu.state.scissor_set(*tile.origin, tile.size, tile.size)
                     self._framebuffer.clear(depth=1.0)
                 gpu.state.scissor_test_set(False)
-        alpha_offset, origin = sample
+        alphas, origin = sample
         self._render_instanced(plan, work, shaders, cull_front, stats, origin)
         for index, tile, casters, key in work:
             if any(c.cutouts or c.hair is not None for c in casters):
@@ -361,7 +369,7 @@ class ShadowAtlas:
                     gpu.state.depth_mask_set(True)
                     tile_ubo = self._tile_ubo(index, TILE_STRUCT.pack([tile.record(origin)]))
                     raster = tile.fit.orthographic and not _crosses_near(tile.fit, casters)
-                    self._draw_strips_and_cutouts(casters, tile_ubo, raster, shaders, sample, stats)
+                    self._draw_strips_and_cutouts(casters, tile_ubo, raster, shaders, (alphas[index], origin), stats)
                     gpu.state.depth_test_set("NONE")
                     gpu.state.depth_mask_set(False)
             self._drawn(index, key, tile, casters, stats)

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from ..enums import DEPTH_FORMAT
 from ..scene import simplify
 from ..scene.materials import Material
 from ..shadows import light_bins, lightspace
@@ -15,6 +16,7 @@ from ..shadows.planning import (
     Density,
     FrameShare,
     MapOptions,
+    ShadowPlan,
     ViewFit,
     frame_sizes,
     frame_tiles,
@@ -61,6 +63,7 @@ class ShadowPass:
         self.reflective = bool(reflective)
         self.receivers = None if receivers is None or not len(receivers) else np.asarray(receivers, np.float64)
         self.depth_range = UNSET
+        self.atlas.growing = False  # the frame's first maps size the atlas afresh
         self._receivers = None
         self._sun_parts = None
         self._casters = (None, None, False)
@@ -165,10 +168,18 @@ class ShadowPass:
     def draw(self, frame, sample):
         """Plan the maps ``sample`` (``renderer.Sample``: its draws and lights, planned from its
         unjittered camera) of ``frame`` (``renderer.FramePlan``) needs (numpy) and draw the
-        ones whose content changed. The frame's ``GpuCaches`` serve alpha cutouts (material
-        blocks, images) and the casters' levels of detail in each map (batches). Returns the plan."""
+        ones whose content changed: a batch of one (``plan_sample``, ``draw_batch``). Returns
+        the plan (also ``sample.plan``)."""
+        sample.plan = self.plan_sample(frame, sample)
+        self.draw_batch(frame, [sample])
+        return sample.plan
+
+    def plan_sample(self, frame, sample):
+        """The maps ``sample`` needs (numpy, nothing drawn): planned at the frame's sizes (or
+        clamped where the GPU's largest texture or the bounce's budget asks), shifted by the
+        sample's map jitter, with shadow linking's casters. Returns the plan."""
         draws, lights, camera, stats = sample.draws, sample.lights, sample.camera, sample.stats
-        settings, size, caches = frame.settings, frame.size, frame.caches
+        settings, size = frame.settings, frame.size
         map_size = max(1, int(settings.shadow_map_size))
         plan = self.plan(draws, lights, camera, settings, size, map_size, (self._sizes, self._derived))
         if not plan.tiles:
@@ -214,22 +225,122 @@ class ShadowPass:
                         tile.casters = np.array(
                             [c for c in tile.casters if blockers.links(draws[c].instance.names)], dtype=np.int64
                         )
-        self.atlas.place(plan, settings.shadow_depth_format, rsm)
+        return plan
+
+    def casters(self, draws, caches):
+        """What each of the frame's ``draws`` casts (``caster``): made once a frame (motion
+        blur gives each sample its draws, and its casters)."""
+        rsm = self.reflective
+        if self._casters[0] is not draws or self._casters[2] != rsm:
+            self._casters = (draws, [caster(d, caches.materials, caches.textures, rsm) for d in draws], rsm)
+        return self._casters[1]
+
+    def batches(self, frame, samples):
+        """``samples`` (planned, in order, sharing one draw list) in groups whose maps are drawn
+        together (``draw_batch``): a group's maps are the union of its samples' (a map two
+        samples plan alike, a light that does not move, is drawn once), at most
+        MAX_SHADOW_TILES, in an atlas no wider than the GPU's largest texture and of at most
+        MAP_BATCH_BYTES (a sample whose maps alone take more is a group of its own)."""
+        limit = _gpu_texture_limit()
+        texel = DEPTH_FORMAT[frame.settings.shadow_depth_format].bytes + (RSM_TEXEL_BYTES if self.reflective else 0)
+        casters = self.casters(samples[0].draws, frame.caches)
+        groups, group, keys, sizes = [], [], set(), []
+        for sample in samples:
+            plan = sample.plan
+            tiles = plan.tiles if plan is not None else []
+            new = {}
+            for tile in tiles:
+                new.setdefault(_content(tile, casters, sample.alpha_offset), tile.size)
+            added = [n for k, n in new.items() if k not in keys]
+            if group and not _fits(sizes + added, texel, limit):
+                groups.append(group)
+                group, keys, sizes = [], set(), list(new.values())
+            else:
+                sizes += added
+            group.append(sample)
+            keys.update(new)
+        groups.append(group)
+        return groups
+
+    def draw_batch(self, frame, samples):
+        """Draw the maps of ``samples`` (a group of ``batches``) whose content changed: the
+        union of their plans placed in the atlas at once (each sample's tiles get their place),
+        every opaque caster batch drawn once for all of them (``ShadowAtlas.render``: instanced,
+        whatever the number of maps and samples). The frame's ``GpuCaches`` serve alpha
+        cutouts (material blocks, images) and the casters' levels of detail in each map."""
+        settings, caches = frame.settings, frame.caches
+        planned = [s for s in samples if s.plan is not None and s.plan.tiles]
+        if not planned:
+            return
+        stats = planned[0].stats
+        draws = planned[0].draws
+        casters = self.casters(draws, caches)
+        rsm = self.reflective
+        # Reflective maps draw each caster per material (its albedo): whole, not simplified.
+        detail = 0.0 if rsm else float(getattr(settings, "shadow_caster_detail", 0.0))
+        tiles, alphas, levels, where, twins = [], [], {}, {}, []
+        for sample in planned:
+            plan = sample.plan
+            assert sample.draws is draws, "a batch's samples share one draw list"
+            at = map_levels(plan, draws, casters, caches.batches, detail)
+            for t, tile in enumerate(plan.tiles):
+                key = _content(tile, casters, sample.alpha_offset)
+                index = where.get(key)
+                if index is None:
+                    index = where[key] = len(tiles)
+                    tiles.append(tile)
+                    alphas.append(sample.alpha_offset)
+                    levels.update({(index, c): lod for (u, c), lod in at.items() if u == t})
+                twins.append((tile, index))
+        # A map two samples share is drawn once: the others reuse it, as a later frame would.
+        stats.shadow_maps_reused += len(twins) - len(tiles)
+        union = ShadowPlan(tiles=tiles)
+        self.atlas.place(union, settings.shadow_depth_format, rsm)
+        self.atlas.growing = True
+        for tile, index in twins:
+            tile.origin = tiles[index].origin
         if self.atlas.rsm_refused:
             stats.messages.append(
                 f"Penumbra: this GPU refused the bounce's reflective maps ({self.atlas.rsm_refused}): "
                 "rendered without the bounce"
             )
-        if self._casters[0] is not draws or self._casters[2] != rsm:  # the frame's, not the sample's
-            self._casters = (draws, [caster(d, caches.materials, caches.textures, rsm) for d in draws], rsm)
-        casters = self._casters[1]
-        # Reflective maps draw each caster per material (its albedo): whole, not simplified.
-        detail = 0.0 if rsm else float(getattr(settings, "shadow_caster_detail", 0.0))
-        levels = map_levels(plan, draws, casters, caches.batches, detail)
         self.atlas.render(
-            plan, casters, caches.shaders, settings.shadow_cull_front, stats, sample.alpha_offset, frame.origin, levels
+            union, casters, caches.shaders, settings.shadow_cull_front, stats, alphas, frame.origin, levels
         )
-        return plan
+
+
+# The atlas of a batch of samples' maps (``ShadowPass.batches``) takes at most this many bytes;
+# a sample whose own maps take more draws them alone (its frame's sizes decided them).
+MAP_BATCH_BYTES = 256 << 20
+
+
+def _content(tile, casters, alpha_offset):
+    """What a planned map holds, wherever it is placed: two samples' maps with the same are
+    one map. Alpha cut-outs cover other texels in each sample (``alpha_offset``)."""
+    fit = tile.fit
+    cutouts = any(casters[c] is not None and casters[c].cutouts for c in tile.casters)
+    return (
+        fit.view_proj.tobytes(),
+        fit.near,
+        fit.far,
+        tile.size,
+        np.asarray(tile.casters, np.int64).tobytes(),
+        alpha_offset if cutouts else None,
+    )
+
+
+def _fits(sizes, texel, limit):
+    """Whether maps of ``sizes`` fit one atlas (``ShadowAtlas.grid`` of slots as wide as the
+    widest, filled by area: ``pack_tiles`` leaves no gap between power-of-two maps) of at
+    most MAP_BATCH_BYTES (``texel`` bytes a texel), at most ``limit`` texels wide and at most
+    MAX_SHADOW_TILES maps."""
+    if len(sizes) > MAX_SHADOW_TILES:
+        return False
+    slot = max(sizes, default=1)
+    # A slot for each map at most; by area, as many as the maps fill.
+    count = min(len(sizes), math.ceil(sum(n * n for n in sizes) / (slot * slot)))
+    columns, rows = ShadowAtlas.grid(count)
+    return columns * slot <= limit and rows * slot <= limit and columns * rows * slot * slot * texel <= MAP_BATCH_BYTES
 
 
 def caster(d, materials, textures, rsm=False):

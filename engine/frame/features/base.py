@@ -42,7 +42,9 @@ class Feature:
       base plan (draw list, lights, the world's light) and before the samples;
     * ``film(frame)``: what it asks of the film, as keywords of ``Film.begin``, and
       ``film_part(frame)``: its own targets there (a ``film.FilmPart``; frames of several samples);
-    * ``before_sample(frame, s)``: a stage of its own before sample ``s`` (settling's test);
+    * ``before_sample(frame, s)``: a stage of its own before sample ``s`` is set up; a frame
+      sets up a batch of samples before it draws them, so a stage that needs the samples
+      before ``s`` drawn says so (``starts_batch(frame, s)``: settling's test);
     * ``prepare(frame, sample)``: its change to the sample's view, scene or lights (``Sample``);
     * ``before_lit(frame, sample)``: GPU work the sample's lit pass reads (a depth prepass);
     * ``after_lit(frame, sample)``: GPU work over what the sample's lit pass left (its
@@ -74,6 +76,11 @@ class Feature:
 
     def before_sample(self, frame, s):
         pass
+
+    def starts_batch(self, frame, s):
+        """Whether sample ``s`` must begin a batch (``Renderer._batch_end``): its
+        ``before_sample`` needs the samples before it drawn (settling's test)."""
+        return False
 
     def prepare(self, frame, sample):
         pass

