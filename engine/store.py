@@ -14,14 +14,15 @@ a 45 ms render thread. The store keeps, keyed by a digest of what each is made f
   tangents    MikkTSpace tangents of a mesh's corners
   corners     the shadow terminator's corner data (``scene/terminator.py``)
   levels      a geometry's levels of detail (``scene/simplify.py``)
+  world       the prefiltered atlas of a world's Environment Texture (``frame/world/prefilter.py``),
+              keyed by the image as its SH read it back (``TextureCache._content``)
 
-Textures a pass samples are not kept here (a world's prefiltered environment was, briefly):
-freed later, in another render's GPU context, such a texture stays bound in the context that
-sampled it, and Blender's GL state there then reads a freed texture (a crash on llvmpipe in a
-later draw). Vertex and index buffers are bound through each render's own batches instead.
+A kept texture (the world's) is freed inside a GPU context like every GPU object here
+(``collect``); renderers free their own at once when let go (``Renderer.release``), not when
+Python's cycle collector runs, which crashed llvmpipe when the world's atlas was first kept.
 
-The viewport shares the pure ones (closed, tangents, corners, levels); geometry and batches are
-kept for final renders only (the viewport's engine keeps its own, invalidated by the
+The viewport shares the pure ones (closed, tangents, corners, levels); geometry, batches and
+worlds are kept for final renders only (the viewport's engine keeps its own, invalidated by the
 depsgraph's updates). Textures and compiled programs have their own pools (``gpu_pool``).
 
 One budget bounds it all (``BUDGET`` bytes, CPU and GPU copies counted alike), the least

@@ -78,7 +78,7 @@ class GpuCaches:
         from .material_blocks import MaterialBlocks
 
         shaders = shaders if shaders is not None else ShaderCache()
-        return cls(shaders, MaterialBlocks(), TextureCache(), Batches(store), pool)
+        return cls(shaders, MaterialBlocks(), TextureCache(store), Batches(store), pool)
 
     @property
     def uploaded(self):

@@ -23,6 +23,7 @@ read back from the GPU (``world_sh``), never from the image's pixels.
 
 import numpy as np
 
+from .geometry import content_key
 from .materials import SH_C0, equirect_sh
 
 # Bytes per texel of the formats Blender gives image textures (mipmaps add a third).
@@ -40,10 +41,13 @@ def stores_premultiplied(image):
 
 
 class TextureCache:
-    def __init__(self):
+    def __init__(self, store=None):
+        self.store = store  # the extension's ``store.Store`` (final renders): prefiltered worlds kept by content
+        self.prefilters = 0  # prefiltered environments built (not found here or in the store) since creation
         self._textures = {}  # image name -> (GPUTexture, premultiplied)
         self._sh = {}  # image name -> its equirectangular SH (9, 3), strength 1
         self._env = {}  # image name -> the image box-filtered as the SH saw it (h, w, 3), strength 1
+        self._read = {}  # image name -> digest of that read-back, as read (``_content``)
         self._prefiltered = {}  # (image name, clamp) -> (its prefiltered atlas, bytes) (``world_prefiltered``)
         self.uploads = 0  # images taken from Blender since creation (tests and the benchmark read it)
         self.upload_bytes = 0  # bytes of those Blender made a texture of for them (``_first_take``)
@@ -56,6 +60,7 @@ class TextureCache:
             entry = self._textures.pop(name, None)
             self._sh.pop(name, None)
             self._env.pop(name, None)
+            self._read.pop(name, None)
             for key in [k for k in self._prefiltered if k[0] == name]:
                 self.bytes -= self._prefiltered.pop(key)[1]
             self._messages.pop(name, None)
@@ -66,6 +71,7 @@ class TextureCache:
         self._textures.clear()
         self._sh.clear()
         self._env.clear()
+        self._read.clear()
         self._prefiltered.clear()
         self._messages.clear()
         self.bytes = 0
@@ -125,6 +131,7 @@ class TextureCache:
             width = max(1, min(SH_WIDTH, texture.width))
             height = max(1, min(SH_WIDTH // 2, texture.height))
             rgba = np.nan_to_num(np.asarray(reduce(texture, premultiplied, width, height), np.float64))
+            self._read[name] = content_key(np.ascontiguousarray(rgba, np.float32))
             env = self._env[name] = np.clip(rgba[..., :3], 0.0, None)
             sh = self._sh[name] = equirect_sh(env)
         return sh
@@ -139,9 +146,29 @@ class TextureCache:
             for old in [k for k in self._prefiltered if k[0] == name][1:]:
                 self.bytes -= self._prefiltered.pop(old)[1]
             texture, premultiplied = self._entry(name)
-            entry = self._prefiltered[key] = (build(texture, premultiplied), int(size))
+            content = self._content(name, texture, premultiplied, clamp)
+            atlas = None if content is None else self.store.get("world", content)
+            if atlas is None:
+                atlas = build(texture, premultiplied)
+                self.prefilters += 1
+                if content is not None:
+                    self.store.put("world", content, atlas, int(size))
+            entry = self._prefiltered[key] = (atlas, int(size))
             self.bytes += entry[1]
         return entry[0]
+
+    def _content(self, name, texture, premultiplied, clamp):
+        """What a prefiltered environment of image ``name`` is kept by in the store (final
+        renders), or None: the digest of the image as ``world_sh`` read it back from Blender's
+        texture (box-filtered to at most SH_WIDTH x SH_WIDTH/2, float32 RGBA: an edit of the
+        pixels changes some box's sum), with the texture's size and format and the clamp. Every
+        F12 reads that back for the world's SH light anyway; the prefilter (a GPU pass over
+        every level) is not made again for the same image."""
+        read = self._read.get(name)
+        if self.store is None or read is None:
+            return None
+        header = repr((name, read, texture.width, texture.height, texture.format, bool(premultiplied), float(clamp)))
+        return content_key(np.frombuffer(header.encode(), np.uint8))
 
     def world_env(self, name):
         """The image ``name`` box-filtered as ``world_sh`` projected it (h, w, 3), row 0 at the

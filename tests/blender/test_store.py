@@ -166,3 +166,57 @@ def test_the_store_sheds_under_memory_pressure_and_stays_within_its_budget():
     assert result["same"] == 0.0
     available, total = result["probe"]
     assert 0 < available <= total  # the probe reads this system's memory (Linux)
+
+
+def test_a_second_f12_under_the_same_hdri_prefilters_nothing():
+    """A world's Environment Texture (a real outdoor HDRI, ``reflection_scenes.hdri_spheres``):
+    the first F12 after the store is emptied prefilters it, the second takes the atlas from
+    the store and draws the same pixels; after its pixels change (``Image.pixels``, then
+    ``update``) it is prefiltered again and draws what an empty store draws."""
+    result, _ = run_child(
+        """
+        from devkit import reflection_scenes
+        from penumbra.engine.frame.features import world_env
+        BUILT = []
+        _build = world_env.prefilter_environment
+
+        def counting(*args, **kwargs):
+            BUILT.append(1)
+            return _build(*args, **kwargs)
+
+        world_env.prefilter_environment = counting
+        scene = reflection_scenes.build("hdri_spheres", 48, 27)
+        engines.configure(scene, "PENUMBRA")
+        scene.penumbra.render_samples = 1
+        f12(scene)
+        store.clear()
+        BUILT.clear()
+        _, _, cold = f12(scene)
+        cold_built = len(BUILT)
+        _, _, warm = f12(scene)
+        warm_built = len(BUILT) - cold_built
+        image = next(i for i in bpy.data.images if i.source == "FILE")
+        pixels = np.empty(len(image.pixels), np.float32)
+        image.pixels.foreach_get(pixels)
+        pixels[0::4] *= 0.25  # the red channel quartered: another sky
+        image.pixels.foreach_set(pixels)
+        image.update()
+        BUILT.clear()
+        _, _, edited = f12(scene)
+        edited_built = len(BUILT)
+        store.clear()
+        _, _, fresh = f12(scene)
+        report(
+            cold_built=cold_built,
+            warm_built=warm_built,
+            edited_built=edited_built,
+            same=float(np.abs(cold - warm).max()),
+            edit_fresh=float(np.abs(edited - fresh).max()),
+            changed=float(np.abs(edited - warm).max()),
+        )
+        """
+    )
+    assert result["cold_built"] == 1 and result["warm_built"] == 0, result
+    assert result["same"] == 0.0
+    assert result["edited_built"] == 1 and result["edit_fresh"] == 0.0, result
+    assert result["changed"] > 0.01  # the edit reached the frame

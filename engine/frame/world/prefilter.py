@@ -14,7 +14,8 @@ its count of GGX directions per texel (a Hammersley set) over a source of the im
 box-filtered to a size that holds what its lobe shows (the world's SH reduction pass,
 ``sh_light.WORLD_REDUCE``: a 4K image is read once per source, never by Python), into one atlas
 (``LEVELS`` stacked upwards). It is kept per image and World › Sun clamp until the image changes
-(``TextureCache.world_prefiltered``): a frame pays a lookup. A constant world needs none (its
+(``TextureCache.world_prefiltered``): a frame pays a lookup; final renders find it in the
+extension's store by the content of the image (``engine/store.py``). A constant world needs none (its
 SH light is exact for every lobe).
 
 Where the world's sun took the light above its threshold (``sun.py``), the sources are clamped
