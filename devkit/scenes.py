@@ -315,6 +315,15 @@ def demo_scene(width=640, height=360):
     return scene
 
 
+def bare_demo(width, height):
+    """The demo scene without its post layers and with every sample in every pixel (Noise
+    Threshold 0): what a frame's samples cost and draw, counted sample by sample."""
+    scene = demo_scene(width, height)
+    scene.penumbra.layers.clear()
+    scene.penumbra.adaptive_threshold = 0.0
+    return scene
+
+
 def textured_asset(width=160, height=90, texels=2048, seed=7):
     """A scanned-asset-like object as glTF's importer builds one (a DamagedHelmet stand-in):
     a smooth mesh of about 16k triangles whose Principled BSDF reads four ``texels``² images

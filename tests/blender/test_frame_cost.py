@@ -70,10 +70,7 @@ def counting_fits():
 
 @pytest.fixture(scope="module")
 def demo(penumbra):
-    scene = scenes.demo_scene(*SIZE)
-    scene.penumbra.layers.clear()
-    scene.penumbra.adaptive_threshold = 0.0
-    return scene
+    return scenes.bare_demo(*SIZE)
 
 
 def test_a_fenced_frame_splits_python_from_gpu_time_per_stage_and_sample(demo, gpu_call):

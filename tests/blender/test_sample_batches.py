@@ -41,10 +41,7 @@ def _frames(gpu_call, scene, samples, batch_sizes, budget=None):
 
 @pytest.fixture(scope="module")
 def demo(penumbra):
-    scene = scenes.demo_scene(*SIZE)
-    scene.penumbra.layers.clear()
-    scene.penumbra.adaptive_threshold = 0.0
-    return scene
+    return scenes.bare_demo(*SIZE)
 
 
 def test_the_image_does_not_depend_on_the_batch_size(demo, gpu_call):
