@@ -291,6 +291,7 @@ class Renderer:
             color, debug_image = self._post(frame, drawn)
         stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
         stats.cpu_seconds, stats.gpu_seconds = clock.cpu, clock.gpu
+        self.film.clock = None  # a fenced clock holds the renderer (``close``)
         stats.upload_bytes = self._uploaded() - counters[0]
         stats.mesh_upload_bytes = self.batches.uploaded - counters[3]
         stats.image_upload_bytes = self.textures.upload_bytes - counters[4]
@@ -800,12 +801,10 @@ class Renderer:
         self.close()
 
     def close(self):
-        """Break the references that lead back to the renderer (each technique's, the film's
-        clock), so that letting it go frees its framebuffers, blocks, batches and textures at
-        once, in the GPU context that is current, not whenever Python's cycle collector runs:
-        possibly in another render's context, or in none (``test_sample_batches.py``:
-        ``test_a_renderer_let_go_frees_its_gpu_objects_at_once``)."""
-        for feature in self.features:
-            feature.renderer = None
+        """Drop what could lead back to the renderer (the film's clock, whose fence is the
+        renderer's; its techniques hold it weakly), so that letting it go frees its
+        framebuffers, blocks, batches and textures at once, in the GPU context that is current,
+        not whenever Python's cycle collector runs: possibly in another render's context, or in
+        none (``test_sample_batches.py``: ``test_a_renderer_let_go_frees_its_gpu_objects_at_once``)."""
         self.features = ()
         self.film.clock = None

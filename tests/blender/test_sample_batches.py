@@ -113,14 +113,15 @@ def test_batches_end_where_adaptive_sampling_checks(demo, gpu_call):
     assert np.abs(batched - one).max() <= 1e-5
 
 
-@pytest.mark.parametrize("final", [False, True])
-def test_a_renderer_let_go_frees_its_gpu_objects_at_once(demo, gpu_call, final):
+@pytest.mark.parametrize(("final", "released"), [(False, True), (True, True), (False, False)])
+def test_a_renderer_let_go_frees_its_gpu_objects_at_once(demo, gpu_call, final, released):
     """``free_gpu`` (the end of every render, inside its GPU context) leaves nothing of the
     renderer for Python's cycle collector: with the collector off, the renderer and its shadow
     atlas (a larger one for a batch of samples) are gone as the engine lets them go. Freed
     later, a framebuffer or a vertex array would be deleted in whatever context is current then
     (another render's, or none): the suite crashed in llvmpipe two tests after such a frame.
-    ``final``: a renderer with the final renders' texture pool, whose textures go to it."""
+    ``final``: a renderer with the final renders' texture pool, whose textures go to it;
+    ``released``: let go through ``free_gpu``, or merely dropped (a viewport engine freed)."""
     import gc
     import weakref
 
@@ -134,7 +135,10 @@ def test_a_renderer_let_go_frees_its_gpu_objects_at_once(demo, gpu_call, final):
         renderer, atlas = weakref.ref(engine.renderer), weakref.ref(engine.renderer.shadows)
         gc.disable()
         try:
-            engine.free_gpu()
+            if released:
+                engine.free_gpu()
+            else:
+                engine.renderer = None
             return renderer() is None, atlas() is None
         finally:
             gc.enable()

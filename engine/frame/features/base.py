@@ -2,6 +2,7 @@
 pass (``LitPart``); the registry is ``features/__init__.py``."""
 
 import dataclasses
+import weakref
 
 
 @dataclasses.dataclass(frozen=True)
@@ -58,7 +59,15 @@ class Feature:
     name = ""
 
     def __init__(self, renderer):
-        self.renderer = renderer
+        # Held weakly: the renderer holds its techniques, and a cycle would leave the renderer
+        # and its GPU objects to Python's cycle collector, freed whenever it runs, in whatever
+        # GPU context is current then (``Renderer.close``).
+        self._renderer = weakref.ref(renderer)
+
+    @property
+    def renderer(self):
+        """The renderer this technique works for (None once it is gone)."""
+        return self._renderer()
 
     def wanted(self, frame):
         """Whether ``frame`` needs this technique (its other hooks run only then)."""
