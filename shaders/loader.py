@@ -73,34 +73,71 @@ class Struct:
         body = "".join(f"  {t.lower()} {n};\n" for t, n in self.fields)
         return f"struct {self.name} {{\n{body}}};\n"
 
+    @cached_property
+    def _plan(self):
+        """The packer's plan: the field names; per field (name, first 32-bit word, words,
+        integer, matrix); the words the float fields fill and those the integer fields fill,
+        in field order."""
+        plan, floats, ints = [], [], []
+        for name, (off, typ) in self.layout.items():
+            _align, size, kind = _STD140[typ]
+            plan.append((name, off // 4, size // 4, kind == "i", typ == "MAT4"))
+            (ints if kind == "i" else floats).extend(range(off // 4, off // 4 + size // 4))
+        return frozenset(self.layout), tuple(plan), np.array(floats, np.intp), np.array(ints, np.intp)
+
     def pack(self, rows, count=None):
         """``rows`` (a list of {field: value}) as std140 bytes of ``count`` elements (default:
         as many as rows, at least one); elements past the rows are zero. Every field of a
-        row must be named in the struct, and every struct field set in every row."""
+        row must be named in the struct, and every struct field set in every row. Integer
+        fields take the value rounded to the nearest integer (half to even)."""
         n = max(len(rows), 1) if count is None else count
         if len(rows) > n:
             raise ValueError(f"{self.name}: {len(rows)} rows for {n} elements")
         data = np.zeros((n, self.stride // 4), np.float32)
         ints = data.view(np.int32)
-        layout = self.layout
+        names, plan, float_words, int_words = self._plan
         for i, row in enumerate(rows):
-            missing = set(layout) - set(row)
-            unknown = set(row) - set(layout)
-            if missing or unknown:
+            if row.keys() != names:
+                missing, unknown = names - set(row), set(row) - names
                 raise KeyError(f"{self.name}: missing {sorted(missing)}, unknown {sorted(unknown)}")
-            for name, value in row.items():
-                off, typ = layout[name]
-                kind = _STD140[typ][2]
-                v = np.asarray(value, dtype=np.float64)
-                if typ == "MAT4":
-                    v = v.T  # GLSL matrices are column-major
-                v = v.ravel()
-                word = off // 4
-                if kind == "i":
-                    ints[i, word : word + len(v)] = np.rint(v).astype(np.int32)
+            # Each field's words in order, floats and integers apart: two numpy writes a row.
+            fl, it = [], []
+            for name, _word, size, integer, matrix in plan:
+                value = row[name]
+                out = it if integer else fl
+                if size == 1 and isinstance(value, (int, float, np.number)):
+                    out.append(value)
+                elif type(value) is tuple and len(value) == size and not matrix:
+                    out.extend(value)
                 else:
-                    data[i, word : word + len(v)] = v
+                    v = np.asarray(value, dtype=np.float64)
+                    if matrix:
+                        v = v.T  # GLSL matrices are column-major
+                    out.extend(v.ravel().tolist())
+            try:
+                fl = np.asarray(fl, dtype=np.float64)
+                it = np.asarray(it, dtype=np.float64)
+            except (TypeError, ValueError):
+                fl = it = None
+            if fl is None or fl.shape != float_words.shape or it.shape != int_words.shape:
+                self._pack_row(data, ints, i, row)  # a value of another length or shape
+                continue
+            data[i, float_words] = fl
+            ints[i, int_words] = np.rint(it).astype(np.int32)
         return data
+
+    def _pack_row(self, data, ints, i, row):
+        """Row ``i`` of ``pack`` field by field: a value of another number of words than its
+        type writes as many words from the field's first."""
+        for name, word, _size, integer, matrix in self._plan[1]:
+            v = np.asarray(row[name], dtype=np.float64)
+            if matrix:
+                v = v.T
+            v = v.ravel()
+            if integer:
+                ints[i, word : word + len(v)] = np.rint(v).astype(np.int32)
+            else:
+                data[i, word : word + len(v)] = v
 
     def unpack(self, data, index, name):
         """One field of element ``index`` of packed ``data`` (for tests)."""

@@ -58,7 +58,8 @@ class LitPass:
         self.textures = caches.textures
         self.film = film
         self._ubos = UniformBlocks()
-        self._jitter_tex = None
+        self._jitter_tex = {}  # disk samples -> their texture
+        self._bins_zero = None
         self._jitter_dummy = None
         self._bins_tex = None
         self._dummy_shadow = None
@@ -307,9 +308,15 @@ class LitPass:
         )
 
     def _ubo(self, name, data):
-        raw = data.tobytes()
-        self.uploaded += len(raw)
-        return self._ubos.get(name, raw)
+        """The block ``name`` holding ``data`` (an array or bytes): sent to the GPU only when
+        it holds something else (a lit pass binds its frame and lights blocks to every program
+        it switches to, and sends them once)."""
+        raw = data if isinstance(data, bytes) else data.tobytes()
+        block = self._ubos.holding(name, raw)
+        if block is None:
+            self.uploaded += len(raw)
+            block = self._ubos.get(name, raw)
+        return block
 
     def _jitter(self, samples):
         """The jittered-disk texture: (JITTER_SIZE, JITTER_SIZE, samples / 2) RGBA, two 2-D
@@ -322,15 +329,16 @@ class LitPass:
                 buf = gpu.types.Buffer("FLOAT", 4, [0.0] * 4)
                 self._jitter_dummy = gpu.types.GPUTexture((1, 1, 1), format="RGBA32F", data=buf)
             return self._jitter_dummy
-        if self._jitter_tex is None or self._jitter_tex[0] != samples:
+        tex = self._jitter_tex.get(samples)
+        if tex is None:
             disk = kernels.jitter_disk(JITTER_SIZE, samples).astype(np.float32)
             # (y, x, sample, 2) -> 3-D texture (x, y, sample pair) of RGBA: z slowest in memory.
             data = disk.reshape(JITTER_SIZE, JITTER_SIZE, samples // 2, 4).transpose(2, 0, 1, 3)
             buf = gpu.types.Buffer("FLOAT", data.size, data.ravel().tolist())
             tex = gpu.types.GPUTexture((JITTER_SIZE, JITTER_SIZE, samples // 2), format="RGBA32F", data=buf)
             self.uploaded += data.nbytes
-            self._jitter_tex = (samples, tex)
-        return self._jitter_tex[1]
+            self._jitter_tex[samples] = tex
+        return tex
 
     def _bins_texture(self, bins):
         """The light-bin masks as an RGBA32F texture (a 1x1 zero texture when not binned).
@@ -343,8 +351,12 @@ class LitPass:
         4.5 and 5.2), and a float upload into an integer texture is not defined."""
         import gpu
 
-        if bins is None:
-            bins = np.zeros((1, 1, 4), np.float32)
+        if bins is None:  # made once
+            if self._bins_zero is None:
+                zero = gpu.types.Buffer("FLOAT", 4, [0.0] * 4)
+                self._bins_zero = gpu.types.GPUTexture((1, 1), format="RGBA32F", data=zero)
+                self.uploaded += 16
+            return self._bins_zero
         rows, cols = bins.shape[:2]
         buf = gpu.types.Buffer("FLOAT", bins.size, np.ascontiguousarray(bins, np.float32).ravel())
         # Kept until the next frame: the draw that samples it runs after this call returns.
@@ -433,6 +445,9 @@ class _Submission:
         self.apart = None  # (entry part, part of a tree): a draw apart (``LitPass.draw_apart``)
         self.light = None  # a light pass's part after the techniques' (``LitPass.draw_light``)
         self.variant = data.variant  # the lit variant its draws take
+        # What every program it binds reads, made and sent once.
+        self.frame_bytes, self.lights_bytes = data.frame.tobytes(), data.lights.tobytes()
+        self.jitter_tex, self.bins_tex = lit._jitter(data.disk_samples), lit._bins_texture(data.bins)
         self.per_draw = None
         # A debug view's entry shader, unless a technique's part brings its own (the settle test's).
         variant = data.variant
@@ -484,12 +499,12 @@ class _Submission:
             shader.bind()
             shader.uniform_float("node_origin", tuple(float(x) for x in self.origin))
         shader.bind()
-        shader.uniform_block("frame", lit._ubo("frame", data.frame))
-        shader.uniform_block("lights", lit._ubo("lights", data.lights))
+        shader.uniform_block("frame", lit._ubo("frame", self.frame_bytes))
+        shader.uniform_block("lights", lit._ubo("lights", self.lights_bytes))
         shader.uniform_block("shadow_tiles", self.tiles)
         shader.uniform_sampler(SHADOW_SAMPLER, self.shadow_tex)
-        shader.uniform_sampler("jitter_tex", lit._jitter(data.disk_samples))
-        shader.uniform_sampler("light_bins", lit._bins_texture(data.bins))
+        shader.uniform_sampler("jitter_tex", self.jitter_tex)
+        shader.uniform_sampler("light_bins", self.bins_tex)
         for name, texture in data.samplers.items():  # the techniques' (``LitPart.samplers``)
             shader.uniform_sampler(name, texture)
         for name, raw in data.blocks.items():  # the techniques' (``LitPart.blocks``)

@@ -131,6 +131,69 @@ def test_a_further_sample_plans_no_light_and_rebuilds_nothing(demo, gpu_call):
     assert 0 < per_sample < 32 * 1024, per_sample
 
 
+def test_a_lit_pass_sends_its_frame_and_lights_blocks_once_whatever_programs_it_binds(demo, gpu_call):
+    """A lit pass that switches programs (one of the demo's materials alpha-hashed, a variant
+    of its own): each program it binds reads the same frame and lights blocks, which go to the
+    GPU once a pass, not once a program; its light bins are made once a pass too."""
+    from devkit import fuzz
+
+    obj = next(o for o in demo.objects if o.type == "MESH" and o.active_material is not None)
+    own = obj.active_material
+    mat = own.copy()
+    obj.active_material = mat
+    fuzz._set(fuzz._principled(mat), ("Alpha",), 0.5)
+    fuzz._set_render_method(mat, blended=False)
+
+    def job(engine, depsgraph):
+        from penumbra.engine.frame import lit_pass
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, demo, *SIZE)
+        engine.render_frame(depsgraph, camera, *SIZE)  # warm: programs compiled
+        lit = engine.renderer.lit_pass
+        sends, passes, textures, bound = {}, [], [], {}
+        bind = lit_pass._Submission.bind
+
+        def counted_bind(self, *args, **kwargs):
+            shader = bind(self, *args, **kwargs)
+            if self.lit is lit:  # the film's pass, not a capture's
+                bound.setdefault(id(self), set()).add(id(shader))
+            return shader
+
+        get, draw, bins = lit._ubos.get, lit.draw, lit._bins_texture
+
+        def counted_get(name, raw):
+            sends[name] = sends.get(name, 0) + 1
+            return get(name, raw)
+
+        def counted_draw(*args, **kwargs):
+            passes.append(1)
+            return draw(*args, **kwargs)
+
+        def counted_bins(*args, **kwargs):
+            textures.append(1)
+            return bins(*args, **kwargs)
+
+        lit._ubos.get, lit.draw, lit._bins_texture = counted_get, counted_draw, counted_bins
+        lit_pass._Submission.bind = counted_bind
+        try:
+            engine.render_frame(depsgraph, camera, *SIZE, samples=(0, 4), sample_count=4)
+        finally:
+            del lit._ubos.get, lit.draw, lit._bins_texture
+            lit_pass._Submission.bind = bind
+        return sends, len(passes), len(textures), max(len(b) for b in bound.values())
+
+    try:
+        sends, passes, textures, programs = gpu_call(job)
+    finally:
+        obj.active_material = own
+    assert programs >= 2, programs  # the pass switches programs
+    assert passes >= 4, passes
+    assert 1 <= sends["frame"] <= passes, (sends, passes)
+    assert 1 <= sends["lights"] <= passes, (sends, passes)
+    assert textures <= passes, (textures, passes)
+
+
 def test_a_viewport_refinement_plans_each_map_once(demo, gpu_call):
     """The viewport renders a frame one sample per redraw (``samples=(k, k + 1)``): its first
     call plans the frame (sizes and moving lights) and its sample; every later call of the
