@@ -7,7 +7,7 @@ to the GPU is unit-tested without one.
 
 import math
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -59,7 +59,7 @@ def disk_samples(settings, sample_count=1):
     ``disk_sample``), at least one ring per sample: the frame reads at least as many taps per
     pixel as a one-sample frame, and a sample pays only for its share."""
     per_sample = int(settings.shadow_samples) // max(1, int(sample_count))
-    return int(np.clip(per_sample // RING * RING, RING, MAX_DISK_SAMPLES))
+    return min(max(per_sample // RING * RING, RING), MAX_DISK_SAMPLES)
 
 
 def indirect_samples(settings):
@@ -128,8 +128,9 @@ def light_row(light, shadow=None, origin=_ZERO):
 
 def frame_row(camera, world_color, light_count, settings, tile_size, atlas_columns, origin=_ZERO):
     view = camera.view @ lightspace.from_origin(origin)  # takes positions relative to ``origin``
+    view_proj = camera.projection @ view
     return {
-        "view_proj": camera.projection @ view,
+        "view_proj": view_proj,
         "view": view,
         "camera_position": camera.position - origin,
         "is_ortho": int(camera.is_ortho),
@@ -164,10 +165,10 @@ def frame_row(camera, world_color, light_count, settings, tile_size, atlas_colum
         "env_params": (0.0, 0.0, 0.0, 0.0),
         "ssr_params": (0.0, 0.0, 0.0, 0.0),
         "ssr_view": view,
-        "ssr_view_proj": camera.projection @ view,
+        "ssr_view_proj": view_proj,
         "refr_params": (0.0, 0.0, 0.0, 0.0),
         "planar_view": view,
-        "planar_view_proj": camera.projection @ view,
+        "planar_view_proj": view_proj,
         "planar_influence": np.zeros((4, 4)),
         "planar_plane": (0.0, 0.0, 1.0, 0.0),
         "planar_params": (0.0, 0.0, 0.0, 0.0),
@@ -245,6 +246,12 @@ class LitInputs:
     parts: tuple = ()
 
 
+@lru_cache(maxsize=16)
+def _pcf_weights(size):
+    """``kernels.pcf_weights`` as the floats a variant holds (the lit pass compiles them in)."""
+    return tuple(float(w) for w in kernels.pcf_weights(size))
+
+
 def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInputs()):
     """Everything the lit pass binds for this sample. ``lights``: at most MAX_LIGHTS snapshot
     lights; ``camera``: the raster camera; ``world_color``: a ``materials.World`` (its SH
@@ -294,7 +301,7 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
     variant = LitVariant(
         **{
             "shadow_filter": settings.shadow_filter if shadowed > sampled else "NONE",  # no map: no filter code at all
-            "pcf_weights": tuple(float(w) for w in kernels.pcf_weights(settings.pcf_kernel_size)),
+            "pcf_weights": _pcf_weights(int(settings.pcf_kernel_size)),
             "specular_model": settings.specular_model,
             "depth_format": atlas.depth_format,
             "disk_samples": int(disk),

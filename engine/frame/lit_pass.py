@@ -60,6 +60,7 @@ class LitPass:
         self._ubos = UniformBlocks()
         self._jitter_tex = {}  # disk samples -> their texture
         self._bins_zero = None
+        self._entries_memo = None  # (draws, key, entries): ``_entries``
         self._jitter_dummy = None
         self._bins_tex = None
         self._dummy_shadow = None
@@ -243,11 +244,25 @@ class LitPass:
                 submit.draw(blended, False, blended=True)
         _reset_state(sample.stats)
 
-    @staticmethod
-    def _entries(draws, camera, atlas, stats, hashed_last):
+    def _entries(self, draws, camera, atlas, stats, hashed_last):
         """The parts to draw: (opaque and alpha-hashed entries nearest first, blended entries
         farthest first, ``_Parts``); an entry is (features, rank, draw, batch, material).
-        ``hashed_last``: alpha-hashed entries after the others (the settle test)."""
+        ``hashed_last``: alpha-hashed entries after the others (the settle test). Found once
+        for a frame's samples: they depend on the draws (a frame's ``Sample.seen``, the same
+        list for all of them), the camera's position and near plane (not its pixel offset) and
+        whether there are maps."""
+        vp_near = camera.projection[2:].tobytes()  # the rows a pixel offset leaves alone
+        key = (camera.view.tobytes(), vp_near, bool(camera.is_ortho), atlas is not None, hashed_last)
+        memo = self._entries_memo
+        if memo is None or memo[0] is not draws or memo[1] != key:
+            memo = self._entries_memo = (draws, key, self._find_entries(draws, camera, atlas, hashed_last))
+        opaque, blended, parts = memo[2]
+        stats.closed_culled += len(parts.outside)
+        return list(opaque), list(blended), parts
+
+    @staticmethod
+    def _find_entries(draws, camera, atlas, hashed_last):
+        """``_entries`` found afresh."""
         # Closed instances wholly beyond the near plane: from there no back face shows.
         outside = set()
         closed = [d for d in draws if d.closed]
@@ -256,7 +271,6 @@ class LitPass:
             near = vp[2] + vp[3]  # clip z + w: positive beyond the near plane
             beyond = np.all(np.stack([d.corners for d in closed]) @ near[:3] + near[3] > 0.0, axis=1)
             outside = {id(d) for d, ok in zip(closed, beyond, strict=True) if ok}
-            stats.closed_culled += len(outside)
         opaque, blended = [], []
         terminators = {}  # id(draw) -> {push constant: value} of its Shadow Terminator features
         for rank, d in enumerate(front_to_back(draws, camera)):

@@ -209,6 +209,7 @@ class Renderer:
         # frames) of the frames drawn while the view moves.
         self._frame_plan = None
         self._navigation = None
+        self._seen = None  # (draw list, the draws of it the camera sees)
 
     pool = property(lambda self: self.caches.pool)
     shaders = property(lambda self: self.caches.shaders)
@@ -676,7 +677,10 @@ class Renderer:
         )
         world = snapshot.world if snapshot.world is not None else snapshot.world_color
         sample.data = build_frame_data(lights, sample.cameras[0], world, frame.settings, plan, inputs)
-        sample.seen = [d for d in sample.draws if d.instance.camera]
+        seen = self._seen
+        if seen is None or seen[0] is not sample.draws:  # the same list for a frame's samples
+            seen = self._seen = (sample.draws, [d for d in sample.draws if d.instance.camera])
+        sample.seen = seen[1]
         sample.masks = (
             light_masks(sample.seen, lights, sample.data.order) if sample.data.variant.light_linking else None
         )

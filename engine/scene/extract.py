@@ -270,15 +270,21 @@ class Camera:
 
     @property
     def position(self):
-        try:
-            return np.linalg.inv(self.view)[:3, 3]
-        except np.linalg.LinAlgError:
-            return np.zeros(3)
+        # Read many times a sample: inverted once per view (a copy, so a caller may change it).
+        key = self.view.tobytes()
+        memo = self.__dict__.get("_position")
+        if memo is None or memo[0] != key:
+            try:
+                position = np.linalg.inv(self.view)[:3, 3]
+            except np.linalg.LinAlgError:
+                position = np.zeros(3)
+            memo = self.__dict__["_position"] = (key, position)
+        return memo[1].copy()
 
     @property
     def forward(self):
         f = -self.view[2, :3]
-        n = np.linalg.norm(f)
+        n = math.sqrt(float(f @ f))
         return f / n if n > 0 else np.array([0.0, 0.0, -1.0])
 
 
