@@ -13,6 +13,7 @@ bins that rectangle touches get the light's bit. Every step is conservative: a l
 listed in a bin it does not reach, never left out of one it does.
 """
 
+import functools
 import itertools
 import math
 
@@ -189,8 +190,10 @@ def bin_masks(rects, width, height, words=4):
     return masks.astype(np.float32)
 
 
+@functools.lru_cache(maxsize=256)
 def word_masks(first, count, words=4):
-    """Per word, the bits of lights ``first .. first + count - 1``."""
+    """Per word, the bits of lights ``first .. first + count - 1`` (a tuple: kept per
+    arguments, every sample asks again)."""
     out = []
     for w in range(words):
         bits = 0
@@ -198,4 +201,4 @@ def word_masks(first, count, words=4):
             if first <= w * WORD_BITS + b < first + count:
                 bits |= 1 << b
         out.append(bits)
-    return out
+    return tuple(out)

@@ -96,7 +96,7 @@ def test_bin_masks_set_exactly_the_bits_of_each_lights_bins():
     assert bits[40 // 16, 20 // 16, 0] & 4 and ((bits[..., 0] & 4) > 0).sum() == 1  # one bin only
     # Light 17 (word 1, bit 1): pixels 300..319 x 170..179 touch bins 18-19 x 10-11.
     assert (bits[..., 1] == 2).sum() == 4 and np.all(bits[10:12, 18:20, 1] == 2)
-    assert light_bins.word_masks(0, 18, 4) == [0xFFFF, 0b11, 0, 0]
+    assert light_bins.word_masks(0, 18, 4) == (0xFFFF, 0b11, 0, 0)
 
 
 def test_degenerate_inputs_never_drop_a_light_that_may_reach():

@@ -347,8 +347,53 @@ def section_cpu(plan):
     t = {k: statistics.median(v) for k, v in times.items()}
     scene.penumbra.render_samples = 16
     note = cpu_note(_fenced_stats(scene))
+    inside, calls = driver_share(scene)
+    note += f"; of a further sample's CPU, {inside * 1e3:.2f} ms inside {calls:.0f} calls of the gpu module (the driver)"
     rows.append(_row("cpu", "demo 160x90, 16 samples (Workbench: 1 sample)", t, note, plan["runs"]))
     return rows
+
+
+def driver_share(scene, samples=16, runs=6):
+    """(render-thread CPU seconds, calls) a further sample of ``scene`` spends inside the gpu
+    module's functions (draws, clears, binds, uniforms, state): on llvmpipe the driver's own
+    work on the calling thread (state validation, vertex shading and binning of each draw),
+    a few microseconds a call on a GPU's driver. Frames of ``samples`` and of 2 samples under
+    ``cProfile`` (the thread's CPU clock), the difference per further sample: the profiler
+    slows Python, not the time spent inside a C call."""
+    import cProfile
+    import pstats
+
+    from penumbra.engine.frame.renderer import Renderer
+
+    def inside(count):
+        scene.penumbra.render_samples = count
+        _render()
+        profile = cProfile.Profile(time.thread_time)
+        render = Renderer.render
+
+        def profiled(self, *args, **kwargs):
+            profile.enable()
+            try:
+                return render(self, *args, **kwargs)
+            finally:
+                profile.disable()
+
+        Renderer.render = profiled
+        try:
+            for _ in range(runs):
+                _render()
+        finally:
+            Renderer.render = render
+        seconds = calls = 0.0
+        for (_file, _line, name), (_cc, ncalls, tottime, _ct, _callers) in pstats.Stats(profile).stats.items():
+            if "of 'GPU" in name or name.startswith("<built-in method gpu."):
+                seconds += tottime
+                calls += ncalls
+        return seconds / runs, calls / runs
+
+    (few, few_calls), (many, many_calls) = inside(2), inside(samples)
+    scene.penumbra.render_samples = samples
+    return (many - few) / (samples - 2), (many_calls - few_calls) / (samples - 2)
 
 
 def _warm_f12(scene, runs, case="textured asset 160x90: a second F12's CPU", clock=time.thread_time):
