@@ -348,7 +348,7 @@ def section_cpu(plan):
     scene.penumbra.render_samples = 16
     note = cpu_note(_fenced_stats(scene))
     inside, calls = driver_share(scene)
-    note += f"; of a further sample's CPU, {inside * 1e3:.2f} ms inside {calls:.0f} calls of the gpu module (the driver)"
+    note += f"; of a further sample's CPU, {inside * 1e3:.2f} ms inside {calls:.0f} calls of the gpu module (driver)"
     rows.append(_row("cpu", "demo 160x90, 16 samples (Workbench: 1 sample)", t, note, plan["runs"]))
     return rows
 
