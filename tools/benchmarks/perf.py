@@ -13,10 +13,11 @@ Sections (``--sections``, all by default):
               Workbench on the same scene, and the demo at 16 samples against Workbench's one;
               then one fenced frame of each (``Renderer.fence_stages``): the render thread's
               CPU time and the GPU's per stage, per sample, bytes uploaded, draw calls and
-              triangles per pass; and the asset's second F12 against its first with the
-              extension's store emptied (``engine/store.py``): render-thread CPU, bytes
-              uploaded; the same in wall time for spheres under a real HDRI (the world's
-              prefiltered environment kept)
+              triangles per pass, and how much of a further sample's CPU is spent inside the
+              gpu module's calls (``driver_share``: the driver's own work); and the asset's
+              second F12 against its first with the extension's store emptied
+              (``engine/store.py``): render-thread CPU, bytes uploaded; the same in wall time
+              for spheres under a real HDRI (the world's prefiltered environment kept)
   resolution  demo scene without post layers at 480x270, 960x540 and 1920x1080
   passes      the demo scene at 960x540, F12, timed pass by pass (the GPU waited for with a
               one-pixel read-back before and after each pass): the depth pass and the lit pass
