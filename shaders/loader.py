@@ -310,6 +310,7 @@ class ShaderCache:
 
     def __init__(self):
         self._cache = {}
+        self._seen = {}  # (id(program), its defines as given) -> (program, shader): ``get``'s fast path
         self.compiled = 0
         self.compile_seconds = 0.0  # spent compiling, over the cache's life
 
@@ -317,6 +318,21 @@ class ShaderCache:
         return len(self._cache)
 
     def get(self, program, defines=None):
+        try:  # asked again as before (a frame asks for the same programs every sample)
+            asked = (id(program), tuple(defines.items()) if defines else ())
+            seen = self._seen.get(asked)
+        except TypeError:  # a define's value that does not hash
+            asked = seen = None
+        if seen is not None and seen[0] is program:
+            return seen[1]
+        shader = self._get(program, defines)
+        if asked is not None:
+            if len(self._seen) >= 4096:
+                self._seen.clear()
+            self._seen[asked] = (program, shader)  # the program held: its id is not reused
+        return shader
+
+    def _get(self, program, defines):
         defines = tuple(sorted({**dict(program.defines), **(defines or {})}.items()))
         key = (program.name, defines)
         shader = self._cache.get(key)

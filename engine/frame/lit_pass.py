@@ -244,6 +244,10 @@ class LitPass:
                 submit.draw(blended, False, blended=True)
         _reset_state(sample.stats)
 
+    def end_frame(self):
+        """Forget what the frame's samples shared (``_entries``): its draws are not kept past it."""
+        self._entries_memo = None
+
     def _entries(self, draws, camera, atlas, stats, hashed_last):
         """The parts to draw: (opaque and alpha-hashed entries nearest first, blended entries
         farthest first, ``_Parts``); an entry is (features, rank, draw, batch, material).

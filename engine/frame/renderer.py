@@ -293,6 +293,8 @@ class Renderer:
         stats.messages.extend(m for m in self.textures.messages() if m not in stats.messages)
         stats.cpu_seconds, stats.gpu_seconds = clock.cpu, clock.gpu
         self.film.clock = None  # a fenced clock holds the renderer (``close``)
+        self._seen = None  # the frame's draws, not kept past it
+        self.lit_pass.end_frame()
         stats.upload_bytes = self._uploaded() - counters[0]
         stats.mesh_upload_bytes = self.batches.uploaded - counters[3]
         stats.image_upload_bytes = self.textures.upload_bytes - counters[4]

@@ -37,6 +37,7 @@ import numpy as np
 from ...counts import ceil_count
 from ...scene.extract import Light
 from ...scene.materials import SH_C0, sh_basis
+from ...shadows.vectors import cross
 from ..sampling import radical_inverse, sobol_2
 
 # The share of directions drawn uniformly over the sphere (the rest follow the luminance).
@@ -403,7 +404,7 @@ def frame_towards(d):
     """A rotation whose Z axis is ``d`` (a light's -Z is where it shines)."""
     z = d / max(np.linalg.norm(d), 1e-300)
     helper = np.array([1.0, 0.0, 0.0]) if abs(z[2]) > 0.9 else np.array([0.0, 0.0, 1.0])
-    x = np.cross(helper, z)
+    x = cross(helper, z)
     x /= max(np.linalg.norm(x), 1e-300)
-    y = np.cross(z, x)
+    y = cross(z, x)
     return np.stack([x, y, z], axis=1)
