@@ -94,6 +94,9 @@ class FilmPart:
 
     name = ""
     lit_targets = 0
+    # Its ``resolve`` writes every pixel of the colour from the accumulation itself (not over
+    # the plain average): ``Film.mean_into`` then draws no plain average first.
+    resolves_colour = False
 
     def framebuffer(self, film, slots, blended=False):
         raise NotImplementedError(f"{self.name}: no targets of its own in the lit pass")
@@ -435,12 +438,15 @@ class Film:
         """The colour's mean over the samples accumulated so far (what ``resolve`` would write,
         the techniques' parts' included) into ``framebuffer`` (one RGBA32F target at the
         film's size), leaving the film's own targets as they are: what a later sample reads of
-        the frame's image (``features/reflections.py``)."""
-        if self._weight is not None:
-            self.fullscreen(WEIGHTED_RESOLVE, framebuffer, {"src_color": self._accum_color, "weight": self._weight}, {})
-        else:
-            inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
-            self.fullscreen(SCALED_COPY, framebuffer, {"src_color": self._accum_color}, {"scale": inverse})
+        the frame's image (``features/reflections.py``). A part that resolves the whole colour
+        itself (``FilmPart.resolves_colour``: the world's ratio) writes it alone."""
+        if not any(part.resolves_colour for part in self.parts):
+            if self._weight is not None:
+                samplers = {"src_color": self._accum_color, "weight": self._weight}
+                self.fullscreen(WEIGHTED_RESOLVE, framebuffer, samplers, {})
+            else:
+                inverse = 1.0 / self._weight_sum if self._weight_sum > 0.0 else 0.0
+                self.fullscreen(SCALED_COPY, framebuffer, {"src_color": self._accum_color}, {"scale": inverse})
         for part in self.parts:
             part.resolve(self, framebuffer)
 

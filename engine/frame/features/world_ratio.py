@@ -74,6 +74,7 @@ class RatioTargets(FilmPart):
 
     name = "world_ratio"
     lit_targets = len(OUTPUTS)
+    resolves_colour = True  # ``RESOLVE`` writes the colour from its accumulation and weight
 
     def __init__(self):
         self.size = None
