@@ -49,6 +49,39 @@ def test_pack_round_trips_floats_ints_and_column_major_matrices():
         s.pack([{"v": (0, 0, 0), "i": 0, "m": m, "t": (0, 0, 0, 0), "extra": 1}])
 
 
+def test_pack_takes_every_kind_of_value_as_a_field_at_a_time_would():
+    """The packer's two numpy writes a row (``Struct._plan``) against a field-by-field
+    reference: numpy scalars, bools, arrays, half-way integers (rounded half to even) and, for
+    a value of another length than its type (a VEC3 given 2 or 4 numbers), as many words from
+    the field's first, as the packer wrote them before."""
+    s = Struct("T", (("FLOAT", "f"), ("INT", "i"), ("VEC3", "v"), ("IVEC2", "k"), ("MAT4", "m"), ("INT", "j")))
+    m = np.arange(16, dtype=np.float64).reshape(4, 4) * 0.5
+
+    def reference(row):
+        out = np.zeros(s.stride // 4, np.float32)
+        ints = out.view(np.int32)
+        for name, (off, typ) in s.layout.items():
+            v = np.asarray(row[name], np.float64)
+            v = (v.T if typ == "MAT4" else v).ravel()
+            word = off // 4
+            if typ in ("INT", "IVEC2"):
+                ints[word : word + len(v)] = np.rint(v).astype(np.int32)
+            else:
+                out[word : word + len(v)] = v
+        return out
+
+    rows = [
+        {"f": np.float32(0.1), "i": 2.5, "v": np.array([1e-40, -0.0, 3e38]), "k": (True, 3.5), "m": m, "j": -7},
+        {"f": 1, "i": -2.5, "v": (1.0, 2.0), "k": np.array([1.5, -1.5]), "m": m.tolist(), "j": False},
+        {"f": 0.5, "i": 7, "v": np.array([1.0, 2.0, 3.0, 4.0]), "k": (0, 0), "m": m, "j": 3},
+    ]
+    data = s.pack(rows)
+    for k, row in enumerate(rows):
+        np.testing.assert_array_equal(data[k].view(np.int32), reference(row).view(np.int32), err_msg=str(k))
+    assert data.view(np.int32)[0, s.layout["i"][0] // 4] == 2  # 2.5 to the even neighbour
+    assert data.view(np.int32)[1, s.layout["i"][0] // 4] == -2
+
+
 def _settings(**overrides):
     source = SimpleNamespace(**{p.name: p.default for p in settings.SCENE_PARAMS})
     vars(source).update(overrides)
