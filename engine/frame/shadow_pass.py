@@ -18,6 +18,7 @@ from ..shadows.planning import (
     MapOptions,
     ShadowPlan,
     ViewFit,
+    cascade_slices,
     frame_sizes,
     frame_tiles,
     plan_shadows,
@@ -46,6 +47,7 @@ class ShadowPass:
         self.reach = 0.0  # pixels the frame's samples look beyond the image (the pixel filter)
         self.reflective = False  # the maps hold what each light sees too (features/bounce.py)
         self.receivers = None  # boxes beyond the draws that take light (``begin_frame``)
+        self._shared = None  # (draws, key, what the frame's plans through one camera share): ``_frame_view``
 
     def begin_frame(self, reach=0.0, reflective=False, receivers=None, navigating=False):
         """Forget the last frame's camera-dependent bounds, casters and map sizes. ``reach``:
@@ -66,6 +68,7 @@ class ShadowPass:
         self.atlas.growing = False  # the frame's first maps size the atlas afresh
         self._receivers = None
         self._sun_parts = None
+        self._shared = None
         self._casters = (None, None, False)
         self._sizes = None
         self._hints = None
@@ -128,13 +131,7 @@ class ShadowPass:
         those a caster can shadow (``MapOptions.reflective``)."""
         sizes, derived = known if known is not None else (None, None)
         cones, reaches = spread if spread is not None else (None, None)
-        corners = corners_of(draws)
-        # What takes light: the draws' boxes and the receivers beyond them (the media).
-        seen = corners if self.receivers is None else np.concatenate([corners, self.receivers])
-        if self.reach > 0.0 and size is not None:
-            projection, size = sampling.widened_projection(camera.projection, self.reach, *size)
-            camera = dataclasses.replace(camera, projection=projection)
-        view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
+        corners, seen, camera, size, view_corners, flat = self._frame_view(draws, camera, settings, size)
         map_size = max(1, int(settings.shadow_map_size)) if map_size is None else map_size
         if self.depth_range is UNSET:
             # The visible depth range and the visible receivers depend only on the unjittered
@@ -152,6 +149,11 @@ class ShadowPass:
             world_map_size=getattr(settings, "world_map_size", None),
             reflective=self.reflective,
         )
+        shared = self._shared[2]
+        if shared["slices"] is None:
+            shared["slices"] = cascade_slices(
+                seen, view_corners, camera, int(settings.shadow_cascades), self.depth_range
+            )
         fit = ViewFit(
             view_corners,
             camera,
@@ -161,9 +163,41 @@ class ShadowPass:
             sun_parts=self._sun_parts,
             extra=self.receivers,
             windows=self.windows,
+            flat=flat,
+            slices=shared["slices"],
         )
         share = FrameShare(known_sizes=sizes, hinted_sizes=self._hints, cones=cones, reaches=reaches, derived=derived)
         return plan_shadows(lights, corners, options, fit, share)
+
+    def _frame_view(self, draws, camera, settings, size):
+        """What every plan of a frame through ``camera`` shares, made once a frame (its
+        samples plan through one unjittered camera, and one draw list, unless the view moves
+        between them: depth of field, motion blur): the draws' boxes, those and the receivers
+        beyond them (the media), the camera widened by the frame's reach and the size it
+        covers then, its frustum's corners (suns fitted to the view), the boxes' flat-caster
+        test (``lightspace.FlatCasters``), and a dict of the rest (the sun's cascade slices)."""
+        key = (
+            camera.projection.tobytes(),
+            camera.view.tobytes(),
+            bool(camera.is_ortho),
+            None if size is None else tuple(size),
+            settings.shadow_sun_fit,
+            int(settings.shadow_cascades),
+            self.reach,
+        )
+        shared = self._shared
+        if shared is not None and shared[0] is draws and shared[1] == key:
+            return shared[3]
+        corners = corners_of(draws)
+        # What takes light: the draws' boxes and the receivers beyond them (the media).
+        seen = corners if self.receivers is None else np.concatenate([corners, self.receivers])
+        if self.reach > 0.0 and size is not None:
+            projection, size = sampling.widened_projection(camera.projection, self.reach, *size)
+            camera = dataclasses.replace(camera, projection=projection)
+        view_corners = _view_corners(camera) if settings.shadow_sun_fit == "VIEW" else None
+        value = (corners, seen, camera, size, view_corners, lightspace.FlatCasters(corners))
+        self._shared = (draws, key, {"slices": None}, value)
+        return value
 
     def draw(self, frame, sample):
         """Plan the maps ``sample`` (``renderer.Sample``: its draws and lights, planned from its

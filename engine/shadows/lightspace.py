@@ -397,41 +397,76 @@ def flat_casters_without_shadow(boxes, direction=None, position=None):
     reaches behind their plane (the side away from the light) or the light grazes them
     edge-on. A planar mesh never shadows itself, so such a box is left out of the light's
     maps: it costs nothing to draw and does not widen the map. Only the MAX_FLAT_TESTS
-    largest flat boxes are tested."""
-    boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 8, 3)
-    n_boxes = len(boxes)
-    free = np.zeros(n_boxes, dtype=bool)
-    if n_boxes == 0:
+    largest flat boxes are tested. (``FlatCasters`` keeps what the test needs of the boxes
+    for every light: a caller testing several lights over the same boxes makes one.)"""
+    return FlatCasters(boxes).free(direction, position)
+
+
+class FlatCasters:
+    """``flat_casters_without_shadow`` over one set of boxes (N, 8, 3), for any number of
+    lights: the flat boxes tested, their planes, and for each side of a plane whether another
+    box reaches beyond it there, found once (a light only picks the side it shines from). A
+    frame's samples fit a map to a new direction of the world, or to a light at a new point
+    of itself, every sample; the boxes, and so this, stay the frame's."""
+
+    def __init__(self, boxes):
+        boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 8, 3)
+        self.boxes = boxes
+        self.count = n_boxes = len(boxes)
+        self._reaches = {}  # (candidate, side) -> another box reaches beyond its plane on that side
+        if n_boxes == 0:
+            self.candidates = np.zeros(0, dtype=np.intp)
+            return
+        edges = boxes[:, [1, 2, 4]] - boxes[:, [0]]  # the box's three edges from corner 0
+        lengths = np.linalg.norm(edges, axis=2)
+        self._longest = longest = lengths.max(axis=1)
+        thin = lengths.argmin(axis=1)
+        rows = np.arange(n_boxes)
+        a, b = edges[rows, (thin + 1) % 3], edges[rows, (thin + 2) % 3]
+        self._normal = normal = cross(a, b)
+        self._area = area = np.linalg.norm(normal, axis=1)
+        flat = flat_boxes(boxes) & (area > 1e-12 * longest**2) & np.isfinite(area)
+        candidates = np.nonzero(flat)[0]
+        self.candidates = candidates[np.argsort(-area[candidates])][:MAX_FLAT_TESTS]
+
+    def _plane(self, i):
+        n = self._normal[i] / self._area[i]
+        return n, float(n @ self.boxes[i, 0])
+
+    def _reach(self, i, side):
+        """Whether a box other than ``i`` reaches beyond box ``i``'s plane on ``side`` (1.0:
+        along its normal, -1.0: against it), by more than the test's tolerance."""
+        key = (int(i), side)
+        found = self._reaches.get(key)
+        if found is None:
+            boxes = self.boxes
+            n, d = self._plane(i)
+            reach = side * (boxes @ n - d)  # > 0: behind the plane, where it could shadow
+            reach[i] = 0.0
+            tolerance = 1e-5 * max(float(np.abs(boxes[i]).max()), self._longest[i])
+            found = self._reaches[key] = bool((reach.max(axis=1) > tolerance).any())
+        return found
+
+    def free(self, direction=None, position=None):
+        """``flat_casters_without_shadow`` of these boxes under a sun along ``direction`` or a
+        light at ``position``."""
+        free = np.zeros(self.count, dtype=bool)
+        if self.count == 0:
+            return free
+        light = normalize(direction) if position is None else None
+        for i in self.candidates:
+            n, d = self._plane(i)
+            if light is not None:
+                s = float(n @ light)
+                grazing = abs(s) <= 1e-9
+            else:
+                s = d - float(n @ np.asarray(position, dtype=np.float64))  # > 0: the light below the plane
+                grazing = abs(s) <= 1e-9 * max(1.0, abs(d))
+            if grazing:
+                free[i] = True  # edge-on to the light: its shadow has no area
+                continue
+            free[i] = not self._reach(i, 1.0 if s > 0.0 else -1.0)
         return free
-    edges = boxes[:, [1, 2, 4]] - boxes[:, [0]]  # the box's three edges from corner 0
-    lengths = np.linalg.norm(edges, axis=2)
-    longest = lengths.max(axis=1)
-    thin = lengths.argmin(axis=1)
-    rows = np.arange(n_boxes)
-    a, b = edges[rows, (thin + 1) % 3], edges[rows, (thin + 2) % 3]
-    normal = cross(a, b)
-    area = np.linalg.norm(normal, axis=1)
-    flat = flat_boxes(boxes) & (area > 1e-12 * longest**2) & np.isfinite(area)
-    candidates = np.nonzero(flat)[0]
-    candidates = candidates[np.argsort(-area[candidates])][:MAX_FLAT_TESTS]
-    light = normalize(direction) if position is None else None
-    for i in candidates:
-        n = normal[i] / area[i]
-        d = float(n @ boxes[i, 0])
-        if light is not None:
-            s = float(n @ light)
-            grazing = abs(s) <= 1e-9
-        else:
-            s = d - float(n @ np.asarray(position, dtype=np.float64))  # > 0: the light below the plane
-            grazing = abs(s) <= 1e-9 * max(1.0, abs(d))
-        if grazing:
-            free[i] = True  # edge-on to the light: its shadow has no area
-            continue
-        reach = np.sign(s) * (boxes @ n - d)  # > 0: behind the plane, where it could shadow
-        reach[i] = 0.0
-        tolerance = 1e-5 * max(float(np.abs(boxes[i]).max()), longest[i])
-        free[i] = not bool((reach.max(axis=1) > tolerance).any())
-    return free
 
 
 MAX_EXACT_CROPS = 32  # receivers cut exactly to a sun map's rectangle (the largest first)

@@ -386,7 +386,10 @@ class ViewFit:
     caller keeps between navigation frames (while the view moves): a cropped perspective map
     keeps the window, and depth, an earlier frame cropped it to while they still hold what
     this view needs of it, so the map's fit, and its content, do not change (``_crop``).
-    None elsewhere: a frame's maps then depend on that frame's view alone."""
+    None elsewhere: a frame's maps then depend on that frame's view alone. ``flat``: a
+    ``lightspace.FlatCasters`` of the plan's boxes the caller keeps for its frame (every
+    light, every sample, tests the same flat boxes), else one a plan. ``slices``: the sun's
+    cascade slices (``cascade_slices``) when the caller keeps them for its frame."""
 
     view_corners: np.ndarray = None
     camera: object = None
@@ -396,6 +399,8 @@ class ViewFit:
     sun_parts: tuple = None
     extra: np.ndarray = None
     windows: dict = None
+    flat: object = None
+    slices: list = None
 
 
 @dataclass(frozen=True)
@@ -438,6 +443,7 @@ class _Scene:
     slices: list
     receivers: object
     sun_parts: tuple  # what the camera sees of every box, once a sun fitted to the whole view needs it
+    flat: lightspace.FlatCasters  # the flat boxes' test of every light
 
     def parts(self):
         if self.sun_parts is None:
@@ -478,12 +484,15 @@ def plan_shadows(lights, corners, options, view=None, share=None):
     if len(corners) == 0:
         return plan
     seen = corners if view.extra is None else np.concatenate([corners, np.asarray(view.extra).reshape(-1, 8, 3)])
-    slices = _cascade_slices(seen, view.view_corners, view.camera, options.cascades, view.depth_range)
+    slices = view.slices
+    if slices is None:
+        slices = cascade_slices(seen, view.view_corners, view.camera, options.cascades, view.depth_range)
     # What the camera sees, once for every spot, point and area map of the frame.
     receivers = view.receivers
     if receivers is None and view.camera is not None:
         receivers = lightspace.visible_receivers(corners, view.camera.projection @ view.camera.view)
-    scene = _Scene(Boxes.of(corners), options, view, slices, receivers, view.sun_parts)
+    flat = view.flat if view.flat is not None and view.flat.count == len(corners) else lightspace.FlatCasters(corners)
+    scene = _Scene(Boxes.of(corners), options, view, slices, receivers, view.sun_parts, flat)
     for i, light in enumerate(lights):
         if not light.use_shadow:
             continue
@@ -564,8 +573,8 @@ def _flat_free(scene, light):
     if scene.options.reflective:  # every lit surface sends light: none is left out
         return np.zeros(len(corners), dtype=bool) if light.type == "SUN" and view_corners is not None else None
     if light.type != "SUN":
-        return lightspace.flat_casters_without_shadow(corners, position=light.position)
-    return None if view_corners is None else lightspace.flat_casters_without_shadow(corners, light.direction)
+        return scene.flat.free(position=light.position)
+    return None if view_corners is None else scene.flat.free(light.direction)
 
 
 def _grown(scene, job):
@@ -607,7 +616,7 @@ def _sun_tiles(scene, job, sizes):
         # Receivers that cast nothing: after the geometry's boxes (caster indices stay the
         # draws'), never casters.
         if flat_free is None and view_corners is not None:
-            flat_free = lightspace.flat_casters_without_shadow(corners, light.direction)
+            flat_free = scene.flat.free(light.direction)
         corners = np.concatenate([corners, np.asarray(extra, np.float64).reshape(-1, 8, 3)])
         if flat_free is not None:
             flat_free = np.concatenate([flat_free, np.ones(len(corners) - count, dtype=bool)])
@@ -736,7 +745,7 @@ def frame_sizes(plan, map_size):
     }
 
 
-def _cascade_slices(corners, view_corners, camera, requested, depth=None):
+def cascade_slices(corners, view_corners, camera, requested, depth=None):
     """[(slice corners, view depth where the slice ends)] of the visible depth range: one
     slice (the view frustum cut to the depth range of what it sees, so a far clip plane
     beyond the geometry does not widen the map), or one per sun cascade. None when the range

@@ -41,15 +41,29 @@ def _render(gpu_call, scene, samples, fenced=False, before=None):
 
 
 @contextmanager
-def counting_fits():
+def counting_fits(shared=False):
     """A list that collects one entry per map fitted (a spot's or a point light's face, a
     sun's cascade) or derived from the frame's plan (a sampled sun's map ``sheared``, a local
-    light's ``moved``: entries named so) while the block runs."""
+    light's ``moved``: entries named so) while the block runs; with ``shared``, also one per
+    flat-caster table made (``FlatCasters``) and per cascade slicing of the view
+    (``cascade_slices``)."""
+    from penumbra.engine.frame import shadow_pass
     from penumbra.engine.shadows import planning
 
     fits = []
     lightspace = planning.lightspace
     original = planning.perspective_tile, lightspace.fit_sun_to_view, lightspace.sheared, lightspace.moved
+    table, slices = lightspace.FlatCasters.__init__, (planning.cascade_slices, shadow_pass.cascade_slices)
+
+    def made(self, boxes):
+        if shared:
+            fits.append("FlatCasters")
+        table(self, boxes)
+
+    def sliced(*args, **kwargs):
+        if shared:
+            fits.append("cascade_slices")
+        return slices[0](*args, **kwargs)
 
     def counted(fn):
         def run(*args, **kwargs):
@@ -62,10 +76,14 @@ def counting_fits():
     planning.lightspace.fit_sun_to_view = counted(original[1])
     lightspace.sheared = counted(original[2])
     lightspace.moved = counted(original[3])
+    lightspace.FlatCasters.__init__ = made
+    planning.cascade_slices = shadow_pass.cascade_slices = sliced
     try:
         yield fits
     finally:
         planning.perspective_tile, lightspace.fit_sun_to_view, lightspace.sheared, lightspace.moved = original
+        lightspace.FlatCasters.__init__ = table
+        planning.cascade_slices, shadow_pass.cascade_slices = slices
 
 
 @pytest.fixture(scope="module")
@@ -97,23 +115,25 @@ def test_a_further_sample_plans_no_light_and_rebuilds_nothing(demo, gpu_call):
     """Maps (a sun's and a spot's) counted over frames of 2 and 10 samples: the 8 further
     samples fit none of them, each map is derived from the frame's first plan (the sun's
     sheared to the sample's direction, the spot's moved to the sample's point of the light),
-    once per sample; the world's directions are fitted once each; no batch or material block
-    is built again, and what a further sample uploads is its uniform blocks and light bins, a
-    few KiB, whatever the scene's size."""
+    once per sample; the world's directions are fitted once each, over the frame's one table
+    of its flat boxes and one slicing of its view; no batch or material block is built again,
+    and what a further sample uploads is its uniform blocks and light bins, a few KiB,
+    whatever the scene's size."""
 
     def count(world_shadows):
         demo.penumbra.world_shadows = world_shadows
-        with counting_fits() as fits:
+        with counting_fits(shared=True) as fits:
             results = {}
             for samples in (2, 10):
                 del fits[:]
                 stats, counters, after = _render(gpu_call, demo, samples)
                 derived = fits.count("sheared") + fits.count("moved")
-                results[samples] = (len(fits) - derived, stats, counters, after, derived)
+                shared = fits.count("FlatCasters") + fits.count("cascade_slices")
+                results[samples] = (len(fits) - derived - shared, stats, counters, after, derived, shared)
         return results
 
     results = count(False)
-    (fits2, stats2, *_, derived2), (fits10, stats10, counters, after, derived10) = results[2], results[10]
+    (fits2, stats2, *_, derived2, _), (fits10, stats10, counters, after, derived10, _) = results[2], results[10]
     maps = stats10.shadow_maps // stats10.samples  # maps drawn per sample (every light moves)
     assert maps >= 2
     assert fits10 == fits2, (fits2, fits10)  # no fit in a further sample
@@ -126,6 +146,8 @@ def test_a_further_sample_plans_no_light_and_rebuilds_nothing(demo, gpu_call):
     assert world[10][1].world_directions - world[2][1].world_directions == 8 * directions
     assert world[10][0] - world[2][0] == 8 * directions, (world[2][0], world[10][0])
     assert world[10][4] - world[2][4] == 8 * maps, (world[2][4], world[10][4])
+    # What every sample's plan shares is made once a frame (and once more by the warm-up frame).
+    assert world[10][5] == world[2][5] == results[10][5] <= 4, (world[2][5], world[10][5])
     assert after == counters  # no batch, no material block made again
     per_sample = (stats10.upload_bytes - stats2.upload_bytes) / 8
     assert 0 < per_sample < 32 * 1024, per_sample

@@ -197,6 +197,69 @@ def test_flat_ground_with_everything_on_it_casts_nothing():
     assert free.tolist() == [True, False]
 
 
+def _flat_test_reference(boxes, direction=None, position=None):
+    """The flat-caster test written for one light, as it was before a table kept its sides."""
+    boxes = np.asarray(boxes, dtype=np.float64).reshape(-1, 8, 3)
+    free = np.zeros(len(boxes), dtype=bool)
+    edges = boxes[:, [1, 2, 4]] - boxes[:, [0]]
+    lengths = np.linalg.norm(edges, axis=2)
+    longest, thin, rows = lengths.max(axis=1), lengths.argmin(axis=1), np.arange(len(boxes))
+    normal = np.cross(edges[rows, (thin + 1) % 3], edges[rows, (thin + 2) % 3])
+    area = np.linalg.norm(normal, axis=1)
+    flat = lightspace.flat_boxes(boxes) & (area > 1e-12 * longest**2) & np.isfinite(area)
+    candidates = np.nonzero(flat)[0]
+    candidates = candidates[np.argsort(-area[candidates])][: lightspace.MAX_FLAT_TESTS]
+    light = lightspace.normalize(direction) if position is None else None
+    for i in candidates:
+        n = normal[i] / area[i]
+        d = float(n @ boxes[i, 0])
+        if light is not None:
+            s = float(n @ light)
+            grazing = abs(s) <= 1e-9
+        else:
+            s = d - float(n @ np.asarray(position, dtype=np.float64))
+            grazing = abs(s) <= 1e-9 * max(1.0, abs(d))
+        if grazing:
+            free[i] = True
+            continue
+        reach = np.sign(s) * (boxes @ n - d)
+        reach[i] = 0.0
+        tolerance = 1e-5 * max(float(np.abs(boxes[i]).max()), longest[i])
+        free[i] = not bool((reach.max(axis=1) > tolerance).any())
+    return free
+
+
+def test_one_flat_caster_table_answers_every_light_as_a_test_of_its_own():
+    """A frame's samples each fit a map to a new direction of the world (or a light at a new
+    point of itself) over the same boxes: ``FlatCasters`` keeps each flat box's two sides and
+    answers every light exactly as a test made for that light alone."""
+    rng = np.random.default_rng(7)
+    boxes = []
+    for k in range(40):  # grounds, walls and cards at random tilts and scales, and solids
+        lo = rng.uniform(-5, 5, 3)
+        size = rng.uniform(0.1, 4.0, 3)
+        if k % 2 == 0:
+            size[k % 3] = 0.0  # flat
+        corners = lightspace.box_corners(lo, lo + size)
+        if k % 4 == 0:
+            q, _r = np.linalg.qr(rng.normal(size=(3, 3)))
+            corners = corners @ q.T
+        boxes.append(corners * 10.0 ** rng.integers(-3, 4))
+    boxes.append(_flat((-100, -100, 0), (100, 100, 0)))
+    boxes = np.stack(boxes)
+    table = lightspace.FlatCasters(boxes)
+    directions = [*rng.normal(size=(60, 3)), (0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)]
+    for direction in directions:
+        expected = _flat_test_reference(boxes, direction)
+        np.testing.assert_array_equal(table.free(direction), expected)
+        np.testing.assert_array_equal(lightspace.flat_casters_without_shadow(boxes, direction), expected)
+    for position in [*rng.uniform(-20, 20, size=(60, 3)), (0.0, 0.0, 0.0), (3.0, 3.0, 0.0)]:
+        np.testing.assert_array_equal(table.free(position=position), _flat_test_reference(boxes, position=position))
+    assert any(table.free((0.0, 0.0, -1.0))) and not all(table.free((0.0, 0.0, -1.0)))
+    assert len(table._reaches) <= 2 * lightspace.MAX_FLAT_TESTS  # each side of each plane found once
+    assert lightspace.FlatCasters(np.zeros((0, 8, 3))).free((0, 0, -1)).shape == (0,)
+
+
 def test_hull_planes_and_clipped_points_of_a_box_crossing_a_frustum():
     cam = lightspace.orthographic(-1, 1, -1, 1, 1.0, 10.0)  # the box x, y in [-1, 1], z in [-10, -1]
     corners = lightspace.frustum_corners(cam)
