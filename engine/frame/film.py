@@ -14,6 +14,7 @@ from .film_programs import (
     MASKED_COPY,
     MASKED_COPY_SHADOW_WEIGHT,
     MASKED_COPY_WEIGHT,
+    MAX_TARGETS,
     SCALED_COPY,
     SCALED_COPY_SHADOW,
     SCALED_RESOLVE_SHADOW,
@@ -21,6 +22,7 @@ from .film_programs import (
     WEIGHTED_RESOLVE_SHADOW,
     convergence_program,
     gathering,
+    with_copies,
 )
 from .sampling import THRESHOLD_SCALE
 from .stats import StageClock
@@ -85,7 +87,8 @@ class FilmPart:
 
     The film calls, for the parts of the frame (``Film.begin``): ``framebuffer`` (the lit
     pass's targets with its own), ``clear`` (before a sample's lit pass), ``begin`` (a fresh
-    frame), ``accumulate`` (each sample), ``accumulated`` (what a sample's value kept copies), ``convergence``
+    frame), ``copies`` (what each sample adds to its accumulations), ``accumulated`` (what a
+    sample's value kept copies), ``convergence``
     (its share of the convergence check), ``resolve`` (after the last sample, into the colour
     target; or into ``framebuffer``, ``Film.mean_into``: the mean so far, over the film's),
     ``resolve_light`` (a light pass's resolve, where the part takes light out of the colour's),
@@ -107,8 +110,10 @@ class FilmPart:
     def begin(self, film):
         pass
 
-    def accumulate(self, film, weight, sample, mask, gather):
-        pass
+    def copies(self, film, sample):
+        """(this sample's target, its accumulation) pairs ``Film.accumulate`` adds to with the
+        sample's weight, in its passes (``sample``: the index; adaptive sampling tracks odd ones)."""
+        return ()
 
     def accumulated(self, film):
         """(accumulation, this sample's target) pairs: where a technique that keeps one
@@ -204,11 +209,11 @@ class Film:
         # one, write the other), each pixel's weight once some pixel converged.
         self.tracking = False
         self.converged = 0  # pixels converged (no more samples)
-        self._half = self._half_fb = None
+        self._half = None
         self._masks = self._mask_fbs = None
         self._mask_index = 0
         self._weight = None
-        self._masked_fbs = {}
+        self._copy_fbs = {}
         # The shading count of tests (``count_shaded``): the lit pass writes 1 into ``shaded``
         # for every pixel it shades; ``shaded_total`` adds them over the frame's samples.
         self.count_shaded = False
@@ -353,35 +358,71 @@ class Film:
         in the pixels that have not converged; ``sample``: its index (adaptive sampling adds
         the odd ones to its second accumulation). ``gather`` (``sampling.gather_uniforms``):
         each pixel takes the sample from the pixels within the filter's reach, by the window's
-        weights, which sum to ``weight`` (the gathering film)."""
+        weights, which sum to ``weight`` (the gathering film).
+
+        Every accumulation a sample adds to takes the same weight, mask and gathering: the
+        colour's pass carries the others (the Emission pass, the every-other-sample
+        accumulation, the techniques' ``FilmPart.copies``) in the targets Blender's gpu module
+        has left (six in all), and those that do not fit go six to a pass. Each target gains
+        exactly what a pass of its own would add."""
         mask = self.mask
-        if mask is None:
-            sources = (self.color, self.shadow)
-            self._scaled_copy(self._accum_fb, sources, weight, aux, blend="ADDITIVE_PREMULT", gather=gather)
-        else:
-            with_shadow = aux and self._accum_shadow is not None
-            samplers = {"src_color": self.color, "converged": mask}
-            if with_shadow:
-                samplers["src_shadow"] = self.shadow
-            program = gathered(
-                MASKED_COPY_SHADOW_WEIGHT if with_shadow else MASKED_COPY_WEIGHT, gather, self.gather_reach
-            )
-            uniforms = {"scale": weight, **(gather or {})}
-            self.fullscreen(program, self._masked_fb(with_shadow), samplers, uniforms, "ADDITIVE_PREMULT")
+        copies = []
         if emission:
-            _accum, accum_fb, _resolve_fb = self._emission_targets
-            self.copy(accum_fb, self.emission, weight, mask, gather)
+            copies.append((self.emission, self._emission_targets[0]))
         if self.tracking and sample % 2 == 1:
-            self.copy(self._half_fb, self.color, weight, mask, gather)
+            copies.append((self.color, self._half))
             self._half_weight_sum += weight
+        for part in self.parts:
+            copies.extend(part.copies(self, sample))
+        with_shadow = aux and self._accum_shadow is not None
+        samplers = {"src_color": self.color}
+        if with_shadow:
+            samplers["src_shadow"] = self.shadow
+        if mask is None:
+            program = SCALED_COPY_SHADOW if with_shadow else SCALED_COPY
+            slots = (self._accum_color, self._accum_shadow) if with_shadow else (self._accum_color,)
+        else:
+            samplers["converged"] = mask
+            program = MASKED_COPY_SHADOW_WEIGHT if with_shadow else MASKED_COPY_WEIGHT
+            slots = (
+                (self._accum_color, self._accum_shadow, self._weight)
+                if with_shadow
+                else (self._accum_color, self._weight)
+            )
+        riding = copies[: MAX_TARGETS - len(slots)]
+        self._add_copies(program, slots, samplers, riding, weight, gather)
+        rest = copies[len(riding) :]
+        for k in range(0, len(rest), MAX_TARGETS):  # what did not fit: six a pass
+            (source, target), *more = rest[k : k + MAX_TARGETS]
+            alone = {"src_color": source} if mask is None else {"src_color": source, "converged": mask}
+            self._add_copies(SCALED_COPY if mask is None else MASKED_COPY, (target,), alone, more, weight, gather)
         if self._shaded_total_fb is not None:
             self.fullscreen(
                 SCALED_COPY, self._shaded_total_fb, {"src_color": self.shaded}, {"scale": 1.0}, "ADDITIVE_PREMULT"
             )
-        for part in self.parts:
-            part.accumulate(self, weight, sample, mask, gather)
         self._weight_sum += weight
         self.sample_weights.append(float(weight))
+
+    def _add_copies(self, program, slots, samplers, copies, weight, gather):
+        """One pass of ``program`` adding ``weight`` times its sources into ``slots``, and each
+        of ``copies`` ((source, accumulation) pairs) likewise (``film_programs.with_copies``)."""
+        samplers = {**samplers, **{f"src_copy{k}": source for k, (source, _target) in enumerate(copies)}}
+        framebuffer = self._copies_framebuffer((*slots, *(target for _source, target in copies)))
+        program = gathered(with_copies(program, len(copies)), gather, self.gather_reach)
+        self.fullscreen(program, framebuffer, samplers, {"scale": weight, **(gather or {})}, "ADDITIVE_PREMULT")
+
+    def _copies_framebuffer(self, slots):
+        """A framebuffer of the colour targets ``slots``, kept while the film keeps its targets
+        (it holds them, so an entry never stands for other textures)."""
+        import gpu
+
+        key = tuple(id(t) for t in slots)
+        found = self._copy_fbs.get(key)
+        if found is None or any(a is not b for a, b in zip(found[0], slots, strict=True)):
+            if len(self._copy_fbs) >= 32:
+                self._copy_fbs.clear()
+            found = self._copy_fbs[key] = (tuple(slots), gpu.types.GPUFrameBuffer(color_slots=tuple(slots)))
+        return found[1]
 
     def copy(self, framebuffer, source, scale, mask, gather=None):
         """framebuffer += scale * source, where not converged (``mask``, when some pixel is);
@@ -482,18 +523,17 @@ class Film:
         self.converged = 0
         self.give([self._weight])
         self._weight = None
-        self._masked_fbs = {}
+        self._copy_fbs = {}
         if not (self.tracking or masks):
             return
         size = self.size
         if self._masks is None or (self._masks[0].width, self._masks[0].height) != size:
             self.give([self._half, *(self._masks or ())])
-            self._half = self._half_fb = None
+            self._half = None
             self._masks = [new_texture(self.pool, size, "R32F") for _ in range(2)]
             self._mask_fbs = [gpu.types.GPUFrameBuffer(color_slots=(m,)) for m in self._masks]
         if self.tracking and self._half is None:
             self._half = new_texture(self.pool, size, "RGBA32F")
-            self._half_fb = gpu.types.GPUFrameBuffer(color_slots=(self._half,))
         if self.tracking:
             self._half.clear(format="FLOAT", value=(0.0, 0.0, 0.0, 0.0))
         for m in self._masks:
@@ -566,7 +606,7 @@ class Film:
             # less than a sample's whole weight, beside a converged one).
             self._weight = new_texture(self.pool, self.size, "RG32F")
             self._weight.clear(format="FLOAT", value=(float(self._weight_sum), float(len(self.sample_weights))))
-            self._masked_fbs = {}
+            self._copy_fbs = {}
         self.converged = count
         return count
 
@@ -614,21 +654,6 @@ class Film:
         values = texture_array(target, 1)[..., 0].copy()
         self.give([target])
         return values
-
-    def _masked_fb(self, with_shadow):
-        """The framebuffer a masked sample is added through: accumulation (colour, shadow) and
-        the weights."""
-        import gpu
-
-        fb = self._masked_fbs.get(with_shadow)
-        if fb is None:
-            slots = (
-                (self._accum_color, self._accum_shadow, self._weight)
-                if with_shadow
-                else (self._accum_color, self._weight)
-            )
-            fb = self._masked_fbs[with_shadow] = gpu.types.GPUFrameBuffer(color_slots=slots)
-        return fb
 
     def mask_depth(self, framebuffer):
         """Clear ``framebuffer``'s z-buffer and write the nearest depth where a pixel
@@ -771,8 +796,8 @@ class Film:
             part.release(self)
         self._emission_fb = None
         self.fb = self.fb_color = self.fb_emit = self._accum_fb = self._resolve_fb = None
-        self._half = self._half_fb = self._masks = self._mask_fbs = self._weight = None
-        self._masked_fbs = {}
+        self._half = self._masks = self._mask_fbs = self._weight = None
+        self._copy_fbs = {}
         self.tracking, self.converged = False, 0
         self.shaded = self.fb_counted = self.shaded_total = self._shaded_total_fb = None
         self._emission_targets = None

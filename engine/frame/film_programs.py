@@ -15,7 +15,7 @@ SCALED_COPY = Program(
     name="scaled_copy",
     vertex="fullscreen.vert.glsl",
     fragment="scaled_copy.frag.glsl",
-    libs=("lib/film_gather.glsl",),
+    libs=("lib/film_gather.glsl", "lib/film_copies.glsl"),
     vertex_in=(("VEC2", "pos"),),
     push_constants=(("IVEC2", "origin"), ("FLOAT", "scale")),
     samplers=(("FLOAT_2D", "src_color"),),
@@ -44,7 +44,7 @@ MASKED_COPY = Program(
     name="masked_copy",
     vertex="fullscreen.vert.glsl",
     fragment="masked_copy.frag.glsl",
-    libs=("lib/film_gather.glsl",),
+    libs=("lib/film_gather.glsl", "lib/film_copies.glsl"),
     vertex_in=(("VEC2", "pos"),),
     push_constants=(("FLOAT", "scale"),),
     samplers=(("FLOAT_2D", "src_color"), ("FLOAT_2D", "converged")),
@@ -130,6 +130,29 @@ CONVERGED_DEPTH = Program(
 # the accumulations; the window's weights along x and y (made in Python) as push constants,
 # its reach compiled in.
 GATHER_PUSH = (("MAT3", "gather_wx"), ("MAT3", "gather_wy"))
+
+
+# Blender's gpu module binds at most this many colour targets to a framebuffer.
+MAX_TARGETS = 6
+
+
+def with_copies(program, count):
+    """``program`` (SCALED_COPY, MASKED_COPY or a variant of theirs) adding ``count`` further
+    sources (``src_copy0`` ..) times its scale into as many further targets (``out_copy0`` ..)
+    in the same pass (lib/film_copies.glsl): a sample's accumulations in as few passes as
+    Blender's six colour targets allow (``film.Film.accumulate``)."""
+    count = int(count)
+    if count <= 0:
+        return program
+    if len(program.outputs) + count > MAX_TARGETS:
+        raise ValueError(f"{program.name}: {len(program.outputs)} targets and {count} copies exceed {MAX_TARGETS}")
+    return replace(
+        program,
+        name=f"{program.name}_copies{count}",
+        samplers=program.samplers + tuple(("FLOAT_2D", f"src_copy{k}") for k in range(count)),
+        outputs=program.outputs + tuple(("VEC4", f"out_copy{k}") for k in range(count)),
+        defines=program.defines + (("EXTRA_COPIES", count),),
+    )
 
 
 def gathering(program, reach):

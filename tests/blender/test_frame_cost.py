@@ -153,6 +153,55 @@ def test_a_further_sample_plans_no_light_and_rebuilds_nothing(demo, gpu_call):
     assert 0 < per_sample < 32 * 1024, per_sample
 
 
+def test_a_samples_accumulations_share_one_pass_while_they_fit_six_targets(demo, gpu_call):
+    """Every accumulation a sample adds to takes its weight, mask and gathering alike: the
+    colour and shadow, the Emission pass, the world ratio's three sums. They go in as few
+    full-frame passes as Blender's six colour targets allow: one a sample here, where the
+    colour, the Emission pass and the ratio each took a pass of their own."""
+    from penumbra.engine.frame.film import Film
+
+    def job(engine, depsgraph):
+        from penumbra.engine.scene.extract import camera_from_scene
+
+        camera = camera_from_scene(depsgraph, demo, *SIZE)
+        engine.render_frame(depsgraph, camera, *SIZE)
+        calls = []  # per sample: (full-frame passes, targets added to)
+        accumulate, fullscreen, add = Film.accumulate, Film.fullscreen, Film._add_copies
+
+        def counted_accumulate(self, *args, **kwargs):
+            calls.append([0, 0])
+            inside.append(True)
+            try:
+                return accumulate(self, *args, **kwargs)
+            finally:
+                inside.pop()
+
+        def counted_add(self, program, slots, samplers, copies, weight, gather):
+            calls[-1][1] += len(slots) + len(copies)
+            return add(self, program, slots, samplers, copies, weight, gather)
+
+        inside = []  # set while a sample accumulates
+
+        def counted_fullscreen(self, *args, **kwargs):
+            if inside:
+                calls[-1][0] += 1
+            return fullscreen(self, *args, **kwargs)
+
+        Film.accumulate, Film._add_copies, Film.fullscreen = counted_accumulate, counted_add, counted_fullscreen
+        try:
+            out = engine.render_frame(depsgraph, camera, *SIZE, samples=(0, 5), sample_count=5, emission=True)
+        finally:
+            Film.accumulate, Film._add_copies, Film.fullscreen = accumulate, add, fullscreen
+        return out.stats, calls
+
+    stats, calls = gpu_call(job)
+    assert "world_ratio" in stats.techniques, stats.techniques
+    assert len(calls) == stats.samples == 5
+    # Colour, shadow, Emission and the ratio's three sums: six targets, one pass.
+    assert all(targets == 6 for _passes, targets in calls), calls
+    assert all(passes == 1 for passes, _targets in calls), calls
+
+
 def test_a_lit_pass_sends_its_frame_and_lights_blocks_once_whatever_programs_it_binds(demo, gpu_call):
     """A lit pass that switches programs (one of the demo's materials alpha-hashed, a variant
     of its own): each program it binds reads the same frame and lights blocks, which go to the

@@ -179,9 +179,8 @@ class PassTargets(FilmPart):
                 self.accum[key] = (target, gpu.types.GPUFrameBuffer(color_slots=(target,)))
             clear_zero(self.accum[key][0])
 
-    def accumulate(self, film, weight, sample, mask, gather):
-        for key, (_target, fb) in self.accum.items():
-            film.copy(fb, self.sample[key], weight, mask, gather)
+    def copies(self, film, sample):
+        return [(self.sample[key], target) for key, (target, _fb) in self.accum.items()]
 
     def accumulated(self, film):
         """Each averaged pass's (accumulation, this sample's target): where settling keeps its

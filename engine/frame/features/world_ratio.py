@@ -7,11 +7,9 @@ negative).
 
 Off (not registered), a frame without portals lights its surfaces with the unshadowed SH light."""
 
-from dataclasses import replace
-
 from ....shaders.loader import Program, ProgramPart
 from ...gpu_pool import new_texture
-from ..film import FilmPart, clear_zero, gathered, gpu_framebuffer
+from ..film import FilmPart, clear_zero, gpu_framebuffer
 from ..world.directions import directions_per_sample, needs_directions
 from .base import Feature, LitPart
 
@@ -31,21 +29,6 @@ _SAMPLERS = tuple(("FLOAT_2D", name) for name in NAMES)
 
 # A sample's targets added to their accumulations in one pass, where not converged (WITH_MASK,
 # ``converged`` then bound).
-COPY = Program(
-    name="world_ratio_copy",
-    vertex="fullscreen.vert.glsl",
-    fragment="world_ratio_copy.frag.glsl",
-    libs=("lib/film_gather.glsl",),
-    vertex_in=(("VEC2", "pos"),),
-    push_constants=(("FLOAT", "scale"),),
-    samplers=_SAMPLERS + (("FLOAT_2D", "converged"),),
-    outputs=OUTPUTS,
-    defines=(("WITH_MASK", False),),
-)
-COPY_MASKED = replace(COPY, name="world_ratio_copy_masked", defines=(("WITH_MASK", True),))
-
-# The resolve: colour - U_d (1 - S_d) - U_s (1 - S_s) from the accumulations, over the total
-# weight (``scale``) or each pixel's (per_pixel > 0.5).
 RESOLVE = Program(
     name="world_ratio_resolve",
     vertex="fullscreen.vert.glsl",
@@ -80,7 +63,6 @@ class RatioTargets(FilmPart):
         self.size = None
         self.sample = None  # the per-sample targets
         self.accum = None  # [(accumulation, its framebuffer)] of each
-        self.accum_fb = None  # all three accumulations, added to in one pass
         self.half = None  # (the sums' every-other-sample accumulation, its framebuffer)
         self.fbs = {}
 
@@ -121,7 +103,6 @@ class RatioTargets(FilmPart):
         if self.accum is None:
             targets = [new_texture(film.pool, film.size, "RGBA32F") for _ in range(3)]
             self.accum = [(t, gpu.types.GPUFrameBuffer(color_slots=(t,))) for t in targets]
-            self.accum_fb = gpu.types.GPUFrameBuffer(color_slots=tuple(targets))
         if film.tracking and self.half is None:
             half = new_texture(film.pool, film.size, "RGBA32F")
             self.half = (half, gpu.types.GPUFrameBuffer(color_slots=(half,)))
@@ -130,15 +111,14 @@ class RatioTargets(FilmPart):
         if film.tracking:
             clear_zero(self.half[0])
 
-    def accumulate(self, film, weight, sample, mask, gather):
+    def copies(self, film, sample):
+        """Its three targets into their accumulations, and the sums into their every-other-sample
+        accumulation (odd samples, when the noise is estimated)."""
         targets = self._targets(film)
-        samplers = dict(zip(NAMES, targets, strict=True))
-        samplers["converged"] = mask if mask is not None else targets[2]  # bound, never read without a mask
-        program = gathered(COPY if mask is None else COPY_MASKED, gather, film.gather_reach)
-        uniforms = {"scale": weight, **(gather or {})}
-        film.fullscreen(program, self.accum_fb, samplers, uniforms, "ADDITIVE_PREMULT")
+        out = [(target, accum) for target, (accum, _fb) in zip(targets, self.accum, strict=True)]
         if film.tracking and sample % 2 == 1:
-            film.copy(self.half[1], targets[2], weight, mask, gather)
+            out.append((targets[2], self.half[0]))
+        return out
 
     def accumulations(self):
         """{sampler name: accumulation} of the ratio's targets (what its resolve reads)."""
@@ -189,7 +169,7 @@ class RatioTargets(FilmPart):
     def release(self, film):
         """Every target back to the film's pool (a new size, the end of a render)."""
         film.give([*(self.sample or ()), *(t for t, _fb in self.accum or ()), self.half[0] if self.half else None])
-        self.sample = self.accum = self.accum_fb = self.half = None
+        self.sample = self.accum = self.half = None
         self.fbs = {}
         self.size = None
 
