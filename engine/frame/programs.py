@@ -692,9 +692,15 @@ _VARIANT_WANTS = {
 
 
 def lit_defines(variant):
-    """The defines of the lit-pass program ``variant`` (a ``LitVariant``)."""
+    """The defines of the lit-pass program ``variant`` (a ``LitVariant``): a dict of its own,
+    made once per variant (a frame's samples and passes ask for the same few)."""
     if not isinstance(variant, LitVariant):
         raise TypeError(f"lit_defines takes a LitVariant, not {type(variant).__name__}")
+    return dict(_lit_defines(variant))
+
+
+@functools.lru_cache(maxsize=256)
+def _lit_defines(variant):
     v = variant
     shadow_filter, pcf_weights, depth_format, pcf_spacing = (
         v.shadow_filter,
@@ -711,26 +717,28 @@ def lit_defines(variant):
     sampled_n, shadowed_n, total_n = light_counts if light_counts is not None else (0, 1, 2)
     gather = bool(filt.pcf_taps and pcf_spacing == 1.0 and DEPTH_FORMAT[depth_format].channels == 1)
     weights = [float(w) for w in pcf_weights] if filt.pcf_taps else [1.0]
-    return {
-        **depth_defines(depth_format),
-        "SHADOW_FILTER": SHADOW_FILTER.define(shadow_filter),
-        "SPECULAR_MODEL": SPECULAR_MODEL.define(v.specular_model),
-        "PCF_RADIUS": len(weights) // 2,
-        "PCF_WEIGHTS_LIST": ", ".join(f"{w:.9g}" for w in weights),
-        "DISK_SAMPLES": v.disk_samples if filt.disk or sampled else 8,
-        "SAMPLED_LIGHTS": bool(sampled),
-        "EARLY_OUT": bool(v.early_out) or not filt.early_out,
-        "AUX_OUTPUTS": bool(v.aux_outputs),
-        "LIGHT_BINS": bool(binned),
-        "PCF_GATHER": gather,
-        "UNROLLED_LIGHTS": unrolled,
-        "HAS_SHADOWED": shadowed_n > sampled_n,
-        "HAS_UNSHADOWED": total_n > shadowed_n,
-        "SAMPLED_COUNT": counts[0],
-        "SHADOWED_COUNT": counts[1],
-        "LIGHT_COUNT": counts[2],
-        "LIGHT_LINKING": bool(v.light_linking),
-        "DEBUG_LIT": bool(v.debug),
-        "WORLD_LIGHTS": bool(v.world_lights),
-        "DEBUG_TERM": int(v.debug_term),
-    }
+    return tuple(
+        {
+            **depth_defines(depth_format),
+            "SHADOW_FILTER": SHADOW_FILTER.define(shadow_filter),
+            "SPECULAR_MODEL": SPECULAR_MODEL.define(v.specular_model),
+            "PCF_RADIUS": len(weights) // 2,
+            "PCF_WEIGHTS_LIST": ", ".join(f"{w:.9g}" for w in weights),
+            "DISK_SAMPLES": v.disk_samples if filt.disk or sampled else 8,
+            "SAMPLED_LIGHTS": bool(sampled),
+            "EARLY_OUT": bool(v.early_out) or not filt.early_out,
+            "AUX_OUTPUTS": bool(v.aux_outputs),
+            "LIGHT_BINS": bool(binned),
+            "PCF_GATHER": gather,
+            "UNROLLED_LIGHTS": unrolled,
+            "HAS_SHADOWED": shadowed_n > sampled_n,
+            "HAS_UNSHADOWED": total_n > shadowed_n,
+            "SAMPLED_COUNT": counts[0],
+            "SHADOWED_COUNT": counts[1],
+            "LIGHT_COUNT": counts[2],
+            "LIGHT_LINKING": bool(v.light_linking),
+            "DEBUG_LIT": bool(v.debug),
+            "WORLD_LIGHTS": bool(v.world_lights),
+            "DEBUG_TERM": int(v.debug_term),
+        }.items()
+    )
