@@ -696,11 +696,12 @@ def lit_defines(variant):
     made once per variant (a frame's samples and passes ask for the same few)."""
     if not isinstance(variant, LitVariant):
         raise TypeError(f"lit_defines takes a LitVariant, not {type(variant).__name__}")
-    return dict(_lit_defines(variant))
+    return dict(_lit_defines(variant, UNROLLED_LIGHTS))
 
 
 @functools.lru_cache(maxsize=256)
-def _lit_defines(variant):
+def _lit_defines(variant, unrolled_lights):
+    """``lit_defines``, kept per variant and the module's UNROLLED_LIGHTS as the call reads it."""
     v = variant
     shadow_filter, pcf_weights, depth_format, pcf_spacing = (
         v.shadow_filter,
@@ -710,7 +711,7 @@ def _lit_defines(variant):
     )
     light_counts, binned, sampled = v.light_counts, v.binned, v.sampled
     filt = SHADOW_FILTER[shadow_filter]
-    unrolled = light_counts is not None and not binned and light_counts[2] <= UNROLLED_LIGHTS
+    unrolled = light_counts is not None and not binned and light_counts[2] <= unrolled_lights
     counts = tuple(int(c) for c in light_counts) if unrolled else (0, 0, 0)
     # Which classes of light the loops must walk (with a map but not sampled, without a map);
     # unknown counts keep both loops.
