@@ -12,6 +12,7 @@ first time a frame needs them, then cached by (program, defines).
 import time
 from dataclasses import dataclass, replace
 from functools import cached_property, lru_cache
+from operator import itemgetter
 from pathlib import Path
 
 import numpy as np
@@ -76,14 +77,23 @@ class Struct:
     @cached_property
     def _plan(self):
         """The packer's plan: the field names; per field (name, first 32-bit word, words,
-        integer, matrix); the words the float fields fill and those the integer fields fill,
-        in field order."""
-        plan, floats, ints = [], [], []
+        integer, matrix); and the fields in groups of one shape (scalars, vectors of a size,
+        matrices; floats and integers apart), each as (getter of its values from a row, their
+        words in order, integer, the shape of a row's values, matrix)."""
+        plan, groups = [], {}
         for name, (off, typ) in self.layout.items():
             _align, size, kind = _STD140[typ]
-            plan.append((name, off // 4, size // 4, kind == "i", typ == "MAT4"))
-            (ints if kind == "i" else floats).extend(range(off // 4, off // 4 + size // 4))
-        return frozenset(self.layout), tuple(plan), np.array(floats, np.intp), np.array(ints, np.intp)
+            words, integer, matrix = size // 4, kind == "i", typ == "MAT4"
+            plan.append((name, off // 4, words, integer, matrix))
+            groups.setdefault((integer, words, matrix), []).append((name, off // 4))
+        packed = []
+        for (integer, words, matrix), fields in groups.items():
+            names = tuple(name for name, _word in fields)
+            getter = itemgetter(*names) if len(names) > 1 else (lambda row, name=names[0]: (row[name],))
+            index = np.array([range(word, word + words) for _name, word in fields], np.intp).ravel()
+            shape = (len(fields), *((4, 4) if matrix else (() if words == 1 else (words,))))
+            packed.append((getter, index, integer, shape, matrix))
+        return frozenset(self.layout), tuple(plan), tuple(packed)
 
     def pack(self, rows, count=None):
         """``rows`` (a list of {field: value}) as std140 bytes of ``count`` elements (default:
@@ -95,35 +105,31 @@ class Struct:
             raise ValueError(f"{self.name}: {len(rows)} rows for {n} elements")
         data = np.zeros((n, self.stride // 4), np.float32)
         ints = data.view(np.int32)
-        names, plan, float_words, int_words = self._plan
-        for i, row in enumerate(rows):
+        names, _plan, groups = self._plan
+        for row in rows:
             if row.keys() != names:
                 missing, unknown = names - set(row), set(row) - names
                 raise KeyError(f"{self.name}: missing {sorted(missing)}, unknown {sorted(unknown)}")
-            # Each field's words in order, floats and integers apart: two numpy writes a row.
-            fl, it = [], []
-            for name, _word, size, integer, matrix in plan:
-                value = row[name]
-                out = it if integer else fl
-                if size == 1 and isinstance(value, (int, float, np.number)):
-                    out.append(value)
-                elif type(value) is tuple and len(value) == size and not matrix:
-                    out.extend(value)
+        if not rows:
+            return data
+        # One numpy write a group of fields of one shape, for every row at once.
+        count_rows = len(rows)
+        try:
+            for getter, index, integer, shape, matrix in groups:
+                values = np.array([getter(row) for row in rows], dtype=np.float64)
+                if values.shape[1:] != shape:
+                    raise ValueError(shape)
+                if matrix:
+                    values = values.transpose(0, 1, 3, 2)  # GLSL matrices are column-major
+                values = values.reshape(count_rows, index.size)
+                if integer:
+                    ints[:count_rows, index] = np.rint(values).astype(np.int32)
                 else:
-                    v = np.asarray(value, dtype=np.float64)
-                    if matrix:
-                        v = v.T  # GLSL matrices are column-major
-                    out.extend(v.ravel().tolist())
-            try:
-                fl = np.asarray(fl, dtype=np.float64)
-                it = np.asarray(it, dtype=np.float64)
-            except (TypeError, ValueError):
-                fl = it = None
-            if fl is None or fl.shape != float_words.shape or it.shape != int_words.shape:
-                self._pack_row(data, ints, i, row)  # a value of another length or shape
-                continue
-            data[i, float_words] = fl
-            ints[i, int_words] = np.rint(it).astype(np.int32)
+                    data[:count_rows, index] = values
+        except (TypeError, ValueError):  # a value of another length or shape: field by field
+            data[:] = 0.0
+            for i, row in enumerate(rows):
+                self._pack_row(data, ints, i, row)
         return data
 
     def _pack_row(self, data, ints, i, row):

@@ -126,62 +126,91 @@ def light_row(light, shadow=None, origin=_ZERO):
     }
 
 
+def kept_light_row(kept, light, shadow=None, origin=_ZERO):
+    """``light_row(light, shadow, origin)``, taken from ``kept`` (a dict kept for one frame, or
+    None) when the same light object, with maps in the same tiles, made it before around the
+    same origin: a light that does not move between a frame's samples is the same object in
+    each (``Renderer.sample``), so its row is made once a frame, not once a sample."""
+    if kept is None:
+        return light_row(light, shadow, origin)
+    where = None if shadow is None else (shadow.mode, tuple(shadow.tiles), tuple(shadow.splits), tuple(shadow.blend))
+    key = (id(light), id(origin), where)
+    entry = kept.get(key)
+    if entry is None or entry[0] is not light or entry[1] is not origin:  # an id reused by another object
+        entry = kept[key] = (light, origin, light_row(light, shadow, origin))
+    return entry[2]
+
+
+_ZERO4 = (0.0, 0.0, 0.0, 0.0)
+_ZERO44 = (_ZERO4,) * 4
+_EYE44 = ((1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+
+# The frame row's fields that take the same value in every frame until a technique's part sets
+# them (``LitPart.rows``): immutable values, so the template is shared and each row a copy.
+_FRAME_DEFAULTS = {
+    "shadowed_count": 0,
+    "shadowed_mask": _ZERO4,
+    "sampled_count": 0,
+    "sampled_mask": _ZERO4,
+    "alpha_offset": 0.5,
+    **{f"world_sh{k}": _ZERO4 for k in range(1, 9)},
+    "ao_projection": _ZERO4,
+    "ao_projection_w": _ZERO4,
+    "ao_viewport": (1.0, 1.0),
+    "ao_distance": 0.0,
+    "ao_jitter": (0.0, 0.0),
+    "sample_index": 0,
+    "lens_coc": _ZERO4,
+    "env_rotation_x": (1.0, 0.0, 0.0, 0.0),
+    "env_rotation_y": (0.0, 1.0, 0.0, 0.0),
+    "env_rotation_z": (0.0, 0.0, 1.0, 0.0),
+    "env_params": _ZERO4,
+    "ssr_params": _ZERO4,
+    "refr_params": _ZERO4,
+    "planar_influence": _ZERO44,
+    "planar_plane": (0.0, 0.0, 1.0, 0.0),
+    "planar_params": _ZERO4,
+    "clip_plane": (0.0, 0.0, 0.0, 1.0),
+    "cube_params": _ZERO4,
+    "cube_probe": (0.0, 0.0, 0.0, -1.0),
+    "cube_probe_influence": _ZERO44,
+    "cube_probe_shape": _ZERO4,
+    "cube_camera": (0.0, 0.0, 0.0, -1.0),
+    "volume_params": _ZERO4,
+    "volume_inv_view": _EYE44,
+    "volume_inv_raster": _EYE44,
+}
+
+
 def frame_row(camera, world_color, light_count, settings, tile_size, atlas_columns, origin=_ZERO):
     view = camera.view @ lightspace.from_origin(origin)  # takes positions relative to ``origin``
     view_proj = camera.projection @ view
-    return {
-        "view_proj": view_proj,
-        "view": view,
-        "camera_position": camera.position - origin,
-        "is_ortho": int(camera.is_ortho),
-        "camera_forward": camera.forward,
-        "light_count": light_count,
-        "shadowed_count": 0,
-        "shadowed_mask": (0, 0, 0, 0),
-        "sampled_count": 0,
-        "sampled_mask": (0, 0, 0, 0),
-        "world_color": np.asarray(world_color, np.float64)[:3],
-        "alpha_offset": 0.5,
-        **{f"world_sh{k}": (0.0, 0.0, 0.0, 0.0) for k in range(1, 9)},
-        "constant_bias": settings.shadow_bias,
-        "slope_bias": settings.shadow_slope_bias,
-        "normal_offset": settings.shadow_normal_offset,
-        "receiver_plane": int(bool(settings.shadow_receiver_plane)),
-        "pcf_spacing": settings.pcf_spacing,
-        "filter_radius": settings.shadow_filter_radius,
-        "max_filter_radius": max_filter_radius(tile_size),
-        "tile_size": tile_size,
-        "atlas_columns": atlas_columns,
-        "ao_projection": (0.0, 0.0, 0.0, 0.0),
-        "ao_projection_w": (0.0, 0.0, 0.0, 0.0),
-        "ao_viewport": (1.0, 1.0),
-        "ao_distance": 0.0,
-        "ao_jitter": (0.0, 0.0),
-        "sample_index": 0,
-        "lens_coc": (0.0, 0.0, 0.0, 0.0),
-        "env_rotation_x": (1.0, 0.0, 0.0, 0.0),
-        "env_rotation_y": (0.0, 1.0, 0.0, 0.0),
-        "env_rotation_z": (0.0, 0.0, 1.0, 0.0),
-        "env_params": (0.0, 0.0, 0.0, 0.0),
-        "ssr_params": (0.0, 0.0, 0.0, 0.0),
-        "ssr_view": view,
-        "ssr_view_proj": view_proj,
-        "refr_params": (0.0, 0.0, 0.0, 0.0),
-        "planar_view": view,
-        "planar_view_proj": view_proj,
-        "planar_influence": np.zeros((4, 4)),
-        "planar_plane": (0.0, 0.0, 1.0, 0.0),
-        "planar_params": (0.0, 0.0, 0.0, 0.0),
-        "clip_plane": (0.0, 0.0, 0.0, 1.0),
-        "cube_params": (0.0, 0.0, 0.0, 0.0),
-        "cube_probe": (0.0, 0.0, 0.0, -1.0),
-        "cube_probe_influence": np.zeros((4, 4)),
-        "cube_probe_shape": (0.0, 0.0, 0.0, 0.0),
-        "cube_camera": (0.0, 0.0, 0.0, -1.0),
-        "volume_params": (0.0, 0.0, 0.0, 0.0),
-        "volume_inv_view": np.eye(4),
-        "volume_inv_raster": np.eye(4),
-    }
+    row = dict(_FRAME_DEFAULTS)
+    row.update(
+        {
+            "view_proj": view_proj,
+            "view": view,
+            "camera_position": camera.position - origin,
+            "is_ortho": int(camera.is_ortho),
+            "camera_forward": camera.forward,
+            "light_count": light_count,
+            "world_color": np.asarray(world_color, np.float64)[:3],
+            "constant_bias": settings.shadow_bias,
+            "slope_bias": settings.shadow_slope_bias,
+            "normal_offset": settings.shadow_normal_offset,
+            "receiver_plane": int(bool(settings.shadow_receiver_plane)),
+            "pcf_spacing": settings.pcf_spacing,
+            "filter_radius": settings.shadow_filter_radius,
+            "max_filter_radius": max_filter_radius(tile_size),
+            "tile_size": tile_size,
+            "atlas_columns": atlas_columns,
+            "ssr_view": view,
+            "ssr_view_proj": view_proj,
+            "planar_view": view,
+            "planar_view_proj": view_proj,
+        }
+    )
+    return row
 
 
 def shading_order(lights, plan):
@@ -231,7 +260,8 @@ class LitInputs:
     ``world_sh``: the surfaces take the world's SH light (False: this sample's directions of
     the world carry all of it, ``world.directions.world_lights`` with portals); ``parts``: the
     frame's techniques' ``features.LitPart`` of this sample (parts of the lit program, rows of
-    the frame block, samplers)."""
+    the frame block, samplers); ``light_rows``: a dict the caller keeps for one frame, where a
+    light that does not move between its samples keeps its row (``kept_light_row``)."""
 
     atlas: AtlasShape = AtlasShape()
     aux_outputs: bool = True
@@ -244,6 +274,7 @@ class LitInputs:
     world_sampled: bool = False
     world_sh: bool = True
     parts: tuple = ()
+    light_rows: dict | None = field(default=None, compare=False)
 
 
 @lru_cache(maxsize=16)
@@ -319,7 +350,9 @@ def build_frame_data(lights, camera, world_color, settings, plan, inputs=LitInpu
     )
     return FrameData(
         frame=FRAME_STRUCT.pack([frame]),
-        lights=LIGHT_STRUCT.pack([light_row(lights[i], plan.lights.get(i), origin) for i in order], MAX_LIGHTS),
+        lights=LIGHT_STRUCT.pack(
+            [kept_light_row(inputs.light_rows, lights[i], plan.lights.get(i), origin) for i in order], MAX_LIGHTS
+        ),
         tiles=packed_tiles(plan, origin),
         variant=variant,
         disk_samples=disk if sampled or (shadowed and SHADOW_FILTER[settings.shadow_filter].disk) else 0,

@@ -122,6 +122,8 @@ class FramePlan:
     reflective: bool = False
     ao_distance: float | None = None
     pass_outputs: dict = dataclasses.field(default_factory=dict)  # the passes' (``features/passes.py``)
+    # The lit pass's light rows made so far this frame (``frame_data.kept_light_row``).
+    light_rows: dict = dataclasses.field(default_factory=dict)
     # A technique changes every pixel it covers from sample to sample in a way the settle test
     # does not see (the volumes' march): settling keeps no pilot's value.
     unsettled: bool = False
@@ -676,6 +678,7 @@ class Renderer:
             world_sampled=frame.world_sampled,
             world_sh=frame.world_sh or not any(lt.world for lt in lights),
             parts=parts,
+            light_rows=frame.light_rows,
         )
         world = snapshot.world if snapshot.world is not None else snapshot.world_color
         sample.data = build_frame_data(lights, sample.cameras[0], world, frame.settings, plan, inputs)

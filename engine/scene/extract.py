@@ -241,8 +241,8 @@ class Light:
     @property
     def direction(self):
         d = -self.matrix[:3, 2]
-        n = np.linalg.norm(d)
-        return d / n if n > 0 and np.isfinite(n) else np.array([0.0, 0.0, -1.0])
+        n = math.sqrt(float(d @ d))  # np.linalg.norm's value, without its dispatch
+        return d / n if n > 0 and math.isfinite(n) else np.array([0.0, 0.0, -1.0])
 
 
 @dataclass(frozen=True)

@@ -38,8 +38,9 @@ BIAS_MATRIX = np.array(
 def normalize(v, fallback=(0.0, 0.0, -1.0)):
     """Unit vector along ``v``; ``fallback`` when ``v`` is zero or not finite."""
     v = np.asarray(v, dtype=np.float64)
-    n = np.linalg.norm(v)
-    if not np.isfinite(n) or n < 1e-30:
+    flat = v.ravel()
+    n = math.sqrt(float(flat @ flat))  # np.linalg.norm's value, without its dispatch
+    if not math.isfinite(n) or n < 1e-30:
         return np.asarray(fallback, dtype=np.float64)
     return v / n
 
