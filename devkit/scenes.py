@@ -157,7 +157,11 @@ def box_over_plane(scene, plane_size=10.0, box_center=(0, 0, 1.5), box_size=1.0,
     return ground, caster
 
 
-def uv_sphere(scene, name="Sphere", center=(0, 0, 0), radius=1.0, segments=32, rings=16, mat=None):
+def uv_sphere(scene, name="Sphere", center=(0, 0, 0), radius=1.0, segments=32, rings=16, mat=None, uvs=False):
+    """A smooth UV sphere built in one fixed order (``bpy.ops.mesh.primitive_uv_sphere_add``
+    orders its faces differently in every Blender process, so a scene built with it does not
+    rasterise the same to the last bit twice). ``uvs``: with a UV map "UVMap" laid out as
+    Blender's (u around from 0 to 1, a seam at u = 1; v from 0 at the bottom pole to 1)."""
     verts = [(0, 0, radius)]
     for r in range(1, rings):
         theta = math.pi * r / rings
@@ -186,6 +190,25 @@ def uv_sphere(scene, name="Sphere", center=(0, 0, 0), radius=1.0, segments=32, r
     ob = mesh_object(scene, name, verts, faces, location=center, mat=mat)
     for poly in ob.data.polygons:
         poly.use_smooth = True
+    if uvs:
+        last = len(verts) - 1
+
+        def corner_uv(face, k):
+            v = face[k]
+            if v in (0, last):  # a pole: the middle of its triangle's segment
+                others = [face[j] for j in range(len(face)) if face[j] not in (0, last)]
+                seg = min((o - 1) % segments for o in others)
+                if {(o - 1) % segments for o in others} == {0, segments - 1}:
+                    seg = segments - 1
+                return ((seg + 0.5) / segments, 1.0 if v == 0 else 0.0)
+            ring, seg = divmod(v - 1, segments)
+            # The face's last segment wraps to 0: it reads u = 1 there (the seam).
+            wraps = any((face[j] - 1) % segments == segments - 1 for j in range(len(face)) if face[j] not in (0, last))
+            u = 1.0 if seg == 0 and wraps else seg / segments
+            return (u, 1.0 - (ring + 1) / rings)
+
+        coords = [corner_uv(face, k) for face in faces for k in range(len(face))]
+        ob.data.uv_layers.new(name="UVMap").data.foreach_set("uv", [c for uv in coords for c in uv])
     return ob
 
 
@@ -376,10 +399,7 @@ def textured_asset(width=160, height=90, texels=2048, seed=7):
     if "Emission Strength" in bsdf.inputs:
         bsdf.inputs["Emission Strength"].default_value = 0.2
     texture("occlusion", "Non-Color")  # glTF keeps occlusion beside the shader, unread
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=1.0, location=(0.0, 0.0, 1.1))
-    ob = bpy.context.object
-    ob.data.materials.append(mat)
-    bpy.ops.object.shade_smooth()
+    uv_sphere(scene, "Sphere", (0.0, 0.0, 1.1), 1.0, segments=128, rings=64, mat=mat, uvs=True)
     light(scene, "Sun", "SUN", 3.0, rotation=(math.radians(40), 0.0, math.radians(30)), angle=math.radians(1.0))
     light(scene, "Point", "POINT", 300.0, location=(-2.5, -2.0, 3.0), shadow_soft_size=0.1)
     look_at(scene, (0.0, -4.5, 2.2), (0.0, 0.0, 1.0), lens=40.0)

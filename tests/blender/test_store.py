@@ -220,3 +220,30 @@ def test_a_second_f12_under_the_same_hdri_prefilters_nothing():
     assert result["same"] == 0.0
     assert result["edited_built"] == 1 and result["edit_fresh"] == 0.0, result
     assert result["changed"] > 0.01  # the edit reached the frame
+
+
+def test_the_textured_asset_is_built_in_one_order_in_every_process():
+    """Blender's UV sphere operator orders its faces differently in every process, so the
+    asset built with it rasterised differently to the last bit from run to run (up to 0.007
+    at the sun's soft shadow edge), which hid whether a change to the engine moved a pixel.
+    ``scenes.uv_sphere`` builds it in one order: two processes make the same corners and UV
+    map, and its UV map is Blender's layout (u around, the seam at u = 1: no face spans it)."""
+    body = """
+    import hashlib
+    scene = scenes.textured_asset(16, 9, texels=8)
+    me = bpy.data.objects["Sphere"].data
+    corners = np.zeros(len(me.loops), np.int32)
+    me.loops.foreach_get("vertex_index", corners)
+    uv = np.zeros(2 * len(me.loops), np.float32)
+    me.uv_layers["UVMap"].data.foreach_get("uv", uv)
+    uv = uv.reshape(-1, 2)
+    span = max(float(np.ptp(uv[list(p.loop_indices), 0])) for p in me.polygons)
+    digest = hashlib.md5(corners.tobytes() + uv.tobytes()).hexdigest()
+    report(digest=digest, span=span, faces=len(me.polygons), u=[float(uv[:, 0].min()), float(uv[:, 0].max())])
+    """
+    first, _ = run_child(body)
+    second, _ = run_child(body)
+    assert first["digest"] == second["digest"]
+    assert first["faces"] == 128 * 64  # 128 segments, 64 rings: quads and the poles' triangles
+    assert first["span"] <= 1.0 / 128 + 1e-6  # no face wraps around the seam
+    assert first["u"] == [0.0, 1.0]
