@@ -17,6 +17,10 @@ os.environ.setdefault("GALLIVM_PERF", "nopt")
 import bpy  # noqa: E402
 import pytest  # noqa: E402
 
+# Each failure's message written to $PENUMBRA_FAILURES the moment it fails (the GPU machine's
+# runner sets it: a run its time limit kills keeps what failed, and why).
+pytest_plugins = ["devkit.failure_log"]
+
 
 @pytest.fixture(scope="session")
 def penumbra():

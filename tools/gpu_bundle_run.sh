@@ -9,7 +9,9 @@
 #   --dest DIR     unpack there (default: a new temporary folder); a bundle already unpacked
 #                  there from the same archive is reused without its parts
 #   --out DIR      results (default: $OUT if set, else ./gpu-results): summary.txt, gl.txt,
-#                  pytest.log, junit.xml, bench.md, bench.log, perf.csv (each under 16 MiB)
+#                  pytest.log, failures.txt (each failure's message as it fails: kept when the
+#                  time limit kills the run), junit.xml, bench.md, bench.log, perf.csv (each
+#                  under 16 MiB)
 #   --check        only check the parts' checksums
 #   PYTEST_ARG...  narrow the suite (default: $PYTEST_ARGS, else the whole suite), e.g.
 #                  gpu_bundle_run.sh tests/core tests/post/test_sepia.py -x
@@ -122,7 +124,7 @@ fi
 # --- environment -----------------------------------------------------------------------------
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
-rm -f "$out"/{summary.txt,gl.txt,pytest.log,junit.xml,bench.md,bench.log,perf.csv}
+rm -f "$out"/{summary.txt,gl.txt,pytest.log,failures.txt,junit.xml,bench.md,bench.log,perf.csv}
 py="$bundle/python/bin/python3.13"
 export LD_LIBRARY_PATH="$bundle/python/lib:$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export PATH="$bundle/python/bin:$PATH"
@@ -217,11 +219,12 @@ if [ "$run_tests" = 1 ]; then
   say "pytest -q ${pytest_args[*]:-tests} (timeout ${t} s)"
   start="$(now)"
   rc=0
-  (cd "$bundle/repo" && timeout -k 15 "$t" "$py" -s -m pytest -q --junitxml="$out/junit.xml" \
-    "${pytest_args[@]:-tests}") > "$out/pytest.log" 2>&1 || rc=$?
-  limit "$out/pytest.log"; limit "$out/junit.xml"
+  (cd "$bundle/repo" && PENUMBRA_FAILURES="$out/failures.txt" timeout -k 15 "$t" "$py" -s -m pytest -q \
+    --junitxml="$out/junit.xml" "${pytest_args[@]:-tests}") > "$out/pytest.log" 2>&1 || rc=$?
+  limit "$out/pytest.log"; limit "$out/junit.xml"; limit "$out/failures.txt"
   tail -n 25 "$out/pytest.log"
-  summary+=("tests: $(describe "$rc" "$t") in $(elapsed "$start") s: $(grep -E '^[=]* *[0-9]+ (passed|failed)|^[=]* *[0-9]+ .* in [0-9.]+s' "$out/pytest.log" | tail -1 | tr -d '=' || true)")
+  failed="$(grep -c '^FAILED ' "$out/failures.txt" 2>/dev/null || true)"
+  summary+=("tests: $(describe "$rc" "$t") in $(elapsed "$start") s: $(grep -E '^[=]* *[0-9]+ (passed|failed)|^[=]* *[0-9]+ .* in [0-9.]+s' "$out/pytest.log" | tail -1 | tr -d '=' || true); ${failed:-0} failure(s) in failures.txt")
   [ "$rc" = 0 ] || status=1
 fi
 if [ "$run_bench" = 1 ]; then
