@@ -48,9 +48,10 @@ def test_the_image_does_not_depend_on_the_batch_size(demo, gpu_call):
     """The demo (a sun, a spot and an area light that move between samples, the world's
     directions with maps) at 12 samples, one sample at a time, in batches of 5 (1 + 5 + 5 +
     1: the first sample is a batch of its own) and of 8 (1 + 8 + 3): the same samples, the
-    same maps (placed elsewhere in a larger atlas), so the same image within 1e-5 of a value
-    near 1 (bit for bit on llvmpipe here; a map placed elsewhere may rasterise a texel's
-    edge otherwise: the last test)."""
+    same maps (placed elsewhere in a larger atlas), so the same image within ``_close``: a
+    map placed elsewhere may rasterise a texel's edge otherwise (the GL leaves a
+    rasteriser's subpixel precision to the implementation; on llvmpipe here the frames are
+    equal bit for bit)."""
     kept = demo.penumbra.world_shadows
     demo.penumbra.world_shadows = True
     try:
@@ -66,7 +67,8 @@ def test_the_image_does_not_depend_on_the_batch_size(demo, gpu_call):
         # sample's maps are drawn or reused either way.
         assert stats.shadow_maps <= stats_one.shadow_maps
         assert stats.shadow_maps + stats.shadow_maps_reused == stats_one.shadow_maps + stats_one.shadow_maps_reused
-        assert np.abs(image - one).max() <= 1e-5, (size, float(np.abs(image - one).max()))
+        ok, diff = _close(image, one)
+        assert ok, (size, diff)
     # A batch draws its maps with as many draw calls as one sample does: 3 batches, not 12.
     assert frames[8][1].shadow_draws < stats_one.shadow_draws / 3
 
@@ -147,7 +149,8 @@ def test_a_batch_follows_the_map_memory_budget(demo, gpu_call):
 
 def test_batches_end_where_adaptive_sampling_checks(demo, gpu_call):
     """With a Noise Threshold the frame checks the noise every few samples: batches end there,
-    so the frame stops after the same samples, with the same image, whatever the batch size."""
+    so the frame stops after the same samples, with the same image (within ``_close``), whatever the
+    batch size."""
     demo.penumbra.adaptive_threshold = 0.05
     try:
         frames = _frames(gpu_call, demo, 24, (1, 8))
@@ -156,7 +159,8 @@ def test_batches_end_where_adaptive_sampling_checks(demo, gpu_call):
     (one, stats_one), (batched, stats) = frames[1], frames[8]
     assert stats.samples == stats_one.samples
     assert stats.pixels_converged == stats_one.pixels_converged
-    assert np.abs(batched - one).max() <= 1e-5
+    ok, diff = _close(batched, one)
+    assert ok, diff
 
 
 @pytest.mark.parametrize(("final", "released"), [(False, True), (True, True), (False, False)])
