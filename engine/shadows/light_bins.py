@@ -45,15 +45,16 @@ def frustum_planes(view_proj):
     return _unit_planes(rows)
 
 
+# The outward normals of an axis-aligned box's faces, +x, -x, +y, -y, +z, -z (unit already:
+# ``_unit_planes`` leaves them as they are, signed zeros included).
+_BOX_NORMALS = np.array([sign * np.eye(3)[axis] for axis in range(3) for sign in (1.0, -1.0)])
+
+
 def box_planes(lo, hi):
     """The six planes of the axis-aligned box [lo, hi]."""
-    rows = []
-    for axis in range(3):
-        n = np.zeros(3)
-        n[axis] = 1.0
-        rows.append((*n, hi[axis]))
-        rows.append((*(-n), -lo[axis]))
-    return _unit_planes(rows)
+    lo = np.asarray(lo, np.float64)
+    hi = np.asarray(hi, np.float64)
+    return np.column_stack((_BOX_NORMALS, (hi[0], -lo[0], hi[1], -lo[1], hi[2], -lo[2])))
 
 
 def influence_planes(light):
@@ -95,21 +96,36 @@ def polytope_vertices(planes, tolerance):
     rule, all triples at once), the points inside all of them kept. (k, 3); empty when the
     polytope is empty."""
     planes = np.asarray(planes, dtype=np.float64)
-    triples = _triples(len(planes))
-    if len(triples) == 0:
-        return np.zeros((0, 3))
-    normals = planes[:, :3]
-    pairs = cross(normals[:, None], normals[None, :])  # (p, p, 3): every pair's cross product
+    return polytope_vertices_many(planes[None], (tolerance,))[0]
+
+
+def polytope_vertices_many(planes, tolerances):
+    """``polytope_vertices`` of each of several polytopes of as many planes, (n, p, 4), with
+    their ``tolerances``, all their triples intersected at once (the same operations on each
+    triple as one polytope at a time, so the same bits): a list of n (k, 3) arrays."""
+    planes = np.asarray(planes, dtype=np.float64)
+    count, p = planes.shape[:2]
+    triples = _triples(p)
+    t = len(triples)
+    if t == 0 or count == 0:
+        return [np.zeros((0, 3)) for _ in range(count)]
+    normals = planes[..., :3]
+    pairs = cross(normals[:, :, None], normals[:, None, :])  # (n, p, p, 3): every pair's cross product
     i, j, k = triples.T
-    c12, c20, c01 = pairs[j, k], pairs[k, i], pairs[i, j]
-    d = planes[triples, 3]  # (t, 3)
-    det = np.einsum("ij,ij->i", normals[i], c12)
+    c12, c20, c01 = (pairs[:, a, b].reshape(-1, 3) for a, b in ((j, k), (k, i), (i, j)))
+    d = planes[:, triples, 3].reshape(-1, 3)  # (n t, 3)
+    det = np.einsum("ij,ij->i", normals[:, i].reshape(-1, 3), c12)
     ok = np.abs(det) > 1e-9
-    if not ok.any():
-        return np.zeros((0, 3))
     x = (d[ok, 0, None] * c12[ok] + d[ok, 1, None] * c20[ok] + d[ok, 2, None] * c01[ok]) / det[ok, None]
-    inside = np.all(x @ planes[:, :3].T - planes[:, 3] <= tolerance, axis=1)
-    return x[inside]
+    out, start = [], 0
+    for m, end in enumerate(np.cumsum(ok.reshape(count, t).sum(axis=1)).tolist()):
+        xm, start = x[start:end], end
+        if len(xm) == 0:
+            out.append(np.zeros((0, 3)))
+            continue
+        inside = np.all(xm @ planes[m, :, :3].T - planes[m, :, 3] <= tolerances[m], axis=1)
+        out.append(xm[inside])
+    return out
 
 
 def light_reach(light):

@@ -290,9 +290,25 @@ def _classify(boxes, planes):
 
 def _cut(planes, points):
     """The vertices of the bounding box of ``points`` cut by the convex region ``planes``."""
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    scale = max(float(np.abs(planes[:, 3]).max()), float(np.abs(points).max()), 1e-300)
-    return light_bins.polytope_vertices(np.concatenate([planes, light_bins.box_planes(lo, hi)]), 1e-6 * scale)
+    return _cuts([(planes, points)])[0]
+
+
+def _cuts(jobs):
+    """``_cut(planes, points)`` of every (planes, points) of ``jobs``, the polytopes of as many
+    planes intersected together (``light_bins.polytope_vertices_many``: the same bits as one
+    at a time, a fraction of the calls)."""
+    groups = {}
+    for n, (planes, points) in enumerate(jobs):
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        scale = max(float(np.abs(planes[:, 3]).max()), float(np.abs(points).max()), 1e-300)
+        stacked = np.concatenate([planes, light_bins.box_planes(lo, hi)])
+        groups.setdefault(len(stacked), []).append((n, stacked, 1e-6 * scale))
+    out = [None] * len(jobs)
+    for group in groups.values():
+        found = light_bins.polytope_vertices_many(np.stack([g[1] for g in group]), [g[2] for g in group])
+        for (n, _planes, _tolerance), vertices in zip(group, found, strict=True):
+            out[n] = vertices
+    return out
 
 
 def clipped_points(boxes, planes, per_box=False):
@@ -308,8 +324,8 @@ def clipped_points(boxes, planes, per_box=False):
         for i in np.nonzero(inside)[0]:
             parts[i] = boxes[i]
         seen |= inside
-        for i in np.nonzero(~inside & ~outside)[0]:
-            v = _cut(planes, boxes[i])
+        crossing = np.nonzero(~inside & ~outside)[0]
+        for i, v in zip(crossing, _cuts([(planes, boxes[i]) for i in crossing]), strict=True):
             if len(v):
                 seen[i] = True
                 parts[i] = v
@@ -365,20 +381,35 @@ def window(points, view, near):
 def pieces_in(planes, boxes, pieces=()):
     """The parts of ``boxes`` (n, 8, 3) and of the convex ``pieces`` (point arrays) inside
     the convex region ``planes``, as a list of point arrays."""
-    out = []
-    if len(boxes):
-        inside, outside = _classify(boxes, planes)
-        if inside.any():
-            out.append(boxes[inside].reshape(-1, 3))
-        pieces = list(pieces) + list(boxes[~inside & ~outside])
-    for p in pieces:
-        s = p @ planes[:, :3].T - planes[:, 3]
-        if np.any(np.all(s > 0.0, axis=0)):
-            continue
-        v = p if np.all(s <= 0.0) else _cut(planes, p)
-        if len(v):
-            out.append(v)
-    return out
+    return pieces_in_many([planes], [boxes], pieces)[0]
+
+
+def pieces_in_many(regions, boxes, pieces=()):
+    """``pieces_in(regions[m], boxes[m], pieces)`` for every m: the parts of each region's
+    boxes and of the ``pieces`` they all share, the boxes and pieces that cross a region cut
+    by it all together (``_cuts``). A list of lists of point arrays, in ``pieces_in``'s order."""
+    outs, jobs, slots = [], [], []
+    for m, (planes, region_boxes) in enumerate(zip(regions, boxes, strict=True)):
+        out, these = [], pieces
+        if len(region_boxes):
+            inside, outside = _classify(region_boxes, planes)
+            if inside.any():
+                out.append(region_boxes[inside].reshape(-1, 3))
+            these = list(pieces) + list(region_boxes[~inside & ~outside])
+        for p in these:
+            s = p @ planes[:, :3].T - planes[:, 3]
+            if np.any(np.all(s > 0.0, axis=0)):
+                continue
+            if np.all(s <= 0.0):
+                out.append(p)
+            else:
+                slots.append((m, len(out)))
+                out.append(None)
+                jobs.append((planes, p))
+        outs.append(out)
+    for (m, slot), v in zip(slots, _cuts(jobs), strict=True):
+        outs[m][slot] = v if len(v) else None
+    return [[v for v in out if v is not None] for out in outs]
 
 
 FLAT = 1e-6  # a box this thin relative to its longest edge is a flat (planar) mesh's

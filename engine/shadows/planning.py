@@ -96,16 +96,33 @@ def needed_size(tile, size, receivers, density, per_pixel):
     across every screen pixel of the visible receivers it holds: a power of two in
     [MIN_MAP_SIZE, size], or ``size``. The finest need is at a vertex of what it holds (the
     ratio of texel to pixel width is linear-fractional in the position)."""
-    fit = tile.fit
+    return needed_sizes([tile], size, receivers, density, per_pixel)[0]
+
+
+def needed_sizes(tiles, size, receivers, density, per_pixel):
+    """``needed_size`` of each of ``tiles`` (None: ``size``), the visible receivers of those
+    that do not hold them already (``Tile.held``: the uncropped ones) clipped to all their
+    frustums at once."""
     if per_pixel <= 0.0:
-        return size
-    if tile.held is not None:
-        points = tile.held
-    else:
-        held = lightspace.pieces_in(light_bins.frustum_planes(fit.view_proj), receivers.whole, receivers.pieces)
-        if not held:
-            return size
-        points = np.concatenate(held)
+        return [size] * len(tiles)
+    missing = [n for n, t in enumerate(tiles) if t is not None and t.held is None]
+    regions = [light_bins.frustum_planes(tiles[n].fit.view_proj) for n in missing]
+    clipped = dict(zip(missing, lightspace.pieces_in_many(regions, [receivers.whole] * len(regions), receivers.pieces)))
+    sizes = []
+    for n, tile in enumerate(tiles):
+        if tile is None:
+            sizes.append(size)
+        elif tile.held is not None:
+            sizes.append(_needed(tile.fit, tile.held, size, density, per_pixel))
+        elif not clipped[n]:
+            sizes.append(size)
+        else:
+            sizes.append(_needed(tile.fit, np.concatenate(clipped[n]), size, density, per_pixel))
+    return sizes
+
+
+def _needed(fit, points, size, density, per_pixel):
+    """``needed_size`` of a map of ``fit`` that holds the receivers' ``points``."""
     view = density.camera_view
     z = np.maximum(-(points @ view[2, :3] + view[2, 3]), 0.0)
     pixel = density.per_depth * z + density.constant
@@ -179,7 +196,63 @@ def perspective_tile(eye, boxes, map_size, kernel=0.0, soft_radius=0.0, crop=Non
 
     ``memo`` (a dict kept for one light and frame) holds what does not depend on the map's
     size, for planning the same light again at another size."""
+    return perspective_tiles([eye], boxes, [map_size], kernel, soft_radius, crop, memo)[0]
+
+
+class _Face(NamedTuple):
+    """A perspective map fitted before it is cropped (``_face_fit``): its ``frustum`` (a
+    ``_Frustum``), the boxes ``inside`` it, its ``size`` and the ``pad`` texels it is widened
+    by, and the key of its eye's direction in the memo."""
+
+    frustum: _Frustum
+    inside: np.ndarray
+    size: int
+    pad: float
+    face: bytes
+
+
+def perspective_tiles(eyes, boxes, sizes, kernel=0.0, soft_radius=0.0, crop=None, memo=None):
+    """``perspective_tile`` of each of ``eyes`` at its size in ``sizes`` (a point light's cube
+    faces), with one ``memo``: each map is fitted alone, then all are cropped together, the
+    visible receivers and the casters clipped to every frustum at once
+    (``lightspace.pieces_in_many``), the same maps as one at a time. A list of tiles (None
+    where ``perspective_tile`` gives none)."""
     memo = {} if memo is None else memo
+    kept = None if crop is None else crop.windows
+    if kept is not None and len(eyes) > 1 and len(kept) + len(eyes) >= _KEPT_WINDOWS:
+        # A crop may empty the kept windows (``_crops``): one map after the other then, as
+        # each one's crop finds what the one before it left.
+        return [perspective_tiles([e], boxes, [z], kernel, soft_radius, crop, memo)[0] for e, z in zip(eyes, sizes)]
+    fits = [_face_fit(eye, boxes, size, kernel, soft_radius, memo) for eye, size in zip(eyes, sizes, strict=True)]
+    tiles = [None] * len(fits)
+    live = [n for n, f in enumerate(fits) if f is not None]
+    if crop is None:
+        for n in live:
+            tiles[n] = _uncropped(fits[n])
+        return tiles
+    keys = {n: (fits[n].face, "window", *fits[n].frustum[1:]) for n in live}
+    missing = [n for n in live if keys[n] not in memo]
+    frustums, insides = [fits[n].frustum for n in missing], [fits[n].inside for n in missing]
+    found = _windows(frustums, boxes.corners, insides, crop, soft_radius)
+    for n, window in zip(missing, found, strict=True):
+        memo[keys[n]] = window
+    cropped = _crops([fits[n] for n in live], boxes.corners, crop.receivers, [memo[keys[n]] for n in live], kept)
+    for n, got in zip(live, cropped, strict=True):
+        if got is _NOTHING:
+            continue
+        if got is None:
+            tiles[n] = _uncropped(fits[n])
+            continue
+        proj, per_distance, inside, far, held = got
+        view, _fov, near, _far = fits[n].frustum
+        tiles[n] = Tile(lightspace.Fit(view, proj, near, far, texel_per_distance=per_distance), inside)
+        tiles[n].held = held
+    return tiles
+
+
+def _face_fit(eye, boxes, map_size, kernel, soft_radius, memo):
+    """``eye``'s map over ``boxes`` fitted and widened by its filter's pad (``perspective_tile``),
+    not cropped: a ``_Face``, or None without casters in it."""
     position, forward, fov = eye
     corners = boxes.corners
     face = np.asarray(forward, dtype=np.float64).tobytes()
@@ -222,65 +295,90 @@ def perspective_tile(eye, boxes, map_size, kernel=0.0, soft_radius=0.0, crop=Non
     else:
         pad = 0.0
     inside, near, far = got
-    if crop is not None:
-        frustum = _Frustum(view, fov, near, far)
-        key = (face, "window", fov, near, far)
-        if key not in memo:
-            memo[key] = _window(frustum, corners, inside, crop, soft_radius)
-        cropped = _crop(frustum, size, corners, crop.receivers, pad, memo[key], crop.windows)
-        if cropped is _NOTHING:
-            return None
-        if cropped is not None:
-            proj, per_distance, inside, far, held = cropped
-            tile = Tile(lightspace.Fit(view, proj, near, far, texel_per_distance=per_distance), inside)
-            tile.held = held
-            return tile
+    return _Face(_Frustum(view, fov, near, far), inside, size, pad, face)
+
+
+def _uncropped(fit):
+    """The tile of a ``_Face`` over its whole frustum."""
+    view, fov, near, far = fit.frustum
     proj = lightspace.perspective(fov, 1.0, near, far)
-    fit = lightspace.Fit(view, proj, near, far, texel_per_distance=2.0 * math.tan(fov / 2.0) / size)
-    return Tile(fit, inside)
+    texel = 2.0 * math.tan(fov / 2.0) / fit.size
+    return Tile(lightspace.Fit(view, proj, near, far, texel_per_distance=texel), fit.inside)
 
 
-_NOTHING = object()  # _crop: no visible receiver in reach of a caster
+_NOTHING = object()  # _crops: no visible receiver in reach of a caster
+# ``ViewFit.windows`` is emptied past this many (lights and sizes come and go while the view moves).
+_KEPT_WINDOWS = 1024
 
 
-def _window(frustum, corners, inside, crop, soft_radius):
-    """The window (tangent units, lower and upper corner) of the visible receivers some caster
-    (of ``inside``) can shadow in the perspective map ``frustum`` (a ``_Frustum``), with those
-    casters; or _NOTHING. Does not depend on the map's size."""
-    view, fov, near, far = frustum
+def _windows(frustums, corners, insides, crop, soft_radius):
+    """Per perspective map ``frustums[k]`` (a ``_Frustum``) and the boxes ``insides[k]`` in
+    it: the window (tangent units, lower and upper corner) of the visible receivers some of
+    those casters can shadow, with those casters; or _NOTHING. Does not depend on the map's
+    size. Every map's receivers, then every map's casters, are clipped at once."""
     receivers, flat_free = crop.receivers, crop.flat_free
-    half = math.tan(fov / 2.0)
-    planes = light_bins.frustum_planes(lightspace.perspective(fov, 1.0, near, far) @ view)
-    seen = lightspace.pieces_in(planes, receivers.whole, receivers.pieces)
-    if not seen:
-        return _NOTHING
-    seen = np.concatenate(seen)
-    r_lo, r_hi = lightspace.window(seen, view, near)
-    casters = inside if flat_free is None else inside[~flat_free[inside]]
-    if len(casters) == 0:
-        return _NOTHING
-    footprint = lightspace.pieces_in(planes, corners[casters])
-    if not footprint:
-        return _NOTHING
-    c_lo, c_hi = lightspace.window(np.concatenate(footprint), view, near)
-    spread = soft_radius / near  # how far (tangent units) a penumbra reaches out of a caster's window
-    w_lo = np.maximum(np.maximum(r_lo, c_lo - spread), -half)
-    w_hi = np.minimum(np.minimum(r_hi, c_hi + spread), half)
-    if np.any(w_hi < w_lo):
-        return _NOTHING
-    return w_lo, w_hi, casters
+    planes = [light_bins.frustum_planes(lightspace.perspective(f.fov, 1.0, f.near, f.far) @ f.view) for f in frustums]
+    seen = lightspace.pieces_in_many(planes, [receivers.whole] * len(planes), receivers.pieces)
+    out = [_NOTHING] * len(frustums)
+    staged = []
+    for n, (frustum, pieces, inside) in enumerate(zip(frustums, seen, insides, strict=True)):
+        if not pieces:
+            continue
+        r_lo, r_hi = lightspace.window(np.concatenate(pieces), frustum.view, frustum.near)
+        casters = inside if flat_free is None else inside[~flat_free[inside]]
+        if len(casters):
+            staged.append((n, r_lo, r_hi, casters))
+    footprints = lightspace.pieces_in_many([planes[n] for n, *_ in staged], [corners[c] for *_, c in staged])
+    for (n, r_lo, r_hi, casters), footprint in zip(staged, footprints, strict=True):
+        if not footprint:
+            continue
+        view, fov, near, _far = frustums[n]
+        half = math.tan(fov / 2.0)
+        c_lo, c_hi = lightspace.window(np.concatenate(footprint), view, near)
+        spread = soft_radius / near  # how far (tangent units) a penumbra reaches out of a caster's window
+        w_lo = np.maximum(np.maximum(r_lo, c_lo - spread), -half)
+        w_hi = np.minimum(np.minimum(r_hi, c_hi + spread), half)
+        if not np.any(w_hi < w_lo):
+            out[n] = (w_lo, w_hi, casters)
+    return out
 
 
-def _crop(frustum, size, corners, receivers, pad, window, kept=None):
-    """The perspective map ``frustum`` of ``size`` texels cut to what it must hold (see
-    ``perspective_tile``): (projection, texel per distance, casters, far, the visible
-    receivers' points it holds), None when cropping gains nothing, or _NOTHING. ``window``:
-    ``_window``'s answer. ``kept`` (``ViewFit.windows``): the window and far plane an earlier
-    frame cut this same frustum (eye, direction, depth range, size) to are taken again while
-    they hold this one's, and this one's are kept there for the next frame."""
-    if window is _NOTHING:
-        return _NOTHING
-    view, fov, near, far = frustum
+def _crops(faces, corners, receivers, windows, kept=None):
+    """Each map of ``faces`` (``_Face``) cut to what it must hold (see ``perspective_tile``):
+    (projection, texel per distance, casters, far, the visible receivers' points it holds),
+    None when cropping gains nothing, or _NOTHING. ``windows``: ``_windows``' answers.
+    ``kept`` (``ViewFit.windows``): the window and far plane an earlier frame cut this same
+    frustum (eye, direction, depth range, size) to are taken again while they hold this
+    one's, and this one's are kept there for the next frame. The receivers every map holds
+    are clipped to them all at once."""
+    out = [None] * len(faces)
+    staged = []
+    for n, (fit, window) in enumerate(zip(faces, windows, strict=True)):
+        if window is _NOTHING:
+            out[n] = _NOTHING
+            continue
+        cut = _crop_window(fit, corners, window, kept)
+        if cut is None or cut is _NOTHING:
+            out[n] = cut
+            continue
+        staged.append((n, cut))
+    views = [faces[n].frustum.view for n, _cut in staged]
+    regions = [light_bins.frustum_planes(cut[0] @ view) for (_n, cut), view in zip(staged, views, strict=True)]
+    held = lightspace.pieces_in_many(regions, [receivers.whole] * len(regions), receivers.pieces)
+    for (n, cut), view, points in zip(staged, views, held, strict=True):
+        if not points:
+            out[n] = _NOTHING
+            continue
+        out[n] = _crop_depth(faces[n], cut, view, np.concatenate(points), kept)
+    return out
+
+
+def _crop_window(fit, corners, window, kept):
+    """``_crops``' first part for one map: its square window snapped to texels (or the one
+    ``kept`` holds), its off-centre projection and the casters whose window meets it; as
+    (projection, (left, right, bottom, top), texel, casters, slot, old), or None / _NOTHING."""
+    view, fov, near, far = fit.frustum
+    size, pad = fit.size, fit.pad
     w_lo, w_hi, casters = window
     half = math.tan(fov / 2.0)
     # Square texels, the extent quantised in 2^(1/4) steps and the window snapped to whole
@@ -315,13 +413,16 @@ def _crop(frustum, size, corners, receivers, pad, window, kept=None):
     if len(casters) == 0:
         return _NOTHING
     proj = lightspace.off_center_perspective(left, right, bottom, top, near, far)
-    # Nothing beyond the farthest visible receiver in the map's window needs a depth. The far
-    # plane is quantised up in 2^(1/8) steps of its ratio to the near one, as the extent is, so
-    # a moving view that sees a little more or less depth keeps the map (and its content key).
-    held = lightspace.pieces_in(light_bins.frustum_planes(proj @ view), receivers.whole, receivers.pieces)
-    if not held:
-        return _NOTHING
-    held = np.concatenate(held)
+    return proj, (left, right, bottom, top), texel, casters, slot, old
+
+
+def _crop_depth(fit, cut, view, held, kept):
+    """``_crops``' last part for one map: nothing beyond the farthest visible receiver in the
+    map's window (``held``, its points) needs a depth. The far plane is quantised up in
+    2^(1/8) steps of its ratio to the near one, as the extent is, so a moving view that sees
+    a little more or less depth keeps the map (and its content key)."""
+    proj, (left, right, bottom, top), texel, casters, slot, old = cut
+    _view, _fov, near, far = fit.frustum
     deepest = -float((held @ view[2, :3] + view[2, 3]).min())
     if near < deepest * 1.01 < far:
         far = min(far, near * 2.0 ** (math.ceil(math.log2(deepest * 1.01 / near) * 8.0) / 8.0))
@@ -329,7 +430,7 @@ def _crop(frustum, size, corners, receivers, pad, window, kept=None):
             far = old[4]
         proj = lightspace.off_center_perspective(left, right, bottom, top, near, far)
     if slot is not None:
-        if len(kept) >= 1024:  # a bound: lights and sizes come and go while the view moves
+        if len(kept) >= _KEPT_WINDOWS:
             kept.clear()
         kept[slot] = (left, right, bottom, top, far)
     return proj, texel, casters, far, held
@@ -558,7 +659,7 @@ def _at_density(scene, job, tiles, mode, largest, hint=None):
     if density is None or receivers is None or not camera_bound or not any(t is not None for t in tiles):
         return tiles, mode
     per_pixel = density.texels_per_pixel * (1.0 if job.soft else max(1.0, scene.options.kernel - 1.0))
-    sizes = [largest if t is None else needed_size(t, largest, receivers, density, per_pixel) for t in tiles]
+    sizes = needed_sizes(tiles, largest, receivers, density, per_pixel)
     sizes = [min(s, largest) for s in _hinted(sizes, hint)]
     if min(sizes, default=largest) < largest:
         smaller, smaller_mode = _light_tiles(scene, job, sizes)
@@ -684,20 +785,23 @@ def _cube_tiles(scene, job, sizes):
     boxes, seen = _grown(scene, job)
     crop = None if seen is None else Crop(seen, job.flat_free, scene.view.windows)
     soft = job.soft
-    tiles = [
-        None
-        if light.type == "AREA" and behind_area_light(fwd, light.direction)
-        else perspective_tile(
-            Eye(light.position, fwd, math.pi / 2.0),
-            boxes,
-            sizes[k],
-            kernel=1.0 if soft else scene.options.kernel,
-            soft_radius=light.shadow_radius * light.penumbra_scale if soft else 0.0,
-            crop=crop,
-            memo=job.memo,
-        )
+    faces = [
+        k
         for k, fwd in enumerate(lightspace.CUBE_FORWARDS)
+        if not (light.type == "AREA" and behind_area_light(fwd, light.direction))
     ]
+    planned = perspective_tiles(
+        [Eye(light.position, lightspace.CUBE_FORWARDS[k], math.pi / 2.0) for k in faces],
+        boxes,
+        [sizes[k] for k in faces],
+        kernel=1.0 if soft else scene.options.kernel,
+        soft_radius=light.shadow_radius * light.penumbra_scale if soft else 0.0,
+        crop=crop,
+        memo=job.memo,
+    )
+    tiles = [None] * len(lightspace.CUBE_FORWARDS)
+    for k, tile in zip(faces, planned, strict=True):
+        tiles[k] = tile
     return tiles, "CUBE"
 
 

@@ -52,7 +52,7 @@ def counting_fits(shared=False):
 
     fits = []
     lightspace = planning.lightspace
-    original = planning.perspective_tile, lightspace.fit_sun_to_view, lightspace.sheared, lightspace.moved
+    original = planning._face_fit, lightspace.fit_sun_to_view, lightspace.sheared, lightspace.moved
     table, slices = lightspace.FlatCasters.__init__, (planning.cascade_slices, shadow_pass.cascade_slices)
 
     def made(self, boxes):
@@ -72,7 +72,7 @@ def counting_fits(shared=False):
 
         return run
 
-    planning.perspective_tile = counted(original[0])
+    planning._face_fit = counted(original[0])  # a spot's map or a cube's face, fitted
     planning.lightspace.fit_sun_to_view = counted(original[1])
     lightspace.sheared = counted(original[2])
     lightspace.moved = counted(original[3])
@@ -81,7 +81,7 @@ def counting_fits(shared=False):
     try:
         yield fits
     finally:
-        planning.perspective_tile, lightspace.fit_sun_to_view, lightspace.sheared, lightspace.moved = original
+        planning._face_fit, lightspace.fit_sun_to_view, lightspace.sheared, lightspace.moved = original
         lightspace.FlatCasters.__init__ = table
         planning.cascade_slices, shadow_pass.cascade_slices = slices
 
