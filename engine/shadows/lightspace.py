@@ -5,6 +5,7 @@ values. Matrices are 4x4 float64, column-vector convention (``clip = P @ V @ wor
 as Blender's ``mathutils`` and OpenGL.
 """
 
+import itertools
 import math
 
 import numpy as np
@@ -390,17 +391,25 @@ def pieces_in_many(regions, boxes, pieces=()):
     by it all together (``_cuts``). A list of lists of point arrays, in ``pieces_in``'s order."""
     outs, jobs, slots = [], [], []
     for m, (planes, region_boxes) in enumerate(zip(regions, boxes, strict=True)):
-        out, these = [], pieces
+        out, crossing = [], ()
         if len(region_boxes):
             inside, outside = _classify(region_boxes, planes)
             if inside.any():
                 out.append(region_boxes[inside].reshape(-1, 3))
-            these = list(pieces) + list(region_boxes[~inside & ~outside])
-        for p in these:
-            s = p @ planes[:, :3].T - planes[:, 3]
-            if np.any(np.all(s > 0.0, axis=0)):
+            crossing = region_boxes[~inside & ~outside]
+        # Each piece wholly outside one of the planes (skipped), wholly inside them all (taken
+        # whole), or cut; the crossing boxes (8 corners each) all at once, the same products.
+        tests = []
+        for p in pieces:
+            side = p @ planes[:, :3].T - planes[:, 3]
+            tests.append((bool(np.any(np.all(side > 0.0, axis=0))), bool(np.all(side <= 0.0))))
+        if len(crossing):
+            side = crossing @ planes[:, :3].T - planes[:, 3]
+            tests += zip(np.any(np.all(side > 0.0, axis=1), axis=1).tolist(), np.all(side <= 0.0, axis=(1, 2)).tolist())
+        for p, (away, within) in zip(itertools.chain(pieces, crossing), tests, strict=True):
+            if away:
                 continue
-            if np.all(s <= 0.0):
+            if within:
                 out.append(p)
             else:
                 slots.append((m, len(out)))
