@@ -179,6 +179,18 @@ def spot_field(count, width=960, height=540):
     return scene
 
 
+def point_field(count, width=160, height=90):
+    """``spot_field``'s ground and boxes lit by ``count`` shadowed point lights 4 m above it
+    (a point light's map is a cube of six faces, each planned on its own)."""
+    scene = spot_field(0, width, height)
+    side = math.ceil(math.sqrt(count))
+    for i in range(count):
+        x = ((i % side) + 0.5) / side * 20.0 - 10.0
+        y = ((i // side) + 0.5) / side * 20.0 - 10.0
+        scenes.light(scene, f"Point{i}", "POINT", 4000.0 / count, location=(x, y, 4.0))
+    return scene
+
+
 def object_field(count, instanced):
     """``count`` cubes on a square grid over a ground, as separate objects with their own mesh
     or as collection instances of one cube; one sun."""
@@ -319,8 +331,9 @@ def cpu_note(stats):
 
 def section_cpu(plan):
     """At 160x90, where the pixels cost next to nothing even on llvmpipe, what a frame's CPU
-    work costs against Workbench's: a textured asset at 1 sample, and the demo at 16 samples
-    against Workbench's one sample; each with the CPU/GPU split of one fenced frame."""
+    work costs against Workbench's: a textured asset at 1 sample, 8 point lights over a field
+    of boxes at 1 sample (their maps' planning), and the demo at 16 samples against
+    Workbench's one sample; each with the CPU/GPU split of one fenced frame."""
     rows = []
     asset = scenes.textured_asset(160, 90)
     t = paired(asset, plan["runs"])
@@ -333,6 +346,9 @@ def section_cpu(plan):
     hdri.penumbra.render_samples = 1
     case = "spheres under an HDRI 160x90, 1 sample: a second F12"
     rows.append(_warm_f12(hdri, plan["runs"], case, time.perf_counter))
+    points = point_field(8)
+    t = paired(points, plan["runs"])
+    rows.append(_row("cpu", "8 point lights 160x90, 1 sample", t, cpu_note(_fenced_stats(points)), plan["runs"]))
     scene = demo(160, 90)
     times = {"PENUMBRA": [], "WORKBENCH": []}
     for key, setup in (("PENUMBRA", _penumbra), ("WORKBENCH", _workbench)):  # warm-up
