@@ -198,3 +198,37 @@ def test_a_cubes_faces_are_clipped_in_three_passes_not_three_a_face(monkeypatch)
         assert len(calls) <= 3, (trial, calls)
         if sum(t is not None for t in tiles) >= 2:
             assert sum(calls) >= 2  # the faces' pieces went in together
+
+
+@pytest.mark.parametrize("scale", [1e-4, 1.0, 1e4])
+def test_degenerate_scenes_plan_the_same_faces_together_with_finite_maps(scale):
+    """At 10^-4 and 10^4 m: a light on a box's corner, a light inside a box, boxes of no
+    volume (a point, a segment, a flat card) and a ground. Planned together or one face at a
+    time, the tiles are equal, and every map's matrices are finite with near < far."""
+    s = scale
+    corners = np.stack(
+        [
+            lightspace.box_corners((-10 * s, -10 * s, 0.0), (10 * s, 10 * s, 0.0)),  # a ground
+            lightspace.box_corners((0.0, 0.0, 0.0), (s, s, s)),  # the light sits on its corner
+            lightspace.box_corners((2 * s, 2 * s, s), (2 * s, 2 * s, s)),  # a point
+            lightspace.box_corners((-2 * s, s, 0.5 * s), (-s, s, 0.5 * s)),  # a segment
+            lightspace.box_corners((s, -3 * s, 0.0), (2 * s, -3 * s, 2 * s)),  # a card
+            lightspace.box_corners((-3 * s, -3 * s, 0.0), (-2 * s, -2 * s, 2 * s)),  # holds the second light
+        ]
+    )
+    view = lightspace.look_at((0.0, -12 * s, 8 * s), (0.0, 12.0, -8.0))
+    receivers = lightspace.visible_receivers(corners, lightspace.perspective(0.9, 1.5, 0.01 * s, 100 * s) @ view)
+    boxes = planning.Boxes.of(corners)
+    for light in (np.array([s, s, s]), np.array([-2.5 * s, -2.5 * s, s])):
+        flat_free = lightspace.FlatCasters(corners).free(position=light)
+        eyes = [planning.Eye(light, f, math.pi / 2) for f in lightspace.CUBE_FORWARDS]
+        for size, kernel, soft in ((2048, 3.0, 0.0), (16, 0.0, 0.2 * s)):
+            crop = planning.Crop(receivers, flat_free)
+            memo = {}
+            alone = [planning.perspective_tile(eye, boxes, size, kernel, soft, crop, memo) for eye in eyes]
+            together = planning.perspective_tiles(eyes, boxes, [size] * 6, kernel, soft, crop, {})
+            assert [_tile_key(t) for t in together] == [_tile_key(t) for t in alone]
+            tiles = [t for t in together if t is not None]
+            assert tiles, (scale, light, size)
+            for tile in tiles:
+                assert np.all(np.isfinite(tile.fit.view_proj)) and 0.0 < tile.fit.near < tile.fit.far
